@@ -1,0 +1,49 @@
+#pragma once
+// Open-loop force sources for the paper's open-loop studies (Xie & Liang Sec. 4). The source
+// defines a force F(t) [N]; the command is u = F/(Ka*Kf) so that the thrust equals F.
+//   step:  F = offset + amplitude           for t >= start_time, else offset
+//   sine:  F = offset + amplitude*sin(2*pi*f*(t - start_time) + phase)   for t >= start_time
+//   ramp:  F = offset + rate*(t - start_time)  for t >= start_time (capped at |amplitude| if > 0)
+//   csv:   F from a file with columns t and force_N (or u), zero-order hold between rows
+
+#include <string>
+#include <vector>
+
+#include "feeddrive/controller/controller.hpp"
+
+namespace feeddrive::controller {
+
+enum class OpenLoopKind { kStep, kSine, kRamp, kCsv };
+std::string to_string(OpenLoopKind k);
+OpenLoopKind open_loop_kind_from_string(const std::string& s);  ///< "step"|"sine"|"ramp"|"csv"
+
+struct OpenLoopParams {
+  OpenLoopKind kind{OpenLoopKind::kStep};
+  double amplitude{12.0};   ///< [N] (step height, sine amplitude, ramp cap; 0 = no cap)
+  double frequency{1.0};    ///< [Hz] (sine)
+  double phase{0.0};        ///< [rad] (sine)
+  double offset{0.0};       ///< [N]
+  double rate{100.0};       ///< [N/s] (ramp)
+  double start_time{0.0};   ///< [s]
+  std::string file;         ///< CSV path (csv)
+  double thrust_gain{250.0};  ///< Ka*Kf [N/V] used to turn force into u
+  double u_min{-1e9};       ///< [V]
+  double u_max{1e9};        ///< [V]
+  void validate(const std::string& prefix = "controller") const;
+};
+
+class OpenLoopSource final : public Controller {
+ public:
+  explicit OpenLoopSource(const OpenLoopParams& p);
+  Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
+                 const Truth* truth) override;
+  std::string name() const override { return "open_loop"; }
+  /// The force F(t) [N] of the source.
+  double force(double t) const;
+
+ private:
+  OpenLoopParams p_;
+  std::vector<double> csv_t_, csv_u_;  // csv rows: time and u
+};
+
+}  // namespace feeddrive::controller

@@ -1,0 +1,68 @@
+#pragma once
+// Model-based sliding-mode controller of Xie & Liang (Sec. 5.2, eqs. 16-19):
+//
+//   e = xd - x,   S = de/dt + lambda*e,   reaching law dS/dt = -eta*sw(S) - k*S   (eq. 18)
+//   u = m/(Ka*Kf) * (xd'' + lambda*(xd' - x') + eta*sw(S) + k*S) + (F^f + F^g + F^r)/(Ka*Kf)
+//                                                                                 (eq. 19)
+// with sw = sgn (the paper), sat(S/phi) or tanh(S/phi) (boundary layer phi [m/s]).
+// Units are SI, eta in m/s^2 (see paper-analysis.md Sec. 3.3). m, Ka*Kf and the force models
+// are the controller's *model* (SlidingModeParams::model), which may differ from the plant.
+//
+// The reluctance ripple depends on the commanded force itself, F^r = Fcog(x) + Ka*Kf*u*r(x),
+// so the law is solved for u exactly:  Ka*Kf*u*(1 - r(x)) = m*(...) + F^f + F^g + Fcog(x).
+
+#include <memory>
+
+#include "feeddrive/controller/controller.hpp"
+#include "feeddrive/controller/friction_observer.hpp"
+#include "feeddrive/plant/params.hpp"
+
+namespace feeddrive::controller {
+
+enum class Switching { kSign, kSaturation, kTanh };
+std::string to_string(Switching s);
+Switching switching_from_string(const std::string& s);  ///< "sgn" | "sat" | "tanh"
+
+/// Where the friction estimate F^f gets its bristle state.
+enum class StateSource {
+  kTrue,      ///< from the plant's true state (the paper's "all states available")
+  kObserver,  ///< from an observer driven by the measured velocity
+};
+std::string to_string(StateSource s);
+StateSource state_source_from_string(const std::string& s);  ///< "true" | "observer"
+
+struct SlidingModeParams {
+  double eta{5.0};      ///< [m/s^2]
+  double k{10.0};       ///< [1/s]
+  double lambda{50.0};  ///< [1/s]
+  Switching switching{Switching::kSign};
+  double boundary_layer{1e-3};  ///< phi [m/s], for sat and tanh
+  bool compensate_friction{true};
+  bool compensate_ripple{true};
+  bool compensate_grinding{true};
+  bool feedforward_acceleration{true};  ///< include m*xd''
+  StateSource friction_state{StateSource::kTrue};
+  StateSource grinding_state{StateSource::kTrue};
+  double observer_gain{0.0};  ///< L [1/s] of the bristle observer correction, see friction_observer.hpp
+  double u_min{-10.0};        ///< [V]
+  double u_max{10.0};         ///< [V]
+  plant::PlantParams model;   ///< the controller's model of the drive
+  double period{1e-4};        ///< control period T [s] (for the observers)
+  void validate(const std::string& prefix = "controller") const;
+};
+
+class SlidingModeController final : public Controller {
+ public:
+  explicit SlidingModeController(const SlidingModeParams& p);
+  Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
+                 const Truth* truth) override;
+  bool needs_truth() const override;
+  std::string name() const override { return "sliding_mode"; }
+
+ private:
+  SlidingModeParams p_;
+  FrictionObserver friction_observer_;
+  GrindingObserver grinding_observer_;
+};
+
+}  // namespace feeddrive::controller

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs every build, test and run dependency of feeddrive on Debian 12 (bookworm).
+# Idempotent: apt-get skips what is already installed. Uses sudo when not root.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+PACKAGES=(
+  build-essential cmake pkg-config git
+  liblcm-dev liblcm-bin libglib2.0-dev
+  libeigen3-dev libsundials-dev libspdlog-dev libfmt-dev
+  libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
+  libbenchmark-dev libceres-dev
+  gnuplot-nox
+  iproute2 nftables util-linux
+  lua5.2 liblcm-lua
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
