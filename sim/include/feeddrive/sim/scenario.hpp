@@ -1,0 +1,83 @@
+#pragma once
+// A scenario: everything that defines one run, loaded from YAML (schema: docs/scenario.md).
+//
+//   name: ...            (optional)
+//   duration: 1.5        [s]
+//   control_period: 1e-4 [s]
+//   plant:      {...}    feeddrive::plant::PlantParams
+//   controller: {type: sliding_mode | cascade | open_loop, ...}
+//   reference:  {type: sine | step | accel_limited | scurve | ramp | waypoints | none, ...}
+//   analysis:   {settled_after: 0.25}   (optional)
+//
+// Loading is strict: an unknown or misspelt key, a missing value, a non-number, NaN or a value
+// that fails validate() throws ScenarioError with a one-line message naming the key and value.
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "feeddrive/controller/cascade.hpp"
+#include "feeddrive/controller/open_loop.hpp"
+#include "feeddrive/controller/sliding_mode.hpp"
+#include "feeddrive/plant/params.hpp"
+#include "feeddrive/trajectory/trajectory.hpp"
+
+namespace feeddrive::sim {
+
+class ScenarioError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class ControllerType { kSlidingMode, kCascade, kOpenLoop };
+enum class ReferenceType { kNone, kSine, kStep, kAccelLimited, kSCurve, kRamp, kWaypoints };
+
+struct ReferenceConfig {
+  ReferenceType type{ReferenceType::kNone};
+  trajectory::SineParams sine;
+  trajectory::StepParams step;
+  trajectory::AccelLimitedParams accel_limited;
+  trajectory::SCurveParams scurve;
+  trajectory::RampParams ramp;
+  std::string waypoints_file;  ///< resolved against the scenario file's folder
+};
+
+struct ControllerConfig {
+  ControllerType type{ControllerType::kSlidingMode};
+  controller::SlidingModeParams sliding_mode;
+  controller::CascadeParams cascade;
+  controller::OpenLoopParams open_loop;
+};
+
+struct AnalysisConfig {
+  /// Start [s] of the "settled" window over which the *_settled error metrics are computed.
+  double settled_after{0.25};
+};
+
+struct Scenario {
+  std::string name;
+  std::string path;  ///< file it was loaded from ("" if parsed from a string)
+  double duration{1.0};        ///< [s]
+  double control_period{1e-4}; ///< [s]
+  plant::PlantParams plant;
+  ControllerConfig controller;
+  ReferenceConfig reference;
+  AnalysisConfig analysis;
+
+  /// Number of control steps: round(duration / control_period).
+  long steps() const;
+  /// Time of step k: k * control_period (computed, never accumulated).
+  double time_of(long k) const { return static_cast<double>(k) * control_period; }
+};
+
+/// Loads and validates a scenario file. Throws ScenarioError("<file>: <key> = <value>: <why>").
+Scenario load_scenario(const std::string& path);
+/// Parses and validates YAML text; base_dir resolves relative file names; origin names the
+/// source in messages.
+Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
+                        const std::string& origin = "scenario");
+
+std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s);
+std::unique_ptr<controller::Controller> make_controller(const Scenario& s);
+
+}  // namespace feeddrive::sim

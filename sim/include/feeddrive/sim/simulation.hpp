@@ -1,0 +1,45 @@
+#pragma once
+// The in-process lockstep loop: reference -> controller -> plant, one record per control step.
+//
+//   for k = 0 .. N-1,  t_k = k*T:
+//     r_k = reference(t_k);  m_k = plant.measure();  c_k = controller(r_k, m_k, truth_k)
+//     record(t_k, r_k, state_k, m_k, c_k, forces(state_k, u_k));  plant.advance(u_k, t_{k+1})
+//
+// The multi-process service runs the same components in the same order, so both produce the
+// same records bit for bit.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "feeddrive/plant/cvode_integrator.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+namespace feeddrive::sim {
+
+/// One row of timeseries.csv (columns documented in docs/scenario.md).
+struct Record {
+  double t{0.0};
+  double xd{0.0}, vd{0.0}, ad{0.0}, jd{0.0};  ///< reference [m, m/s, m/s^2, m/s^3]
+  double x{0.0}, v{0.0}, z{0.0}, fg{0.0}, i{0.0};  ///< true state
+  double x_measured{0.0}, v_measured{0.0};   ///< sensor output
+  double u{0.0}, u_unsaturated{0.0};         ///< command [V]
+  double f_thrust{0.0}, f_friction{0.0}, f_ripple{0.0}, f_grinding{0.0};  ///< [N]
+  double sliding{0.0}, z_estimate{0.0};      ///< controller diagnostics (NaN if none)
+};
+
+/// Column names of timeseries.csv, in order.
+const std::vector<std::string>& record_columns();
+/// The values of a record in the order of record_columns().
+std::vector<double> record_values(const Record& r);
+
+struct RunResult {
+  std::vector<Record> records;
+  double wall_time_s{0.0};
+  plant::CvodeIntegrator::Stats integrator;
+};
+
+/// Runs a scenario in-process. progress(k, N) is called every few thousand steps if given.
+RunResult run(const Scenario& s, const std::function<void(long, long)>& progress = {});
+
+}  // namespace feeddrive::sim

@@ -1,0 +1,44 @@
+#pragma once
+// Run metrics (summary.json). Errors are true-state errors: e = xd - x, e_v = vd - v.
+// "settled" metrics are over t >= analysis.settled_after.
+
+#include <string>
+#include <vector>
+
+#include "feeddrive/sim/simulation.hpp"
+
+namespace feeddrive::sim {
+
+struct Summary {
+  long steps{0};
+  double sim_time_s{0.0};
+  double wall_time_s{0.0};
+  double position_error_max_abs_m{0.0};
+  double position_error_rms_m{0.0};
+  double position_error_p95_abs_m{0.0};
+  double velocity_error_max_abs_mps{0.0};
+  double velocity_error_max_abs_after_first_mps{0.0};  ///< excludes the first sample
+  double velocity_error_rms_mps{0.0};
+  double settled_after_s{0.0};
+  double position_error_max_abs_settled_m{0.0};
+  double position_error_rms_settled_m{0.0};
+  double velocity_error_max_abs_settled_mps{0.0};
+  double control_min{0.0};
+  double control_max{0.0};
+  double control_total_variation{0.0};  ///< sum |u_k - u_{k-1}| [V]
+  long control_saturated_steps{0};
+  double final_position_m{0.0};
+  double final_velocity_mps{0.0};
+  double final_bristle_m{0.0};
+  double final_friction_N{0.0};
+  double max_position_m{0.0};
+  double min_position_m{0.0};
+  long integrator_steps{0};
+  long integrator_rhs_evals{0};
+};
+
+Summary summarize(const RunResult& r, const Scenario& s);
+/// The summary as a JSON document (also carries the scenario name and path).
+std::string summary_json(const Summary& sum, const Scenario& s);
+
+}  // namespace feeddrive::sim

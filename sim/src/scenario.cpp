@@ -1,0 +1,367 @@
+#include "feeddrive/sim/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "feeddrive/sim/yaml_reader.hpp"
+
+namespace feeddrive::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using plant::PlantParams;
+
+// --- plant ---------------------------------------------------------------------------------
+
+void read_friction(MapReader r, plant::FrictionParams& f) {
+  std::string model = plant::to_string(f.model);
+  r.string("model", model);
+  try {
+    f.model = plant::friction_model_from_string(model);
+  } catch (const std::invalid_argument& e) {
+    r.fail("model", " = " + std::string(e.what()));
+  }
+  r.number("static_force", f.static_force);
+  r.number("coulomb_force", f.coulomb_force);
+  r.number("stribeck_velocity", f.stribeck_velocity);
+  r.number("stribeck_exponent", f.stribeck_exponent);
+  r.number("bristle_stiffness", f.bristle_stiffness);
+  r.number("bristle_damping", f.bristle_damping);
+  r.number("viscous", f.viscous);
+  r.number("damping_decay_velocity", f.damping_decay_velocity);
+  r.number("static_smoothing_velocity", f.static_smoothing_velocity);
+  r.finish();
+}
+
+void read_ripple(MapReader r, plant::RippleParams& p) {
+  r.boolean("enabled", p.enabled);
+  r.number("pitch", p.pitch);
+  r.number("cogging_amplitude", p.cogging_amplitude);
+  r.number("cogging_phase", p.cogging_phase);
+  r.number("cogging_third", p.cogging_third);
+  r.number("cogging_third_phase", p.cogging_third_phase);
+  r.number("reluctance_amplitude", p.reluctance_amplitude);
+  r.number("reluctance_phase", p.reluctance_phase);
+  r.number("reluctance_third", p.reluctance_third);
+  r.number("reluctance_third_phase", p.reluctance_third_phase);
+  r.finish();
+}
+
+void read_grinding(MapReader r, plant::GrindingParams& p) {
+  r.boolean("enabled", p.enabled);
+  r.number("stiffness", p.stiffness);
+  r.number("dullness", p.dullness);
+  r.number("workpiece_diameter", p.workpiece_diameter);
+  r.number("wheel_width", p.wheel_width);
+  r.number_or_infinite("contact_position", p.contact_position);
+  r.finish();
+}
+
+void read_electrical(MapReader r, plant::ElectricalParams& p) {
+  r.boolean("enabled", p.enabled);
+  r.number("resistance", p.resistance);
+  r.number("inductance", p.inductance);
+  r.number("back_emf", p.back_emf);
+  r.finish();
+}
+
+void read_sensor(MapReader r, plant::SensorParams& p) {
+  r.number("quantization", p.quantization);
+  r.number("noise_stddev", p.noise_stddev);
+  r.unsigned_integer("seed", p.seed);
+  r.string("velocity", p.velocity);
+  r.finish();
+}
+
+void read_integrator(MapReader r, plant::IntegratorParams& p) {
+  r.number("rtol", p.rtol);
+  r.number("atol_position", p.atol_position);
+  r.number("atol_velocity", p.atol_velocity);
+  r.number("atol_bristle", p.atol_bristle);
+  r.number("atol_grinding", p.atol_grinding);
+  r.number("atol_current", p.atol_current);
+  r.integer("max_steps", p.max_steps);
+  r.finish();
+}
+
+void read_initial(MapReader r, plant::InitialState& p) {
+  r.number("position", p.position);
+  r.number("velocity", p.velocity);
+  r.number("bristle", p.bristle);
+  r.number("grinding", p.grinding);
+  r.number("current", p.current);
+  r.finish();
+}
+
+void read_plant(MapReader r, PlantParams& p) {
+  r.number("mass", p.mass);
+  r.number("amplifier_gain", p.amplifier_gain);
+  r.number("force_constant", p.force_constant);
+  read_friction(r.child("friction"), p.friction);
+  read_ripple(r.child("ripple"), p.ripple);
+  read_grinding(r.child("grinding"), p.grinding);
+  read_electrical(r.child("electrical"), p.electrical);
+  read_sensor(r.child("sensor"), p.sensor);
+  read_integrator(r.child("integrator"), p.integrator);
+  read_initial(r.child("initial"), p.initial);
+  r.finish();
+}
+
+// --- controller ----------------------------------------------------------------------------
+
+template <typename Enum, typename Parse>
+void read_enum(MapReader& r, const std::string& key, Enum& out, Parse parse, const std::string& current) {
+  std::string s = current;
+  r.string(key, s);
+  try {
+    out = parse(s);
+  } catch (const std::invalid_argument& e) {
+    r.fail(key, " = '" + s + "': " + e.what());
+  }
+}
+
+void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
+  r.number("eta", p.eta);
+  r.number("k", p.k);
+  r.number("lambda", p.lambda);
+  read_enum(r, "switching", p.switching, controller::switching_from_string, controller::to_string(p.switching));
+  r.number("boundary_layer", p.boundary_layer);
+  r.boolean("compensate_friction", p.compensate_friction);
+  r.boolean("compensate_ripple", p.compensate_ripple);
+  r.boolean("compensate_grinding", p.compensate_grinding);
+  r.boolean("feedforward_acceleration", p.feedforward_acceleration);
+  read_enum(r, "friction_state", p.friction_state, controller::state_source_from_string,
+            controller::to_string(p.friction_state));
+  read_enum(r, "grinding_state", p.grinding_state, controller::state_source_from_string,
+            controller::to_string(p.grinding_state));
+  r.number("observer_gain", p.observer_gain);
+  r.number("u_min", p.u_min);
+  r.number("u_max", p.u_max);
+  read_plant(r.child("model"), p.model);
+}
+
+void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model) {
+  r.number("kp", p.kp);
+  r.number("kv", p.kv);
+  r.number("ki", p.ki);
+  r.number("velocity_feedforward", p.velocity_feedforward);
+  r.number("acceleration_feedforward", p.acceleration_feedforward);
+  r.number("u_min", p.u_min);
+  r.number("u_max", p.u_max);
+  read_plant(r.child("model"), model);
+  p.mass = model.mass;
+  p.thrust_gain = model.thrust_gain();
+}
+
+void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::string& base_dir) {
+  read_enum(r, "kind", p.kind, controller::open_loop_kind_from_string, controller::to_string(p.kind));
+  r.number("amplitude", p.amplitude);
+  r.number("frequency", p.frequency);
+  r.number("phase", p.phase);
+  r.number("offset", p.offset);
+  r.number("rate", p.rate);
+  r.number("start_time", p.start_time);
+  r.number("u_min", p.u_min);
+  r.number("u_max", p.u_max);
+  r.string("file", p.file);
+  if (!p.file.empty() && fs::path(p.file).is_relative()) p.file = (fs::path(base_dir) / p.file).string();
+}
+
+// --- reference -----------------------------------------------------------------------------
+
+ReferenceType reference_type_from_string(MapReader& r, const std::string& s) {
+  if (s == "none") return ReferenceType::kNone;
+  if (s == "sine") return ReferenceType::kSine;
+  if (s == "step") return ReferenceType::kStep;
+  if (s == "accel_limited") return ReferenceType::kAccelLimited;
+  if (s == "scurve") return ReferenceType::kSCurve;
+  if (s == "ramp") return ReferenceType::kRamp;
+  if (s == "waypoints") return ReferenceType::kWaypoints;
+  r.fail("type", " = '" + s + "': expected one of none, sine, step, accel_limited, scurve, ramp, waypoints");
+}
+
+void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir) {
+  std::string type = "none";
+  r.string("type", type);
+  c.type = reference_type_from_string(r, type);
+  switch (c.type) {
+    case ReferenceType::kNone:
+      break;
+    case ReferenceType::kSine:
+      r.number("amplitude", c.sine.amplitude);
+      r.number("frequency", c.sine.frequency);
+      r.number("phase", c.sine.phase);
+      r.number("offset", c.sine.offset);
+      r.number("start_time", c.sine.start_time);
+      break;
+    case ReferenceType::kStep:
+      r.number("amplitude", c.step.amplitude);
+      r.number("step_time", c.step.step_time);
+      r.number("initial", c.step.initial);
+      break;
+    case ReferenceType::kAccelLimited:
+      r.number("distance", c.accel_limited.distance);
+      r.number("max_velocity", c.accel_limited.max_velocity);
+      r.number("max_acceleration", c.accel_limited.max_acceleration);
+      r.number("start_time", c.accel_limited.start_time);
+      r.number("initial", c.accel_limited.initial);
+      break;
+    case ReferenceType::kSCurve:
+      r.number("distance", c.scurve.distance);
+      r.number("max_velocity", c.scurve.max_velocity);
+      r.number("max_acceleration", c.scurve.max_acceleration);
+      r.number("max_jerk", c.scurve.max_jerk);
+      r.number("start_time", c.scurve.start_time);
+      r.number("initial", c.scurve.initial);
+      break;
+    case ReferenceType::kRamp:
+      r.number("velocity", c.ramp.velocity);
+      r.number("start_time", c.ramp.start_time);
+      r.number("initial", c.ramp.initial);
+      break;
+    case ReferenceType::kWaypoints:
+      c.waypoints_file = r.required_string("file");
+      if (fs::path(c.waypoints_file).is_relative())
+        c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
+      break;
+  }
+  r.finish();
+}
+
+void validate_reference(const ReferenceConfig& c) {
+  switch (c.type) {
+    case ReferenceType::kNone: break;
+    case ReferenceType::kSine: c.sine.validate("reference"); break;
+    case ReferenceType::kStep: c.step.validate("reference"); break;
+    case ReferenceType::kAccelLimited: c.accel_limited.validate("reference"); break;
+    case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
+    case ReferenceType::kRamp: c.ramp.validate("reference"); break;
+    case ReferenceType::kWaypoints: trajectory::read_waypoints_csv(c.waypoints_file); break;
+  }
+}
+
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
+  if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
+  MapReader top(root, "");
+  Scenario s;
+  top.string("name", s.name);
+  if (!top.has("duration")) top.fail("duration", ": missing (required)");
+  if (!top.has("control_period")) top.fail("control_period", ": missing (required)");
+  top.number("duration", s.duration);
+  top.number("control_period", s.control_period);
+  if (!(s.duration > 0.0)) top.fail("duration", " = " + root["duration"].Scalar() + ": must be > 0");
+  if (!(s.control_period > 0.0))
+    top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
+  if (s.control_period > s.duration)
+    top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
+
+  read_plant(top.child("plant"), s.plant);
+
+  MapReader c = top.child("controller");
+  std::string type = c.required_string("type");
+  if (type == "sliding_mode") {
+    s.controller.type = ControllerType::kSlidingMode;
+    s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself
+    // A model never carries the plant's sensor or initial state; they are not part of it.
+    read_sliding_mode(c, s.controller.sliding_mode);
+    s.controller.sliding_mode.period = s.control_period;
+  } else if (type == "cascade") {
+    s.controller.type = ControllerType::kCascade;
+    read_cascade(c, s.controller.cascade, s.plant);
+    s.controller.cascade.period = s.control_period;
+  } else if (type == "open_loop") {
+    s.controller.type = ControllerType::kOpenLoop;
+    read_open_loop(c, s.controller.open_loop, base_dir);
+    s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
+  } else {
+    c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop");
+  }
+  c.finish();
+
+  read_reference(top.child("reference"), s.reference, base_dir);
+  MapReader a = top.child("analysis");
+  a.number("settled_after", s.analysis.settled_after);
+  a.finish();
+  top.finish();
+  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
+
+  // Component validation: each validate() names its key and value.
+  try {
+    s.plant.validate("plant");
+    switch (s.controller.type) {
+      case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
+      case ControllerType::kCascade: s.controller.cascade.validate("controller"); break;
+      case ControllerType::kOpenLoop: s.controller.open_loop.validate("controller"); break;
+    }
+    validate_reference(s.reference);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
+  if (s.steps() < 1) throw ScenarioError("duration: shorter than one control period");
+  return s;
+}
+
+}  // namespace
+
+long Scenario::steps() const { return std::lround(duration / control_period); }
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
+  try {
+    YAML::Node root;
+    try {
+      root = YAML::Load(yaml_text);
+    } catch (const YAML::Exception& e) {
+      throw ScenarioError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    }
+    Scenario s = parse_node(root, base_dir);
+    return s;
+  } catch (const ScenarioError& e) {
+    throw ScenarioError(origin + ": " + e.what());
+  } catch (const std::exception& e) {
+    throw ScenarioError(origin + ": " + e.what());
+  }
+}
+
+Scenario load_scenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError(path + ": cannot read the scenario file");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  if (in.bad()) throw ScenarioError(path + ": cannot read the scenario file");
+  const fs::path p(path);
+  Scenario s = parse_scenario(buf.str(), p.parent_path().empty() ? "." : p.parent_path().string(), path);
+  s.path = path;
+  if (s.name.empty()) s.name = p.stem().string();
+  return s;
+}
+
+std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {
+  const ReferenceConfig& c = s.reference;
+  switch (c.type) {
+    case ReferenceType::kNone: return trajectory::make_ramp({0.0, 0.0, 0.0});
+    case ReferenceType::kSine: return trajectory::make_sine(c.sine);
+    case ReferenceType::kStep: return trajectory::make_step(c.step);
+    case ReferenceType::kAccelLimited: return trajectory::make_accel_limited(c.accel_limited);
+    case ReferenceType::kSCurve: return trajectory::make_scurve(c.scurve);
+    case ReferenceType::kRamp: return trajectory::make_ramp(c.ramp);
+    case ReferenceType::kWaypoints:
+      return trajectory::make_waypoints(trajectory::read_waypoints_csv(c.waypoints_file));
+  }
+  return nullptr;
+}
+
+std::unique_ptr<controller::Controller> make_controller(const Scenario& s) {
+  switch (s.controller.type) {
+    case ControllerType::kSlidingMode:
+      return std::make_unique<controller::SlidingModeController>(s.controller.sliding_mode);
+    case ControllerType::kCascade:
+      return std::make_unique<controller::CascadeController>(s.controller.cascade);
+    case ControllerType::kOpenLoop:
+      return std::make_unique<controller::OpenLoopSource>(s.controller.open_loop);
+  }
+  return nullptr;
+}
+
+}  // namespace feeddrive::sim

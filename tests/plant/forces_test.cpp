@@ -1,0 +1,138 @@
+// Force laws against their closed forms and the analytic Jacobian against finite differences.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "feeddrive/plant/dynamics.hpp"
+#include "feeddrive/plant/forces.hpp"
+
+namespace feeddrive::plant {
+namespace {
+
+TEST(Stribeck, LimitsAreStaticAndCoulomb) {
+  const FrictionParams p;
+  EXPECT_DOUBLE_EQ(stribeck(p, 0.0), p.static_force);
+  // exp(-(10/0.1)^2) underflows to 0: g is exactly Fc far above vs.
+  EXPECT_DOUBLE_EQ(stribeck(p, 10.0), p.coulomb_force);
+  // At v = vs: g = Fc + (Fs - Fc)/e.
+  EXPECT_NEAR(stribeck(p, -0.1), 80.0 + 40.0 / M_E, 1e-12);
+}
+
+TEST(LuGre, SteadyStateEqualsStaticMap) {
+  // At dz/dt = 0, z = sgn(v) g(v)/sigma0 and F = g(v) sgn(v) + sigma2 v (Canudas de Wit 1995 eq. 4).
+  const FrictionParams p;
+  for (double v : {-0.5, -0.01, 1e-4, 0.1, 0.8}) {
+    const double z = std::copysign(stribeck(p, v) / p.bristle_stiffness, v);
+    EXPECT_NEAR(lugre_zdot(p, v, z), 0.0, 1e-15);
+    EXPECT_NEAR(friction_force(p, v, z), std::copysign(stribeck(p, v), v) + p.viscous * v, 1e-9);
+  }
+}
+
+TEST(LuGre, ZeroVelocityFreezesBristle) {
+  const FrictionParams p;
+  EXPECT_EQ(lugre_zdot(p, 0.0, 3e-5), 0.0);
+  EXPECT_DOUBLE_EQ(friction_force(p, 0.0, 3e-5), p.bristle_stiffness * 3e-5);
+}
+
+TEST(LuGre, MicroDampingDecays) {
+  FrictionParams p;
+  p.damping_decay_velocity = 1e-3;
+  EXPECT_DOUBLE_EQ(micro_damping(p, 0.0), p.bristle_damping);
+  EXPECT_NEAR(micro_damping(p, 1e-3), p.bristle_damping / M_E, 1e-9);
+  p.damping_decay_velocity = 0.0;
+  EXPECT_DOUBLE_EQ(micro_damping(p, 1.0), p.bristle_damping);
+}
+
+TEST(Ripple, MatchesEquations14And15) {
+  RippleParams p;
+  p.enabled = true;
+  const double x = 0.0071, fdes = 200.0;
+  const double th = 2 * M_PI * x / p.pitch;
+  const double cog = p.cogging_amplitude * std::sin(th) + p.cogging_third * std::sin(3 * th);
+  const double rel = fdes * (p.reluctance_amplitude * std::sin(th) + p.reluctance_third * std::sin(3 * th));
+  EXPECT_NEAR(ripple_force(p, x, fdes), cog + rel, 1e-12);
+  // Periodic in the pitch.
+  EXPECT_NEAR(ripple_force(p, x + 5 * p.pitch, fdes), cog + rel, 1e-9);
+  p.enabled = false;
+  EXPECT_EQ(ripple_force(p, x, fdes), 0.0);
+}
+
+TEST(Grinding, ContactAndSteadyState) {
+  GrindingParams p;
+  p.enabled = true;
+  EXPECT_NEAR(p.damping(), 2.5e9 * M_PI * 0.05 * 0.02, 1e-3);  // C = c*pi*dw*bs = 7.85e6 N*s/m
+  EXPECT_NEAR(p.time_constant(), p.damping() / 2e7, 1e-15);
+  // Steady state Fg = C*v makes the rate vanish (eq. 13 at s = 0).
+  const double v = 1e-6;
+  EXPECT_NEAR(grinding_rate(p, 0.0, v, p.damping() * v), 0.0, 1e-12);
+  p.contact_position = 1e-3;
+  EXPECT_EQ(grinding_force(p, 0.0, 5.0), 0.0);
+  EXPECT_EQ(grinding_force(p, 2e-3, 5.0), 5.0);
+}
+
+// Central finite differences of derivative() against jacobian(), on seeded random states with
+// every sub-model on. Step h_j = 1e-6 * scale_j; the tolerance 1e-5 relative to the row scale
+// covers the O(h^2) truncation and the cancellation error (~1e-16/h relative).
+TEST(Dynamics, AnalyticJacobianMatchesFiniteDifferences) {
+  for (FrictionModel fm : {FrictionModel::kLuGre, FrictionModel::kStatic}) {
+    PlantParams p;
+    p.friction.model = fm;
+    p.friction.damping_decay_velocity = 0.05;
+    p.ripple.enabled = true;
+    p.grinding.enabled = true;
+    p.grinding.contact_position = -1.0;
+    p.electrical.enabled = true;
+    p.friction.static_smoothing_velocity = 1e-2;
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> ux(-0.05, 0.05), uv(-0.5, 0.5), uz(-5e-5, 5e-5),
+        ufg(-50, 50), ui(-5, 5), uu(-3, 3);
+    const StateVector scale{1e-2, 1e-1, 1e-5, 10.0, 1.0};
+    for (int trial = 0; trial < 200; ++trial) {
+      State s{ux(rng), uv(rng), uz(rng), ufg(rng), ui(rng)};
+      const double u = uu(rng);
+      const Jacobian J = jacobian(p, s, u);
+      for (int c = 0; c < kStateSize; ++c) {
+        const double h = 1e-6 * scale[c];
+        StateVector yp = s.to_vector(), ym = s.to_vector();
+        yp[c] += h;
+        ym[c] -= h;
+        const StateVector fp = derivative(p, State::from_vector(yp), u);
+        const StateVector fm_ = derivative(p, State::from_vector(ym), u);
+        for (int r = 0; r < kStateSize; ++r) {
+          const double fd = (fp[r] - fm_[r]) / (2 * h);
+          // Truncation O(h^2) plus round-off ~1e-15*|f|/h of the difference quotient.
+          const double tol = 1e-5 * std::abs(J[r][c]) + 1e-14 * std::max(std::abs(fp[r]), std::abs(fm_[r])) / h +
+                             1e-12;
+          EXPECT_NEAR(J[r][c], fd, tol) << "friction " << to_string(fm) << " row " << r << " col " << c;
+        }
+      }
+    }
+  }
+}
+
+TEST(Params, ValidateNamesKeyAndValue) {
+  PlantParams p;
+  p.mass = -1.0;
+  try {
+    p.validate();
+    FAIL() << "expected an exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "plant.mass = -1: must be > 0");
+  }
+  p = PlantParams{};
+  p.friction.bristle_stiffness = std::nan("");
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = PlantParams{};
+  p.friction.static_force = 50.0;  // below Fc = 80
+  try {
+    p.validate();
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("plant.friction.static_force = 50"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace feeddrive::plant
