@@ -6,11 +6,11 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PACKAGES=(
   build-essential cmake pkg-config git
-  liblcm-dev liblcm-bin libglib2.0-dev
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev
   libeigen3-dev libsundials-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libbenchmark-dev libceres-dev
-  gnuplot-nox
+  gnuplot-nox jq
   iproute2 nftables util-linux
   lua5.2 liblcm-lua
 )

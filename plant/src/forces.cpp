@@ -6,11 +6,18 @@ namespace feeddrive::plant {
 namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 double sgn(double v) { return (v > 0.0) - (v < 0.0); }
+// r^d, with the paper's delta = 2 (and 1) special-cased: std::pow is the costliest call of the
+// right-hand side, and r*r is exact.
+double power(double r, double d) {
+  if (d == 2.0) return r * r;
+  if (d == 1.0) return r;
+  return std::pow(r, d);
+}
 }  // namespace
 
 double stribeck(const FrictionParams& p, double v) {
   const double r = std::abs(v / p.stribeck_velocity);
-  return p.coulomb_force + (p.static_force - p.coulomb_force) * std::exp(-std::pow(r, p.stribeck_exponent));
+  return p.coulomb_force + (p.static_force - p.coulomb_force) * std::exp(-power(r, p.stribeck_exponent));
 }
 
 double stribeck_derivative(const FrictionParams& p, double v) {
@@ -18,7 +25,7 @@ double stribeck_derivative(const FrictionParams& p, double v) {
   if (v == 0.0) return 0.0;  // exact for d > 1; the one-sided limit is used for d <= 1
   const double r = std::abs(v / p.stribeck_velocity);
   const double d = p.stribeck_exponent;
-  return -(p.static_force - p.coulomb_force) * std::exp(-std::pow(r, d)) * d * std::pow(r, d - 1.0) *
+  return -(p.static_force - p.coulomb_force) * std::exp(-power(r, d)) * d * power(r, d - 1.0) *
          sgn(v) / p.stribeck_velocity;
 }
 

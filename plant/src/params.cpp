@@ -41,7 +41,7 @@ FrictionModel friction_model_from_string(const std::string& s) {
   if (s == "lugre") return FrictionModel::kLuGre;
   if (s == "static") return FrictionModel::kStatic;
   if (s == "none") return FrictionModel::kNone;
-  throw std::invalid_argument("'" + s + "': expected one of lugre, static, none");
+  throw std::invalid_argument("expected one of lugre, static, none");
 }
 
 void FrictionParams::validate(const std::string& prefix) const {
@@ -123,6 +123,7 @@ void PlantParams::validate(const std::string& prefix) const {
   require_positive(prefix + ".mass", mass);
   require_positive(prefix + ".amplifier_gain", amplifier_gain);
   require_positive(prefix + ".force_constant", force_constant);
+  require_positive(prefix + ".input_limit", input_limit);
   friction.validate(prefix + ".friction");
   ripple.validate(prefix + ".ripple");
   grinding.validate(prefix + ".grinding");

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   feeddrive::sim::Scenario scenario;
   try {
     scenario = feeddrive::sim::load_scenario(scenario_path);
+    feeddrive::sim::check_output_dir(out_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -68,10 +68,22 @@ void write_plots(const std::string& dir, const std::string& title) {
   fs::remove(dir + "/gnuplot.log");
 }
 
+void check_output_dir(const std::string& out_dir) {
+  const fs::path p(out_dir);
+  std::error_code ec;
+  if (!fs::exists(p, ec)) return;
+  if (!fs::is_directory(p, ec))
+    throw std::invalid_argument("--out " + out_dir + ": exists and is not a folder");
+  if (fs::is_empty(p, ec) || fs::exists(p / "summary.json", ec)) return;
+  throw std::invalid_argument("--out " + out_dir +
+                              ": folder exists and is not a feeddrive output (no summary.json); refusing to replace it");
+}
+
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots) {
+                   bool plots, const std::string& extra_json) {
   const fs::path target = fs::absolute(out_dir).lexically_normal();
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  check_output_dir(target.string());
   fs::create_directories(parent);
   const fs::path tmp = parent / ("." + target.filename().string() + ".partial-" + std::to_string(::getpid()));
   fs::remove_all(tmp);
@@ -80,7 +92,7 @@ void write_results(const std::string& out_dir, const RunResult& r, const Summary
     write_timeseries_csv((tmp / "timeseries.csv").string(), r.records);
     {
       std::ofstream js(tmp / "summary.json");
-      js << summary_json(sum, s);
+      js << summary_json(sum, s, extra_json);
       if (!js) throw std::runtime_error((tmp / "summary.json").string() + ": write failed");
     }
     if (plots) write_plots(tmp.string(), s.name);

@@ -21,7 +21,7 @@ void read_friction(MapReader r, plant::FrictionParams& f) {
   try {
     f.model = plant::friction_model_from_string(model);
   } catch (const std::invalid_argument& e) {
-    r.fail("model", " = " + std::string(e.what()));
+    r.fail("model", " = '" + model + "': " + e.what());
   }
   r.number("static_force", f.static_force);
   r.number("coulomb_force", f.coulomb_force);
@@ -99,6 +99,7 @@ void read_plant(MapReader r, PlantParams& p) {
   r.number("mass", p.mass);
   r.number("amplifier_gain", p.amplifier_gain);
   r.number("force_constant", p.force_constant);
+  r.number("input_limit", p.input_limit);
   read_friction(r.child("friction"), p.friction);
   read_ripple(r.child("ripple"), p.ripple);
   read_grinding(r.child("grinding"), p.grinding);
@@ -137,6 +138,10 @@ void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
   read_enum(r, "grinding_state", p.grinding_state, controller::state_source_from_string,
             controller::to_string(p.grinding_state));
   r.number("observer_gain", p.observer_gain);
+  read_enum(r, "motion_state", p.motion_state, controller::motion_source_from_string,
+            controller::to_string(p.motion_state));
+  r.number("motion_observer_bandwidth", p.motion_observer_bandwidth);
+  r.boolean("motion_observer_disturbance", p.motion_observer_disturbance);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
   read_plant(r.child("model"), p.model);

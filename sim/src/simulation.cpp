@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "feeddrive/plant/command.hpp"
 #include "feeddrive/plant/plant.hpp"
 
 namespace feeddrive::sim {
@@ -34,7 +35,8 @@ RunResult run(const Scenario& s, const std::function<void(long, long)>& progress
     const plant::State st = drive.state();
     const controller::Truth truth{st.z, st.fg};
     const controller::Command cmd = controller->update(ref, meas, &truth);
-    const plant::Forces f = drive.forces(cmd.u);
+    const double u = plant::admit_command(cmd.u, s.plant.input_limit).u;
+    const plant::Forces f = drive.forces(u);
 
     Record r;
     r.t = t;
@@ -49,7 +51,7 @@ RunResult run(const Scenario& s, const std::function<void(long, long)>& progress
     r.i = st.i;
     r.x_measured = meas.x;
     r.v_measured = meas.v;
-    r.u = cmd.u;
+    r.u = u;  // what the drive applied (plant/command.hpp)
     r.u_unsaturated = cmd.u_unsaturated;
     r.f_thrust = f.thrust;
     r.f_friction = f.friction;
@@ -59,7 +61,7 @@ RunResult run(const Scenario& s, const std::function<void(long, long)>& progress
     r.z_estimate = cmd.z_estimate;
     result.records.push_back(r);
 
-    drive.advance(cmd.u, s.time_of(k + 1));
+    drive.advance(u, s.time_of(k + 1));
     if (progress && (k % 5000 == 0 || k + 1 == n)) progress(k + 1, n);
   }
   result.integrator = drive.integrator_stats();

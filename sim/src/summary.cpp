@@ -15,6 +15,8 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   m.settled_after_s = s.analysis.settled_after;
   m.integrator_steps = r.integrator.steps;
   m.integrator_rhs_evals = r.integrator.rhs_evals;
+  m.integrator_jac_evals = r.integrator.jac_evals;
+  m.integrator_error_test_fails = r.integrator.error_test_fails;
   if (rec.empty()) return m;
 
   double se = 0.0, sev = 0.0, se_settled = 0.0;
@@ -61,7 +63,7 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   return m;
 }
 
-std::string summary_json(const Summary& m, const Scenario& s) {
+std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
   nlohmann::ordered_json j;
   j["scenario"] = s.name;
   j["scenario_path"] = s.path;
@@ -92,6 +94,12 @@ std::string summary_json(const Summary& m, const Scenario& s) {
   j["min_position_m"] = m.min_position_m;
   j["integrator_steps"] = m.integrator_steps;
   j["integrator_rhs_evals"] = m.integrator_rhs_evals;
+  j["integrator_jac_evals"] = m.integrator_jac_evals;
+  j["integrator_error_test_fails"] = m.integrator_error_test_fails;
+  if (!extra.empty()) {
+    const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
+    for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();
+  }
   return j.dump(2) + "\n";
 }
 

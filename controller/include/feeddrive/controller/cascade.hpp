@@ -20,7 +20,7 @@ struct CascadeParams {
   double velocity_feedforward{1.0};      ///< kff_v [-]
   double acceleration_feedforward{1.0};  ///< kff_a [-]
   double mass{102.04};         ///< m^ [kg]
-  double thrust_gain{250.0};   ///< (Ka*Kf)^ [N/V]
+  double thrust_gain{260.0};   ///< (Ka*Kf)^ [N/V]
   double u_min{-10.0};         ///< [V]
   double u_max{10.0};          ///< [V]
   double period{1e-4};         ///< T [s]

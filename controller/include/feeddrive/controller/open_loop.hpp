@@ -26,7 +26,7 @@ struct OpenLoopParams {
   double rate{100.0};       ///< [N/s] (ramp)
   double start_time{0.0};   ///< [s]
   std::string file;         ///< CSV path (csv)
-  double thrust_gain{250.0};  ///< Ka*Kf [N/V] used to turn force into u
+  double thrust_gain{260.0};  ///< Ka*Kf [N/V] used to turn force into u
   double u_min{-1e9};       ///< [V]
   double u_max{1e9};        ///< [V]
   void validate(const std::string& prefix = "controller") const;

@@ -10,11 +10,16 @@
 //
 // The reluctance ripple depends on the commanded force itself, F^r = Fcog(x) + Ka*Kf*u*r(x),
 // so the law is solved for u exactly:  Ka*Kf*u*(1 - r(x)) = m*(...) + F^f + F^g + Fcog(x).
+//
+// Order within one period: (optionally) correct the x,v observer with the new sample; compute
+// u from the estimates at t_k; then advance the force observers and predict x,v over [t_k, t_k+T]
+// with u held (so nothing uses information from after t_k).
 
 #include <memory>
 
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
+#include "feeddrive/controller/state_observer.hpp"
 #include "feeddrive/plant/params.hpp"
 
 namespace feeddrive::controller {
@@ -31,6 +36,14 @@ enum class StateSource {
 std::string to_string(StateSource s);
 StateSource state_source_from_string(const std::string& s);  ///< "true" | "observer"
 
+/// Where x and v in e and de/dt come from.
+enum class MotionSource {
+  kMeasured,  ///< the measured position and velocity as they are (the paper)
+  kObserver,  ///< a model-based observer of x and v (state_observer.hpp) fed by the encoder
+};
+std::string to_string(MotionSource s);
+MotionSource motion_source_from_string(const std::string& s);  ///< "measured" | "observer"
+
 struct SlidingModeParams {
   double eta{5.0};      ///< [m/s^2]
   double k{10.0};       ///< [1/s]
@@ -44,6 +57,11 @@ struct SlidingModeParams {
   StateSource friction_state{StateSource::kTrue};
   StateSource grinding_state{StateSource::kTrue};
   double observer_gain{0.0};  ///< L [1/s] of the bristle observer correction, see friction_observer.hpp
+  MotionSource motion_state{MotionSource::kMeasured};
+  double motion_observer_bandwidth{300.0};  ///< w_o [rad/s] of the x,v observer
+  /// Estimate a lumped disturbance acceleration d^ in the x,v observer and add m*d^ to the
+  /// force (motion_state = observer only).
+  bool motion_observer_disturbance{true};
   double u_min{-10.0};        ///< [V]
   double u_max{10.0};         ///< [V]
   plant::PlantParams model;   ///< the controller's model of the drive
@@ -63,6 +81,7 @@ class SlidingModeController final : public Controller {
   SlidingModeParams p_;
   FrictionObserver friction_observer_;
   GrindingObserver grinding_observer_;
+  StateObserver motion_observer_;
 };
 
 }  // namespace feeddrive::controller

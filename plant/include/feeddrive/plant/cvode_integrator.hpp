@@ -5,6 +5,12 @@
 // dynamics.hpp, per-state absolute tolerances. The held control input u is piecewise constant,
 // so the caller advances exactly to each control-period boundary and the integrator restarts
 // there (CVodeReInit), as the CVODE guide prescribes for jump discontinuities in f.
+// Within a period CVODE integrates only the active states (dynamics.hpp active_states), and for
+// x and v their deviations from the period's Taylor prediction
+//   x = x_k + v_k*tau + a_k*tau^2/2 + j_k*tau^3/6 + y_x,   v = v_k + a_k*tau + j_k*tau^2/2 + y_v
+// (a_k = f_v, j_k = sum_j df_v/dy_j * f_j at the period start). Their errors are then bounded by
+// the absolute tolerances, not by rtol times the axis position, and the BDF restart at order 1
+// needs few steps because the deviations start at O(tau^3).
 // Every failed SUNDIALS call becomes a std::runtime_error naming the call and its flag.
 
 #include <memory>

@@ -129,8 +129,11 @@ struct InitialState {
 struct PlantParams {
   /// m [kg]: from the paper's zeta = 0.7, m = ((sigma1+sigma2)/1.4)^2/sigma0 = 102.04 kg.
   double mass{102.04};
-  double amplifier_gain{2.5};   ///< Ka [A/V] (or V/V with the electrical option).
+  double amplifier_gain{2.6};   ///< Ka [A/V] (or V/V with the electrical option); Ka*Kf = 260 N/V.
   double force_constant{100.0}; ///< Kf [N/A]. Thrust = Ka*Kf*u without electrical dynamics.
+  /// Amplifier input range [V]: |u| above it is clipped, a non-finite u is rejected
+  /// (command.hpp). 100 V: far above every controller's own limit, so it only guards.
+  double input_limit{100.0};
   FrictionParams friction;
   RippleParams ripple;
   GrindingParams grinding;

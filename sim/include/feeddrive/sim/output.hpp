@@ -17,8 +17,13 @@ void write_timeseries_csv(const std::string& path, const std::vector<Record>& re
 /// (position.png, velocity_error.png, control.png, forces.png). Throws on failure.
 void write_plots(const std::string& dir, const std::string& title);
 
-/// Writes timeseries.csv, summary.json and the plots into out_dir atomically.
+/// Throws std::invalid_argument unless out_dir is absent, empty, or a previous feeddrive output
+/// (holds summary.json): an unrelated folder is never replaced.
+void check_output_dir(const std::string& out_dir);
+
+/// Writes timeseries.csv, summary.json (with the keys of extra_json appended) and the plots into
+/// out_dir atomically.
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots = true);
+                   bool plots = true, const std::string& extra_json = "");
 
 }  // namespace feeddrive::sim

@@ -35,10 +35,13 @@ struct Summary {
   double min_position_m{0.0};
   long integrator_steps{0};
   long integrator_rhs_evals{0};
+  long integrator_jac_evals{0};
+  long integrator_error_test_fails{0};
 };
 
 Summary summarize(const RunResult& r, const Scenario& s);
-/// The summary as a JSON document (also carries the scenario name and path).
-std::string summary_json(const Summary& sum, const Scenario& s);
+/// The summary as a JSON document (also carries the scenario name and path). `extra`, if not
+/// empty, is a JSON object whose keys are appended (the monitor's lockstep statistics).
+std::string summary_json(const Summary& sum, const Scenario& s, const std::string& extra = "");
 
 }  // namespace feeddrive::sim

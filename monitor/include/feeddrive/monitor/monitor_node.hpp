@@ -1,0 +1,52 @@
+#pragma once
+// The monitor process: subscribes to every channel of a run, records every step (asking for
+// what it missed), acknowledges recorded steps (the plant's flow control), prints a live
+// progress line, and writes DIR/timeseries.csv and DIR/summary.json in feeddrive-sim's format
+// plus the lockstep statistics. Ends when the run ends, a role fails, or a role stops answering;
+// in every case it writes what it recorded and says where the run stopped.
+//
+// attach = true joins a running system or a log played back by lcm-logplayer: it records from
+// the first state it sees, never asks for resends, and does not acknowledge (the plant's flow
+// control stays with the run's own monitor).
+
+#include <string>
+
+#include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/run_summary_t.hpp"
+#include "feeddrive/service/node.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+namespace feeddrive::monitor {
+
+struct MonitorOptions {
+  std::string out_dir;
+  bool plots{true};
+  bool attach{false};
+  double progress_interval_s{0.5};
+};
+
+class MonitorNode : public service::Node {
+ public:
+  MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt);
+  /// Returns true if the run completed; writes the results in every case.
+  bool run();
+  const run_summary_t& summary() const { return summary_; }
+
+ private:
+  void request_missing();
+  void progress(bool force);
+  void finish(bool completed, const std::string& failure);
+
+  sim::Scenario s_;
+  MonitorOptions mopt_;
+  Recorder rec_;
+  std::int64_t start_us_{0};
+  std::int64_t last_row_us_{0};
+  std::int64_t last_request_us_{0};
+  std::int64_t last_progress_us_{0};
+  std::int64_t last_ack_sent_{-1};
+  std::int64_t lost_{0};
+  run_summary_t summary_;
+};
+
+}  // namespace feeddrive::monitor

@@ -1,0 +1,94 @@
+#pragma once
+// Assembles the rows of timeseries.csv from the messages of a run, in any arrival order, with
+// duplicates ignored. Row k needs drive_state_t k, reference_t k, control_command_t k and the
+// drive_state_t k+1 that carries what was applied during step k (or the end-of-run marker).
+// In real-time runs (drive_state_t.realtime) a step may have no command of its own (it came too
+// late, the plant applied the previous one): the row is then written once state k+2 (or the end)
+// is there, with the command's diagnostic fields NaN; the applied u always comes from the plant.
+// Pure logic, no I/O: used by the live monitor and by the log converter alike.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "feeddrive/control_command_t.hpp"
+#include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/reference_t.hpp"
+#include "feeddrive/sim/simulation.hpp"
+
+namespace feeddrive::monitor {
+
+/// One message a row is waiting for.
+struct Missing {
+  std::string what;  ///< "state", "reference" or "command"
+  std::string role;  ///< who publishes it: "plant", "trajectory", "controller"
+  std::int64_t seq;
+};
+
+class Recorder {
+ public:
+  /// attach = false: rows start at step 0 and a gap is never skipped. attach = true: rows start
+  /// at the first step whose state is seen (joining a running system or a log mid-way).
+  explicit Recorder(bool attach = false) : attach_(attach) {}
+
+  void on_state(const drive_state_t& m, std::int64_t recv_us);
+  void on_reference(const reference_t& m, std::int64_t recv_us);
+  void on_command(const control_command_t& m, std::int64_t recv_us);
+
+  /// Moves every complete row, in order, to records(); returns how many were added.
+  std::size_t flush();
+
+  std::int64_t next() const { return next_; }             ///< first step not recorded
+  std::int64_t steps() const { return steps_; }           ///< steps of the run (-1 until known)
+  std::int64_t highest_state() const { return highest_state_; }
+  bool end_seen() const { return end_seen_; }
+  bool complete() const { return end_seen_ && next_ >= steps_; }
+  /// What row next() is waiting for.
+  std::vector<Missing> missing() const;
+
+  const std::vector<sim::Record>& records() const { return records_; }
+  std::int64_t duplicates() const { return duplicates_; }
+  /// Steps per second of the run between the first and the newest state received (0 if < 2).
+  double steps_per_second() const;
+  std::int64_t commandless_rows() const { return commandless_; }  ///< real time: steps without a command
+  /// The latest counters the plant reported.
+  std::int64_t rejected_commands() const { return rejected_; }
+  std::int64_t missed_deadlines() const { return missed_; }
+  bool safe_state() const { return safe_state_; }
+
+  /// Per-hop latencies from receive times [us]: state k -> command k, command k -> state k+1,
+  /// state k -> reference k+1 (only when the reference came after the state).
+  const std::vector<double>& latency_state_to_command() const { return lat_sc_; }
+  const std::vector<double>& latency_command_to_state() const { return lat_cs_; }
+  const std::vector<double>& latency_state_to_reference() const { return lat_sr_; }
+
+ private:
+  template <typename Msg>
+  struct Seen {
+    Msg msg;
+    std::int64_t recv_us;
+  };
+  bool attach_;
+  std::int64_t next_{0};
+  bool started_{false};
+  std::int64_t steps_{-1};
+  std::int64_t highest_state_{-1};
+  bool end_seen_{false};
+  std::map<std::int64_t, Seen<drive_state_t>> states_;
+  std::map<std::int64_t, Seen<reference_t>> refs_;
+  std::map<std::int64_t, Seen<control_command_t>> cmds_;
+  std::vector<sim::Record> records_;
+  std::int64_t duplicates_{0};
+  std::int64_t commandless_{0};
+  std::int64_t first_state_seq_{-1}, first_state_us_{0}, last_state_us_{0};
+  std::int64_t rejected_{0};
+  std::int64_t missed_{0};
+  bool safe_state_{false};
+  std::vector<double> lat_sc_, lat_cs_, lat_sr_;
+};
+
+/// p-quantile (0..1) of a sample, NaN when empty.
+double quantile(std::vector<double> v, double p);
+
+}  // namespace feeddrive::monitor

@@ -1,0 +1,205 @@
+#include "feeddrive/monitor/monitor_node.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <thread>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "feeddrive/control_command_t.hpp"
+#include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/sim/output.hpp"
+#include "feeddrive/sim/summary.hpp"
+
+namespace feeddrive::monitor {
+
+using service::mono_us;
+using service::us;
+
+MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
+    : Node(mopt.attach ? "monitor-attached" : "monitor", opt), s_(s), mopt_(mopt), rec_(mopt.attach) {
+  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) { rec_.on_state(m, t); });
+  bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
+    for (const reference_t& m : b.refs) rec_.on_reference(m, t);
+  });
+  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) { rec_.on_command(m, t); });
+}
+
+void MonitorNode::request_missing() {
+  if (mopt_.attach) return;
+  const std::int64_t now = mono_us();
+  // Something is missing if later steps are already flowing, or nothing came for a while.
+  const bool behind = rec_.highest_state() > rec_.next() + 1;
+  const bool quiet = now - last_row_us_ > us(options().resend_interval_s) * 4;
+  if (!behind && !quiet) return;
+  if (now - last_request_us_ < us(options().resend_interval_s)) return;
+  last_request_us_ = now;
+  const std::string* channel = nullptr;
+  for (const Missing& m : rec_.missing()) {
+    if (m.what == "state") channel = &channels().state;
+    if (m.what == "reference") channel = &channels().reference;
+    if (m.what == "command") channel = &channels().command;
+    // Only ask for what was sent already: the step after the newest state is not lost, it is
+    // not there yet.
+    if (m.seq > rec_.highest_state()) continue;
+    if (m.what == "command" && m.seq == rec_.highest_state()) continue;
+    request_resend(*channel, m.seq);
+    ++lost_;
+  }
+}
+
+void MonitorNode::progress(bool force) {
+  const std::int64_t now = mono_us();
+  if (!force && now - last_progress_us_ < us(mopt_.progress_interval_s)) return;
+  last_progress_us_ = now;
+  if (options().quiet) return;
+  const auto& r = rec_.records();
+  const double sim_t = static_cast<double>(rec_.next()) * s_.control_period;
+  const double wall = static_cast<double>(now - start_us_) * 1e-6;
+  const double err = r.empty() ? 0.0 : (r.back().xd - (std::isnan(r.back().x) ? r.back().x_measured : r.back().x));
+  std::fprintf(stderr, "\r[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um   ",
+               static_cast<long long>(rec_.next()), static_cast<long long>(rec_.steps() < 0 ? s_.steps() : rec_.steps()),
+               sim_t, wall > 0 ? sim_t / wall : 0.0, err * 1e6);
+  if (force) std::fprintf(stderr, "\n");
+}
+
+bool MonitorNode::run() {
+  set_state("running");
+  start_us_ = last_row_us_ = mono_us();
+  std::string failure;
+  try {
+    for (;;) {
+      // Off the critical path: take messages in batches, at most ~500 wake-ups per second.
+      if (bus().poll(std::chrono::microseconds(1000))) std::this_thread::sleep_for(std::chrono::microseconds(2000));
+      const std::size_t added = rec_.flush();
+      const std::int64_t now = mono_us();
+      if (added > 0) last_row_us_ = now;
+      if (!mopt_.attach) {
+        acked_seq = rec_.next();
+        set_seq(rec_.next());
+        // Acknowledge often enough that the plant's window never closes.
+        const bool due = acked_seq - last_ack_sent_ >= std::max<long>(options().monitor_window / 4, 1);
+        heartbeat(due);
+        if (due) last_ack_sent_ = acked_seq;
+      }
+      progress(false);
+      if (rec_.complete()) break;
+      request_missing();
+      check_peers();
+      const double limit = rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
+      if (now - last_row_us_ > us(limit)) {
+        if (mopt_.attach && rec_.highest_state() < 0)
+          throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) + " s");
+        std::string who;
+        for (const Missing& m : rec_.missing())
+          who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+        throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " + service::seconds_text(limit) +
+                                  " s: no " + who);
+      }
+    }
+  } catch (const service::RunFailure& e) {
+    failure = e.what();
+  }
+  progress(true);
+  finish(failure.empty(), failure);
+  return failure.empty();
+}
+
+void MonitorNode::finish(bool completed, const std::string& failure) {
+  sim::RunResult r;
+  r.records = rec_.records();
+  r.wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
+  const sim::Summary sum = sim::summarize(r, s_);
+
+  std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(), invalid_total = bus().invalid();
+  for (const char* role : {"plant", "controller", "trajectory"}) {
+    if (const process_status_t* p = peer(role)) {
+      resends_total += p->resends;
+      duplicates_total += p->duplicates;
+      invalid_total += p->invalid;
+    }
+  }
+  const auto lat = [](const std::vector<double>& v, double q) { return quantile(v, q); };
+  summary_.scenario = s_.name;
+  summary_.completed = completed;
+  summary_.failure = failure;
+  summary_.steps = static_cast<std::int64_t>(r.records.size());
+  summary_.stopped_at_seq = rec_.next();
+  summary_.sim_time_s = sum.sim_time_s;
+  summary_.wall_time_s = r.wall_time_s;
+  summary_.position_error_max_abs_m = sum.position_error_max_abs_m;
+  summary_.position_error_rms_m = sum.position_error_rms_m;
+  summary_.velocity_error_max_abs_mps = sum.velocity_error_max_abs_mps;
+  summary_.control_min = sum.control_min;
+  summary_.control_max = sum.control_max;
+  summary_.control_total_variation = sum.control_total_variation;
+  summary_.resends = resends_total;
+  summary_.lost = lost_;
+  summary_.duplicates = duplicates_total;
+  summary_.invalid = invalid_total;
+  summary_.rejected_commands = rec_.rejected_commands();
+  summary_.deadline_misses = rec_.missed_deadlines();
+  summary_.latency_state_to_command_p50_us = lat(rec_.latency_state_to_command(), 0.5);
+  summary_.latency_state_to_command_p99_us = lat(rec_.latency_state_to_command(), 0.99);
+  summary_.latency_command_to_state_p50_us = lat(rec_.latency_command_to_state(), 0.5);
+  summary_.latency_command_to_state_p99_us = lat(rec_.latency_command_to_state(), 0.99);
+  summary_.latency_state_to_reference_p50_us = lat(rec_.latency_state_to_reference(), 0.5);
+  summary_.latency_state_to_reference_p99_us = lat(rec_.latency_state_to_reference(), 0.99);
+
+  nlohmann::ordered_json j;
+  auto& l = j["lockstep"];
+  l["mode"] = options().realtime ? "realtime" : "lockstep";
+  l["completed"] = completed;
+  l["failure"] = failure;
+  l["steps_expected"] = rec_.steps() < 0 ? s_.steps() : rec_.steps();
+  l["stopped_at_step"] = rec_.next();
+  l["resends"] = resends_total;
+  l["lost"] = lost_;
+  l["duplicates"] = duplicates_total;
+  l["invalid_messages"] = invalid_total;
+  l["rejected_commands"] = rec_.rejected_commands();
+  l["deadline_misses"] = rec_.missed_deadlines();
+  l["steps_without_command"] = rec_.commandless_rows();
+  l["steps_per_second"] = rec_.steps_per_second();
+  {
+    // One step on the wire: state + command + 1/16 of a reference block, each an LCM datagram of
+    // an 8-byte header, the channel name and its NUL, and the encoded message.
+    const auto packet = [](const std::string& channel, int payload) {
+      return 8 + static_cast<int>(channel.size()) + 1 + payload;
+    };
+    l["bytes_per_step"] = packet(channels().state, drive_state_t().getEncodedSize()) +
+                          (packet(channels().reference, 12) + 16 * reference_t().getEncodedSize()) / 16 +
+                          packet(channels().command, control_command_t().getEncodedSize());
+  }
+  l["safe_state"] = rec_.safe_state();
+  const auto hop = [&](const char* name, const std::vector<double>& v) {
+    l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.size()}};
+  };
+  hop("state_to_command", rec_.latency_state_to_command());
+  hop("command_to_state", rec_.latency_command_to_state());
+  hop("state_to_reference", rec_.latency_state_to_reference());
+  for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["latency_us"]["state_to_reference"]})
+    for (const char* q : {"p50", "p99"})
+      if (std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
+
+  try {
+    sim::write_results(mopt_.out_dir, r, sum, s_, mopt_.plots && !r.records.empty(), j.dump());
+  } catch (const std::exception& e) {
+    spdlog::error("monitor: writing {} failed: {}", mopt_.out_dir, e.what());
+    completed = false;
+  }
+  bus().publish(channels().summary, summary_);
+  if (completed) {
+    set_state("done");
+  } else {
+    announce_failure(failure);
+  }
+  if (!options().quiet)
+    spdlog::info("monitor: {} steps recorded{} -> {}", r.records.size(),
+                 completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + failure + ")",
+                 mopt_.out_dir);
+}
+
+}  // namespace feeddrive::monitor

@@ -1,0 +1,27 @@
+// feeddrive-controller: the scenario's controller (sliding mode, cascade or open loop) as an LCM
+// process. Wiring only: scenario -> make_controller -> ControllerNode (service/controller_node.hpp).
+#include "feeddrive/service/cli.hpp"
+#include "feeddrive/service/controller_node.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+int main(int argc, char** argv) {
+  using namespace feeddrive;
+  CLI::App app{"feeddrive-controller: answers <prefix>_STATE with <prefix>_CMD using <prefix>_REF "
+               "(docs/lcm-contract.md)",
+               "feeddrive-controller"};
+  std::string scenario_path;
+  service::NodeOptions opt;
+  app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
+  service::add_node_options(app, opt);
+  return service::run_process(app, argc, argv, opt, [&] {
+    const sim::Scenario s = sim::load_scenario(scenario_path);
+    service::ControllerNode node(sim::make_controller(s), opt);
+    try {
+      node.run();
+    } catch (const service::RunFailure& e) {
+      node.announce_failure(e.what());
+      throw;
+    }
+    return 0;
+  });
+}

@@ -1,0 +1,27 @@
+// feeddrive-plant: the simulated feed drive (feeddrive::plant + CVODE) as an LCM process.
+// Wiring only: scenario -> PlantNode (service/plant_node.hpp).
+#include "feeddrive/service/cli.hpp"
+#include "feeddrive/service/plant_node.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+int main(int argc, char** argv) {
+  using namespace feeddrive;
+  CLI::App app{"feeddrive-plant: the simulated linear-motor feed drive, publishing <prefix>_STATE and "
+               "applying <prefix>_CMD (docs/lcm-contract.md)",
+               "feeddrive-plant"};
+  std::string scenario_path;
+  service::NodeOptions opt;
+  app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
+  service::add_node_options(app, opt);
+  return service::run_process(app, argc, argv, opt, [&] {
+    const sim::Scenario s = sim::load_scenario(scenario_path);
+    service::PlantNode node(s, opt);
+    try {
+      node.run();
+    } catch (const service::RunFailure& e) {
+      node.announce_failure(e.what());
+      throw;
+    }
+    return 0;
+  });
+}

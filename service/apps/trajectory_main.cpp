@@ -1,0 +1,26 @@
+// feeddrive-trajectory: the scenario's reference as an LCM process. Wiring only:
+// scenario -> make_reference -> TrajectoryNode (service/trajectory_node.hpp).
+#include "feeddrive/service/cli.hpp"
+#include "feeddrive/service/trajectory_node.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+int main(int argc, char** argv) {
+  using namespace feeddrive;
+  CLI::App app{"feeddrive-trajectory: publishes <prefix>_REF ahead of <prefix>_STATE (docs/lcm-contract.md)",
+               "feeddrive-trajectory"};
+  std::string scenario_path;
+  service::NodeOptions opt;
+  app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
+  service::add_node_options(app, opt);
+  return service::run_process(app, argc, argv, opt, [&] {
+    const sim::Scenario s = sim::load_scenario(scenario_path);
+    service::TrajectoryNode node(s, opt);
+    try {
+      node.run();
+    } catch (const service::RunFailure& e) {
+      node.announce_failure(e.what());
+      throw;
+    }
+    return 0;
+  });
+}

@@ -1,0 +1,151 @@
+#pragma once
+// LCM transport of the multi-process service: one LCM instance, typed subscriptions that count
+// and drop undecodable messages (wrong type or fingerprint) instead of crashing, and publishers
+// that keep their recent messages so a lost one can be re-published on request.
+//
+// Nothing here knows about drives: the nodes (plant_node.hpp, ...) hold the protocol logic.
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace feeddrive::service {
+
+/// LCM URL used when none is given: multicast on the LCM default group with ttl = 0 (nothing
+/// leaves the machine) and a 4 MB receive buffer (LCM's default is the kernel's, which drops
+/// under bursts).
+std::string default_lcm_url();
+
+/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY.
+struct Channels {
+  explicit Channels(const std::string& prefix);
+  std::string state, command, reference, status, resend, summary;
+};
+
+/// Microseconds since the Unix epoch (process_status_t.utime) and a monotonic clock [us].
+std::int64_t wall_utime();
+std::int64_t mono_us();
+
+class Bus {
+ public:
+  /// Throws std::runtime_error naming the URL when LCM cannot be initialised.
+  explicit Bus(const std::string& url);
+  Bus(const Bus&) = delete;
+  Bus& operator=(const Bus&) = delete;
+
+  /// Subscribes to `channel`, decoding every message as Msg. Messages that fail to decode
+  /// (another type, another fingerprint, truncated) are counted in invalid() and dropped.
+  /// recv_us is the monotonic receive time [us].
+  template <typename Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t recv_us)> handler);
+
+  /// Publishes a message. Returns false (and counts) when LCM reports a send error.
+  template <typename Msg>
+  bool publish(const std::string& channel, const Msg& msg);
+
+  /// Dispatches the messages that arrive within `timeout` (at least one wait). Returns true if
+  /// at least one message was handled. Rethrows the first exception a handler threw.
+  bool poll(std::chrono::microseconds timeout);
+
+  std::int64_t invalid() const { return invalid_; }
+  std::int64_t send_errors() const { return send_errors_; }
+  const std::string& url() const { return url_; }
+
+ private:
+  struct Raw {
+    std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f;
+    void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { f(rbuf, channel); }
+  };
+  void subscribe_raw(const std::string& channel,
+                     std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f);
+
+  std::string url_;
+  lcm::LCM lcm_;
+  std::vector<std::unique_ptr<Raw>> raws_;
+  std::int64_t invalid_{0};
+  std::int64_t send_errors_{0};
+  std::int64_t last_invalid_log_us_{-1};
+  std::exception_ptr error_;
+};
+
+/// Remembers the last `capacity` messages published on one channel, by step number, and
+/// re-publishes one on request.
+template <typename Msg>
+class Outbox {
+ public:
+  Outbox(Bus& bus, std::string channel, std::size_t capacity = 65536)
+      : bus_(bus), channel_(std::move(channel)), capacity_(capacity) {}
+  void publish(std::int64_t seq, const Msg& msg) {
+    auto [it, inserted] = sent_.insert_or_assign(seq, msg);
+    (void)it;
+    if (inserted) order_.push_back(seq);
+    while (order_.size() > capacity_) {
+      sent_.erase(order_.front());
+      order_.pop_front();
+    }
+    bus_.publish(channel_, msg);
+  }
+  /// Re-publishes message `seq` if it is still kept; returns whether it was.
+  bool republish(std::int64_t seq) {
+    const auto it = sent_.find(seq);
+    if (it == sent_.end()) return false;
+    bus_.publish(channel_, it->second);
+    ++resends_;
+    return true;
+  }
+  bool has(std::int64_t seq) const { return sent_.count(seq) != 0; }
+  const std::string& channel() const { return channel_; }
+  std::int64_t resends() const { return resends_; }
+
+ private:
+  Bus& bus_;
+  std::string channel_;
+  std::size_t capacity_;
+  std::map<std::int64_t, Msg> sent_;
+  std::deque<std::int64_t> order_;
+  std::int64_t resends_{0};
+};
+
+// --- template definitions -------------------------------------------------------------------
+
+template <typename Msg>
+void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t)> handler) {
+  subscribe_raw(channel, [this, handler](const lcm::ReceiveBuffer* rbuf, const std::string& ch) {
+    Msg msg;
+    const std::int64_t now = mono_us();
+    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) {
+      ++invalid_;
+      if (last_invalid_log_us_ < 0 || now - last_invalid_log_us_ > 1000000) {
+        last_invalid_log_us_ = now;
+        std::fprintf(stderr, "feeddrive: ignored a message on %s that is not a %s (%u bytes)\n",
+                     ch.c_str(), Msg::getTypeName(), rbuf->data_size);
+      }
+      return;
+    }
+    // An exception must not unwind through LCM's C dispatch: keep it for poll() to rethrow.
+    try {
+      handler(msg, now);
+    } catch (...) {
+      if (!error_) error_ = std::current_exception();
+    }
+  });
+}
+
+template <typename Msg>
+bool Bus::publish(const std::string& channel, const Msg& msg) {
+  if (lcm_.publish(channel, &msg) != 0) {
+    ++send_errors_;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace feeddrive::service

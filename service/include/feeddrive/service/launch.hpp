@@ -1,0 +1,38 @@
+#pragma once
+// feeddrive-launch: starts the four processes of a run (plant, controller, trajectory,
+// monitor) with the same scenario, LCM URL and channel prefix, forwards SIGINT/SIGTERM to them,
+// waits, and reports. A role named in `external` is not started: a process the user runs
+// (hardware driver, external controller) takes it.
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "feeddrive/service/node.hpp"
+
+namespace feeddrive::service {
+
+struct LaunchOptions {
+  std::string scenario;
+  std::string out_dir;
+  std::set<std::string> external;  ///< roles left to the user: "controller", "plant", "trajectory"
+  bool plots{true};
+  std::string bin_dir;  ///< where the feeddrive-* executables are (default: next to the launcher)
+  /// After one process fails, how long the others get to notice before they are terminated [s].
+  double grace_s{10.0};
+  /// nice() increment of the monitor and the trajectory, which are off the step's critical path.
+  int off_path_niceness{10};
+};
+
+struct LaunchResult {
+  int exit_code{0};             ///< 0 if every started process exited 0
+  std::vector<std::string> failed;  ///< "role (exit n)" of each process that did not exit 0
+};
+
+/// Validates roles (std::invalid_argument naming a bad one), starts, waits, reports.
+LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt);
+
+/// The directory of the running executable.
+std::string executable_dir();
+
+}  // namespace feeddrive::service

@@ -1,0 +1,100 @@
+#pragma once
+// What every process of the lockstep service shares: options, the bus and its channels, the
+// heartbeat (process_status_t), resend requests, and the view of the other roles' status.
+//
+// Protocol (docs/lcm-contract.md): the plant publishes drive_state_t k and waits for
+// control_command_t k; it re-publishes state k every resend interval until the command comes.
+// The controller answers state k once it also has reference_t k, and answers a repeated state k
+// with the same command. The trajectory publishes reference k+1 when it sees state k, and
+// re-publishes k and k+1 when it sees state k repeated. The monitor records every step and
+// asks for what it missed on <prefix>_RESEND; the plant stays within a window of the monitor's
+// acknowledged step, so nothing is lost. Every wait has a timeout that names the missing role.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "feeddrive/process_status_t.hpp"
+#include "feeddrive/resend_request_t.hpp"
+#include "feeddrive/service/bus.hpp"
+
+namespace feeddrive::service {
+
+struct NodeOptions {
+  std::string lcm_url{default_lcm_url()};
+  std::string prefix{"FD"};
+  double start_timeout_s{30.0};      ///< how long to wait for the other roles to show up (step 0)
+  double step_timeout_s{5.0};        ///< no progress for this long: fail, naming the missing role
+  double resend_interval_s{0.002};   ///< re-publish a pending message after this long
+  long monitor_window{4096};         ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
+  double linger_s{10.0};             ///< after the end: keep answering resend requests until the monitor is done
+  bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
+  int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
+  bool quiet{false};
+};
+
+/// Thrown when a run cannot go on: another role failed or stopped answering.
+struct RunFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class Node {
+ public:
+  Node(std::string role, const NodeOptions& opt);
+  virtual ~Node() = default;
+
+  const std::string& role() const { return role_; }
+  Bus& bus() { return bus_; }
+  const Channels& channels() const { return ch_; }
+  const NodeOptions& options() const { return opt_; }
+
+  /// Publishes the heartbeat if due (every 100 ms) or when forced.
+  void heartbeat(bool force = false);
+  /// Publishes state "failed" with the message (several times: it must not get lost).
+  void announce_failure(const std::string& message);
+  void set_state(const std::string& state) { state_ = state; heartbeat(true); }
+  void set_seq(std::int64_t seq) { seq_ = seq; }
+
+  void request_resend(const std::string& channel, std::int64_t seq);
+
+  /// Throws RunFailure if another role announced a failure.
+  void check_peers() const;
+  /// The latest status of a role, if any was seen.
+  const process_status_t* peer(const std::string& role) const;
+  bool monitor_done() const;
+
+  std::int64_t resends{0};
+  std::int64_t duplicates{0};
+  std::int64_t invalid_content{0};
+  std::int64_t acked_seq{-1};  ///< monitor only: every step below is recorded
+
+ protected:
+  /// Called for resend requests on `channel`; re-publish `seq` if this node owns the channel.
+  std::function<void(const resend_request_t&)> on_resend_request;
+
+ private:
+  std::string role_;
+  NodeOptions opt_;
+  Bus bus_;
+  Channels ch_;
+  std::string state_{"starting"};
+  std::int64_t seq_{-1};
+  std::int64_t last_heartbeat_us_{-1};
+  std::map<std::string, process_status_t> peers_;
+};
+
+/// Installs SIGINT/SIGTERM handlers that make every wait end with RunFailure("interrupted").
+void install_signal_handlers();
+/// The signal that interrupted the process, or 0.
+int interrupted_by();
+
+/// "2", "0.5", "30": a duration in seconds for messages (shortest exact form, %g).
+std::string seconds_text(double s);
+
+/// Seconds to microseconds.
+inline std::int64_t us(double seconds) { return static_cast<std::int64_t>(seconds * 1e6); }
+
+}  // namespace feeddrive::service

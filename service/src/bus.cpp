@@ -1,0 +1,72 @@
+#include "feeddrive/service/bus.hpp"
+
+#include <poll.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <stdexcept>
+
+namespace feeddrive::service {
+
+std::string default_lcm_url() { return "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"; }
+
+Channels::Channels(const std::string& prefix)
+    : state(prefix + "_STATE"),
+      command(prefix + "_CMD"),
+      reference(prefix + "_REF"),
+      status(prefix + "_STATUS"),
+      resend(prefix + "_RESEND"),
+      summary(prefix + "_SUMMARY") {}
+
+std::int64_t wall_utime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::int64_t mono_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+Bus::Bus(const std::string& url) : url_(url), lcm_(url) {
+  if (!lcm_.good())
+    throw std::runtime_error("cannot open LCM at '" + url +
+                             "' (is there a multicast route? see docs/lcm-contract.md)");
+}
+
+void Bus::subscribe_raw(const std::string& channel,
+                        std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f) {
+  raws_.push_back(std::make_unique<Raw>(Raw{std::move(f)}));
+  lcm::Subscription* sub = lcm_.subscribe(channel, &Raw::handle, raws_.back().get());
+  // LCM drops silently when a subscription's queue overflows (default 30 messages).
+  if (sub != nullptr) sub->setQueueCapacity(100000);
+}
+
+bool Bus::poll(std::chrono::microseconds timeout) {
+  const int fd = lcm_.getFileno();
+  bool handled = false;
+  const std::int64_t deadline = mono_us() + timeout.count();
+  for (;;) {
+    const std::int64_t left = deadline - mono_us();
+    struct pollfd p{fd, POLLIN, 0};
+    const std::int64_t wait_us = handled ? 0 : std::max<std::int64_t>(left, 0);
+    struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+    const int r = ::ppoll(&p, 1, &ts, nullptr);
+    if (r < 0) {
+      if (errno == EINTR) return handled;
+      throw std::runtime_error("poll on the LCM socket failed");
+    }
+    if (r == 0) return handled;  // nothing (more) waiting
+    if (lcm_.handle() != 0) throw std::runtime_error("lcm handle() failed");
+    handled = true;
+    if (error_) {
+      std::exception_ptr e = error_;
+      error_ = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+}
+
+}  // namespace feeddrive::service

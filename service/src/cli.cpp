@@ -1,0 +1,63 @@
+#include "feeddrive/service/cli.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "feeddrive/sim/scenario.hpp"
+
+namespace feeddrive::service {
+
+void add_node_options(CLI::App& app, NodeOptions& opt) {
+  app.add_option("--lcm-url", opt.lcm_url, "LCM URL (default: multicast, ttl=0, 4 MB receive buffer)")
+      ->capture_default_str();
+  app.add_option("--prefix", opt.prefix, "channel prefix: <prefix>_STATE, _CMD, _REF, ...")->capture_default_str();
+  app.add_option("--start-timeout", opt.start_timeout_s, "seconds to wait for the other roles to start")
+      ->capture_default_str();
+  app.add_option("--step-timeout", opt.step_timeout_s, "seconds without progress before failing")
+      ->capture_default_str();
+  app.add_option("--resend-interval", opt.resend_interval_s, "seconds before a pending message is re-published")
+      ->capture_default_str();
+  app.add_option("--monitor-window", opt.monitor_window,
+                 "plant: max steps ahead of the monitor's acknowledgement (0: do not wait for a monitor)")
+      ->capture_default_str();
+  app.add_option("--linger", opt.linger_s, "seconds to keep answering resend requests after the end")
+      ->capture_default_str();
+  app.add_flag("--realtime", opt.realtime, "real-time mode: the plant is paced by the wall clock");
+  app.add_option("--max-bad-commands", opt.max_bad_commands,
+                 "real time: missed or invalid commands in a row before the plant goes to zero thrust")
+      ->capture_default_str();
+  app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
+}
+
+int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  auto logger = spdlog::stderr_color_mt(app.get_name());
+  logger->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(opt.quiet ? spdlog::level::warn : spdlog::level::info);
+  install_signal_handlers();
+  try {
+    return body();
+  } catch (const sim::ScenarioError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const RunFailure& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace feeddrive::service

@@ -1,0 +1,93 @@
+#include "feeddrive/service/controller_node.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "feeddrive/service/translate.hpp"
+
+namespace feeddrive::service {
+
+ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt)
+    : Node("controller", opt), controller_(std::move(c)), commands_(bus(), channels().command) {
+  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
+    if (m.end_of_run) {
+      end_ = true;
+      return;
+    }
+    if (m.seq < next_seq_) {  // already answered: the command got lost, send it again
+      ++duplicates;
+      if (commands_.republish(m.seq)) ++resends;
+      return;
+    }
+    if (pending_ && pending_->seq == m.seq) {
+      ++duplicates;
+      return;
+    }
+    pending_ = m;
+    pending_since_us_ = now;
+    try_answer();
+  });
+  bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t) {
+    for (const reference_t& m : b.refs) {
+      if (m.seq < next_seq_ || refs_.count(m.seq)) {
+        ++duplicates;
+        continue;
+      }
+      refs_[m.seq] = m;
+    }
+    try_answer();
+  });
+  on_resend_request = [this](const resend_request_t& r) {
+    if (r.channel == commands_.channel() && commands_.republish(r.seq)) ++resends;
+  };
+}
+
+void ControllerNode::try_answer() {
+  if (!pending_) return;
+  const auto it = refs_.find(pending_->seq);
+  if (it == refs_.end()) return;
+  const drive_state_t st = *pending_;
+  pending_.reset();
+  const controller::Truth truth = to_truth(st.truth);
+  if (controller_->needs_truth() && !st.truth.valid)
+    throw RunFailure("the controller is configured with friction_state/grinding_state = true, but the plant "
+                     "sends no truth (hardware); use the observers");
+  const controller::Command c =
+      controller_->update(to_sample(it->second), to_measurement(st), st.truth.valid ? &truth : nullptr);
+  commands_.publish(st.seq, to_message(st.seq, st.t, c));
+  next_seq_ = st.seq + 1;
+  set_seq(st.seq);
+  last_progress_us_ = mono_us();
+  refs_.erase(refs_.begin(), refs_.upper_bound(st.seq));
+}
+
+void ControllerNode::run() {
+  set_state("running");
+  last_progress_us_ = mono_us();
+  const std::int64_t resend_us = us(options().resend_interval_s);
+  while (!end_) {
+    bus().poll(std::chrono::microseconds(resend_us));
+    const std::int64_t now = mono_us();
+    if (pending_ && now - pending_since_us_ > resend_us && now - last_ref_request_us_ > resend_us) {
+      request_resend(channels().reference, pending_->seq);
+      last_ref_request_us_ = now;
+    }
+    const double limit = next_seq_ == 0 ? options().start_timeout_s : options().step_timeout_s;
+    if (now - last_progress_us_ > us(limit)) {
+      if (pending_)
+        throw RunFailure("no reference from the trajectory for step " + std::to_string(pending_->seq) +
+                         " within " + seconds_text(limit) + " s");
+      throw RunFailure("no state from the plant for step " + std::to_string(next_seq_) + " within " +
+                       seconds_text(limit) + " s");
+    }
+    check_peers();
+    heartbeat();
+  }
+  set_state("done");
+  const std::int64_t start = mono_us();
+  while (!monitor_done() && mono_us() - start < us(options().linger_s)) {
+    bus().poll(std::chrono::microseconds(20000));
+    heartbeat();
+  }
+}
+
+}  // namespace feeddrive::service

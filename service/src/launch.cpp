@@ -1,0 +1,122 @@
+#include "feeddrive/service/launch.hpp"
+
+#include <signal.h>
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+namespace feeddrive::service {
+namespace {
+
+std::string fmt_double(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::vector<std::string> common_args(const NodeOptions& opt) {
+  std::vector<std::string> a = {"--lcm-url", opt.lcm_url, "--prefix", opt.prefix,
+                                "--start-timeout", fmt_double(opt.start_timeout_s),
+                                "--step-timeout", fmt_double(opt.step_timeout_s),
+                                "--resend-interval", fmt_double(opt.resend_interval_s),
+                                "--monitor-window", std::to_string(opt.monitor_window),
+                                "--linger", fmt_double(opt.linger_s),
+                                "--max-bad-commands", std::to_string(opt.max_bad_commands)};
+  if (opt.realtime) a.push_back("--realtime");
+  return a;
+}
+
+pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int niceness) {
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(exe.c_str()));
+  for (const auto& s : args) argv.push_back(const_cast<char*>(s.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    if (niceness != 0 && ::nice(niceness) == -1) std::fprintf(stderr, "warning: nice(%d) failed\n", niceness);
+    ::execv(exe.c_str(), argv.data());
+    std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+}  // namespace
+
+std::string executable_dir() {
+  return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
+}
+
+LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
+  const std::vector<std::string> roles = {"monitor", "plant", "trajectory", "controller"};
+  for (const auto& r : lo.external)
+    if (r != "controller" && r != "plant" && r != "trajectory")
+      throw std::invalid_argument("--external " + r + ": expected one of controller, plant, trajectory");
+  const std::string bin = lo.bin_dir.empty() ? executable_dir() : lo.bin_dir;
+
+  std::map<pid_t, std::string> running;
+  for (const auto& role : roles) {
+    if (lo.external.count(role)) {
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}", role, opt.lcm_url, opt.prefix);
+      continue;
+    }
+    std::vector<std::string> args = {lo.scenario};
+    const auto common = common_args(opt);
+    args.insert(args.end(), common.begin(), common.end());
+    if (role != "monitor" || opt.quiet) args.push_back("--quiet");
+    if (role == "monitor") {
+      args.insert(args.end(), {"--out", lo.out_dir});
+      if (!lo.plots) args.push_back("--no-plots");
+    }
+    const std::string exe = bin + "/feeddrive-" + role;
+    if (::access(exe.c_str(), X_OK) != 0) throw std::runtime_error("cannot find " + exe);
+    // The monitor and the trajectory are off the step's critical path (plant -> controller ->
+    // plant): on a machine with few cores they yield to it.
+    const bool off_path = role == "monitor" || role == "trajectory";
+    running[spawn(exe, args, off_path ? lo.off_path_niceness : 0)] = role;
+  }
+
+  LaunchResult result;
+  int forwarded = 0;
+  std::int64_t first_failure_us = -1;
+  bool terminated = false;
+  while (!running.empty()) {
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid > 0) {
+      const std::string role = running[pid];
+      running.erase(pid);
+      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      if (code != 0) {
+        result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
+        if (first_failure_us < 0) first_failure_us = mono_us();
+      }
+      continue;
+    }
+    // Forward Ctrl-C / SIGTERM to every child once.
+    const int sig = interrupted_by();
+    if (sig != 0 && forwarded != sig) {
+      forwarded = sig;
+      for (const auto& [p, role] : running) ::kill(p, sig);
+    }
+    // One failed: the others notice (status or timeout); terminate stragglers after a grace period.
+    if (first_failure_us >= 0 && !terminated && mono_us() - first_failure_us > us(lo.grace_s)) {
+      terminated = true;
+      for (const auto& [p, role] : running) {
+        spdlog::error("{} still running {} s after a failure: terminating it", role, lo.grace_s);
+        ::kill(p, SIGTERM);
+      }
+    }
+    ::usleep(20000);
+  }
+  result.exit_code = result.failed.empty() ? 0 : 1;
+  return result;
+}
+
+}  // namespace feeddrive::service

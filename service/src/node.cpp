@@ -1,0 +1,97 @@
+#include "feeddrive/service/node.hpp"
+
+#include <csignal>
+#include <cstdio>
+
+namespace feeddrive::service {
+namespace {
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void on_signal(int sig) { g_signal = sig; }
+}  // namespace
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking poll returns EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int interrupted_by() { return g_signal; }
+
+std::string seconds_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", s);
+  return buf;
+}
+
+Node::Node(std::string role, const NodeOptions& opt)
+    : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url), ch_(opt.prefix) {
+  bus_.subscribe<process_status_t>(ch_.status, [this](const process_status_t& m, std::int64_t) {
+    if (m.role != role_) peers_[m.role] = m;
+  });
+  bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
+    if (on_resend_request) on_resend_request(m);
+  });
+}
+
+void Node::heartbeat(bool force) {
+  const std::int64_t now = mono_us();
+  if (!force && last_heartbeat_us_ >= 0 && now - last_heartbeat_us_ < 100000) return;
+  last_heartbeat_us_ = now;
+  process_status_t m;
+  m.utime = wall_utime();
+  m.role = role_;
+  m.state = state_;
+  m.seq = seq_;
+  m.acked_seq = acked_seq;
+  m.message = "";
+  m.resends = resends;
+  m.duplicates = duplicates;
+  m.invalid = bus_.invalid() + invalid_content;
+  bus_.publish(ch_.status, m);
+}
+
+void Node::announce_failure(const std::string& message) {
+  state_ = "failed";
+  process_status_t m;
+  m.role = role_;
+  m.state = "failed";
+  m.seq = seq_;
+  m.acked_seq = acked_seq;
+  m.message = message;
+  m.resends = resends;
+  m.duplicates = duplicates;
+  m.invalid = bus_.invalid() + invalid_content;
+  for (int i = 0; i < 3; ++i) {
+    m.utime = wall_utime();
+    bus_.publish(ch_.status, m);
+  }
+}
+
+void Node::request_resend(const std::string& channel, std::int64_t seq) {
+  resend_request_t m;
+  m.requester = role_;
+  m.channel = channel;
+  m.seq = seq;
+  bus_.publish(ch_.resend, m);
+}
+
+void Node::check_peers() const {
+  if (g_signal != 0) throw RunFailure(std::string("interrupted by ") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM"));
+  for (const auto& [role, st] : peers_)
+    if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
+}
+
+const process_status_t* Node::peer(const std::string& role) const {
+  const auto it = peers_.find(role);
+  return it == peers_.end() ? nullptr : &it->second;
+}
+
+bool Node::monitor_done() const {
+  const process_status_t* m = peer("monitor");
+  return m != nullptr && (m->state == "done" || m->state == "failed");
+}
+
+}  // namespace feeddrive::service

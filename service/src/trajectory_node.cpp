@@ -1,0 +1,70 @@
+#include "feeddrive/service/trajectory_node.hpp"
+
+#include "feeddrive/service/translate.hpp"
+
+namespace feeddrive::service {
+
+TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
+    : Node("trajectory", opt), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
+  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
+    if (m.end_of_run) {
+      end_ = true;
+      return;
+    }
+    if (m.seq <= highest_state_) {  // repeated state: whatever it needed got lost
+      ++duplicates;
+      send_block(m.seq / kBlock, true);
+      if ((m.seq + 1) % kBlock == 0) send_block((m.seq + 1) / kBlock, true);
+      return;
+    }
+    highest_state_ = m.seq;
+    last_progress_us_ = now;
+    set_seq(m.seq);
+    // Keep at least half a block of references ahead of the newest state.
+    send_block(m.seq / kBlock, false);
+    send_block((m.seq + kBlock / 2) / kBlock, false);
+  });
+  on_resend_request = [this](const resend_request_t& r) {
+    if (r.channel == blocks_.channel() && r.seq >= 0) send_block(r.seq / kBlock, true);
+  };
+}
+
+void TrajectoryNode::send_block(std::int64_t b, bool resend) {
+  const std::int64_t first = b * kBlock;
+  if (first < 0 || first >= s_.steps()) return;
+  if (blocks_.has(b)) {
+    if (resend && blocks_.republish(b)) ++resends;
+    return;
+  }
+  reference_block_t m;
+  m.first_seq = first;
+  m.count = static_cast<std::int32_t>(std::min<std::int64_t>(kBlock, s_.steps() - first));
+  for (std::int64_t k = first; k < first + m.count; ++k) {
+    const double t = s_.time_of(k);
+    m.refs.push_back(to_message(k, t, reference_->sample(t)));
+  }
+  blocks_.publish(b, m);
+}
+
+void TrajectoryNode::run() {
+  set_state("running");
+  send_block(0, false);
+  last_progress_us_ = mono_us();
+  while (!end_) {
+    bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));
+    const double limit = highest_state_ < 0 ? options().start_timeout_s : options().step_timeout_s;
+    if (mono_us() - last_progress_us_ > us(limit))
+      throw RunFailure("no state from the plant for step " + std::to_string(highest_state_ + 1) + " within " +
+                       seconds_text(limit) + " s");
+    check_peers();
+    heartbeat();
+  }
+  set_state("done");
+  const std::int64_t start = mono_us();
+  while (!monitor_done() && mono_us() - start < us(options().linger_s)) {
+    bus().poll(std::chrono::microseconds(20000));
+    heartbeat();
+  }
+}
+
+}  // namespace feeddrive::service

@@ -1,0 +1,25 @@
+# Shared helpers of the multi-process tests. Each test runs inside its own network namespace
+# (scripts/netns-run.sh, from ctest), so tests in parallel never hear each other.
+# Usage in a test:  source "$(dirname "$0")/lib.sh" "$@"   (arguments: SOURCE_DIR BUILD_DIR)
+set -euo pipefail
+SRC=$(cd "$1" && pwd)
+BUILD=$(cd "$2" && pwd)
+BIN=$BUILD/bin
+URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/feeddrive-test.XXXXXX")
+trap 'jobs -p | xargs -r kill -9 2>/dev/null || true; rm -rf "$TMP"' EXIT
+export PATH="$BIN:$PATH"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+pass() { echo "PASS: $*"; }
+# json FILE JQ-FILTER
+json() { jq -r "$2" "$1"; }
+# Runs feeddrive-sim on a scenario into DIR (the in-process reference result).
+sim_run() { timeout 300 feeddrive-sim "$1" --out "$2" --no-plots --quiet; }
+# Same bytes or fail, naming the first differing line.
+same_csv() {
+  if ! cmp -s "$1" "$2"; then
+    diff <(head -c 2000000 "$1") <(head -c 2000000 "$2") | head -5 >&2 || true
+    fail "$1 and $2 differ"
+  fi
+}

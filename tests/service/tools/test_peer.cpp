@@ -1,0 +1,84 @@
+// fd-test-peer: misbehaving peers for the service tests, built on the same transport.
+//   nan-controller  answers like a controller but sends NaN at steps k % 7 == 3 and 1e9 V at
+//                   k % 7 == 5 (a plant must reject/clip and count them), 0.5 V otherwise
+//   stall-controller answers with 0.5 V for the first --steps states, then goes silent
+//   junk            publishes, every 1 ms for --seconds, a reference_block_t on <prefix>_CMD, a
+//                   control_command_t on <prefix>_STATE and 7 random bytes on <prefix>_REF
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <thread>
+
+#include "feeddrive/control_command_t.hpp"
+#include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/service/bus.hpp"
+
+using namespace feeddrive;
+using namespace feeddrive::service;
+
+int main(int argc, char** argv) {
+  CLI::App app{"fd-test-peer: misbehaving LCM peers for tests", "fd-test-peer"};
+  std::string mode, url = default_lcm_url(), prefix = "FD";
+  long steps = 100;
+  double seconds = 1.0;
+  app.add_option("mode", mode)->required()->check(CLI::IsMember({"nan-controller", "stall-controller", "junk"}));
+  app.add_option("--lcm-url", url);
+  app.add_option("--prefix", prefix);
+  app.add_option("--steps", steps);
+  app.add_option("--seconds", seconds);
+  CLI11_PARSE(app, argc, argv);
+
+  Bus bus(url);
+  const Channels ch(prefix);
+  if (mode == "junk") {
+    lcm::LCM raw(url);
+    std::mt19937 rng(7);
+    const auto end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    long n = 0;
+    while (mono_us() < end) {
+      reference_block_t r{};
+      r.count = 1;
+      r.refs.resize(1);
+      bus.publish(ch.command, r);
+      control_command_t c{};
+      bus.publish(ch.state, c);
+      unsigned char bytes[7];
+      for (auto& b : bytes) b = static_cast<unsigned char>(rng());
+      raw.publish(ch.reference, bytes, sizeof bytes);
+      ++n;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    std::printf("junk: %ld rounds\n", n);
+    return 0;
+  }
+  std::map<std::int64_t, control_command_t> answered;
+  bool end = false;
+  std::int64_t last_us = mono_us();
+  bus.subscribe<drive_state_t>(ch.state, [&](const drive_state_t& m, std::int64_t now) {
+    if (m.end_of_run) {
+      end = true;
+      return;
+    }
+    last_us = now;
+    if (mode == "stall-controller" && m.seq >= steps) return;
+    auto it = answered.find(m.seq);
+    if (it == answered.end()) {
+      control_command_t c{};
+      c.seq = m.seq;
+      c.t = m.t;
+      c.u = 0.5;
+      if (mode == "nan-controller" && m.seq % 7 == 3) c.u = std::nan("");
+      if (mode == "nan-controller" && m.seq % 7 == 5) c.u = 1e9;
+      c.u_unsaturated = c.u;
+      c.sliding = c.z_estimate = std::nan("");
+      it = answered.emplace(m.seq, c).first;
+    }
+    bus.publish(ch.command, it->second);
+  });
+  while (!end && mono_us() - last_us < 10'000'000) bus.poll(std::chrono::milliseconds(10));
+  std::printf("%s: %zu steps answered\n", mode.c_str(), answered.size());
+  return 0;
+}

@@ -1,0 +1,148 @@
+// Strict scenario loading: every bad input is one line naming the key and the value.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "feeddrive/sim/scenario.hpp"
+
+namespace feeddrive::sim {
+namespace {
+
+const char* kMinimal = R"(
+duration: 0.01
+control_period: 1e-4
+plant: {}
+controller: {type: sliding_mode}
+reference: {type: sine, amplitude: 0.1, frequency: 1.0}
+)";
+
+std::string error_of(const std::string& yaml) {
+  try {
+    parse_scenario(yaml, ".", "s.yaml");
+  } catch (const ScenarioError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "error must be one line: " << msg;
+    return msg;
+  }
+  ADD_FAILURE() << "expected a ScenarioError for:\n" << yaml;
+  return "";
+}
+
+std::string with(const std::string& from, const std::string& to) {
+  std::string s = kMinimal;
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
+TEST(Scenario, MinimalUsesDefaultsAndModelEqualsPlant) {
+  const Scenario s = parse_scenario(kMinimal);
+  EXPECT_EQ(s.steps(), 100);
+  EXPECT_DOUBLE_EQ(s.plant.mass, 102.04);
+  EXPECT_DOUBLE_EQ(s.plant.friction.bristle_stiffness, 2e6);
+  EXPECT_EQ(s.controller.type, ControllerType::kSlidingMode);
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.mass, s.plant.mass);
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.period, 1e-4);
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.eta, 5.0);
+}
+
+TEST(Scenario, ControllerModelOverridesOnlyGivenKeys) {
+  const Scenario s = parse_scenario(with("{type: sliding_mode}", "{type: sliding_mode, model: {mass: 110, friction: {coulomb_force: 70}}}"));
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.mass, 110.0);
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.friction.coulomb_force, 70.0);
+  EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.friction.static_force, 120.0);
+  EXPECT_DOUBLE_EQ(s.plant.mass, 102.04);
+}
+
+TEST(Scenario, UnknownKeySuggestsTheNearestKnownKey) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {frction: {model: none}}")),
+            "s.yaml: plant.frction: unknown key (did you mean 'friction'?)");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {friction: {coulomb: 3}}")),
+            "s.yaml: plant.friction.coulomb: unknown key");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "durration: 3\n"),
+            "s.yaml: durration: unknown key (did you mean 'duration'?)");
+}
+
+TEST(Scenario, MissingValuesAndSections) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: }")), "s.yaml: plant.mass: missing value");
+  EXPECT_EQ(error_of(with("duration: 0.01\n", "")), "s.yaml: duration: missing (required)");
+  EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {eta: 3}")),
+            "s.yaml: controller.type: missing (required)");
+}
+
+TEST(Scenario, NonPositiveMassAndPeriod) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: 0}")), "s.yaml: plant.mass = 0: must be > 0");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: -3.5}")), "s.yaml: plant.mass = -3.5: must be > 0");
+  EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: 0")),
+            "s.yaml: control_period = 0: must be > 0");
+  EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: -1e-4")),
+            "s.yaml: control_period = -1e-4: must be > 0");
+}
+
+TEST(Scenario, NanInfAndGarbage) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: .nan}")),
+            "s.yaml: plant.mass = '.nan': NaN is not allowed");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: nan}")),
+            "s.yaml: plant.mass = 'nan': NaN is not allowed");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: .inf}")), "s.yaml: plant.mass = .inf: must be finite");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: heavy}")),
+            "s.yaml: plant.mass = 'heavy': not a number");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {ripple: {enabled: maybe}}")),
+            "s.yaml: plant.ripple.enabled = 'maybe': expected true or false");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: [1, 2]}")),
+            "s.yaml: plant.mass = (a list): expected a single value");
+}
+
+TEST(Scenario, BadEnumsNameTheChoices) {
+  EXPECT_NE(error_of(with("controller: {type: sliding_mode}", "controller: {type: pid}"))
+                .find("controller.type = 'pid': expected one of sliding_mode, cascade, open_loop"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("plant: {}", "plant: {friction: {model: dahl}}")).find("plant.friction.model = 'dahl'"),
+            std::string::npos);
+  EXPECT_NE(error_of(with("{type: sine, amplitude: 0.1, frequency: 1.0}", "{type: spline}"))
+                .find("reference.type = 'spline'"),
+            std::string::npos);
+}
+
+TEST(Scenario, ComponentValidationIsReported) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {friction: {static_force: 50}}")),
+            "s.yaml: plant.friction.static_force = 50: must be >= coulomb_force");
+  const std::string e = error_of(with("{type: sliding_mode}", "{type: sliding_mode, lambda: -1}"));
+  EXPECT_NE(e.find("controller.lambda"), std::string::npos) << e;
+  EXPECT_NE(e.find("-1"), std::string::npos) << e;
+}
+
+TEST(Scenario, SyntaxErrorNamesTheLine) {
+  const std::string e = error_of("duration: 1\ncontrol_period: [1e-4\nplant: {}\n");
+  EXPECT_NE(e.find("s.yaml: line"), std::string::npos) << e;
+  EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
+}
+
+TEST(Scenario, UnreadableFile) {
+  try {
+    load_scenario("/nonexistent/feeddrive.yaml");
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/feeddrive.yaml: cannot read the scenario file");
+  }
+}
+
+TEST(Scenario, EveryShippedScenarioLoads) {
+  for (const char* dir : {"/scenarios/paper", "/scenarios"}) {
+    const std::string path = std::string(FEEDDRIVE_SOURCE_DIR) + dir;
+    int n = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(path)) {
+      if (entry.path().extension() != ".yaml") continue;
+      EXPECT_NO_THROW(load_scenario(entry.path().string())) << entry.path();
+      ++n;
+    }
+    if (std::string(dir) == "/scenarios/paper") {
+      EXPECT_GE(n, 20);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace feeddrive::sim
