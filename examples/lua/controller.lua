@@ -9,7 +9,7 @@ and follows the same message protocol as build/bin/feeddrive-controller
 
 Channels (<P> = --prefix, default FD):
   <P>_STATE   drive_state_t      from the plant, one per step k (repeated until command k comes)
-  <P>_REF     reference_t        from the trajectory, normally one step ahead of the state
+  <P>_REF     reference_block_t  from the trajectory: 16 reference_t, half a block or more ahead
   <P>_CMD     control_command_t  published here, one per step
   <P>_STATUS  process_status_t   heartbeats of every process (this one: role "controller")
   <P>_RESEND  resend_request_t   "please re-publish message seq of channel C"
@@ -188,7 +188,7 @@ local KEEP = 65536              -- commands remembered for repeats and resend re
 local lc = lcm.lcm.new(opt['lcm-url'])   -- raises "error lcm create" on a bad URL
 
 local commands = {}             -- seq -> encoded control_command_t
-local refs = {}                 -- seq -> reference_t (not yet used)
+local refs = {}                 -- seq -> reference_t (from the blocks, not yet used)
 local peers = {}                -- role -> latest process_status_t
 local pending = nil             -- newest unanswered drive_state_t
 local pending_age_ms = 0        -- ms the pending state has waited (idle waits + plant repeats)
@@ -374,12 +374,15 @@ subscribe(ch.state, feeddrive.drive_state_t, function(m)
   try_answer()
 end)
 
-subscribe(ch.reference, feeddrive.reference_t, function(m)
-  if m.seq < next_seq or refs[m.seq] then
-    counters.duplicates = counters.duplicates + 1
-    return
+subscribe(ch.reference, feeddrive.reference_block_t, function(b)
+  for i = 1, b.count do
+    local m = b.refs[i]
+    if m.seq < next_seq or refs[m.seq] then
+      counters.duplicates = counters.duplicates + 1
+    else
+      refs[m.seq] = m
+    end
   end
-  refs[m.seq] = m
   try_answer()
 end)
 

@@ -1,10 +1,9 @@
 #include "feeddrive/monitor/log_reader.hpp"
 
-#include <lcm/lcm-cpp.hpp>
-
-#include <cstdio>
-#include <filesystem>
+#include <cstdint>
+#include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
@@ -12,10 +11,76 @@
 namespace feeddrive::monitor {
 namespace {
 
+// One event of an LCM log file (the format of lcm/eventlog.c, LCM 1.3): a big-endian header
+//   uint32 sync = 0xEDA1DA01, int64 event number, int64 timestamp [us], int32 channel length,
+//   int32 data length,
+// then the channel name and the payload. We parse it ourselves rather than with lcm::LogFile
+// because liblcm prints its own diagnostics to stderr on a corrupt event, and a bad log must get
+// exactly one line that names the event and the byte offset.
+struct Event {
+  std::int64_t timestamp{0};
+  std::string channel;
+  std::vector<std::uint8_t> data;
+};
+
+constexpr std::uint32_t kSync = 0xEDA1DA01u;
+constexpr std::int32_t kMaxChannel = 4096;        // far above LCM's 63-character channel limit
+constexpr std::int32_t kMaxData = 64 * 1024 * 1024;  // our messages are < 1 KB
+
+std::uint64_t big_endian(const std::uint8_t* p, int n) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
+  return v;
+}
+
+class LogParser {
+ public:
+  explicit LogParser(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+    if (!in_) throw std::invalid_argument(path + ": cannot open the LCM log");
+    in_.seekg(0, std::ios::end);
+    size_ = static_cast<std::int64_t>(in_.tellg());
+    in_.seekg(0);
+  }
+
+  // Reads the next event into `ev`; false at the clean end of the file. Throws on corruption.
+  bool next(Event& ev, long events_so_far) {
+    if (offset_ == size_) return false;
+    std::uint8_t h[28];
+    if (size_ - offset_ < static_cast<std::int64_t>(sizeof h)) corrupt(events_so_far, "truncated event header");
+    in_.read(reinterpret_cast<char*>(h), sizeof h);
+    if (static_cast<std::uint32_t>(big_endian(h, 4)) != kSync) corrupt(events_so_far, "bad sync word");
+    ev.timestamp = static_cast<std::int64_t>(big_endian(h + 12, 8));
+    const auto channel_len = static_cast<std::int32_t>(big_endian(h + 20, 4));
+    const auto data_len = static_cast<std::int32_t>(big_endian(h + 24, 4));
+    if (channel_len <= 0 || channel_len > kMaxChannel) corrupt(events_so_far, "bad channel length");
+    if (data_len < 0 || data_len > kMaxData) corrupt(events_so_far, "bad data length");
+    if (size_ - offset_ - static_cast<std::int64_t>(sizeof h) < std::int64_t{channel_len} + data_len)
+      corrupt(events_so_far, "truncated event");
+    ev.channel.resize(static_cast<std::size_t>(channel_len));
+    in_.read(ev.channel.data(), channel_len);
+    ev.data.resize(static_cast<std::size_t>(data_len));
+    in_.read(reinterpret_cast<char*>(ev.data.data()), data_len);
+    if (!in_) corrupt(events_so_far, "read error");
+    offset_ += static_cast<std::int64_t>(sizeof h) + channel_len + data_len;
+    return true;
+  }
+
+ private:
+  [[noreturn]] void corrupt(long events, const char* what) const {
+    throw std::invalid_argument(path_ + ": corrupt LCM log after event " + std::to_string(events) + " (" + what +
+                                " at byte " + std::to_string(offset_) + " of " + std::to_string(size_) + ")");
+  }
+
+  std::string path_;
+  std::ifstream in_;
+  std::int64_t size_{0};
+  std::int64_t offset_{0};
+};
+
 template <typename Msg, typename F>
-void decode_into(const lcm::LogEvent& ev, LogConversion& out, F&& f) {
+void decode_into(const Event& ev, LogConversion& out, F&& f) {
   Msg m;
-  if (m.decode(ev.data, 0, static_cast<int>(ev.datalen)) < 0) {
+  if (m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) < 0) {
     ++out.undecodable;
     return;
   }
@@ -25,31 +90,20 @@ void decode_into(const lcm::LogEvent& ev, LogConversion& out, F&& f) {
 }  // namespace
 
 LogConversion read_log(const std::string& path, const std::string& prefix) {
-  lcm::LogFile log(path, "r");
-  if (!log.good()) throw std::invalid_argument(path + ": cannot open the LCM log");
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
+  LogParser log(path);
   const service::Channels ch(prefix);
   LogConversion out;
-  for (;;) {
-    const lcm::LogEvent* ev = log.readNextEvent();
-    if (ev == nullptr) {
-      // NULL at the end of the file is the normal end; NULL before it is a corrupt event.
-      const long pos = std::ftell(log.getFilePtr());
-      if (!ec && pos >= 0 && static_cast<std::uintmax_t>(pos) < size)
-        throw std::invalid_argument(path + ": corrupt LCM log after event " + std::to_string(out.events) +
-                                    " (byte " + std::to_string(pos) + " of " + std::to_string(size) + ")");
-      break;
-    }
+  Event ev;
+  while (log.next(ev, out.events)) {
     ++out.events;
-    if (ev->channel == ch.state) {
-      decode_into<drive_state_t>(*ev, out, [&](const drive_state_t& m, std::int64_t t) { out.recorder.on_state(m, t); });
-    } else if (ev->channel == ch.reference) {
-      decode_into<reference_block_t>(*ev, out, [&](const reference_block_t& b, std::int64_t t) {
+    if (ev.channel == ch.state) {
+      decode_into<drive_state_t>(ev, out, [&](const drive_state_t& m, std::int64_t t) { out.recorder.on_state(m, t); });
+    } else if (ev.channel == ch.reference) {
+      decode_into<reference_block_t>(ev, out, [&](const reference_block_t& b, std::int64_t t) {
         for (const reference_t& m : b.refs) out.recorder.on_reference(m, t);
       });
-    } else if (ev->channel == ch.command) {
-      decode_into<control_command_t>(*ev, out, [&](const control_command_t& m, std::int64_t t) { out.recorder.on_command(m, t); });
+    } else if (ev.channel == ch.command) {
+      decode_into<control_command_t>(ev, out, [&](const control_command_t& m, std::int64_t t) { out.recorder.on_command(m, t); });
     } else {
       ++out.foreign_events;
     }

@@ -59,21 +59,28 @@ double rk4_reaching_max(double s0, double eta, double k, double lambda) {
 // The same loop in exact discrete time: a pure mass under a zero-order hold is integrated exactly
 // by x+ = x + v T + a T^2/2, v+ = v + a T with a = Ka*Kf*u/m = the law's commanded acceleration
 // (exact model, no forces). Written out here from eq. 19, independently of the controller class.
-double discrete_reaching_max(double amplitude, double omega, double eta, double k, double lambda,
-                             double period, double t_end) {
+double discrete_reaching_max_window(double amplitude, double omega, double eta, double k, double lambda,
+                                    double period, double t0, double t1) {
   double x = 0.0, v = 0.0, e_max = 0.0;
-  const long n = std::lround(t_end / period);
+  const long n = std::lround(t1 / period) + 1;
   for (long i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * period;
     const double xd = amplitude * std::sin(omega * t), vd = amplitude * omega * std::cos(omega * t);
     const double ad = -amplitude * omega * omega * std::sin(omega * t);
     const double e = xd - x, ed = vd - v, s = ed + lambda * e;
-    e_max = std::max(e_max, std::abs(e));
+    if (t >= t0 && t <= t1) e_max = std::max(e_max, std::abs(e));
     const double a = ad + lambda * ed + eta * ((s > 0) - (s < 0)) + k * s;
     x += v * period + 0.5 * a * period * period;
     v += a * period;
   }
   return e_max;
+}
+
+// max |e| over [0, t_end) of the exact discrete loop.
+double discrete_reaching_max(double amplitude, double omega, double eta, double k, double lambda,
+                             double period, double t_end) {
+  return discrete_reaching_max_window(amplitude, omega, eta, k, lambda, period, 0.0,
+                                      t_end - 0.5 * period);
 }
 
 // Fig. 18 on an exact pure-mass plant: 100 mm, 1 Hz sinusoid from rest, period 1e-4 s, the paper's
@@ -122,9 +129,19 @@ TEST(SlidingModeClosedLoop, SinusoidFromRestMatchesTheReachingPhaseSolution) {
   // sliding = S: at t = 0, S = vd(0) = A w exactly (plant at rest at x = 0 = xd(0)).
   EXPECT_NEAR(run.front().sliding, A * w, 1e-15);
   // After the reaching phase (S = 0 at t_r = 0.08 s) e decays like e^{-lambda t}: by 1.5 s the
-  // 6.8 mm have become 1e-30 m; what remains is the discrete sgn chatter, of order
-  // eta*T^2 = 5e-8 m. The claim: < 1 um (Fig. 18 "then -> 0").
-  EXPECT_LT(test::max_abs_error(run, 1.5, 2.0), 1e-6);
+  // 6.8 mm have become 1e-30 m; what remains is the discrete sgn chatter. In discrete time the
+  // hard sgn holds S only inside the quasi-sliding band |S| <= (eta + k|S|)*T ~ eta*T = 5e-4 m/s
+  // (one period of full switching action), and e = S filtered by 1/(s + lambda), so
+  // |e| <= eta*T/lambda = 1e-5 m. The exact discrete loop gives 2.08 um (max |S| 3.6e-4 m/s).
+  const double settled = test::max_abs_error(run, 1.5, 2.0);
+  const double settled_discrete = discrete_reaching_max_window(A, w, eta, k, lambda, T, 1.5, 2.0);
+  EXPECT_LT(settled, eta * T / lambda);
+  // CVODE vs the exact discrete loop in the chattering phase: a rounding-level difference can
+  // flip one sgn inside the band and shift the chatter pattern, so not 1e-9 as in the reaching
+  // phase; 10 % still fails a wrong law (a missing k*S or lambda*e' term changes the band).
+  EXPECT_NEAR(settled, settled_discrete, 0.1 * settled_discrete);
+  // Fig. 18 "then -> 0": over 3 orders of magnitude below the 6.84 mm start error.
+  EXPECT_LT(settled, 1e-3 * peak);
 }
 
 // The x,v,d observer's disturbance estimate compensates a force the model does not know. A pure
