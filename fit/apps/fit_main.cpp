@@ -1,0 +1,82 @@
+// feeddrive-fit: finds where a model and measured data disagree, names the missing effect, adds
+// it, and shows the gap shrink (docs/fit.md). Wiring only: load -> run_fit -> write_outputs.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "feeddrive/fit/data.hpp"
+#include "feeddrive/fit/report.hpp"
+#include "feeddrive/fit/workflow.hpp"
+#include "feeddrive/sim/scenario.hpp"
+
+int main(int argc, char** argv) {
+  using namespace feeddrive;
+  CLI::App app{"feeddrive-fit: model-discrepancy workflow (docs/fit.md)", "feeddrive-fit"};
+  std::string scenario_path, data_path, out_dir, prefix = "FD";
+  fit::FitOptions opt;
+  fit::CsvOptions csv;
+  bool no_plots = false, quiet = false;
+  app.add_option("--scenario,-s", scenario_path, "the model: a feeddrive scenario YAML")->required();
+  app.add_option("--data,-d", data_path, "measured data: CSV (t, x, u or force_N[, xd, v]) or an lcm-logger log (.lcm, .lcmlog, .log)")
+      ->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically)")->required();
+  app.add_option("--max-effects", opt.max_effects, "most effects to add")->capture_default_str()->check(CLI::Range(0, 11));
+  app.add_option("--score-threshold", opt.score_threshold, "least BIC score of a significant effect")->capture_default_str();
+  app.add_option("--min-gap-reduction", opt.min_gap_reduction, "least fraction by which an effect must shrink the replay gap")
+      ->capture_default_str();
+  app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")->capture_default_str();
+  app.add_option("--filter-half-width", opt.record.filter_half_width, "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
+      ->capture_default_str();
+  app.add_option("--prefix", prefix, "channel prefix of an LCM log")->capture_default_str();
+  app.add_option("--position-column", csv.position_column, "CSV column with the measured position")->capture_default_str();
+  app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  app.add_flag("--quiet,-q", quiet, "print only the result table and errors");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
+  if (quiet) spdlog::set_level(spdlog::level::warn);
+  try {
+    sim::Scenario scenario;
+    fit::MeasuredData data;
+    try {
+      scenario = sim::load_scenario(scenario_path);
+      data = fit::load_data(data_path, prefix, csv);
+    } catch (const sim::ScenarioError& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    } catch (const fit::DataError& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+    fit::Record rec;
+    try {
+      rec = fit::prepare(data, opt.record);
+    } catch (const fit::DataError& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+    spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),
+                 scenario_path);
+    const fit::FitResult r = fit::run_fit(rec, scenario.plant, opt, [](const std::string& s) { spdlog::info("{}", s); });
+    fit::write_outputs(out_dir, scenario_path, rec, r, !no_plots);
+    std::printf("%-4s %-24s %14s %18s\n", "step", "model", "gap [um]", "force RMS [N]");
+    std::printf("%-4d %-24s %14.4g %18.4g\n", 0, "as given", r.replay_initial.gap * 1e6, r.force_rms_initial);
+    int k = 0;
+    for (const auto& st : r.steps)
+      if (st.accepted)
+        std::printf("%-4d %-24s %14.4g %18.4g\n", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
+                    st.force_rms_after);
+    std::printf("%s\nresults: %s/{findings.json,model.fitted.yaml,report.md}\n", r.conclusion.c_str(), out_dir.c_str());
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,615 @@
+#include "feeddrive/fit/identify.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include "feeddrive/plant/effects.hpp"
+
+namespace feeddrive::fit {
+namespace {
+
+thread_local long evaluations = 0;  // force-residual evaluations by the Ceres functors
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Ctx {
+  const Record& rec;
+  const plant::PlantParams& model;
+  const Eigen::VectorXd* r0;  // residual of the model without the candidate (may be null)
+  double x_mean;
+};
+
+double x_mean_of(const Record& rec) {
+  const auto& x = rec.data->x;
+  return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+}
+
+using Theta = std::vector<double>;
+
+// One candidate: its optimisation vector theta <-> vocabulary parameters, its starts, bounds.
+struct Spec {
+  std::string name;
+  int dim;
+  std::vector<int> fixed;  // theta entries held constant by Ceres (scanned by the starts)
+  std::function<Effect(const Theta&, const Ctx&)> to_effect;
+  std::function<Theta(const Effect&, const Ctx&)> from_effect;
+  std::function<std::vector<Theta>(const Ctx&)> starts;
+  std::vector<std::pair<int, double>> lower, upper;
+};
+
+// Best pitches of a ripple-like regressor  r0 ~ A sin(kappa x) + B cos(kappa x)  (times the
+// thrust for reluctance), by a periodogram over the wavenumber kappa. Returns {pitch, A, B}
+// (the effect's own coefficients: r0 = -filtered F_extra) of the three strongest local maxima.
+std::vector<std::array<double, 3>> pitch_periodogram(const Ctx& c, bool times_thrust) {
+  const Record& rec = c.rec;
+  const Motion& m = rec.motion;
+  const long ni = static_cast<long>(m.x_mid.size());
+  const double range = std::max(rec.x_max - rec.x_min, 1e-4);
+  const double p_max = range;
+  const double p_min = std::min(0.5 * p_max, std::max(1e-3, 4.0 * rec.v_max_abs * rec.bank.half_width));
+  const double k_lo = 2 * kPi / p_max, k_hi = 2 * kPi / p_min, dk = 2 * kPi / (8.0 * range);
+  const double gain = thrust_per_input(rec, c.model);
+  const Eigen::VectorXd& r0 = *c.r0;
+  std::vector<double> kappa, gain_rss;
+  std::vector<std::array<double, 2>> coef;
+  Eigen::VectorXd s(ni), co(ni);
+  for (double k = k_lo; k <= k_hi && kappa.size() < 4000; k += dk) {
+    for (long j = 0; j < ni; ++j) {
+      const double f = times_thrust ? gain * rec.input[j] : 1.0;
+      s[j] = f * std::sin(k * m.x_mid[j]);
+      co[j] = f * std::cos(k * m.x_mid[j]);
+    }
+    const Eigen::VectorXd fs = apply(rec.bank, s), fc = apply(rec.bank, co);
+    Eigen::Matrix2d A;
+    A << fs.dot(fs), fs.dot(fc), fs.dot(fc), fc.dot(fc);
+    const Eigen::Vector2d b(fs.dot(r0), fc.dot(r0));
+    const Eigen::Vector2d x = A.ldlt().solve(b);
+    kappa.push_back(k);
+    gain_rss.push_back(std::isfinite(x.dot(b)) ? x.dot(b) : 0.0);
+    coef.push_back({-x[0], -x[1]});
+  }
+  std::vector<std::size_t> peaks;
+  for (std::size_t i = 0; i < kappa.size(); ++i) {
+    const bool left = i == 0 || gain_rss[i] >= gain_rss[i - 1];
+    const bool right = i + 1 == kappa.size() || gain_rss[i] >= gain_rss[i + 1];
+    if (left && right) peaks.push_back(i);
+  }
+  std::sort(peaks.begin(), peaks.end(), [&](std::size_t a, std::size_t b) { return gain_rss[a] > gain_rss[b]; });
+  std::vector<std::array<double, 3>> out;
+  for (std::size_t q = 0; q < peaks.size() && q < 3; ++q)
+    out.push_back({2 * kPi / kappa[peaks[q]], coef[peaks[q]][0], coef[peaks[q]][1]});
+  return out;
+}
+
+std::vector<double> quantiles(std::vector<double> v, const std::vector<double>& qs) {
+  std::sort(v.begin(), v.end());
+  std::vector<double> out;
+  for (double q : qs) out.push_back(v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]);
+  return out;
+}
+
+const std::vector<Spec>& specs() {
+  static const std::vector<Spec> all = [] {
+    std::vector<Spec> s;
+    const auto one = [](const char* name, const char* param, double start) {
+      Spec sp;
+      sp.name = name;
+      sp.dim = 1;
+      const std::string p = param;
+      sp.to_effect = [name = std::string(name), p](const Theta& t, const Ctx&) { return Effect{name, {{p, t[0]}}}; };
+      sp.from_effect = [p](const Effect& e, const Ctx&) { return Theta{e.parameters.at(p)}; };
+      sp.starts = [start](const Ctx&) { return std::vector<Theta>{{start}}; };
+      return sp;
+    };
+    s.push_back(one("constant_force", "force_N", 0.0));
+    s.push_back(one("coulomb_friction", "coulomb_N", 0.0));
+    s.push_back(one("viscous_friction", "viscous_Ns_per_m", 0.0));
+    {
+      Spec sp;
+      sp.name = "stribeck_friction";
+      sp.dim = 3;  // Fs, Fc, ln vs
+      sp.to_effect = [](const Theta& t, const Ctx&) {
+        return Effect{"stribeck_friction",
+                      {{"static_N", t[0]}, {"coulomb_N", t[1]}, {"stribeck_velocity_mps", std::exp(t[2])}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx&) {
+        return Theta{e.parameters.at("static_N"), e.parameters.at("coulomb_N"),
+                     std::log(e.parameters.at("stribeck_velocity_mps"))};
+      };
+      sp.starts = [](const Ctx& c) {
+        std::vector<Theta> out;
+        const double vmax = std::max(c.rec.v_max_abs, 1e-6);
+        for (double f : {0.003, 0.03, 0.3}) out.push_back({0.0, 0.0, std::log(f * vmax)});
+        return out;
+      };
+      s.push_back(sp);
+    }
+    {
+      Spec sp;
+      sp.name = "presliding";
+      sp.dim = 2;  // ln sigma0, sigma1
+      sp.to_effect = [](const Theta& t, const Ctx&) {
+        return Effect{"presliding", {{"bristle_stiffness_N_per_m", std::exp(t[0])}, {"bristle_damping_Ns_per_m", t[1]}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx&) {
+        return Theta{std::log(e.parameters.at("bristle_stiffness_N_per_m")), e.parameters.at("bristle_damping_Ns_per_m")};
+      };
+      sp.starts = [](const Ctx& c) {
+        const double s1 = c.model.friction.model == plant::FrictionModel::kLuGre ? c.model.friction.bristle_damping : 0.0;
+        std::vector<Theta> out;
+        for (double s0 : {1e5, 1e6, 1e7, 1e8}) out.push_back({std::log(s0), s1});
+        return out;
+      };
+      sp.lower = {{1, 0.0}};
+      s.push_back(sp);
+    }
+    {
+      Spec sp;
+      sp.name = "cogging_ripple";
+      sp.dim = 5;  // ln p, a cos(phi), a sin(phi), b cos(phi3), b sin(phi3)
+      sp.to_effect = [](const Theta& t, const Ctx&) {
+        return Effect{"cogging_ripple",
+                      {{"pitch_m", std::exp(t[0])},
+                       {"amplitude_N", std::hypot(t[1], t[2])},
+                       {"phase_rad", std::atan2(t[2], t[1])},
+                       {"third_harmonic_N", std::hypot(t[3], t[4])},
+                       {"third_phase_rad", std::atan2(t[4], t[3])}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx&) {
+        const auto& p = e.parameters;
+        return Theta{std::log(p.at("pitch_m")), p.at("amplitude_N") * std::cos(p.at("phase_rad")),
+                     p.at("amplitude_N") * std::sin(p.at("phase_rad")),
+                     p.at("third_harmonic_N") * std::cos(p.at("third_phase_rad")),
+                     p.at("third_harmonic_N") * std::sin(p.at("third_phase_rad"))};
+      };
+      sp.starts = [](const Ctx& c) {
+        std::vector<Theta> out;
+        for (const auto& pk : pitch_periodogram(c, false)) out.push_back({std::log(pk[0]), pk[1], pk[2], 0.0, 0.0});
+        return out;
+      };
+      s.push_back(sp);
+    }
+    {
+      Spec sp;
+      sp.name = "reluctance_ripple";
+      sp.dim = 3;  // ln p, A cos(phi), A sin(phi)
+      sp.to_effect = [](const Theta& t, const Ctx&) {
+        return Effect{"reluctance_ripple",
+                      {{"pitch_m", std::exp(t[0])},
+                       {"relative_amplitude", std::hypot(t[1], t[2])},
+                       {"phase_rad", std::atan2(t[2], t[1])}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx&) {
+        const auto& p = e.parameters;
+        return Theta{std::log(p.at("pitch_m")), p.at("relative_amplitude") * std::cos(p.at("phase_rad")),
+                     p.at("relative_amplitude") * std::sin(p.at("phase_rad"))};
+      };
+      sp.starts = [](const Ctx& c) {
+        std::vector<Theta> out;
+        for (const auto& pk : pitch_periodogram(c, true)) out.push_back({std::log(pk[0]), pk[1], pk[2]});
+        return out;
+      };
+      s.push_back(sp);
+    }
+    {
+      Spec sp;
+      sp.name = "grinding_force";
+      sp.dim = 3;  // ln C, ln ke, contact position (scanned, held by Ceres)
+      sp.fixed = {2};
+      sp.to_effect = [](const Theta& t, const Ctx&) {
+        return Effect{"grinding_force", {{"gain_Ns_per_m", std::exp(t[0])},
+                                         {"stiffness_N_per_m", std::exp(t[1])},
+                                         {"contact_position_m", t[2]}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx&) {
+        const auto& p = e.parameters;
+        return Theta{std::log(p.at("gain_Ns_per_m")), std::log(p.at("stiffness_N_per_m")), p.at("contact_position_m")};
+      };
+      sp.starts = [](const Ctx& c) {
+        std::vector<double> qs;
+        for (int i = 0; i <= 9; ++i) qs.push_back(0.1 * i);
+        std::vector<double> contacts = quantiles(c.rec.data->x, qs);
+        contacts.front() = c.rec.x_min - 1e-3;  // always in contact
+        std::vector<Theta> out;
+        for (double xc : contacts) out.push_back({std::log(1e4), std::log(1e6), xc});
+        return out;
+      };
+      s.push_back(sp);
+    }
+    {
+      Spec sp;
+      sp.name = "spring_force";
+      sp.dim = 2;  // k, F0 = k*(x_mean - rest)
+      sp.to_effect = [](const Theta& t, const Ctx& c) {
+        const double rest = std::abs(t[0]) > 1e-12 ? c.x_mean - t[1] / t[0] : c.x_mean;
+        return Effect{"spring_force", {{"stiffness_N_per_m", t[0]}, {"rest_position_m", rest}}};
+      };
+      sp.from_effect = [](const Effect& e, const Ctx& c) {
+        const double k = e.parameters.at("stiffness_N_per_m");
+        return Theta{k, k * (c.x_mean - e.parameters.at("rest_position_m"))};
+      };
+      sp.starts = [](const Ctx&) { return std::vector<Theta>{{0.0, 0.0}}; };
+      s.push_back(sp);
+    }
+    {
+      Spec sp = one("mass_error", "mass_kg", 0.0);
+      sp.starts = [](const Ctx& c) { return std::vector<Theta>{{plant::effective_params(c.model).mass}}; };
+      sp.lower = {{0, 1e-6}};
+      s.push_back(sp);
+    }
+    {
+      Spec sp = one("input_delay", "delay_s", 0.0);
+      sp.starts = [](const Ctx& c) {
+        const double T = c.rec.period;
+        return std::vector<Theta>{{0.5 * T}, {2.0 * T}, {8.0 * T}};
+      };
+      s.push_back(sp);
+    }
+    return s;
+  }();
+  return all;
+}
+
+const Spec& spec(const std::string& name) {
+  for (const Spec& s : specs())
+    if (s.name == name) return s;
+  throw std::invalid_argument("unknown effect '" + name + "'");
+}
+
+// Sets the upper bound of input_delay to the filter half-width (a longer delay is outside what
+// one filter window can see) and returns the bounds of a spec.
+std::vector<std::pair<int, double>> upper_bounds(const Spec& s, const Ctx& c) {
+  if (s.name == "input_delay") return {{0, c.rec.bank.half_width}};
+  return s.upper;
+}
+std::vector<std::pair<int, double>> lower_bounds(const Spec& s) {
+  if (s.name == "input_delay") return {{0, 0.0}};
+  return s.lower;
+}
+
+struct Block {
+  const Spec* spec;
+  int offset;
+};
+
+plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<Block>& blocks, const double* th,
+                              const Ctx& c) {
+  plant::PlantParams p = base;
+  for (const Block& b : blocks) {
+    const Theta t(th + b.offset, th + b.offset + b.spec->dim);
+    apply_effect(b.spec->to_effect(t, c), p);
+  }
+  return p;
+}
+
+struct ResidualFunctor {
+  const Record* rec;
+  const plant::PlantParams* base;
+  std::vector<Block> blocks;
+  const Ctx* ctx;
+  bool operator()(double const* const* params, double* residuals) const {
+    ++evaluations;
+    const plant::PlantParams p = with_theta(*base, blocks, params[0], *ctx);
+    const Eigen::VectorXd r = force_residual(*rec, p);
+    for (long i = 0; i < r.size(); ++i) {
+      if (!std::isfinite(r[i])) return false;
+      residuals[i] = r[i];
+    }
+    return true;
+  }
+};
+
+struct Solved {
+  Theta theta;
+  double rss{std::numeric_limits<double>::infinity()};
+  bool converged{false};
+};
+
+Solved solve(const Record& rec, const plant::PlantParams& base, const std::vector<Block>& blocks, Theta theta,
+             const Ctx& ctx, int max_iterations) {
+  const int dim = static_cast<int>(theta.size());
+  auto* functor = new ResidualFunctor{&rec, &base, blocks, &ctx};
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::CENTRAL>(functor);
+  cost->AddParameterBlock(dim);
+  cost->SetNumResiduals(static_cast<int>(rec.bank.tau.size()));
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, theta.data());
+  std::vector<int> fixed;
+  for (const Block& b : blocks) {
+    for (int f : b.spec->fixed) fixed.push_back(b.offset + f);
+    for (auto [i, v] : lower_bounds(*b.spec)) problem.SetParameterLowerBound(theta.data(), b.offset + i, v);
+    for (auto [i, v] : upper_bounds(*b.spec, ctx)) problem.SetParameterUpperBound(theta.data(), b.offset + i, v);
+  }
+  if (!fixed.empty()) {
+    if (static_cast<int>(fixed.size()) == dim) {
+      problem.SetParameterBlockConstant(theta.data());
+    } else {
+      problem.SetManifold(theta.data(), new ceres::SubsetManifold(dim, fixed));
+    }
+  }
+  ceres::Solver::Options opt;
+  opt.max_num_iterations = max_iterations;
+  opt.linear_solver_type = ceres::DENSE_QR;
+  opt.logging_type = ceres::SILENT;
+  opt.minimizer_progress_to_stdout = false;
+  opt.num_threads = 1;
+  ceres::Solver::Summary sum;
+  ceres::Solve(opt, &problem, &sum);
+  Solved out;
+  out.theta = theta;
+  out.rss = 2.0 * sum.final_cost;
+  out.converged = sum.termination_type == ceres::CONVERGENCE;
+  if (!std::isfinite(out.rss)) out.rss = std::numeric_limits<double>::infinity();
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& effect_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const Spec& s : specs()) n.push_back(s.name);
+    return n;
+  }();
+  return names;
+}
+
+void apply_effect(const Effect& e, plant::PlantParams& p) {
+  auto& x = p.effects;
+  const auto& q = e.parameters;
+  const auto get = [&](const char* k) {
+    const auto it = q.find(k);
+    if (it == q.end()) throw std::invalid_argument("effect " + e.name + ": missing parameter " + k);
+    return it->second;
+  };
+  if (e.name == "constant_force") {
+    x.constant_force = {true, get("force_N")};
+  } else if (e.name == "coulomb_friction") {
+    x.coulomb_friction = {true, get("coulomb_N")};
+  } else if (e.name == "viscous_friction") {
+    x.viscous_friction = {true, get("viscous_Ns_per_m")};
+  } else if (e.name == "stribeck_friction") {
+    x.stribeck_friction = {true, get("static_N"), get("coulomb_N"), get("stribeck_velocity_mps")};
+  } else if (e.name == "presliding") {
+    x.presliding = {true, get("bristle_stiffness_N_per_m"), get("bristle_damping_Ns_per_m")};
+  } else if (e.name == "cogging_ripple") {
+    x.cogging_ripple = {true, get("pitch_m"), get("amplitude_N"), get("phase_rad"), get("third_harmonic_N"),
+                        get("third_phase_rad")};
+  } else if (e.name == "reluctance_ripple") {
+    x.reluctance_ripple = {true, get("pitch_m"), get("relative_amplitude"), get("phase_rad")};
+  } else if (e.name == "grinding_force") {
+    x.grinding_force = {true, get("gain_Ns_per_m"), get("stiffness_N_per_m"), get("contact_position_m")};
+  } else if (e.name == "spring_force") {
+    x.spring_force = {true, get("stiffness_N_per_m"), get("rest_position_m")};
+  } else if (e.name == "mass_error") {
+    x.mass_error = {true, get("mass_kg")};
+  } else if (e.name == "input_delay") {
+    x.input_delay = {true, get("delay_s")};
+  } else {
+    throw std::invalid_argument("unknown effect '" + e.name + "'");
+  }
+}
+
+std::vector<Effect> effects_of(const plant::PlantParams& p) {
+  const auto& x = p.effects;
+  std::vector<Effect> out;
+  if (x.constant_force.enabled) out.push_back({"constant_force", {{"force_N", x.constant_force.force_N}}});
+  if (x.coulomb_friction.enabled) out.push_back({"coulomb_friction", {{"coulomb_N", x.coulomb_friction.coulomb_N}}});
+  if (x.viscous_friction.enabled)
+    out.push_back({"viscous_friction", {{"viscous_Ns_per_m", x.viscous_friction.viscous_Ns_per_m}}});
+  if (x.stribeck_friction.enabled)
+    out.push_back({"stribeck_friction",
+                   {{"static_N", x.stribeck_friction.static_N},
+                    {"coulomb_N", x.stribeck_friction.coulomb_N},
+                    {"stribeck_velocity_mps", x.stribeck_friction.stribeck_velocity_mps}}});
+  if (x.presliding.enabled)
+    out.push_back({"presliding",
+                   {{"bristle_stiffness_N_per_m", x.presliding.bristle_stiffness_N_per_m},
+                    {"bristle_damping_Ns_per_m", x.presliding.bristle_damping_Ns_per_m}}});
+  if (x.cogging_ripple.enabled)
+    out.push_back({"cogging_ripple",
+                   {{"pitch_m", x.cogging_ripple.pitch_m},
+                    {"amplitude_N", x.cogging_ripple.amplitude_N},
+                    {"phase_rad", x.cogging_ripple.phase_rad},
+                    {"third_harmonic_N", x.cogging_ripple.third_harmonic_N},
+                    {"third_phase_rad", x.cogging_ripple.third_phase_rad}}});
+  if (x.reluctance_ripple.enabled)
+    out.push_back({"reluctance_ripple",
+                   {{"pitch_m", x.reluctance_ripple.pitch_m},
+                    {"relative_amplitude", x.reluctance_ripple.relative_amplitude},
+                    {"phase_rad", x.reluctance_ripple.phase_rad}}});
+  if (x.grinding_force.enabled)
+    out.push_back({"grinding_force",
+                   {{"gain_Ns_per_m", x.grinding_force.gain_Ns_per_m},
+                    {"stiffness_N_per_m", x.grinding_force.stiffness_N_per_m},
+                    {"contact_position_m", x.grinding_force.contact_position_m}}});
+  if (x.spring_force.enabled)
+    out.push_back({"spring_force",
+                   {{"stiffness_N_per_m", x.spring_force.stiffness_N_per_m},
+                    {"rest_position_m", x.spring_force.rest_position_m}}});
+  if (x.mass_error.enabled) out.push_back({"mass_error", {{"mass_kg", x.mass_error.mass_kg}}});
+  if (x.input_delay.enabled) out.push_back({"input_delay", {{"delay_s", x.input_delay.delay_s}}});
+  // vocabulary order
+  std::sort(out.begin(), out.end(), [](const Effect& a, const Effect& b) {
+    const auto& n = effect_names();
+    return std::find(n.begin(), n.end(), a.name) < std::find(n.begin(), n.end(), b.name);
+  });
+  return out;
+}
+
+double bic(const Eigen::VectorXd& r, int k, long n_active) {
+  const double n = static_cast<double>(n_active > 0 ? n_active : r.size());
+  const double rss = std::max(r.squaredNorm(), 1e-300);
+  return n * std::log(rss / n) + k * std::log(n);
+}
+
+CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
+                           const Eigen::VectorXd& residual0) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const long ev0 = evaluations;
+  const Spec& s = spec(name);
+  const Ctx ctx{rec, model, &residual0, x_mean_of(rec)};
+  const std::vector<Block> blocks{{&s, 0}};
+  std::vector<Theta> starts = s.starts(ctx);
+  CandidateFit out;
+  out.parameters = s.dim;
+  if (starts.empty()) {
+    out.effect = {name, {}};
+    out.rss = residual0.squaredNorm();
+    out.bic = bic(residual0, 0, rec.active_points());
+    out.score = -std::numeric_limits<double>::infinity();
+    return out;
+  }
+  // Stage 1: a few iterations from every start; stage 2: the best two to convergence.
+  std::vector<Solved> first;
+  for (const Theta& t : starts) first.push_back(solve(rec, model, blocks, t, ctx, starts.size() > 4 ? 6 : 50));
+  std::sort(first.begin(), first.end(), [](const Solved& a, const Solved& b) { return a.rss < b.rss; });
+  Solved best = first.front();
+  if (starts.size() > 4 || !best.converged) {
+    best.rss = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < first.size() && i < 2; ++i) {
+      const Solved s2 = solve(rec, model, blocks, first[i].theta, ctx, 100);
+      if (s2.rss < best.rss) best = s2;
+    }
+  }
+  // A scanned parameter (held by Ceres, e.g. the contact position): golden-section search
+  // between the neighbouring start values of the best one, refitting the others at each probe.
+  if (s.fixed.size() == 1 && starts.size() > 2) {
+    const int f = s.fixed.front();
+    std::vector<double> grid;
+    for (const Theta& t : starts) grid.push_back(t[static_cast<std::size_t>(f)]);
+    std::sort(grid.begin(), grid.end());
+    const auto it = std::lower_bound(grid.begin(), grid.end(), best.theta[static_cast<std::size_t>(f)]);
+    const std::size_t i = static_cast<std::size_t>(it - grid.begin());
+    double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
+    const auto probe = [&](double v) {
+      Theta t = best.theta;
+      t[static_cast<std::size_t>(f)] = v;
+      return solve(rec, model, blocks, t, ctx, 15);
+    };
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+    Solved sa = probe(a), sb = probe(b);
+    for (int k = 0; k < 12; ++k) {
+      if (sa.rss < sb.rss) {
+        hi = b;
+        b = a;
+        sb = sa;
+        a = hi - g * (hi - lo);
+        sa = probe(a);
+      } else {
+        lo = a;
+        a = b;
+        sa = sb;
+        b = lo + g * (hi - lo);
+        sb = probe(b);
+      }
+    }
+    const Solved& cand = sa.rss < sb.rss ? sa : sb;
+    if (cand.rss < best.rss) best = solve(rec, model, blocks, cand.theta, ctx, 100);
+  }
+  out.effect = s.to_effect(best.theta, ctx);
+  plant::PlantParams p = model;
+  apply_effect(out.effect, p);
+  const Eigen::VectorXd r = force_residual(rec, p);
+  out.rss = r.squaredNorm();
+  out.bic = bic(r, s.dim, rec.active_points());
+  out.score = bic(residual0, 0, rec.active_points()) - out.bic;
+  out.converged = best.converged;
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.evaluations = evaluations - ev0;
+  if (!std::isfinite(out.score)) out.score = -std::numeric_limits<double>::infinity();
+  return out;
+}
+
+std::vector<CandidateFit> rank_candidates(const Record& rec, const plant::PlantParams& model) {
+  const Eigen::VectorXd r0 = force_residual(rec, model);
+  std::vector<std::string> enabled;
+  for (const Effect& e : effects_of(model)) enabled.push_back(e.name);
+  std::vector<CandidateFit> out;
+  for (const std::string& name : effect_names()) {
+    if (std::find(enabled.begin(), enabled.end(), name) != enabled.end()) continue;
+    out.push_back(fit_candidate(rec, model, name, r0));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const CandidateFit& a, const CandidateFit& b) { return a.score > b.score; });
+  // Parsimony: a candidate within kParsimony of the best score is not distinguishable from it
+  // (a BIC difference below 10 is not "very strong" evidence, Kass & Raftery 1995); among those
+  // the one with the fewest parameters goes first (e.g. a constant force before a spring with
+  // a negligible stiffness, viscous friction before a grinding force that acts like one).
+  if (!out.empty()) {
+    constexpr double kParsimony = 10.0;
+    const double top = out.front().score;
+    std::size_t pick = 0;
+    for (std::size_t i = 1; i < out.size() && out[i].score >= top - kParsimony; ++i)
+      if (out[i].parameters < out[pick].parameters) pick = i;
+    std::rotate(out.begin(), out.begin() + static_cast<long>(pick), out.begin() + static_cast<long>(pick) + 1);
+  }
+  return out;
+}
+
+plant::PlantParams refine_jointly(const Record& rec, const plant::PlantParams& model) {
+  const std::vector<Effect> effects = effects_of(model);
+  if (effects.empty()) return model;
+  const Eigen::VectorXd r0 = force_residual(rec, model);
+  const Ctx ctx{rec, model, &r0, x_mean_of(rec)};
+  plant::PlantParams base = model;
+  base.effects = plant::EffectsParams{};
+  std::vector<Block> blocks;
+  Theta theta;
+  for (const Effect& e : effects) {
+    const Spec& s = spec(e.name);
+    blocks.push_back({&s, static_cast<int>(theta.size())});
+    const Theta t = s.from_effect(e, ctx);
+    theta.insert(theta.end(), t.begin(), t.end());
+  }
+  const Solved sol = solve(rec, base, blocks, theta, ctx, 100);
+  if (!(sol.rss < r0.squaredNorm())) return model;
+  plant::PlantParams out = base;
+  for (const Block& b : blocks) {
+    const Theta t(sol.theta.begin() + b.offset, sol.theta.begin() + b.offset + b.spec->dim);
+    apply_effect(b.spec->to_effect(t, ctx), out);
+  }
+  return out;
+}
+
+std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, const Effect& e) {
+  const auto& b = rec.bank;
+  const auto& m = rec.motion;
+  std::vector<double> out(b.tau.size());
+  const auto at = [&](std::size_t i) { return static_cast<std::size_t>(b.nearest[i]); };
+  const std::string& n = e.name;
+  if (n == "coulomb_friction" || n == "viscous_friction" || n == "stribeck_friction" || n == "presliding") {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = m.v[at(i)] * 1e3;
+    return {"velocity [mm/s]", out};
+  }
+  if (n == "cogging_ripple" || n == "reluctance_ripple") {
+    const double p = e.parameters.at("pitch_m");
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double q = std::fmod(m.x[at(i)], p);
+      out[i] = (q < 0 ? q + p : q) * 1e3;
+    }
+    return {"position modulo the pitch [mm]", out};
+  }
+  if (n == "grinding_force" || n == "spring_force") {
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = m.x[at(i)] * 1e3;
+    return {"position [mm]", out};
+  }
+  if (n == "mass_error") return {"filtered acceleration [m/s^2]", b.accel};
+  if (n == "input_delay") {
+    const double d = rec.period;
+    const Eigen::VectorXd ahead = apply_delayed(b, rec.data->t, rec.input, -d);
+    const Eigen::VectorXd behind = apply_delayed(b, rec.data->t, rec.input, d);
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = (ahead[static_cast<long>(i)] - behind[static_cast<long>(i)]) / (2 * d);
+    return {"input rate [input unit/s]", out};
+  }
+  return {"t [s]", b.tau};
+}
+
+}  // namespace feeddrive::fit

@@ -1,0 +1,207 @@
+#include "feeddrive/fit/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "feeddrive/plant/effects.hpp"
+#include "feeddrive/plant/forces.hpp"
+
+namespace feeddrive::fit {
+
+Record prepare(const MeasuredData& d, const RecordOptions& opt) {
+  Record r;
+  r.data = &d;
+  r.cache = std::make_shared<Record::Cache>();
+  r.period = d.median_period();
+  const int M = opt.motion_half_window > 0
+                    ? opt.motion_half_window
+                    : std::max(3, static_cast<int>(std::lround(2e-3 / r.period)));
+  const double L = opt.filter_half_width > 0 ? opt.filter_half_width : std::max(0.01, 10.0 * r.period);
+  if (d.size() < static_cast<std::size_t>(2 * M + 1))
+    throw DataError(d.source + ": " + std::to_string(d.size()) + " samples: too few for the motion estimate");
+  r.motion = estimate_motion(d.t, d.x, M);
+  try {
+    r.bank = make_filter_bank(d.t, d.x, r.motion, L);
+  } catch (const std::invalid_argument& e) {
+    throw DataError(d.source + ": " + e.what() + " (too few samples for the fit)");
+  }
+  r.input.resize(static_cast<long>(d.size()) - 1);
+  for (long j = 0; j + 1 < static_cast<long>(d.size()); ++j) r.input[j] = d.input[static_cast<std::size_t>(j)];
+  const auto [xmin, xmax] = std::minmax_element(d.x.begin(), d.x.end());
+  r.x_min = *xmin;
+  r.x_max = *xmax;
+  for (std::size_t k = 0; k < d.size(); ++k) {
+    r.v_max_abs = std::max(r.v_max_abs, std::abs(r.motion.v[k]));
+    r.a_max_abs = std::max(r.a_max_abs, std::abs(r.motion.a[k]));
+  }
+  return r;
+}
+
+long Record::active_points() const {
+  long n = static_cast<long>(bank.tau.size());
+  for (char m : masked) n -= m ? 1 : 0;
+  return n;
+}
+
+void mask_stiction(Record& r, const plant::PlantParams& model) {
+  r.masked.assign(r.bank.tau.size(), 0);
+  if (model.friction.model != plant::FrictionModel::kStatic) return;
+  const double vs = std::max(1e-4, 20.0 * model.friction.static_smoothing_velocity);
+  const auto& v = r.motion.v;
+  for (int i = 0; i < r.bank.w.outerSize(); ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(r.bank.w, i); it; ++it) {
+      const long j = it.col();
+      if (std::abs(v[j]) < vs && std::abs(v[j + 1]) < vs) r.masked[i] = 1;
+    }
+}
+
+double thrust_per_input(const Record& r, const plant::PlantParams& p) {
+  return r.data->input_kind == InputKind::kCommand ? p.thrust_gain() : 1.0;
+}
+
+namespace {
+
+// z after h seconds at velocity v held (exact solution of the linear ODE for constant v).
+double advance_z(const plant::FrictionParams& f, double z, double v, double h) {
+  if (f.model != plant::FrictionModel::kLuGre || v == 0.0) return z;
+  const double g = plant::stribeck(f, v);
+  const double a = f.bristle_stiffness * std::abs(v) / g;
+  const double zss = v / a;
+  return zss + (z - zss) * std::exp(-a * h);
+}
+
+double advance_fg(const plant::GrindingParams& g, double fg, double x, double v, double h) {
+  if (!g.enabled) return fg;
+  const double C = g.damping();
+  const double fss = plant::in_contact(g, x) ? C * v : 0.0;
+  return fss + (fg - fss) * std::exp(-g.stiffness / C * h);
+}
+
+}  // namespace
+
+namespace {
+
+bool same(const plant::FrictionParams& a, const plant::FrictionParams& b) {
+  return a.model == b.model && a.static_force == b.static_force && a.coulomb_force == b.coulomb_force &&
+         a.stribeck_velocity == b.stribeck_velocity && a.stribeck_exponent == b.stribeck_exponent &&
+         a.bristle_stiffness == b.bristle_stiffness && a.bristle_damping == b.bristle_damping &&
+         a.viscous == b.viscous && a.damping_decay_velocity == b.damping_decay_velocity &&
+         a.static_smoothing_velocity == b.static_smoothing_velocity;
+}
+
+bool same(const plant::GrindingParams& a, const plant::GrindingParams& b) {
+  return a.enabled == b.enabled && a.stiffness == b.stiffness && a.dullness == b.dullness &&
+         a.workpiece_diameter == b.workpiece_diameter && a.wheel_width == b.wheel_width &&
+         a.contact_position == b.contact_position;
+}
+
+// Friction (part 0) or grinding (part 1) force averaged over each interval, with the internal
+// state at the samples. Friction and grinding depend on v through fast internal states (and,
+// for the static model, on sgn v), so they are averaged over S sub-steps with v^ and x^
+// interpolated by the parabola through the interval's ends and midpoint; 32 sub-steps where
+// v^ is small or changes sign (a reversal inside the interval), 4 elsewhere.
+void internal_force(const Record& r, const plant::PlantParams& pe, int part, Eigen::VectorXd& force,
+                    std::vector<double>& state) {
+  const Motion& m = r.motion;
+  const long n = static_cast<long>(m.x.size());
+  force.resize(n - 1);
+  state.assign(static_cast<std::size_t>(n), 0.0);
+  if ((part == 0 && pe.friction.model == plant::FrictionModel::kNone) || (part == 1 && !pe.grinding.enabled)) {
+    force.setZero();
+    if (part == 1) std::fill(state.begin(), state.end(), pe.initial.grinding);
+    return;
+  }
+  double y = part == 0 ? pe.initial.bristle : pe.initial.grinding;
+  state[0] = y;
+  const double slow_velocity = std::max(1e-4, 100.0 * pe.friction.static_smoothing_velocity);
+  for (long j = 0; j + 1 < n; ++j) {
+    const double x = m.x_mid[j], v = m.v_mid[j], h = m.dt[j];
+    const double v0 = m.v[j], v1 = m.v[j + 1];
+    const double x0 = m.x[j], x1 = m.x[j + 1];
+    const bool slow = (v0 > 0) != (v1 > 0) || std::min(std::abs(v0), std::abs(v1)) < slow_velocity;
+    const int S = slow ? 32 : 4;
+    const double hs = h / S;
+    double fsum = 0.0;
+    for (int q = 0; q < S; ++q) {
+      const double sq = (q + 0.5) / S;  // sub-step midpoint in [0, 1]
+      const auto par = [sq](double y0, double ym, double y1) {  // parabola through (0,y0), (1/2,ym), (1,y1)
+        return y0 * (2 * sq - 1) * (sq - 1) + ym * 4 * sq * (1 - sq) + y1 * sq * (2 * sq - 1);
+      };
+      const double vs = par(v0, v, v1), xs = par(x0, x, x1);
+      if (part == 0) {
+        y = advance_z(pe.friction, y, vs, 0.5 * hs);
+        fsum += plant::friction_force(pe.friction, vs, y);
+        y = advance_z(pe.friction, y, vs, 0.5 * hs);
+      } else {
+        y = advance_fg(pe.grinding, y, xs, vs, 0.5 * hs);
+        fsum += plant::grinding_force(pe.grinding, xs, y);
+        y = advance_fg(pe.grinding, y, xs, vs, 0.5 * hs);
+      }
+    }
+    force[j] = fsum / S;
+    state[static_cast<std::size_t>(j + 1)] = y;
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Internal* internal) {
+  const plant::PlantParams pe = plant::effective_params(p);
+  const MeasuredData& d = *r.data;
+  const long n = static_cast<long>(d.size());
+  const double gain = thrust_per_input(r, pe);
+  const double delay = p.effects.input_delay.enabled ? p.effects.input_delay.delay_s : 0.0;
+  const Motion& m = r.motion;
+
+  // Friction along the motion is the costly part and the same for every candidate that does
+  // not change the friction model: it is cached (filtered) with the params it was computed for.
+  Record::Cache& c = *r.cache;
+  if (!c.friction_valid || !same(c.friction, pe.friction) || c.bristle0 != pe.initial.bristle) {
+    Eigen::VectorXd f;
+    internal_force(r, pe, 0, f, c.z);
+    c.friction_filtered = apply(r.bank, f);
+    c.friction = pe.friction;
+    c.bristle0 = pe.initial.bristle;
+    c.friction_valid = true;
+  }
+  if (!c.grinding_valid || !same(c.grinding, pe.grinding) || c.grinding0 != pe.initial.grinding) {
+    Eigen::VectorXd f;
+    internal_force(r, pe, 1, f, c.fg);
+    c.grinding_filtered = apply(r.bank, f);
+    c.grinding = pe.grinding;
+    c.grinding0 = pe.initial.grinding;
+    c.grinding_valid = true;
+  }
+  if (internal) {
+    internal->z = c.z;
+    internal->fg = c.fg;
+  }
+  Eigen::VectorXd force(n - 1);
+  long held = 0;  // index of the input held at t_mid - delay
+  for (long j = 0; j + 1 < n; ++j) {
+    const double x = m.x_mid[j], v = m.v_mid[j];
+    double thrust;
+    if (delay > 0.0) {
+      const double ts = m.t_mid[j] - delay;
+      while (held + 1 < n && d.t[held + 1] <= ts) ++held;
+      thrust = gain * r.input[std::min(held, n - 2)];
+    } else {
+      thrust = gain * r.input[j];
+    }
+    force[j] = plant::ripple_force(pe.ripple, x, thrust) + plant::extra_force(pe, x, v, thrust);
+  }
+  Eigen::VectorXd thrust_f;
+  if (delay > 0.0) {
+    thrust_f = apply_delayed(r.bank, d.t, gain * r.input, delay);
+  } else {
+    thrust_f = apply(r.bank, gain * r.input);
+  }
+  const Eigen::Map<const Eigen::VectorXd> accel(r.bank.accel.data(), static_cast<long>(r.bank.accel.size()));
+  Eigen::VectorXd res = pe.mass * accel - thrust_f + c.friction_filtered + c.grinding_filtered + apply(r.bank, force);
+  for (std::size_t i = 0; i < r.masked.size(); ++i)
+    if (r.masked[i]) res[static_cast<long>(i)] = 0.0;
+  return res;
+}
+
+}  // namespace feeddrive::fit

@@ -1,0 +1,264 @@
+#include "feeddrive/fit/report.hpp"
+
+#include <yaml-cpp/yaml.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+
+namespace feeddrive::fit {
+namespace fs = std::filesystem;
+
+std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::PlantParams& fitted) {
+  YAML::Node root = YAML::LoadFile(scenario_path);
+  const fs::path base = fs::absolute(scenario_path).parent_path();
+  if (root["reference"] && root["reference"]["file"]) {
+    const fs::path f = root["reference"]["file"].as<std::string>();
+    if (f.is_relative()) root["reference"]["file"] = (base / f).lexically_normal().string();
+  }
+  if (!root["plant"]) root["plant"] = YAML::Node(YAML::NodeType::Map);
+  YAML::Node effects = root["plant"]["effects"];
+  for (const Effect& e : effects_of(fitted)) {
+    YAML::Node m(YAML::NodeType::Map);
+    for (const auto& [k, v] : e.parameters) m[k] = v;
+    effects[e.name] = m;
+  }
+  root["plant"]["effects"] = effects;
+  YAML::Emitter em;
+  em.SetDoublePrecision(15);
+  em << root;
+  return std::string("# feeddrive-fit: ") + scenario_path + " plus the fitted effects under plant.effects\n" +
+         em.c_str() + "\n";
+}
+
+namespace {
+
+nlohmann::json params_json(const Effect& e) {
+  nlohmann::json p = nlohmann::json::object();
+  for (const auto& [k, v] : e.parameters) p[k] = v;
+  return p;
+}
+
+nlohmann::json bins_json(const std::vector<Bin>& bins) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Bin& b : bins)
+    a.push_back({{"bin", b.label}, {"points", b.points}, {"force_rms_N", b.force_rms}, {"share", b.share},
+                 {"concentration", b.concentration}, {"gap_m", b.gap}});
+  return a;
+}
+
+}  // namespace
+
+std::string findings_json(const FitResult& r) {
+  nlohmann::json j;
+  j["gap_initial"] = r.replay_initial.gap;
+  j["gap_final"] = r.replay_final.gap;
+  j["gap_unit"] = "m";
+  j["force_residual_rms_initial_N"] = r.force_rms_initial;
+  j["force_residual_rms_final_N"] = r.force_rms_final;
+  j["effects"] = nlohmann::json::array();
+  for (const StepResult& st : r.steps) {
+    if (!st.accepted) continue;
+    Effect final = st.effect;
+    for (const Effect& e : r.effects)
+      if (e.name == st.effect.name) final = e;
+    j["effects"].push_back({{"name", final.name},
+                            {"parameters", params_json(final)},
+                            {"score", st.score},
+                            {"gap_before", st.gap_before},
+                            {"gap_after", st.gap_after}});
+  }
+  j["conclusion"] = r.conclusion;
+  nlohmann::json steps = nlohmann::json::array();
+  for (const StepResult& st : r.steps) {
+    nlohmann::json rk = nlohmann::json::array();
+    for (const CandidateFit& c : st.ranking)
+      rk.push_back({{"name", c.effect.name}, {"score", c.score}, {"parameters", params_json(c.effect)},
+                    {"k", c.parameters}, {"rss_N2", c.rss}});
+    steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk},
+                     {"localisation", {{"summary", st.localisation.summary},
+                                       {"time", bins_json(st.localisation.time)},
+                                       {"velocity", bins_json(st.localisation.velocity)},
+                                       {"acceleration", bins_json(st.localisation.acceleration)},
+                                       {"position", bins_json(st.localisation.position)}}}});
+  }
+  j["steps"] = steps;
+  return j.dump(2) + "\n";
+}
+
+namespace {
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream f(p);
+  f << text;
+  if (!f) throw std::runtime_error(p.string() + ": write failed");
+}
+
+std::string table(const std::vector<Bin>& bins) {
+  std::ostringstream s;
+  s << "| bin | points | force RMS [N] | share of residual | concentration | replay gap [um] |\n|---|---|---|---|---|---|\n";
+  char buf[256];
+  for (const Bin& b : bins) {
+    std::snprintf(buf, sizeof buf, "| %s | %ld | %.3g | %.1f %% | %.2f | %.3g |\n", b.label.c_str(), b.points,
+                  b.force_rms, 100 * b.share, b.concentration, b.gap * 1e6);
+    s << buf;
+  }
+  return s.str();
+}
+
+std::string params_text(const Effect& e) {
+  std::string s;
+  char buf[96];
+  for (const auto& [k, v] : e.parameters) {
+    std::snprintf(buf, sizeof buf, "%s%s = %.6g", s.empty() ? "" : ", ", k.c_str(), v);
+    s += buf;
+  }
+  return s;
+}
+
+void run_gnuplot(const fs::path& dir, const std::string& script) {
+  write_file(dir / "plots.gp", script);
+  const std::string cmd = "cd '" + dir.string() + "' && gnuplot plots.gp > gnuplot.log 2>&1";
+  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("gnuplot failed (see " + (dir / "gnuplot.log").string() + ")");
+  fs::remove(dir / "gnuplot.log");
+}
+
+}  // namespace
+
+void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
+                   const FitResult& r, bool plots) {
+  {
+    std::error_code ec;
+    const fs::path d(out_dir);
+    if (fs::exists(d, ec) && !(fs::is_directory(d, ec) && (fs::is_empty(d, ec) || fs::exists(d / "findings.json", ec))))
+      throw std::invalid_argument("--out " + out_dir +
+                                  ": exists and is not an earlier feeddrive-fit output (no findings.json); not replacing it");
+  }
+  const fs::path final_dir = fs::absolute(out_dir);
+  const fs::path tmp = final_dir.parent_path() / (final_dir.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  try {
+    write_file(tmp / "findings.json", findings_json(r));
+    write_file(tmp / "model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
+    const MeasuredData& d = *rec.data;
+    // data behind the plots
+    {
+      std::ofstream f(tmp / "replay.csv");
+      f << "t,x,x_sim_initial,x_sim_final,error_initial,error_final\n";
+      f.precision(12);
+      for (std::size_t k = 0; k < d.size(); ++k)
+        f << d.t[k] << ',' << d.x[k] << ',' << r.replay_initial.x_sim[k] << ',' << r.replay_final.x_sim[k] << ','
+          << r.replay_initial.error[k] << ',' << r.replay_final.error[k] << '\n';
+    }
+    {
+      std::ofstream f(tmp / "gap.csv");
+      f << "step,label,gap_m,force_rms_N\n";
+      f << "0,initial," << r.replay_initial.gap << ',' << r.force_rms_initial << '\n';
+      int k = 1;
+      for (const StepResult& st : r.steps)
+        if (st.accepted) f << k++ << ",+" << st.effect.name << ',' << st.gap_after << ',' << st.force_rms_after << '\n';
+    }
+    int n_eff = 0;
+    for (const StepResult& st : r.steps) {
+      if (!st.accepted) continue;
+      ++n_eff;
+      const auto [label, xs] = effect_regressor(rec, st.effect);
+      std::ofstream f(tmp / ("effect" + std::to_string(n_eff) + ".csv"));
+      f << "regressor,residual_before,effect_force,residual_after\n";
+      for (std::size_t i = 0; i < xs.size(); ++i) {
+        const long li = static_cast<long>(i);
+        // r = -filtered F_extra: the effect's own filtered force is -(r_after - r_before)
+        f << xs[i] << ',' << -st.residual_before[li] << ',' << -(st.residual_before[li] - st.residual_after[li])
+          << ',' << -st.residual_after[li] << '\n';
+      }
+    }
+    // report.md
+    std::ostringstream md;
+    char buf[512];
+    md << "# feeddrive-fit report\n\n"
+       << "- model: `" << scenario_path << "`\n- data: `" << d.source << "` (" << d.size() << " samples, "
+       << d.t.back() - d.t.front() << " s, median period " << rec.period * 1e3 << " ms)\n"
+       << "- filter half-width L = " << rec.bank.half_width * 1e3 << " ms, " << rec.bank.tau.size()
+       << " independent force-residual points\n\n"
+       << "**" << r.conclusion << "**\n\n"
+       << "The gap is the RMS position error of the model replayed from the measured state over windows "
+          "(docs/fit.md); the force measure is the RMS of the filtered force residual.\n\n"
+       << "## Gap after each step\n\n| step | model | gap [um] | force residual RMS [N] |\n|---|---|---|---|\n";
+    std::snprintf(buf, sizeof buf, "| 0 | as given | %.4g | %.4g |\n", r.replay_initial.gap * 1e6, r.force_rms_initial);
+    md << buf;
+    int k = 0;
+    for (const StepResult& st : r.steps) {
+      if (!st.accepted) continue;
+      std::snprintf(buf, sizeof buf, "| %d | + %s | %.4g | %.4g |\n", ++k, st.effect.name.c_str(), st.gap_after * 1e6,
+                    st.force_rms_after);
+      md << buf;
+    }
+    if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
+    md << "\n## Effects found\n\n";
+    if (r.effects.empty()) md << "None: no candidate is significant.\n";
+    for (const Effect& e : r.effects) md << "- `" << e.name << "`: " << params_text(e) << "\n";
+    k = 0;
+    for (std::size_t s = 0; s < r.steps.size(); ++s) {
+      const StepResult& st = r.steps[s];
+      md << "\n## Step " << s + 1 << ": " << st.verdict << "\n\n" << st.localisation.summary << ".\n\n";
+      md << "Candidates (score = BIC without - BIC with the effect; significant above the threshold):\n\n"
+         << "| rank | effect | score | k | parameters |\n|---|---|---|---|---|\n";
+      for (std::size_t i = 0; i < st.ranking.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "| %zu | %s | %.4g | %d | ", i + 1, st.ranking[i].effect.name.c_str(),
+                      st.ranking[i].score, st.ranking[i].parameters);
+        md << buf << params_text(st.ranking[i].effect) << " |\n";
+      }
+      md << "\nWhere the residual was (before this step):\n\n"
+         << "Velocity regimes\n\n" << table(st.localisation.velocity) << "\nAcceleration phases\n\n"
+         << table(st.localisation.acceleration) << "\nPosition\n\n" << table(st.localisation.position)
+         << "\nTime\n\n" << table(st.localisation.time);
+      if (st.accepted && plots) {
+        ++k;
+        md << "\n![residual against the regressor of " << st.effect.name << "](effect" << k << ".png)\n";
+      }
+    }
+    write_file(tmp / "report.md", md.str());
+    if (plots) {
+      std::ostringstream gp;
+      gp << "set datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\nset grid\n"
+         << "set key outside top center horizontal\n";
+      gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
+            "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
+         << "plot 'replay.csv' every ::1 using 1:($2*1e3) with lines lw 2 title 'measured', '' every ::1 using "
+            "1:($3*1e3) with lines title 'model as given', '' every ::1 using 1:($4*1e3) with lines title 'fitted model'\n"
+         << "set ylabel 'x_sim - x [um]'\nplot 'replay.csv' every ::1 using 1:($5*1e6) with lines title 'model as "
+            "given', '' every ::1 using 1:($6*1e6) with lines title 'fitted model'\nunset multiplot\n";
+      gp << "set output 'gap.png'\nset title 'replay gap after each step'\nset xlabel 'step'\nset ylabel 'gap [um]'\n"
+         << "set logscale y\nset style fill solid 0.5\nset boxwidth 0.6\nunset key\n"
+         << "plot 'gap.csv' every ::1 using 1:($3*1e6):xtic(2) with boxes\nunset logscale y\nset key\n";
+      k = 0;
+      for (const StepResult& st : r.steps) {
+        if (!st.accepted) continue;
+        ++k;
+        const auto label = effect_regressor(rec, st.effect).first;
+        gp << "set output 'effect" << k << ".png'\nset title 'step " << k << ": " << st.effect.name
+           << " -- filtered force residual against its regressor'\nset xlabel '" << label
+           << "'\nset ylabel 'force [N]'\nplot 'effect" << k
+           << ".csv' every ::1 using 1:2 with points pt 7 ps 0.4 title 'residual before (-r)', '' every ::1 using "
+              "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
+              "ps 0.3 title 'residual after'\n";
+      }
+      run_gnuplot(tmp, gp.str());
+    }
+    if (fs::exists(final_dir)) fs::remove_all(final_dir);
+    fs::rename(tmp, final_dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace feeddrive::fit
