@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs every build, test and run dependency of feeddrive on Debian 12 (bookworm).
 # Idempotent: apt-get skips what is already installed. Uses sudo when not root.
+# Optional, not installed here: a JDK (default-jdk-headless). With one, the build also writes the
+# jar of the message types that lcm-spy needs (docs/lcm-contract.md); without, that jar and its
+# test (tests/service/lcm_spy_jar_test.sh) are skipped with a message.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -10,7 +13,7 @@ PACKAGES=(
   libeigen3-dev libsundials-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libbenchmark-dev libceres-dev
-  gnuplot-nox jq
+  gnuplot-nox jq python3 python3-yaml
   iproute2 nftables util-linux
   lua5.2 liblcm-lua
 )

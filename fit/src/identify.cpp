@@ -42,6 +42,8 @@ struct Spec {
   std::function<Theta(const Effect&, const Ctx&)> from_effect;
   std::function<std::vector<Theta>(const Ctx&)> starts;
   std::vector<std::pair<int, double>> lower, upper;
+  /// Equivalent parametrisations of a solution to try as well (kept if at least as good).
+  std::function<std::vector<Theta>(const Theta&)> alternatives;
 };
 
 // Best pitches of a ripple-like regressor  r0 ~ A sin(kappa x) + B cos(kappa x)  (times the
@@ -109,26 +111,30 @@ const std::vector<Spec>& specs() {
       return sp;
     };
     s.push_back(one("constant_force", "force_N", 0.0));
+    // Friction and spring effects have the physical sign the plant requires (>= 0).
     s.push_back(one("coulomb_friction", "coulomb_N", 0.0));
+    s.back().lower = {{0, 0.0}};
     s.push_back(one("viscous_friction", "viscous_Ns_per_m", 0.0));
+    s.back().lower = {{0, 0.0}};
     {
       Spec sp;
       sp.name = "stribeck_friction";
-      sp.dim = 3;  // Fs, Fc, ln vs
+      sp.dim = 3;  // Fc, Fs - Fc, ln vs  (Fs >= Fc >= 0, as the plant requires)
       sp.to_effect = [](const Theta& t, const Ctx&) {
         return Effect{"stribeck_friction",
-                      {{"static_N", t[0]}, {"coulomb_N", t[1]}, {"stribeck_velocity_mps", std::exp(t[2])}}};
+                      {{"static_N", t[0] + t[1]}, {"coulomb_N", t[0]}, {"stribeck_velocity_mps", std::exp(t[2])}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
-        return Theta{e.parameters.at("static_N"), e.parameters.at("coulomb_N"),
+        return Theta{e.parameters.at("coulomb_N"), e.parameters.at("static_N") - e.parameters.at("coulomb_N"),
                      std::log(e.parameters.at("stribeck_velocity_mps"))};
       };
       sp.starts = [](const Ctx& c) {
         std::vector<Theta> out;
         const double vmax = std::max(c.rec.v_max_abs, 1e-6);
-        for (double f : {0.003, 0.03, 0.3}) out.push_back({0.0, 0.0, std::log(f * vmax)});
+        for (double f : {0.003, 0.03, 0.3}) out.push_back({0.0, 1.0, std::log(f * vmax)});
         return out;
       };
+      sp.lower = {{0, 0.0}, {1, 0.0}};
       s.push_back(sp);
     }
     {
@@ -173,6 +179,11 @@ const std::vector<Spec>& specs() {
         std::vector<Theta> out;
         for (const auto& pk : pitch_periodogram(c, false)) out.push_back({std::log(pk[0]), pk[1], pk[2], 0.0, 0.0});
         return out;
+      };
+      // A ripple of pitch p is also "the third harmonic of pitch 3p": when the fit lands on the
+      // latter, the fundamental-only form at p is the same force with the physical pitch.
+      sp.alternatives = [](const Theta& t) {
+        return std::vector<Theta>{{t[0] - std::log(3.0), t[3], t[4], 0.0, 0.0}};
       };
       s.push_back(sp);
     }
@@ -236,6 +247,7 @@ const std::vector<Spec>& specs() {
         return Theta{k, k * (c.x_mean - e.parameters.at("rest_position_m"))};
       };
       sp.starts = [](const Ctx&) { return std::vector<Theta>{{0.0, 0.0}}; };
+      sp.lower = {{0, 0.0}};
       s.push_back(sp);
     }
     {
@@ -477,6 +489,12 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
     for (std::size_t i = 0; i < first.size() && i < 2; ++i) {
       const Solved s2 = solve(rec, model, blocks, first[i].theta, ctx, 100);
       if (s2.rss < best.rss) best = s2;
+    }
+  }
+  if (s.alternatives) {
+    for (const Theta& alt : s.alternatives(best.theta)) {
+      const Solved a = solve(rec, model, blocks, alt, ctx, 100);
+      if (a.rss <= best.rss * (1.0 + 1e-3)) best = a;
     }
   }
   // A scanned parameter (held by Ceres, e.g. the contact position): golden-section search

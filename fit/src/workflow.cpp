@@ -35,42 +35,70 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     st.residual_before = r;
     st.ranking = rank_candidates(rec, current);
     if (st.ranking.empty()) break;
-    const CandidateFit& best = st.ranking.front();
-    st.effect = best.effect;
-    st.score = best.score;
-    say("step " + std::to_string(it + 1) + ": best candidate " + best.effect.name + fmt(" (score %.4g)", best.score));
-    if (!(best.score >= opt.score_threshold)) {
-      st.verdict = "no significant effect: the best candidate, " + best.effect.name +
-                   fmt(", scores %.3g < %.3g", best.score, opt.score_threshold);
+    // The best candidate that is significant, valid (its parameters pass the plant's
+    // validate()) and confirmed by the replay; stop at the first significant one that is not
+    // confirmed.
+    const CandidateFit* best = &st.ranking.front();
+    st.effect = best->effect;
+    st.score = best->score;
+    say("step " + std::to_string(it + 1) + ": best candidate " + best->effect.name + fmt(" (score %.4g)", best->score));
+    plant::PlantParams trial;
+    Eigen::VectorXd r2;
+    Replay rp2;
+    bool found = false;
+    std::string why;
+    for (const CandidateFit& c : st.ranking) {
+      if (!(c.score >= opt.score_threshold)) break;
+      trial = current;
+      apply_effect(c.effect, trial);
+      trial = refine_jointly(rec, trial);
+      try {
+        trial.validate();
+      } catch (const std::invalid_argument& e) {
+        why += (why.empty() ? "" : "; ") + c.effect.name + " fitted to invalid values (" + e.what() + ")";
+        continue;
+      }
+      try {
+        r2 = force_residual(rec, trial);
+        rp2 = replay(rec, trial, opt.replay_window);
+      } catch (const std::runtime_error& e) {  // e.g. CVODE cannot integrate the fitted model
+        why += (why.empty() ? "" : "; ") + c.effect.name + " cannot be replayed (" + e.what() + ")";
+        continue;
+      }
+      best = &c;
+      st.effect = c.effect;
+      st.score = c.score;
+      st.gap_after = rp2.gap;
+      st.force_rms_after = rms(r2, rec.active_points());
+      st.residual_after = r2;
+      found = true;
+      break;
+    }
+    if (!found) {
+      st.verdict = "no significant effect: the best candidate, " + st.ranking.front().effect.name +
+                   fmt(", scores %.3g (threshold %.3g)", st.ranking.front().score, opt.score_threshold) +
+                   (why.empty() ? "" : "; " + why);
       st.gap_after = st.gap_before;
       st.force_rms_after = st.force_rms_before;
       st.residual_after = r;
       out.steps.push_back(st);
       break;
     }
-    plant::PlantParams trial = current;
-    apply_effect(best.effect, trial);
-    trial = refine_jointly(rec, trial);
-    const Eigen::VectorXd r2 = force_residual(rec, trial);
-    const Replay rp2 = replay(rec, trial, opt.replay_window);
-    st.gap_after = rp2.gap;
-    st.force_rms_after = rms(r2, rec.active_points());
-    st.residual_after = r2;
     if (!(rp2.gap <= (1.0 - opt.min_gap_reduction) * rp.gap)) {
-      st.verdict = "no significant effect: " + best.effect.name +
-                   fmt(" scores %.3g but does not shrink the replay gap (%.4g -> %.4g um)", best.score,
+      st.verdict = "no significant effect: " + best->effect.name +
+                   fmt(" scores %.3g but does not shrink the replay gap (%.4g -> %.4g um)", best->score,
                        rp.gap * 1e6, rp2.gap * 1e6);
       out.steps.push_back(st);
       break;
     }
     st.accepted = true;
-    st.verdict = "added " + best.effect.name + fmt(": gap %.4g -> %.4g um", rp.gap * 1e6, rp2.gap * 1e6);
+    st.verdict = "added " + best->effect.name + fmt(": gap %.4g -> %.4g um", rp.gap * 1e6, rp2.gap * 1e6);
     say(st.verdict);
     out.steps.push_back(st);
     current = trial;
     r = r2;
     rp = rp2;
-    added.push_back(best.effect.name);
+    added.push_back(best->effect.name);
   }
   out.fitted = current;
   out.replay_final = rp;

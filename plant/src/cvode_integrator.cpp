@@ -25,7 +25,7 @@ T* check_ptr(T* p, const char* call) {
 }
 
 struct UserData {
-  const PlantParams* params{nullptr};
+  const EffectiveParams* params{nullptr};  ///< the effects folded in once, at construction
   /// CVODE holds only the active states (dynamics.hpp active_states): full index of each.
   std::array<int, kStateSize> index{};
   int n{0};
@@ -83,7 +83,8 @@ int jac(sunrealtype t, N_Vector y, N_Vector /*fy*/, SUNMatrix J, void* user_data
 }  // namespace
 
 struct CvodeIntegrator::Impl {
-  PlantParams params;
+  explicit Impl(const PlantParams& p) : params(p) {}
+  EffectiveParams params;
   UserData user;
   SUNContext ctx{nullptr};
   N_Vector y{nullptr};
@@ -118,11 +119,10 @@ struct CvodeIntegrator::Impl {
 };
 
 CvodeIntegrator::CvodeIntegrator(const PlantParams& params, double t0, const StateVector& y0)
-    : impl_(std::make_unique<Impl>()), t_(t0), y_(y0) {
+    : impl_(std::make_unique<Impl>(params)), t_(t0), y_(y0) {
   Impl& m = *impl_;
-  m.params = params;
   m.user.params = &m.params;
-  const auto active = active_states(params);
+  const auto active = active_states(m.params);
   for (int i = 0; i < kStateSize; ++i)
     if (active[i]) m.user.index[m.user.n++] = i;
   const int n = m.user.n;

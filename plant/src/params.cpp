@@ -101,6 +101,62 @@ void ElectricalParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".back_emf", back_emf);
 }
 
+bool EffectsParams::any() const {
+  return constant_force.enabled || coulomb_friction.enabled || viscous_friction.enabled ||
+         stribeck_friction.enabled || presliding.enabled || cogging_ripple.enabled ||
+         reluctance_ripple.enabled || grinding_force.enabled || spring_force.enabled ||
+         mass_error.enabled || input_delay.enabled;
+}
+
+void EffectsParams::validate(const std::string& prefix) const {
+  if (constant_force.enabled) require_finite(prefix + ".constant_force.force_N", constant_force.force_N);
+  if (coulomb_friction.enabled)
+    require_non_negative(prefix + ".coulomb_friction.coulomb_N", coulomb_friction.coulomb_N);
+  if (viscous_friction.enabled)
+    require_non_negative(prefix + ".viscous_friction.viscous_Ns_per_m", viscous_friction.viscous_Ns_per_m);
+  if (stribeck_friction.enabled) {
+    const std::string k = prefix + ".stribeck_friction";
+    require_non_negative(k + ".coulomb_N", stribeck_friction.coulomb_N);
+    require_finite(k + ".static_N", stribeck_friction.static_N);
+    if (stribeck_friction.static_N < stribeck_friction.coulomb_N)
+      fail(k + ".static_N", stribeck_friction.static_N, "must be >= coulomb_N");
+    require_positive(k + ".stribeck_velocity_mps", stribeck_friction.stribeck_velocity_mps);
+  }
+  if (presliding.enabled) {
+    require_positive(prefix + ".presliding.bristle_stiffness_N_per_m", presliding.bristle_stiffness_N_per_m);
+    require_non_negative(prefix + ".presliding.bristle_damping_Ns_per_m", presliding.bristle_damping_Ns_per_m);
+  }
+  if (cogging_ripple.enabled) {
+    const std::string k = prefix + ".cogging_ripple";
+    require_positive(k + ".pitch_m", cogging_ripple.pitch_m);
+    require_finite(k + ".amplitude_N", cogging_ripple.amplitude_N);
+    require_finite(k + ".phase_rad", cogging_ripple.phase_rad);
+    require_finite(k + ".third_harmonic_N", cogging_ripple.third_harmonic_N);
+    require_finite(k + ".third_phase_rad", cogging_ripple.third_phase_rad);
+  }
+  if (reluctance_ripple.enabled) {
+    const std::string k = prefix + ".reluctance_ripple";
+    require_positive(k + ".pitch_m", reluctance_ripple.pitch_m);
+    require_finite(k + ".relative_amplitude", reluctance_ripple.relative_amplitude);
+    require_finite(k + ".phase_rad", reluctance_ripple.phase_rad);
+    // As for ripple.reluctance_amplitude: |amplitude| < 1 keeps the thrust's sign.
+    if (std::abs(reluctance_ripple.relative_amplitude) >= 1.0)
+      fail(k + ".relative_amplitude", reluctance_ripple.relative_amplitude, "|relative_amplitude| must be < 1");
+  }
+  if (grinding_force.enabled) {
+    const std::string k = prefix + ".grinding_force";
+    require_positive(k + ".gain_Ns_per_m", grinding_force.gain_Ns_per_m);
+    require_positive(k + ".stiffness_N_per_m", grinding_force.stiffness_N_per_m);
+    require_finite(k + ".contact_position_m", grinding_force.contact_position_m);
+  }
+  if (spring_force.enabled) {
+    require_non_negative(prefix + ".spring_force.stiffness_N_per_m", spring_force.stiffness_N_per_m);
+    require_finite(prefix + ".spring_force.rest_position_m", spring_force.rest_position_m);
+  }
+  if (mass_error.enabled) require_positive(prefix + ".mass_error.mass_kg", mass_error.mass_kg);
+  if (input_delay.enabled) require_non_negative(prefix + ".input_delay.delay_s", input_delay.delay_s);
+}
+
 void SensorParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".quantization", quantization);
   require_non_negative(prefix + ".noise_stddev", noise_stddev);
@@ -130,6 +186,24 @@ void PlantParams::validate(const std::string& prefix) const {
   electrical.validate(prefix + ".electrical");
   sensor.validate(prefix + ".sensor");
   integrator.validate(prefix + ".integrator");
+  effects.validate(prefix + ".effects");
+  // The friction and grinding sections' values the effects use, checked even where the section
+  // itself is off (its validate() then skips them).
+  if (effects.presliding.enabled) {  // the friction becomes LuGre with Fs, Fc, vs, delta, sigma2
+    FrictionParams lugre = friction;
+    lugre.model = FrictionModel::kLuGre;
+    lugre.bristle_stiffness = effects.presliding.bristle_stiffness_N_per_m;
+    lugre.bristle_damping = effects.presliding.bristle_damping_Ns_per_m;
+    lugre.validate(prefix + ".friction");
+  }
+  if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled)  // sgn = tanh(v/eps)
+    require_positive(prefix + ".friction.static_smoothing_velocity", friction.static_smoothing_velocity);
+  if (effects.stribeck_friction.enabled)
+    require_positive(prefix + ".friction.stribeck_exponent", friction.stribeck_exponent);
+  if (effects.grinding_force.enabled) {  // dullness = C/(pi*dw*bs)
+    require_positive(prefix + ".grinding.workpiece_diameter", grinding.workpiece_diameter);
+    require_positive(prefix + ".grinding.wheel_width", grinding.wheel_width);
+  }
   require_finite(prefix + ".initial.position", initial.position);
   require_finite(prefix + ".initial.velocity", initial.velocity);
   require_finite(prefix + ".initial.bristle", initial.bristle);

@@ -72,7 +72,11 @@ void ControllerNode::run() {
       last_ref_request_us_ = now;
     }
     const double limit = next_seq_ == 0 ? options().start_timeout_s : options().step_timeout_s;
-    if (now - last_progress_us_ > us(limit)) {
+    // As in the trajectory: a plant that still sends its heartbeat waits for another role and
+    // will name it; never wait longer than three timeouts, though.
+    const bool plant_waits = !pending_ && next_seq_ > 0 && peer_alive("plant", 0.5) &&
+                             now - last_progress_us_ <= 3 * us(limit);
+    if (now - last_progress_us_ > us(limit) && !plant_waits) {
       if (pending_)
         throw RunFailure("no reference from the trajectory for step " + std::to_string(pending_->seq) +
                          " within " + seconds_text(limit) + " s");

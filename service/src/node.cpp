@@ -28,8 +28,10 @@ std::string seconds_text(double s) {
 
 Node::Node(std::string role, const NodeOptions& opt)
     : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url), ch_(opt.prefix) {
-  bus_.subscribe<process_status_t>(ch_.status, [this](const process_status_t& m, std::int64_t) {
-    if (m.role != role_) peers_[m.role] = m;
+  bus_.subscribe<process_status_t>(ch_.status, [this](const process_status_t& m, std::int64_t recv_us) {
+    if (m.role == role_) return;
+    peers_[m.role] = m;
+    peer_seen_us_[m.role] = recv_us;
   });
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
     if (on_resend_request) on_resend_request(m);
@@ -87,6 +89,13 @@ void Node::check_peers() const {
 const process_status_t* Node::peer(const std::string& role) const {
   const auto it = peers_.find(role);
   return it == peers_.end() ? nullptr : &it->second;
+}
+
+bool Node::peer_alive(const std::string& role, double seconds) const {
+  const process_status_t* p = peer(role);
+  const auto seen = peer_seen_us_.find(role);
+  return p != nullptr && seen != peer_seen_us_.end() && p->state != "failed" &&
+         mono_us() - seen->second <= us(seconds);
 }
 
 bool Node::monitor_done() const {

@@ -53,7 +53,12 @@ void TrajectoryNode::run() {
   while (!end_) {
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));
     const double limit = highest_state_ < 0 ? options().start_timeout_s : options().step_timeout_s;
-    if (mono_us() - last_progress_us_ > us(limit))
+    // A plant that still sends its heartbeat is waiting for another role (the controller, the
+    // monitor) and will time out naming it; blaming the plant here would hide the real cause.
+    // Never wait longer than three timeouts, though.
+    const std::int64_t waited = mono_us() - last_progress_us_;
+    const bool plant_waits = highest_state_ >= 0 && peer_alive("plant", 0.5) && waited <= 3 * us(limit);
+    if (waited > us(limit) && !plant_waits)
       throw RunFailure("no state from the plant for step " + std::to_string(highest_state_ + 1) + " within " +
                        seconds_text(limit) + " s");
     check_peers();

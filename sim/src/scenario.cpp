@@ -95,7 +95,71 @@ void read_initial(MapReader r, plant::InitialState& p) {
   r.finish();
 }
 
-void read_plant(MapReader r, PlantParams& p) {
+// plant.effects.<name>: listing an effect enables it (an optional `enabled: false` switches it
+// off again); the parameters not given keep the struct's defaults.
+template <typename Effect, typename Read>
+void read_effect(MapReader& effects, const std::string& name, Effect& e, Read read) {
+  const bool listed = effects.has(name);
+  MapReader r = effects.child(name);  // marks the name as known, for finish()'s hints
+  if (!listed) return;
+  e.enabled = true;
+  r.boolean("enabled", e.enabled);
+  read(r, e);
+  r.finish();
+}
+
+void read_effects(MapReader r, plant::EffectsParams& p) {
+  read_effect(r, "constant_force", p.constant_force, [](MapReader& m, plant::ConstantForceEffect& e) {
+    m.number("force_N", e.force_N);
+  });
+  read_effect(r, "coulomb_friction", p.coulomb_friction, [](MapReader& m, plant::CoulombFrictionEffect& e) {
+    m.number("coulomb_N", e.coulomb_N);
+  });
+  read_effect(r, "viscous_friction", p.viscous_friction, [](MapReader& m, plant::ViscousFrictionEffect& e) {
+    m.number("viscous_Ns_per_m", e.viscous_Ns_per_m);
+  });
+  read_effect(r, "stribeck_friction", p.stribeck_friction, [](MapReader& m, plant::StribeckFrictionEffect& e) {
+    m.number("static_N", e.static_N);
+    m.number("coulomb_N", e.coulomb_N);
+    m.number("stribeck_velocity_mps", e.stribeck_velocity_mps);
+  });
+  read_effect(r, "presliding", p.presliding, [](MapReader& m, plant::PreslidingEffect& e) {
+    m.number("bristle_stiffness_N_per_m", e.bristle_stiffness_N_per_m);
+    m.number("bristle_damping_Ns_per_m", e.bristle_damping_Ns_per_m);
+  });
+  read_effect(r, "cogging_ripple", p.cogging_ripple, [](MapReader& m, plant::CoggingRippleEffect& e) {
+    m.number("pitch_m", e.pitch_m);
+    m.number("amplitude_N", e.amplitude_N);
+    m.number("phase_rad", e.phase_rad);
+    m.number("third_harmonic_N", e.third_harmonic_N);
+    m.number("third_phase_rad", e.third_phase_rad);
+  });
+  read_effect(r, "reluctance_ripple", p.reluctance_ripple, [](MapReader& m, plant::ReluctanceRippleEffect& e) {
+    m.number("pitch_m", e.pitch_m);
+    m.number("relative_amplitude", e.relative_amplitude);
+    m.number("phase_rad", e.phase_rad);
+  });
+  read_effect(r, "grinding_force", p.grinding_force, [](MapReader& m, plant::GrindingForceEffect& e) {
+    m.number("gain_Ns_per_m", e.gain_Ns_per_m);
+    m.number("stiffness_N_per_m", e.stiffness_N_per_m);
+    m.number("contact_position_m", e.contact_position_m);
+  });
+  read_effect(r, "spring_force", p.spring_force, [](MapReader& m, plant::SpringForceEffect& e) {
+    m.number("stiffness_N_per_m", e.stiffness_N_per_m);
+    m.number("rest_position_m", e.rest_position_m);
+  });
+  read_effect(r, "mass_error", p.mass_error, [](MapReader& m, plant::MassErrorEffect& e) {
+    m.number("mass_kg", e.mass_kg);
+  });
+  read_effect(r, "input_delay", p.input_delay, [](MapReader& m, plant::InputDelayEffect& e) {
+    m.number("delay_s", e.delay_s);
+  });
+  r.finish();
+}
+
+// The plant (with_effects) or a controller's model of it: a model has no effects, they are the
+// plant's discrepancy from the model.
+void read_plant(MapReader r, PlantParams& p, bool with_effects) {
   r.number("mass", p.mass);
   r.number("amplifier_gain", p.amplifier_gain);
   r.number("force_constant", p.force_constant);
@@ -107,6 +171,12 @@ void read_plant(MapReader r, PlantParams& p) {
   read_sensor(r.child("sensor"), p.sensor);
   read_integrator(r.child("integrator"), p.integrator);
   read_initial(r.child("initial"), p.initial);
+  if (with_effects) {
+    read_effects(r.child("effects"), p.effects);
+  } else if (r.has("effects")) {
+    r.fail("effects", ": a controller model has no effects (they are the plant's discrepancy from "
+                      "the model: plant.effects)");
+  }
   r.finish();
 }
 
@@ -144,7 +214,7 @@ void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
   r.boolean("motion_observer_disturbance", p.motion_observer_disturbance);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), p.model);
+  read_plant(r.child("model"), p.model, false);
 }
 
 void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model) {
@@ -155,7 +225,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model)
   r.number("acceleration_feedforward", p.acceleration_feedforward);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), model);
+  read_plant(r.child("model"), model, false);
   p.mass = model.mass;
   p.thrust_gain = model.thrust_gain();
 }
@@ -262,13 +332,14 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   if (s.control_period > s.duration)
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
 
-  read_plant(top.child("plant"), s.plant);
+  read_plant(top.child("plant"), s.plant, true);
 
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");
   if (type == "sliding_mode") {
     s.controller.type = ControllerType::kSlidingMode;
-    s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself
+    s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself,
+    s.controller.sliding_mode.model.effects = {};  // without the effects it does not know
     // A model never carries the plant's sensor or initial state; they are not part of it.
     read_sliding_mode(c, s.controller.sliding_mode);
     s.controller.sliding_mode.period = s.control_period;

@@ -37,7 +37,7 @@ inline std::vector<trajectory::Waypoint> rich_waypoints(double duration, std::ui
   // held at 0 for 0.3 s: the spline then leaves rest smoothly
   std::vector<trajectory::Waypoint> w{{0.0, 0.0}, {0.1, 0.0}, {0.2, 0.0}, {0.3, 0.0}};
   double t = 0.3;
-  while (t + 0.9 < duration) {
+  while (t + 0.7 < duration - 0.4) {  // the last random point stays before the final hold
     t += dt(rng);
     w.push_back({t, x(rng)});
   }

@@ -85,6 +85,11 @@ TEST_P(HiddenEffect, IsNamedRecoveredAndShrinksTheGap) {
     for (std::size_t i = 0; i < st.ranking.size() && i < 4; ++i)
       std::printf("    %-20s %10.4g\n", st.ranking[i].effect.name.c_str(), st.ranking[i].score);
   }
+  for (const auto& e : r.effects) {
+    std::printf("  fitted %s:", e.name.c_str());
+    for (const auto& [k, v] : e.parameters) std::printf(" %s=%.6g", k.c_str(), v);
+    std::printf("\n");
+  }
   ASSERT_FALSE(r.effects.empty()) << "no effect named";
   EXPECT_EQ(r.effects.front().name, c.truth.name);
   if (r.effects.front().name != c.truth.name) return;

@@ -5,7 +5,10 @@
 # feeddrive-sim. Set-up as in docs/deployment.md: an address per host, a multicast route
 # 239.0.0.0/8 on the veth, multicast on.
 source "$(dirname "$0")/lib.sh" "$@"
+command -v ip >/dev/null || fail "ip (Debian package iproute2, scripts/install-deps.sh) is not installed"
 A=fdA$$; B=fdB$$
+ip netns add "$A" 2>/dev/null || skip "cannot create named network namespaces (ip netns add needs root)"
+ip netns del "$A"
 cleanup_ns() { ip netns del "$A" 2>/dev/null || true; ip netns del "$B" 2>/dev/null || true; }
 trap 'cleanup_ns; jobs -p | xargs -r kill -9 2>/dev/null || true; rm -rf "$TMP"' EXIT
 ip netns add "$A"; ip netns add "$B"

@@ -21,5 +21,5 @@ stopped=$(json "$TMP/mp/summary.json" .lockstep.stopped_at_step)
 rows=$(( $(wc -l < "$TMP/mp/timeseries.csv") - 1 ))
 [ "$rows" = "$stopped" ] || fail "$rows rows but stopped_at_step $stopped"
 [ "$stopped" -gt 0 ] && [ "$stopped" -lt 15000 ] || fail "stopped_at_step $stopped"
-json "$TMP/mp/summary.json" .lockstep.failure | grep -q controller || fail "failure does not name the controller"
+failure=$(json "$TMP/mp/summary.json" .lockstep.failure); printf "%s" "$failure" | grep -q controller || fail "failure does not name the controller: $failure"
 pass "controller killed: launch exit $rc after ${elapsed}s; stopped at step $stopped: $(json "$TMP/mp/summary.json" .lockstep.failure)"

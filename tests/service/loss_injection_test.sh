@@ -3,7 +3,12 @@
 # packets at random (every role's messages: states, commands, references, status, resend
 # requests). The run must still complete and be byte-identical to feeddrive-sim.
 source "$(dirname "$0")/lib.sh" "$@"
-command -v nft >/dev/null || fail "nft (Debian package nftables) is not installed"
+# The rule must only ever drop packets in this test's own namespace, never on the host.
+[ "${FEEDDRIVE_NETNS:-}" = private ] ||
+  skip "no private network namespace (run through scripts/netns-run.sh as root or with CAP_SYS_ADMIN): the nftables rule would drop the host's multicast"
+command -v nft >/dev/null || fail "nft (Debian package nftables, scripts/install-deps.sh) is not installed"
+nft list tables >/dev/null 2>&1 || skip "nft cannot change the rules of this namespace (needs CAP_NET_ADMIN)"
+trap 'nft delete table inet fdloss 2>/dev/null || true; jobs -p | xargs -r kill -9 2>/dev/null || true; rm -rf "$TMP"' EXIT
 nft add table inet fdloss
 nft add chain inet fdloss out '{ type filter hook output priority 0; }'
 nft add rule inet fdloss out ip daddr 239.0.0.0/8 numgen random mod 100 '<' 3 counter drop

@@ -11,6 +11,9 @@
 // (a_k = f_v, j_k = sum_j df_v/dy_j * f_j at the period start). Their errors are then bounded by
 // the absolute tolerances, not by rtol times the axis position, and the BDF restart at order 1
 // needs few steps because the deviations start at O(tau^3).
+// The right-hand side is dynamics.hpp's on the effective params (effects.hpp), folded once at
+// construction; the input u given to advance() is the one the ODE sees (Plant::advance delays it
+// for the input_delay effect).
 // Every failed SUNDIALS call becomes a std::runtime_error naming the call and its flag.
 
 #include <memory>

@@ -1,7 +1,8 @@
 #pragma once
 // Pure force laws of the feed drive: no state beyond the arguments, no I/O.
 // Each function gives the equation it implements and its source. Sign convention: every force
-// here *opposes* the thrust, as in m*x'' = Ka*Kf*u - F_friction - F_ripple - F_grinding.
+// here *opposes* the thrust, as in m*x'' = Ka*Kf*u - F_friction - F_ripple - F_grinding (the
+// model-discrepancy effects add - F_extra: effects.hpp).
 
 #include "feeddrive/plant/params.hpp"
 

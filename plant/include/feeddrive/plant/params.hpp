@@ -87,6 +87,97 @@ struct ElectricalParams {
   void validate(const std::string& prefix = "electrical") const;
 };
 
+/// Extra forces of the model-discrepancy vocabulary (issue: feeddrive-fit, docs/fit.md). Each
+/// adds one more force F_extra to  m*x'' = Ka*Kf*u - F_friction - F_ripple - F_grinding - F_extra,
+/// or modifies the model as named. Every effect is off (enabled = false) by default. The field
+/// names are the vocabulary's parameter names; the YAML keys under plant.effects.<name> are the
+/// same strings.
+struct ConstantForceEffect {  ///< F = force_N (gravity on an incline, cable weight, offset)
+  bool enabled{false};
+  double force_N{0.0};
+};
+struct CoulombFrictionEffect {  ///< F = coulomb_N*sgn(v), sgn smoothed as tanh(v/eps) (eps: friction.static_smoothing_velocity)
+  bool enabled{false};
+  double coulomb_N{0.0};
+};
+struct ViscousFrictionEffect {  ///< F = viscous_Ns_per_m*v
+  bool enabled{false};
+  double viscous_Ns_per_m{0.0};
+};
+/// F = sgn(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta)), delta =
+/// friction.stribeck_exponent, sgn smoothed as for coulomb_friction.
+struct StribeckFrictionEffect {
+  bool enabled{false};
+  double static_N{0.0};
+  double coulomb_N{0.0};
+  double stribeck_velocity_mps{0.01};
+};
+/// The LuGre bristle dynamics (Canudas de Wit 1995): the friction becomes LuGre with
+/// sigma0 = bristle_stiffness_N_per_m and sigma1 = bristle_damping_Ns_per_m, keeping Fs, Fc, vs,
+/// delta and sigma2 of the friction section. F_extra = F_LuGre - F_friction(model).
+struct PreslidingEffect {
+  bool enabled{false};
+  double bristle_stiffness_N_per_m{2e6};
+  double bristle_damping_Ns_per_m{0.0};
+};
+/// F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
+struct CoggingRippleEffect {
+  bool enabled{false};
+  double pitch_m{0.03};
+  double amplitude_N{0.0};
+  double phase_rad{0.0};
+  double third_harmonic_N{0.0};
+  double third_phase_rad{0.0};
+};
+/// F = Ka*Kf*u*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)  (the thrust actually produced)
+struct ReluctanceRippleEffect {
+  bool enabled{false};
+  double pitch_m{0.03};
+  double relative_amplitude{0.0};
+  double phase_rad{0.0};
+};
+/// Hahn-Lindsay grinding force (the grinding section's model) with C = gain_Ns_per_m,
+/// ke = stiffness_N_per_m and contact past contact_position_m. Uses the Fg state.
+struct GrindingForceEffect {
+  bool enabled{false};
+  double gain_Ns_per_m{7.85e6};
+  double stiffness_N_per_m{2e7};
+  double contact_position_m{0.0};
+};
+/// F = stiffness_N_per_m*(x - rest_position_m)  (a cable carrier)
+struct SpringForceEffect {
+  bool enabled{false};
+  double stiffness_N_per_m{0.0};
+  double rest_position_m{0.0};
+};
+/// The true moving mass replaces PlantParams::mass.
+struct MassErrorEffect {
+  bool enabled{false};
+  double mass_kg{102.04};
+};
+/// The thrust acts delay_s after the command: F_thrust(t) = Ka*Kf*u(t - delay_s) (u = 0 before t0).
+struct InputDelayEffect {
+  bool enabled{false};
+  double delay_s{0.0};
+};
+
+struct EffectsParams {
+  ConstantForceEffect constant_force;
+  CoulombFrictionEffect coulomb_friction;
+  ViscousFrictionEffect viscous_friction;
+  StribeckFrictionEffect stribeck_friction;
+  PreslidingEffect presliding;
+  CoggingRippleEffect cogging_ripple;
+  ReluctanceRippleEffect reluctance_ripple;
+  GrindingForceEffect grinding_force;
+  SpringForceEffect spring_force;
+  MassErrorEffect mass_error;
+  InputDelayEffect input_delay;
+
+  bool any() const;
+  void validate(const std::string& prefix = "effects") const;
+};
+
 /// Position sensor (encoder) model. Both effects off by default.
 struct SensorParams {
   double quantization{0.0};    ///< q [m]; 0 = ideal. x_meas = q*round((x + n)/q).
@@ -141,6 +232,7 @@ struct PlantParams {
   SensorParams sensor;
   IntegratorParams integrator;
   InitialState initial;
+  EffectsParams effects;  ///< model-discrepancy effects (docs/fit.md); all off by default
 
   double thrust_gain() const { return amplifier_gain * force_constant; }  ///< Ka*Kf [N/V]
   void validate(const std::string& prefix = "plant") const;

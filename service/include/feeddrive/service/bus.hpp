@@ -43,7 +43,7 @@ class Bus {
 
   /// Subscribes to `channel`, decoding every message as Msg. Messages that fail to decode
   /// (another type, another fingerprint, truncated) are counted in invalid() and dropped.
-  /// recv_us is the monotonic receive time [us].
+  /// recv_us is the monotonic time [us] at which LCM received the datagram.
   template <typename Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t recv_us)> handler);
 
@@ -130,9 +130,19 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
       }
       return;
     }
+    // The receive time is when LCM read the datagram off the socket (recv_utime: the kernel's
+    // SO_TIMESTAMP where available, else LCM's clock on reading), not when handle() dispatches
+    // it: a process that drains its socket in batches (the monitor) would otherwise stamp a
+    // whole batch with one time, and the latency per hop would measure nothing. recv_utime is
+    // wall-clock; its age moves it onto the monotonic clock.
+    std::int64_t recv = now;
+    if (rbuf->recv_utime > 0) {
+      const std::int64_t age = wall_utime() - rbuf->recv_utime;
+      if (age > 0 && age < 10000000) recv = now - age;
+    }
     // An exception must not unwind through LCM's C dispatch: keep it for poll() to rethrow.
     try {
-      handler(msg, now);
+      handler(msg, recv);
     } catch (...) {
       if (!error_) error_ = std::current_exception();
     }

@@ -64,6 +64,9 @@ class Node {
   void check_peers() const;
   /// The latest status of a role, if any was seen.
   const process_status_t* peer(const std::string& role) const;
+  /// True if `role` published a status that is not "failed" within the last `seconds`: it is
+  /// alive and running its own timeouts, so a wait on it is not yet its fault to report.
+  bool peer_alive(const std::string& role, double seconds) const;
   bool monitor_done() const;
 
   std::int64_t resends{0};
@@ -84,6 +87,7 @@ class Node {
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
   std::map<std::string, process_status_t> peers_;
+  std::map<std::string, std::int64_t> peer_seen_us_;
 };
 
 /// Installs SIGINT/SIGTERM handlers that make every wait end with RunFailure("interrupted").

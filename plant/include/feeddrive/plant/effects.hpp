@@ -1,0 +1,52 @@
+#pragma once
+// The model-discrepancy effects (params.hpp: EffectsParams; docs/fit.md) as pure functions.
+//
+// The plant equation with effects is
+//   m_eff*x'' = F_thrust_eff - F_friction_eff - F_ripple - F_grinding_eff - F_extra
+// where
+//   * effective_params() folds the effects that *modify* a sub-model into the base sections:
+//       presliding     -> friction.model = lugre, sigma0 = bristle_stiffness_N_per_m,
+//                         sigma1 = bristle_damping_Ns_per_m (Fs, Fc, vs, delta, sigma2 kept);
+//       grinding_force -> grinding.enabled, C = gain_Ns_per_m (dullness = C/(pi*dw*bs)),
+//                         ke = stiffness_N_per_m, contact_position = contact_position_m;
+//       mass_error     -> mass = mass_kg;
+//     (input_delay is applied by Plant::advance: the thrust uses u(t - delay_s));
+//   * extra_force() is the sum of the additive effects:
+//       constant_force     F = force_N
+//       coulomb_friction   F = coulomb_N*sgn_eps(v)
+//       viscous_friction   F = viscous_Ns_per_m*v
+//       stribeck_friction  F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))
+//       cogging_ripple     F = amplitude_N*sin(2 pi x/pitch_m + phase_rad)
+//                            + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
+//       reluctance_ripple  F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)
+//       spring_force       F = stiffness_N_per_m*(x - rest_position_m)
+//     with sgn_eps(v) = tanh(v/eps), eps = friction.static_smoothing_velocity, and
+//     delta = friction.stribeck_exponent.
+
+#include "feeddrive/plant/params.hpp"
+
+namespace feeddrive::plant {
+
+/// The params with presliding, grinding_force and mass_error folded into the base sections
+/// (see above). The effects themselves are left in place (extra_force() ignores those three).
+PlantParams effective_params(const PlantParams& p);
+
+/// Sum of the additive effects at position x [m], velocity v [m/s] and produced thrust [N].
+double extra_force(const PlantParams& p, double x, double v, double thrust);
+
+/// Partial derivatives of extra_force() with respect to x and v (for the analytic Jacobian), and
+/// with respect to the thrust (reluctance_ripple: relative_amplitude*sin(2 pi x/pitch_m + phase_rad);
+/// the Jacobian's d/di is Kf times it with the electrical option).
+struct ExtraForceGradient {
+  double dx{0.0};
+  double dv{0.0};
+  double dthrust{0.0};
+};
+ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v, double thrust);
+
+/// True if any effect that effective_params() folds in (presliding, grinding_force, mass_error) is on.
+bool folds_into_params(const EffectsParams& e);
+/// True if any additive effect (a term of extra_force()) is on; extra_force() is 0 otherwise.
+bool has_extra_force(const EffectsParams& e);
+
+}  // namespace feeddrive::plant

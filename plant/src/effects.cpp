@@ -1,0 +1,112 @@
+#include "feeddrive/plant/effects.hpp"
+
+#include <cmath>
+
+#include "feeddrive/plant/forces.hpp"
+
+namespace feeddrive::plant {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// The Stribeck curve of the stribeck_friction effect as a FrictionParams, so that it shares
+// forces.hpp's g(v) and dg/dv (and their delta = 1, 2 fast paths):
+//   g(v) = coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta).
+FrictionParams stribeck_curve(const PlantParams& p) {
+  const StribeckFrictionEffect& e = p.effects.stribeck_friction;
+  FrictionParams f;
+  f.static_force = e.static_N;
+  f.coulomb_force = e.coulomb_N;
+  f.stribeck_velocity = e.stribeck_velocity_mps;
+  f.stribeck_exponent = p.friction.stribeck_exponent;
+  return f;
+}
+
+}  // namespace
+
+bool folds_into_params(const EffectsParams& e) {
+  return e.presliding.enabled || e.grinding_force.enabled || e.mass_error.enabled;
+}
+
+bool has_extra_force(const EffectsParams& e) {
+  return e.constant_force.enabled || e.coulomb_friction.enabled || e.viscous_friction.enabled ||
+         e.stribeck_friction.enabled || e.cogging_ripple.enabled || e.reluctance_ripple.enabled ||
+         e.spring_force.enabled;
+}
+
+PlantParams effective_params(const PlantParams& p) {
+  PlantParams e = p;
+  const EffectsParams& fx = p.effects;
+  if (fx.presliding.enabled) {
+    e.friction.model = FrictionModel::kLuGre;
+    e.friction.bristle_stiffness = fx.presliding.bristle_stiffness_N_per_m;
+    e.friction.bristle_damping = fx.presliding.bristle_damping_Ns_per_m;
+  }
+  if (fx.grinding_force.enabled) {
+    e.grinding.enabled = true;
+    // C = c*pi*dw*bs (GrindingParams::damping), solved for the dullness c.
+    e.grinding.dullness =
+        fx.grinding_force.gain_Ns_per_m / (M_PI * p.grinding.workpiece_diameter * p.grinding.wheel_width);
+    e.grinding.stiffness = fx.grinding_force.stiffness_N_per_m;
+    e.grinding.contact_position = fx.grinding_force.contact_position_m;
+  }
+  if (fx.mass_error.enabled) e.mass = fx.mass_error.mass_kg;
+  return e;
+}
+
+double extra_force(const PlantParams& p, double x, double v, double thrust) {
+  const EffectsParams& fx = p.effects;
+  const double eps = p.friction.static_smoothing_velocity;
+  double F = 0.0;
+  if (fx.constant_force.enabled) F += fx.constant_force.force_N;
+  if (fx.coulomb_friction.enabled) F += fx.coulomb_friction.coulomb_N * std::tanh(v / eps);
+  if (fx.viscous_friction.enabled) F += fx.viscous_friction.viscous_Ns_per_m * v;
+  if (fx.stribeck_friction.enabled) F += std::tanh(v / eps) * stribeck(stribeck_curve(p), v);
+  if (fx.cogging_ripple.enabled) {
+    const CoggingRippleEffect& c = fx.cogging_ripple;
+    const double th = kTwoPi * x / c.pitch_m;
+    F += c.amplitude_N * std::sin(th + c.phase_rad) + c.third_harmonic_N * std::sin(3.0 * th + c.third_phase_rad);
+  }
+  if (fx.reluctance_ripple.enabled) {
+    const ReluctanceRippleEffect& r = fx.reluctance_ripple;
+    F += thrust * r.relative_amplitude * std::sin(kTwoPi * x / r.pitch_m + r.phase_rad);
+  }
+  if (fx.spring_force.enabled) F += fx.spring_force.stiffness_N_per_m * (x - fx.spring_force.rest_position_m);
+  return F;
+}
+
+ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v, double thrust) {
+  const EffectsParams& fx = p.effects;
+  const double eps = p.friction.static_smoothing_velocity;
+  ExtraForceGradient g;
+  // d/dv tanh(v/eps) = (1 - tanh^2)/eps
+  if (fx.coulomb_friction.enabled) {
+    const double th = std::tanh(v / eps);
+    g.dv += fx.coulomb_friction.coulomb_N * (1.0 - th * th) / eps;
+  }
+  if (fx.viscous_friction.enabled) g.dv += fx.viscous_friction.viscous_Ns_per_m;
+  if (fx.stribeck_friction.enabled) {
+    // d/dv [tanh(v/eps)*g(v)] = (1 - tanh^2)/eps*g(v) + tanh(v/eps)*g'(v)
+    const FrictionParams curve = stribeck_curve(p);
+    const double th = std::tanh(v / eps);
+    g.dv += (1.0 - th * th) / eps * stribeck(curve, v) + th * stribeck_derivative(curve, v);
+  }
+  if (fx.cogging_ripple.enabled) {
+    const CoggingRippleEffect& c = fx.cogging_ripple;
+    const double w = kTwoPi / c.pitch_m;
+    const double th = w * x;
+    g.dx += w * (c.amplitude_N * std::cos(th + c.phase_rad) +
+                 3.0 * c.third_harmonic_N * std::cos(3.0 * th + c.third_phase_rad));
+  }
+  if (fx.reluctance_ripple.enabled) {
+    const ReluctanceRippleEffect& r = fx.reluctance_ripple;
+    const double w = kTwoPi / r.pitch_m;
+    const double phase = w * x + r.phase_rad;
+    g.dx += thrust * r.relative_amplitude * w * std::cos(phase);
+    g.dthrust += r.relative_amplitude * std::sin(phase);
+  }
+  if (fx.spring_force.enabled) g.dx += fx.spring_force.stiffness_N_per_m;
+  return g;
+}
+
+}  // namespace feeddrive::plant
