@@ -106,3 +106,41 @@ INSTANTIATE_TEST_SUITE_P(Vocabulary, HiddenEffect, ::testing::ValuesIn(cases()),
 
 }  // namespace
 }  // namespace feeddrive::fit
+
+namespace feeddrive::fit {
+namespace {
+
+// The same at another sample rate and encoder: 5 kHz, 100 nm quantization, 4 s (the filter
+// half-width stays 10 ms, now 50 samples). Two effects of different kinds: a ripple (position
+// regressor) and input delay (time regressor, the one most sensitive to the sample period).
+TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
+  const std::vector<Effect> effects = {
+      {"reluctance_ripple", {{"pitch_m", 0.032}, {"relative_amplitude", 0.04}, {"phase_rad", 1.1}}},
+      {"input_delay", {{"delay_s", 1.1e-3}}}};
+  for (const Effect& e : effects) {
+    const plant::PlantParams model = test::base_model();
+    plant::PlantParams truth = model;
+    apply_effect(e, truth);
+    test::Recording ro;
+    ro.period = 2e-4;
+    ro.quantization = 100e-9;
+    ro.duration = 4.0;
+    ro.seed = 23;
+    const MeasuredData data = test::record(truth, ro, test::temp_dir());
+    FitOptions opt;
+    opt.max_effects = 1;
+    const FitResult r = run_fit(prepare(data), model, opt);
+    ASSERT_FALSE(r.effects.empty()) << e.name << ": " << r.steps.front().verdict;
+    EXPECT_EQ(r.effects.front().name, e.name);
+    if (r.effects.front().name != e.name) continue;
+    // pitch within 2 %, delay within 20 % (the tolerances of the 1 kHz tests)
+    if (e.name == "reluctance_ripple")
+      EXPECT_NEAR(r.effects.front().parameters.at("pitch_m"), 0.032, 0.02 * 0.032);
+    else
+      EXPECT_NEAR(r.effects.front().parameters.at("delay_s"), 1.1e-3, 0.2 * 1.1e-3);
+    EXPECT_LT(r.steps.front().gap_after, r.steps.front().gap_before / 5.0) << e.name;
+  }
+}
+
+}  // namespace
+}  // namespace feeddrive::fit
