@@ -132,17 +132,18 @@ Localisation localise(const Record& rec, const Eigen::VectorXd& r, const Replay&
   std::vector<int> vel(n), acc(n), pos(n), tim(n);
   const int npos = 8, ntim = 10;
   const double t0 = d.t.front(), t1 = d.t.back(), range = std::max(rec.x_max - rec.x_min, 1e-12);
-  // reversal: within +-L of the sample the velocity is both above v0 and below -v0
+  // reversal: within +-3L of the sample the velocity is both above v0/2 and below -v0/2
   std::vector<char> reversal(n, 0);
   {
+    const double R = 3.0 * L, vr = 0.5 * v0;
     long lo = 0, hi = 0;
     for (long k = 0; k < n; ++k) {
-      while (d.t[k] - d.t[lo] > L) ++lo;
-      while (hi + 1 < n && d.t[hi + 1] - d.t[k] <= L) ++hi;
+      while (d.t[k] - d.t[lo] > R) ++lo;
+      while (hi + 1 < n && d.t[hi + 1] - d.t[k] <= R) ++hi;
       bool up = false, down = false;
       for (long j = lo; j <= hi; ++j) {
-        up = up || m.v[j] > v0;
-        down = down || m.v[j] < -v0;
+        up = up || m.v[j] > vr;
+        down = down || m.v[j] < -vr;
       }
       reversal[k] = up && down;
     }
@@ -172,7 +173,7 @@ Localisation localise(const Record& rec, const Eigen::VectorXd& r, const Replay&
                   1e3 * (rec.x_min + range * (b + 1) / npos));
     pl.push_back(buf);
   }
-  std::snprintf(buf, sizeof buf, "near zero velocity (|v| < %.3g mm/s)", v0 * 1e3);
+  std::snprintf(buf, sizeof buf, "near zero velocity (below %.3g mm/s)", v0 * 1e3);
   loc.time = bins(tl, at_points(tim), r, tim, rp);
   loc.velocity = bins({"reversal", buf, "moving"}, at_points(vel), r, vel, rp);
   loc.acceleration = bins({"constant velocity", "accelerating", "decelerating"}, at_points(acc), r, acc, rp);

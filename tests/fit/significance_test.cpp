@@ -8,8 +8,9 @@
 namespace feeddrive::fit {
 namespace {
 
-// A constant 15 N (an inclined axis) and a 4 N cogging ripple of 24 mm pitch: both are found, the
-// larger one first, and together they shrink the gap at least 5x.
+// A constant 15 N (an inclined axis) and a 4 N cogging ripple of 24 mm pitch (0.9 % of the 450 N
+// peak thrust of these records): both are found, the larger one first, and together they shrink
+// the gap at least 5x.
 TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   const plant::PlantParams model = test::base_model();
   plant::PlantParams truth = model;
@@ -31,6 +32,30 @@ TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   EXPECT_NEAR(r.effects[1].parameters.at("pitch_m"), 0.024, 0.02 * 0.024);
   EXPECT_NEAR(r.effects[1].parameters.at("amplitude_N"), 4.0, 0.8);
   EXPECT_LT(r.replay_final.gap, r.replay_initial.gap / 5.0);
+}
+
+// The input given as the thrust itself (column force_N, thrust = Ka*Kf*u) instead of u: the same
+// effect with the same force. 1 %: the two runs differ only in rounding of the thrust.
+TEST(FitSignificance, ForceInputFindsTheSameEffect) {
+  const plant::PlantParams model = test::base_model();
+  plant::PlantParams truth = model;
+  apply_effect({"constant_force", {{"force_N", -12.0}}}, truth);
+  test::Recording ro;
+  ro.seed = 8;
+  ro.duration = 5.0;
+  const MeasuredData data = test::record(truth, ro, test::temp_dir());
+  MeasuredData forces = data;
+  forces.input_kind = InputKind::kForce;
+  for (double& u : forces.input) u *= model.thrust_gain();
+  FitOptions opt;
+  opt.max_effects = 1;
+  const FitResult a = run_fit(prepare(data), model, opt);
+  const FitResult b = run_fit(prepare(forces), model, opt);
+  ASSERT_EQ(a.effects.size(), 1u);
+  ASSERT_EQ(b.effects.size(), 1u);
+  EXPECT_EQ(b.effects[0].name, "constant_force");
+  EXPECT_NEAR(b.effects[0].parameters.at("force_N"), a.effects[0].parameters.at("force_N"), 0.12);
+  EXPECT_NEAR(b.replay_final.gap, a.replay_final.gap, 0.01 * a.replay_final.gap);
 }
 
 // The model is the drive: only the encoder (50 nm), position noise (20 nm) and time-stamp jitter
