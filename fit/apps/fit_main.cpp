@@ -28,37 +28,27 @@ int main(int argc, char** argv) {
   app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")->capture_default_str();
   app.add_option("--filter-half-width", opt.record.filter_half_width, "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
       ->capture_default_str();
-  app.add_option("--prefix", prefix, "channel prefix of an LCM log")->capture_default_str();
+  app.add_option("--prefix", prefix, "channel prefix of an LCM log (ignored for CSV)")->capture_default_str();
   app.add_option("--position-column", csv.position_column, "CSV column with the measured position")->capture_default_str();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only the result table and errors");
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {  // one line, as for every bad input
+    std::fprintf(stderr, "error: %s (see --help)\n", e.what());
+    return 2;
   }
   spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
   try {
-    sim::Scenario scenario;
-    fit::MeasuredData data;
-    try {
-      scenario = sim::load_scenario(scenario_path);
-      data = fit::load_data(data_path, prefix, csv);
-    } catch (const sim::ScenarioError& e) {
-      std::fprintf(stderr, "error: %s\n", e.what());
-      return 2;
-    } catch (const fit::DataError& e) {
-      std::fprintf(stderr, "error: %s\n", e.what());
-      return 2;
-    }
-    fit::Record rec;
-    try {
-      rec = fit::prepare(data, opt.record);
-    } catch (const fit::DataError& e) {
-      std::fprintf(stderr, "error: %s\n", e.what());
-      return 2;
-    }
+    // Bad input (scenario, data, too short a record, an --out that must not be replaced) is a
+    // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.
+    fit::check_output_dir(out_dir);
+    const sim::Scenario scenario = sim::load_scenario(scenario_path);
+    const fit::MeasuredData data = fit::load_data(data_path, prefix, csv);
+    const fit::Record rec = fit::prepare(data, opt.record);
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),
                  scenario_path);
     const fit::FitResult r = fit::run_fit(rec, scenario.plant, opt, [](const std::string& s) { spdlog::info("{}", s); });
@@ -72,7 +62,13 @@ int main(int argc, char** argv) {
                     st.force_rms_after);
     std::printf("%s\nresults: %s/{findings.json,model.fitted.yaml,report.md}\n", r.conclusion.c_str(), out_dir.c_str());
     return 0;
-  } catch (const std::invalid_argument& e) {
+  } catch (const sim::ScenarioError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const fit::DataError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {  // e.g. --out names an unrelated folder
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -74,6 +75,7 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
   std::vector<std::string> header;
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (!trim(line).empty()) {
       header = split(line);
       break;
@@ -87,10 +89,13 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
     if (!col.emplace(header[c], c).second)
       throw DataError(origin + ": line " + std::to_string(line_no) + ": column '" + header[c] + "' appears twice");
   }
+  const std::string hint = (header.size() == 1 && (line.find(';') != std::string::npos || line.find('\t') != std::string::npos))
+                               ? "; columns must be separated by commas"
+                               : "";
   const auto require = [&](const std::string& name) {
     const auto it = col.find(name);
     if (it == col.end())
-      throw DataError(origin + ": missing column '" + name + "' (header: " + short_value(line) + ")");
+      throw DataError(origin + ": missing column '" + name + "' (header: " + short_value(line) + hint + ")");
     return it->second;
   };
   const std::size_t ct = require("t");
@@ -103,11 +108,12 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
     cu = col["force_N"];
     d.input_kind = InputKind::kForce;
   } else {
-    throw DataError(origin + ": missing column 'u' or 'force_N' (the input; header: " + short_value(line) + ")");
+    throw DataError(origin + ": missing column 'u' or 'force_N' (the input; header: " + short_value(line) + hint + ")");
   }
   const long cxd = col.count("xd") ? static_cast<long>(col["xd"]) : -1;
   const long cv = col.count("v") ? static_cast<long>(col["v"]) : -1;
 
+  std::string previous_t;
   while (std::getline(in, line)) {
     ++line_no;
     if (trim(line).empty()) continue;
@@ -129,8 +135,9 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
     const double t = number(ct);
     if (!d.t.empty() && !(t > d.t.back()))
       throw DataError(origin + ": line " + std::to_string(line_no) + ", column t: " + cells[ct] +
-                      (t == d.t.back() ? " repeats the previous time" : " is before the previous time ") +
-                      (t == d.t.back() ? "" : std::to_string(d.t.back())) + " (times must increase)");
+                      (t == d.t.back() ? " repeats the previous time" : " is before the previous time " + previous_t) +
+                      " (times must increase)");
+    previous_t = cells[ct];
     d.t.push_back(t);
     d.x.push_back(number(cx));
     d.input.push_back(number(cu));
@@ -142,6 +149,8 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
 }
 
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw DataError(path + ": is a folder, not a data file");
   std::ifstream f(path, std::ios::binary);
   if (!f) throw DataError(path + ": cannot open the data file");
   std::ostringstream ss;

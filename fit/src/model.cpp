@@ -157,21 +157,21 @@ Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Int
   // Friction along the motion is the costly part and the same for every candidate that does
   // not change the friction model: it is cached (filtered) with the params it was computed for.
   Record::Cache& c = *r.cache;
-  if (!c.friction_valid || !same(c.friction, pe.friction) || c.bristle0 != pe.initial.bristle) {
+  const auto refresh = [&](int part, bool& valid, Eigen::VectorXd& filtered, std::vector<double>& state) {
     Eigen::VectorXd f;
-    internal_force(r, pe, 0, f, c.z);
-    c.friction_filtered = apply(r.bank, f);
+    internal_force(r, pe, part, f, state);
+    filtered = apply(r.bank, f);
+    valid = true;
+  };
+  if (!c.friction_valid || !same(c.friction, pe.friction) || c.bristle0 != pe.initial.bristle) {
+    refresh(0, c.friction_valid, c.friction_filtered, c.z);
     c.friction = pe.friction;
     c.bristle0 = pe.initial.bristle;
-    c.friction_valid = true;
   }
   if (!c.grinding_valid || !same(c.grinding, pe.grinding) || c.grinding0 != pe.initial.grinding) {
-    Eigen::VectorXd f;
-    internal_force(r, pe, 1, f, c.fg);
-    c.grinding_filtered = apply(r.bank, f);
+    refresh(1, c.grinding_valid, c.grinding_filtered, c.fg);
     c.grinding = pe.grinding;
     c.grinding0 = pe.initial.grinding;
-    c.grinding_valid = true;
   }
   if (internal) {
     internal->z = c.z;

@@ -131,15 +131,17 @@ void run_gnuplot(const fs::path& dir, const std::string& script) {
 
 }  // namespace
 
+void check_output_dir(const std::string& out_dir) {
+  std::error_code ec;
+  const fs::path d(out_dir);
+  if (fs::exists(d, ec) && !(fs::is_directory(d, ec) && (fs::is_empty(d, ec) || fs::exists(d / "findings.json", ec))))
+    throw std::invalid_argument("--out " + out_dir +
+                                ": exists and is not an earlier feeddrive-fit output (no findings.json); not replacing it");
+}
+
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
                    const FitResult& r, bool plots) {
-  {
-    std::error_code ec;
-    const fs::path d(out_dir);
-    if (fs::exists(d, ec) && !(fs::is_directory(d, ec) && (fs::is_empty(d, ec) || fs::exists(d / "findings.json", ec))))
-      throw std::invalid_argument("--out " + out_dir +
-                                  ": exists and is not an earlier feeddrive-fit output (no findings.json); not replacing it");
-  }
+  check_output_dir(out_dir);
   const fs::path final_dir = fs::absolute(out_dir);
   const fs::path tmp = final_dir.parent_path() / (final_dir.filename().string() + ".tmp-" + std::to_string(::getpid()));
   fs::remove_all(tmp);

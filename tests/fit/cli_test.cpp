@@ -34,6 +34,16 @@ fs::path scratch() {
   return dir;
 }
 
+// Removes the scratch folder when the test program ends.
+class ScratchCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(scratch(), ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
@@ -64,7 +74,7 @@ ProcResult run(const std::string& exe, const std::string& args, int timeout_s = 
 
 ProcResult run_fit(const std::string& args) { return run(kFit, args); }
 
-// A good model scenario: the fit tests' model, but the real data never reach the fit on bad input.
+// A valid model (the bad-input cases fail on the data, before any fit).
 fs::path model_scenario() { return kScenarios / "model.yaml"; }
 
 // n rows of t, x, u (1 kHz, a slow sine): valid data, for the cases that break one thing in it.
@@ -155,6 +165,42 @@ TEST(FitCli, UnreadableDataFile) {
   EXPECT_NE(l.err.find("does_not_exist.lcmlog: cannot open"), std::string::npos) << l.err;
   // An empty CSV file.
   expect_data_error("empty.csv", "", {"empty.csv", "empty file"});
+}
+
+TEST(FitCli, FolderSeparatorAndByteOrderMark) {
+  // A folder given as the data file says so.
+  fs::create_directories(scratch() / "adir");
+  const fs::path out = scratch() / "out_adir";
+  const ProcResult r = run_fit("--scenario " + model_scenario().string() + " --data " + (scratch() / "adir").string() +
+                               " --out " + out.string() + " -q --no-plots");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("is a folder"), std::string::npos) << r.err;
+  // Semicolons instead of commas: the message says what separates columns.
+  expect_data_error("semicolons.csv", csv("t;x;u", good_rows(100)), {"missing column 't'", "separated by commas"});
+  // A UTF-8 byte-order mark before the header is not part of the first column's name: the file
+  // is read, and fails only where it is meant to (too few rows).
+  expect_data_error("bom.csv", "\xEF\xBB\xBF" + csv("t,x,u", good_rows(10)), {"bom.csv", "10 samples"});
+}
+
+TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
+  // A missing or out-of-range option: one line, exit 2.
+  for (const std::string args : {"--scenario x.yaml --data y.csv", "--scenario x.yaml --data y.csv --out z --max-effects 99"}) {
+    const ProcResult r = run_fit(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": [" << r.err << "]";
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  }
+  // --out naming an unrelated folder is refused before anything is loaded: the data file need
+  // not even exist for the message to be about the folder.
+  fs::create_directories(scratch() / "mine");
+  std::ofstream(scratch() / "mine" / "keep.txt") << "mine\n";
+  const ProcResult r = run_fit("--scenario " + model_scenario().string() + " --data " +
+                               (scratch() / "not_there.csv").string() + " --out " + (scratch() / "mine").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("mine"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("not_there.csv"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(scratch() / "mine" / "keep.txt"), "mine\n");
 }
 
 TEST(FitCli, CorruptLcmLog) {

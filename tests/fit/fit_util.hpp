@@ -3,7 +3,10 @@
 // loop under the cascade controller, following a rich seeded reference (random waypoints through
 // a natural cubic spline: reversals, low and high speeds, travel over several magnet pitches),
 // recorded like a real drive: encoder quantization, position noise, time stamps with jitter.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "feeddrive/fit/data.hpp"
@@ -75,9 +78,18 @@ inline std::string write_waypoints(const std::vector<trajectory::Waypoint>& w, c
 
 /// Runs the recording and returns what the tool sees (t with jitter, measured x, u, xd).
 inline MeasuredData record(const plant::PlantParams& truth, const Recording& r, const std::string& tmp_dir) {
-  const std::string wp =
-      write_waypoints(rich_waypoints(r.duration, r.seed), tmp_dir + "/waypoints-" + std::to_string(r.seed) + ".csv");
-  const sim::RunResult run = sim::run(recording_scenario(truth, r, wp));
+  // one file per process and seed: ctest runs test cases in parallel processes
+  const std::string wp = write_waypoints(rich_waypoints(r.duration, r.seed),
+                                         tmp_dir + "/feeddrive-waypoints-" + std::to_string(::getpid()) + "-" +
+                                             std::to_string(r.seed) + ".csv");
+  sim::RunResult run;
+  try {
+    run = sim::run(recording_scenario(truth, r, wp));
+  } catch (...) {
+    std::remove(wp.c_str());
+    throw;
+  }
+  std::remove(wp.c_str());
   std::mt19937_64 rng(r.seed * 104729 + 3);
   std::uniform_real_distribution<double> jit(-r.jitter * r.period, r.jitter * r.period);
   MeasuredData d;

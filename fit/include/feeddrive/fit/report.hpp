@@ -16,6 +16,10 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
 /// gap_after}], ...}.
 std::string findings_json(const FitResult& r);
 
+/// Throws std::invalid_argument unless out_dir is absent, empty, or an earlier feeddrive-fit
+/// output (holds findings.json): an unrelated folder is never replaced.
+void check_output_dir(const std::string& out_dir);
+
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
                    const FitResult& r, bool plots);
 
