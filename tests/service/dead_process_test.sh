@@ -1,25 +1,35 @@
 #!/usr/bin/env bash
-# A process that dies: kill -9 the controller mid-run. The others must time out with an error
-# naming the controller and the step, exit non-zero, never hang, and the monitor must write
-# what it recorded, with the step where the run stopped.
+# A process that dies: kill -9 the controller, then (in a new run) the plant, then the
+# trajectory, mid-run. The others must time out with an error naming the dead role and the step,
+# exit non-zero, never hang, and the monitor must write what it recorded, with the step where the
+# run stopped.
 source "$(dirname "$0")/lib.sh" "$@"
-scen=$SRC/scenarios/paper/smc_bl_jerk_limited.yaml
+# The jerk-limited move held for 10 s (100,000 steps, ~10 s of lockstep): still running when a
+# process is killed after 1.5 s, however fast the machine.
+scen=$TMP/long.yaml
+sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+grep -q '^duration: 10.0' "$scen" || fail "could not lengthen the scenario"
 opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
-start=$(date +%s)
-timeout 60 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots --external controller "${opts[@]}" 2> "$TMP/launch.err" & l=$!
-feeddrive-controller "$scen" "${opts[@]}" -q & c=$!   # no timeout wrapper: $c must be the controller itself
-sleep 1.5
-kill -9 $c; echo "killed controller"
-set +e; wait $l; rc=$?; set -e
-elapsed=$(( $(date +%s) - start ))
-[ $rc -ne 0 ] || fail "launch exited 0 after the controller died"
-[ $rc -ne 124 ] || fail "launch hung (timeout)"
-grep -q "no command from the controller for step" "$TMP/launch.err" || { cat "$TMP/launch.err" >&2; fail "no error naming the controller"; }
-[ -f "$TMP/mp/summary.json" ] || fail "the monitor wrote no summary"
-[ "$(json "$TMP/mp/summary.json" .lockstep.completed)" = false ] || fail "summary says completed"
-stopped=$(json "$TMP/mp/summary.json" .lockstep.stopped_at_step)
-rows=$(( $(wc -l < "$TMP/mp/timeseries.csv") - 1 ))
-[ "$rows" = "$stopped" ] || fail "$rows rows but stopped_at_step $stopped"
-[ "$stopped" -gt 0 ] && [ "$stopped" -lt 15000 ] || fail "stopped_at_step $stopped"
-failure=$(json "$TMP/mp/summary.json" .lockstep.failure); printf "%s" "$failure" | grep -q controller || fail "failure does not name the controller: $failure"
-pass "controller killed: launch exit $rc after ${elapsed}s; stopped at step $stopped: $(json "$TMP/mp/summary.json" .lockstep.failure)"
+for role in controller plant trajectory; do
+  out=$TMP/$role
+  start=$(date +%s)
+  timeout 60 feeddrive-launch "$scen" --out "$out" --no-plots --external "$role" "${opts[@]}" 2> "$TMP/launch-$role.err" & l=$!
+  "feeddrive-$role" "$scen" "${opts[@]}" -q & p=$!   # no timeout wrapper: $p must be the process itself
+  sleep 1.5
+  kill -9 $p; echo "killed $role"
+  set +e; wait $l; rc=$?; set -e
+  elapsed=$(( $(date +%s) - start ))
+  [ $rc -ne 0 ] || fail "launch exited 0 after the $role died"
+  [ $rc -ne 124 ] || fail "launch hung (timeout) after the $role died"
+  grep -Eq "from the $role (for|within)? ?.*step [0-9]+|$role.*step [0-9]+" "$TMP/launch-$role.err" ||
+    { cat "$TMP/launch-$role.err" >&2; fail "no error naming the $role and the step"; }
+  [ -f "$out/summary.json" ] || fail "the monitor wrote no summary ($role killed)"
+  [ "$(json "$out/summary.json" .lockstep.completed)" = false ] || fail "summary says completed ($role killed)"
+  stopped=$(json "$out/summary.json" .lockstep.stopped_at_step)
+  rows=$(( $(wc -l < "$out/timeseries.csv") - 1 ))
+  [ "$rows" = "$stopped" ] || fail "$rows rows but stopped_at_step $stopped ($role killed)"
+  [ "$stopped" -gt 0 ] && [ "$stopped" -lt 100000 ] || fail "stopped_at_step $stopped ($role killed)"
+  failure=$(json "$out/summary.json" .lockstep.failure)
+  printf "%s" "$failure" | grep -q "$role" || fail "failure does not name the $role: $failure"
+  pass "$role killed: launch exit $rc after ${elapsed}s; stopped at step $stopped: $failure"
+done
