@@ -22,15 +22,12 @@ void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
     }
     last_state_us_ = recv_us;
   }
-  if (attach_ && !started_) {
-    next_ = m.seq;
-    started_ = true;
-  }
   if (m.seq < next_ || states_.count(m.seq)) {
     ++duplicates_;
     return;
   }
   states_[m.seq] = {m, recv_us};
+  maybe_start();
   const auto c = cmds_.find(m.seq - 1);
   if (c != cmds_.end() && recv_us >= c->second.recv_us) lat_cs_.push_back(static_cast<double>(recv_us - c->second.recv_us));
 }
@@ -41,6 +38,8 @@ void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
     return;
   }
   refs_[m.seq] = {m, recv_us};
+  if (first_ref_seq_ < 0) first_ref_seq_ = m.seq;
+  maybe_start();
   const auto s = states_.find(m.seq - 1);
   if (s != states_.end() && recv_us >= s->second.recv_us) lat_sr_.push_back(static_cast<double>(recv_us - s->second.recv_us));
 }
@@ -55,8 +54,21 @@ void Recorder::on_command(const control_command_t& m, std::int64_t recv_us) {
   if (s != states_.end() && recv_us >= s->second.recv_us) lat_sc_.push_back(static_cast<double>(recv_us - s->second.recv_us));
 }
 
+void Recorder::maybe_start() {
+  // Attach mode: references arrive in blocks ahead of the states, so the first row is the first
+  // step for which both the state and the reference can have been seen: max(first state, first
+  // reference). What came before it is dropped.
+  if (!attach_ || started_ || first_state_seq_ < 0 || first_ref_seq_ < 0) return;
+  next_ = std::max(first_state_seq_, first_ref_seq_);
+  started_ = true;
+  states_.erase(states_.begin(), states_.lower_bound(next_));
+  refs_.erase(refs_.begin(), refs_.lower_bound(next_));
+  cmds_.erase(cmds_.begin(), cmds_.lower_bound(next_));
+}
+
 std::size_t Recorder::flush() {
   std::size_t added = 0;
+  if (attach_ && !started_) return 0;
   for (;;) {
     if (steps_ >= 0 && next_ >= steps_) break;
     const auto s = states_.find(next_);

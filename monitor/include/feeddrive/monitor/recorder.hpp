@@ -29,7 +29,8 @@ struct Missing {
 class Recorder {
  public:
   /// attach = false: rows start at step 0 and a gap is never skipped. attach = true: rows start
-  /// at the first step whose state is seen (joining a running system or a log mid-way).
+  /// at the first step whose state and reference can both have been seen, max(first state,
+  /// first reference) (joining a running system or a log mid-way).
   explicit Recorder(bool attach = false) : attach_(attach) {}
 
   void on_state(const drive_state_t& m, std::int64_t recv_us);
@@ -82,6 +83,8 @@ class Recorder {
   std::int64_t duplicates_{0};
   std::int64_t commandless_{0};
   std::int64_t first_state_seq_{-1}, first_state_us_{0}, last_state_us_{0};
+  std::int64_t first_ref_seq_{-1};
+  void maybe_start();
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
   bool safe_state_{false};
