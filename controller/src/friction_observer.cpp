@@ -40,7 +40,7 @@ void GrindingObserver::advance(double x, double v) {
   if (!std::isfinite(x) || !std::isfinite(v)) return;  // no information: hold F^g
   const double tau = p_.time_constant();
   const double decay = std::exp(-period_ / tau);
-  const double target = plant::in_contact(p_, x) ? p_.damping() * v : 0.0;
+  const double target = plant::contact_fraction(p_, x) * p_.damping() * v;
   fg_ = target + (fg_ - target) * decay;
 }
 

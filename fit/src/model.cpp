@@ -74,7 +74,7 @@ double advance_z(const plant::FrictionParams& f, double z, double v, double h) {
 double advance_fg(const plant::GrindingParams& g, double fg, double x, double v, double h) {
   if (!g.enabled) return fg;
   const double C = g.damping();
-  const double fss = plant::in_contact(g, x) ? C * v : 0.0;
+  const double fss = plant::contact_fraction(g, x) * C * v;
   return fss + (fg - fss) * std::exp(-g.stiffness / C * h);
 }
 

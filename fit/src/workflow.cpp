@@ -92,7 +92,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       break;
     }
     st.accepted = true;
-    st.verdict = "added " + best->effect.name + fmt(": gap %.4g -> %.4g um", rp.gap * 1e6, rp2.gap * 1e6);
+    st.verdict = "added " + best->effect.name + fmt(": gap %.4g -> %.4g um", rp.gap * 1e6, rp2.gap * 1e6) +
+                 (why.empty() ? "" : " (passed over: " + why + ")");
     say(st.verdict);
     out.steps.push_back(st);
     current = trial;

@@ -55,10 +55,11 @@ Jacobian jacobian_of(const PlantParams& p, bool extra, const State& s, double u)
   }
   ExtraForceGradient dFe;
   if (extra) dFe = extra_force_gradient(p, s.x, s.v, F_thrust);
-  J[kV][kX] = -(dFr_dx + dFe.dx) / m;
+  const double ds_dx = p.grinding.enabled ? contact_fraction_dx(p.grinding, s.x) : 0.0;
+  J[kV][kX] = -(dFr_dx + dFe.dx + ds_dx * s.fg) / m;
   J[kV][kV] = -(fj.dF_dv + dFe.dv) / m;
   J[kV][kZ] = -fj.dF_dz / m;
-  J[kV][kFg] = (p.grinding.enabled && in_contact(p.grinding, s.x)) ? -1.0 / m : 0.0;
+  J[kV][kFg] = p.grinding.enabled ? -contact_fraction(p.grinding, s.x) / m : 0.0;
   if (p.electrical.enabled) J[kV][kI] = p.force_constant * (1.0 - dFr_dthrust - dFe.dthrust) / m;
 
   // z' = v - sigma0*|v|*z/g(v)
@@ -67,9 +68,10 @@ Jacobian jacobian_of(const PlantParams& p, bool extra, const State& s, double u)
     J[kZ][kZ] = fj.dzdot_dz;
   }
 
-  // Fg' = ke*v - (ke/C)*Fg   (in contact);  -(ke/C)*Fg out of contact
+  // Fg' = s(x)*ke*v - (ke/C)*Fg
   if (p.grinding.enabled) {
-    J[kFg][kV] = in_contact(p.grinding, s.x) ? p.grinding.stiffness : 0.0;
+    J[kFg][kX] = ds_dx * p.grinding.stiffness * s.v;
+    J[kFg][kV] = contact_fraction(p.grinding, s.x) * p.grinding.stiffness;
     J[kFg][kFg] = -1.0 / p.grinding.time_constant();
   }
 

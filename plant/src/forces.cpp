@@ -1,5 +1,6 @@
 #include "feeddrive/plant/forces.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace feeddrive::plant {
@@ -117,16 +118,27 @@ double ripple_force(const RippleParams& p, double x, double desired_force) {
   return cogging_force(p, x) + desired_force * reluctance_factor(p, x);
 }
 
+double contact_fraction(const GrindingParams& p, double x) {
+  if (!(x > p.contact_position)) return 0.0;
+  if (p.contact_width <= 0.0) return 1.0;
+  return std::min(1.0, (x - p.contact_position) / p.contact_width);
+}
+
+double contact_fraction_dx(const GrindingParams& p, double x) {
+  return (p.contact_width > 0.0 && x > p.contact_position && x < p.contact_position + p.contact_width)
+             ? 1.0 / p.contact_width
+             : 0.0;
+}
+
 bool in_contact(const GrindingParams& p, double x) { return x > p.contact_position; }
 
 double grinding_rate(const GrindingParams& p, double x, double v, double fg) {
   if (!p.enabled) return 0.0;
-  const double relax = p.stiffness / p.damping() * fg;
-  return in_contact(p, x) ? p.stiffness * v - relax : -relax;
+  return contact_fraction(p, x) * p.stiffness * v - p.stiffness / p.damping() * fg;
 }
 
 double grinding_force(const GrindingParams& p, double x, double fg) {
-  return (p.enabled && in_contact(p, x)) ? fg : 0.0;
+  return p.enabled ? contact_fraction(p, x) * fg : 0.0;
 }
 
 }  // namespace feeddrive::plant

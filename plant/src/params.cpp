@@ -90,6 +90,7 @@ void GrindingParams::validate(const std::string& prefix) const {
   require_positive(prefix + ".dullness", dullness);
   require_positive(prefix + ".workpiece_diameter", workpiece_diameter);
   require_positive(prefix + ".wheel_width", wheel_width);
+  if (!(contact_width >= 0.0) || !std::isfinite(contact_width)) fail(prefix + ".contact_width", contact_width, "must be >= 0");
   if (std::isnan(contact_position) || contact_position == std::numeric_limits<double>::infinity())
     fail(prefix + ".contact_position", contact_position, "must be a number or -inf");
 }

@@ -56,6 +56,7 @@ void read_grinding(MapReader r, plant::GrindingParams& p) {
   r.number("workpiece_diameter", p.workpiece_diameter);
   r.number("wheel_width", p.wheel_width);
   r.number_or_infinite("contact_position", p.contact_position);
+  r.number("contact_width", p.contact_width);
   r.finish();
 }
 

@@ -70,6 +70,37 @@ TEST(Grinding, ContactAndSteadyState) {
   p.contact_position = 1e-3;
   EXPECT_EQ(grinding_force(p, 0.0, 5.0), 0.0);
   EXPECT_EQ(grinding_force(p, 2e-3, 5.0), 5.0);
+  // The wheel engages over contact_width (1 um): s rises linearly, so the force is continuous;
+  // half-way it is half of Fg, and the rate's ke*v term is scaled alike.
+  EXPECT_EQ(contact_fraction(p, 1e-3), 0.0);
+  EXPECT_NEAR(grinding_force(p, 1e-3 + 0.5e-6, 5.0), 2.5, 1e-9);
+  EXPECT_NEAR(grinding_rate(p, 1e-3 + 0.5e-6, v, 0.0), 0.5 * p.stiffness * v, 1e-9 * p.stiffness * v);
+  EXPECT_NEAR(contact_fraction_dx(p, 1e-3 + 0.5e-6), 1e6, 1e-6);
+  EXPECT_EQ(contact_fraction_dx(p, 2e-3), 0.0);
+  p.contact_width = 0.0;  // a step
+  EXPECT_EQ(grinding_force(p, 1e-3 + 1e-12, 5.0), 5.0);
+}
+
+// Inside the engagement band the Jacobian has the dFg/dx terms: central differences on states
+// within the band (h = 1e-9 m, far inside the 1 um band; tolerance as below).
+TEST(Dynamics, JacobianInsideTheContactBand) {
+  PlantParams p;
+  p.friction.model = FrictionModel::kNone;
+  p.grinding.enabled = true;
+  p.grinding.contact_position = 1e-3;
+  const State s{1e-3 + 0.4e-6, 2e-3, 0.0, 40.0, 0.0};
+  const Jacobian J = jacobian(p, s, 1.0);
+  for (int c : {kX, kV, kFg}) {
+    const double h = c == kX ? 1e-9 : (c == kV ? 1e-7 : 1e-5);
+    StateVector yp = s.to_vector(), ym = s.to_vector();
+    yp[c] += h;
+    ym[c] -= h;
+    const StateVector fp = derivative(p, State::from_vector(yp), 1.0), fm = derivative(p, State::from_vector(ym), 1.0);
+    for (int r : {kV, kFg}) {
+      const double fd = (fp[r] - fm[r]) / (2 * h);
+      EXPECT_NEAR(J[r][c], fd, 1e-6 * std::abs(J[r][c]) + 1e-14 * std::abs(fp[r]) / h + 1e-12) << r << "," << c;
+    }
+  }
 }
 
 // Central finite differences of derivative() against jacobian(), on seeded random states with

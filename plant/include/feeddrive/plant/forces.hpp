@@ -49,13 +49,19 @@ double reluctance_factor_dx(const RippleParams& p, double x);
 /// Total ripple  F_r = Fc(x) + F_desired*r(x);  0 when ripple is disabled.
 double ripple_force(const RippleParams& p, double x, double desired_force);
 
-/// True when the wheel touches the work: x > contact_position.
+/// Contact fraction s(x) = clamp((x - x_c)/w, 0, 1), x_c = contact_position, w = contact_width
+/// (a step at x_c when w = 0): 0 out of contact, 1 in full contact.
+double contact_fraction(const GrindingParams& p, double x);
+/// ds/dx (0 outside the engagement band).
+double contact_fraction_dx(const GrindingParams& p, double x);
+/// True when the wheel touches the work: s(x) > 0, i.e. x > contact_position.
 bool in_contact(const GrindingParams& p, double x);
 /// Hahn-Lindsay normal force rate (Xie & Liang eq. 13 as an ODE, V_r = v):
-///   in contact:  dFg/dt = ke*v - (ke/C)*Fg,   C = c*pi*dw*bs;
-///   out of contact the deflection relaxes: dFg/dt = -(ke/C)*Fg.
+///   dFg/dt = s(x)*ke*v - (ke/C)*Fg,   C = c*pi*dw*bs
+/// (in full contact eq. 13; out of contact the deflection relaxes: dFg/dt = -(ke/C)*Fg).
 double grinding_rate(const GrindingParams& p, double x, double v, double fg);
-/// The grinding force acting on the slide: Fg in contact, 0 out of contact or when disabled.
+/// The grinding force acting on the slide: s(x)*Fg (Fg in full contact, 0 out of contact), 0
+/// when disabled.
 double grinding_force(const GrindingParams& p, double x, double fg);
 
 }  // namespace feeddrive::plant

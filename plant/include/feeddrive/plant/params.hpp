@@ -68,6 +68,10 @@ struct GrindingParams {
   double wheel_width{0.02};           ///< bs [m].
   /// Contact begins when x > contact_position [m]. -inf (default): always in contact.
   double contact_position{-std::numeric_limits<double>::infinity()};
+  /// w [m]: the wheel engages over x in (contact_position, contact_position + w) (surface
+  /// roughness), so the force is continuous in x and the integrator never chatters on the
+  /// contact surface. 0: a step.
+  double contact_width{1e-6};
 
   /// C = c*pi*dw*bs [N*s/m]: the steady-state force per infeed velocity.
   double damping() const;
