@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "feeddrive/sim/scenario.hpp"
+#include "scenario_error.hpp"
 #include "feeddrive/sim/simulation.hpp"
 
 namespace feeddrive::sim {
@@ -22,17 +23,7 @@ reference: {type: sine, amplitude: 0.1, frequency: 1.0}
 )";
 }
 
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_scenario(yaml, ".", "s.yaml");
-  } catch (const ScenarioError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "error must be one line: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << "expected a ScenarioError for:\n" << yaml;
-  return "";
-}
+using test::error_of;
 
 TEST(ScenarioEffects, NoneByDefault) {
   const Scenario s = parse_scenario(scenario_with_effects("    {}"));

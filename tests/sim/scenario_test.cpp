@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "feeddrive/sim/scenario.hpp"
+#include "scenario_error.hpp"
 
 namespace feeddrive::sim {
 namespace {
@@ -18,17 +19,7 @@ controller: {type: sliding_mode}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
 )";
 
-std::string error_of(const std::string& yaml) {
-  try {
-    parse_scenario(yaml, ".", "s.yaml");
-  } catch (const ScenarioError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "error must be one line: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << "expected a ScenarioError for:\n" << yaml;
-  return "";
-}
+using test::error_of;
 
 std::string with(const std::string& from, const std::string& to) {
   std::string s = kMinimal;
