@@ -4,7 +4,8 @@
 #   1. a raw LCM ping-pong between two processes (bench/lcm_pingpong.cpp): one round trip per step;
 #   2. the four-process lockstep run (plant + controller + trajectory + monitor) of the paper's
 #      boundary-layer jerk-limited move, 15,000 steps; steps/s from the monitor (first to last step).
-# Each is run ROUNDS times (default 3), alternating; medians and their ratio are printed.
+# Each is run ROUNDS times (default 3), alternating; medians and their ratio are printed, for
+# two placements: free (the scheduler's) and one core (all processes of both pinned to CPU 0).
 # Target: lockstep >= 0.8 x ping-pong. Message sizes are printed too (target < 1 KB per step).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,20 +14,28 @@ ROUNDS=${2:-3}
 URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'
 TMP=$(mktemp -d)
 trap 'jobs -p | xargs -r kill 2>/dev/null || true; rm -rf "$TMP"' EXIT
-pp=(); ls_rates=()
-for r in $(seq "$ROUNDS"); do
-  "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PP$r" & srv=$!
-  rate=$("$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PP$r" | awk '/pingpong_rate/ { print $2 }')
-  wait $srv
-  pp+=("$rate")
-  "$BUILD/bin/feeddrive-launch" scenarios/paper/smc_bl_jerk_limited.yaml --out "$TMP/run$r" --no-plots -q \
-      --lcm-url "$URL" --prefix "LS$r"
-  ls_rates+=("$(jq -r .lockstep.steps_per_second "$TMP/run$r/summary.json")")
-  echo "round $r: ping-pong ${pp[-1]} round trips/s, lockstep ${ls_rates[-1]} steps/s"
-done
 median() { printf '%s\n' "$@" | sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
-mp=$(median "${pp[@]}"); ml=$(median "${ls_rates[@]}")
-echo "median ping-pong:  $mp round trips/s"
-echo "median lockstep:   $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
-awk -v l="$ml" -v p="$mp" 'BEGIN { printf "ratio lockstep / ping-pong: %.3f (target >= 0.8)\n", l / p }'
-echo "bytes per step on the wire: $(jq -r .lockstep.bytes_per_step "$TMP/run1/summary.json") (target < 1024)"
+# bench PLACEMENT: "free" (the scheduler places the processes) or "one-core" (every process of
+# both benchmarks pinned to CPU 0: taskset for the ping-pong, feeddrive-launch --cpus 0).
+bench() {
+  local placement=$1 pin=() cpus=() pp=() ls_rates=()
+  if [ "$placement" = one-core ]; then pin=(taskset -c 0); cpus=(--cpus 0); fi
+  for r in $(seq "$ROUNDS"); do
+    "${pin[@]}" "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PP$placement$r" & srv=$!
+    rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PP$placement$r" |
+           awk '/pingpong_rate/ { print $2 }')
+    wait $srv
+    pp+=("$rate")
+    "$BUILD/bin/feeddrive-launch" scenarios/paper/smc_bl_jerk_limited.yaml --out "$TMP/run$placement$r" --no-plots -q \
+        --lcm-url "$URL" --prefix "LS$placement$r" "${cpus[@]}"
+    ls_rates+=("$(jq -r .lockstep.steps_per_second "$TMP/run$placement$r/summary.json")")
+    echo "$placement round $r: ping-pong ${pp[-1]} round trips/s, lockstep ${ls_rates[-1]} steps/s"
+  done
+  local mp ml
+  mp=$(median "${pp[@]}"); ml=$(median "${ls_rates[@]}")
+  echo "$placement: median ping-pong $mp round trips/s, median lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
+  awk -v l="$ml" -v p="$mp" -v w="$placement" 'BEGIN { printf "%s: ratio lockstep / ping-pong: %.3f (target >= 0.8)\n", w, l / p }'
+}
+bench free
+bench one-core
+echo "bytes per step on the wire: $(jq -r .lockstep.bytes_per_step "$TMP/runfree1/summary.json") (target < 1024)"

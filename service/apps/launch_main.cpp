@@ -24,10 +24,14 @@ int main(int argc, char** argv) {
   app.add_option("--external", external, "leave ROLE (controller, plant or trajectory) to a process you start")
       ->type_name("ROLE");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  std::string cpus;
+  app.add_option("--cpus", cpus, "pin every process to these CPUs, e.g. 0 or 0,1 (a lockstep chain runs fastest on one core where cross-core wake-ups are slow)")
+      ->type_name("LIST");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     lo.external.insert(external.begin(), external.end());
     lo.plots = !no_plots;
+    if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
     const sim::Scenario s = sim::load_scenario(lo.scenario);  // bad input fails here, before any process starts
     sim::check_output_dir(lo.out_dir);
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);

@@ -1,11 +1,13 @@
 #include "feeddrive/service/launch.hpp"
 
+#include <sched.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -31,7 +33,7 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   return a;
 }
 
-pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int niceness) {
+pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int niceness, const std::vector<int>& cpus) {
   std::vector<char*> argv;
   argv.push_back(const_cast<char*>(exe.c_str()));
   for (const auto& s : args) argv.push_back(const_cast<char*>(s.c_str()));
@@ -40,6 +42,12 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     if (niceness != 0 && ::nice(niceness) == -1) std::fprintf(stderr, "warning: nice(%d) failed\n", niceness);
+    if (!cpus.empty()) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      for (int c : cpus) CPU_SET(c, &set);
+      if (::sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "warning: sched_setaffinity failed\n");
+    }
     ::execv(exe.c_str(), argv.data());
     std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
     ::_exit(127);
@@ -51,6 +59,25 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
 
 std::string executable_dir() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
+}
+
+std::vector<int> parse_cpu_list(const std::string& text) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (::sched_getaffinity(0, sizeof allowed, &allowed) != 0) throw std::runtime_error("sched_getaffinity failed");
+  std::vector<int> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    char* stop = nullptr;
+    const long c = std::strtol(item.c_str(), &stop, 10);
+    if (item.empty() || *stop != '\0' || c < 0 || c >= CPU_SETSIZE || !CPU_ISSET(static_cast<int>(c), &allowed))
+      throw std::invalid_argument("--cpus " + text + ": '" + item + "' is not a CPU this process may use");
+    out.push_back(static_cast<int>(c));
+    start = end + 1;
+  }
+  return out;
 }
 
 LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
@@ -79,7 +106,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
     // The monitor and the trajectory are off the step's critical path (plant -> controller ->
     // plant): on a machine with few cores they yield to it.
     const bool off_path = role == "monitor" || role == "trajectory";
-    running[spawn(exe, args, off_path ? lo.off_path_niceness : 0)] = role;
+    running[spawn(exe, args, off_path ? lo.off_path_niceness : 0, lo.cpus)] = role;
   }
 
   LaunchResult result;

@@ -22,7 +22,16 @@ struct LaunchOptions {
   double grace_s{10.0};
   /// nice() increment of the monitor and the trajectory, which are off the step's critical path.
   int off_path_niceness{10};
+  /// CPUs every started process is pinned to (sched_setaffinity); empty: no pinning. A lockstep
+  /// run is a strict chain (state -> command -> state), so its processes never need to run at
+  /// once, and on machines where waking a process on another core is slow (virtual machines)
+  /// one core is fastest (bench/lockstep_bench.sh measures it).
+  std::vector<int> cpus;
 };
+
+/// Parses a CPU list "0" or "0,2" (each an index this process may run on). Throws
+/// std::invalid_argument naming the bad entry.
+std::vector<int> parse_cpu_list(const std::string& text);
 
 struct LaunchResult {
   int exit_code{0};             ///< 0 if every started process exited 0
