@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
       plant::PlantParams model = fit::test::base_model();
       if (d.static_model) model.friction.model = plant::FrictionModel::kStatic;
       plant::PlantParams truth = model;
-      fit::apply_effect(e, truth);
+      plant::set_effect(truth.effects, e);
       fit::test::Recording ro;
       ro.seed = static_cast<std::uint64_t>(100 + s);
       ro.duration = duration;

@@ -3,7 +3,6 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -14,8 +13,6 @@
 
 namespace feeddrive::fit {
 namespace {
-
-thread_local long evaluations = 0;  // force-residual evaluations by the Ceres functors
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -41,7 +38,9 @@ struct Spec {
   std::function<Effect(const Theta&, const Ctx&)> to_effect;
   std::function<Theta(const Effect&, const Ctx&)> from_effect;
   std::function<std::vector<Theta>(const Ctx&)> starts;
-  std::vector<std::pair<int, double>> lower, upper;
+  std::vector<std::pair<int, double>> lower;
+  /// Upper bounds; they may depend on the record (e.g. the filter window).
+  std::function<std::vector<std::pair<int, double>>(const Ctx&)> upper;
   /// Equivalent parametrisations of a solution to try as well (kept if at least as good).
   std::function<std::vector<Theta>(const Theta&)> alternatives;
 };
@@ -262,6 +261,9 @@ const std::vector<Spec>& specs() {
         const double T = c.rec.period;
         return std::vector<Theta>{{0.5 * T}, {2.0 * T}, {8.0 * T}};
       };
+      // 0 <= delay <= L: a longer delay is outside what one filter window can see.
+      sp.lower = {{0, 0.0}};
+      sp.upper = [](const Ctx& c) { return std::vector<std::pair<int, double>>{{0, c.rec.bank.half_width}}; };
       s.push_back(sp);
     }
     return s;
@@ -275,17 +277,6 @@ const Spec& spec(const std::string& name) {
   throw std::invalid_argument("unknown effect '" + name + "'");
 }
 
-// Sets the upper bound of input_delay to the filter half-width (a longer delay is outside what
-// one filter window can see) and returns the bounds of a spec.
-std::vector<std::pair<int, double>> upper_bounds(const Spec& s, const Ctx& c) {
-  if (s.name == "input_delay") return {{0, c.rec.bank.half_width}};
-  return s.upper;
-}
-std::vector<std::pair<int, double>> lower_bounds(const Spec& s) {
-  if (s.name == "input_delay") return {{0, 0.0}};
-  return s.lower;
-}
-
 struct Block {
   const Spec* spec;
   int offset;
@@ -296,7 +287,7 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
   plant::PlantParams p = base;
   for (const Block& b : blocks) {
     const Theta t(th + b.offset, th + b.offset + b.spec->dim);
-    apply_effect(b.spec->to_effect(t, c), p);
+    plant::set_effect(p.effects, b.spec->to_effect(t, c));
   }
   return p;
 }
@@ -307,7 +298,6 @@ struct ResidualFunctor {
   std::vector<Block> blocks;
   const Ctx* ctx;
   bool operator()(double const* const* params, double* residuals) const {
-    ++evaluations;
     const plant::PlantParams p = with_theta(*base, blocks, params[0], *ctx);
     const Eigen::VectorXd r = force_residual(*rec, p);
     for (long i = 0; i < r.size(); ++i) {
@@ -336,8 +326,9 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
   std::vector<int> fixed;
   for (const Block& b : blocks) {
     for (int f : b.spec->fixed) fixed.push_back(b.offset + f);
-    for (auto [i, v] : lower_bounds(*b.spec)) problem.SetParameterLowerBound(theta.data(), b.offset + i, v);
-    for (auto [i, v] : upper_bounds(*b.spec, ctx)) problem.SetParameterUpperBound(theta.data(), b.offset + i, v);
+    for (auto [i, v] : b.spec->lower) problem.SetParameterLowerBound(theta.data(), b.offset + i, v);
+    if (b.spec->upper)
+      for (auto [i, v] : b.spec->upper(ctx)) problem.SetParameterUpperBound(theta.data(), b.offset + i, v);
   }
   if (!fixed.empty()) {
     if (static_cast<int>(fixed.size()) == dim) {
@@ -364,98 +355,6 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
 
 }  // namespace
 
-const std::vector<std::string>& effect_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (const Spec& s : specs()) n.push_back(s.name);
-    return n;
-  }();
-  return names;
-}
-
-void apply_effect(const Effect& e, plant::PlantParams& p) {
-  auto& x = p.effects;
-  const auto& q = e.parameters;
-  const auto get = [&](const char* k) {
-    const auto it = q.find(k);
-    if (it == q.end()) throw std::invalid_argument("effect " + e.name + ": missing parameter " + k);
-    return it->second;
-  };
-  if (e.name == "constant_force") {
-    x.constant_force = {true, get("force_N")};
-  } else if (e.name == "coulomb_friction") {
-    x.coulomb_friction = {true, get("coulomb_N")};
-  } else if (e.name == "viscous_friction") {
-    x.viscous_friction = {true, get("viscous_Ns_per_m")};
-  } else if (e.name == "stribeck_friction") {
-    x.stribeck_friction = {true, get("static_N"), get("coulomb_N"), get("stribeck_velocity_mps")};
-  } else if (e.name == "presliding") {
-    x.presliding = {true, get("bristle_stiffness_N_per_m"), get("bristle_damping_Ns_per_m")};
-  } else if (e.name == "cogging_ripple") {
-    x.cogging_ripple = {true, get("pitch_m"), get("amplitude_N"), get("phase_rad"), get("third_harmonic_N"),
-                        get("third_phase_rad")};
-  } else if (e.name == "reluctance_ripple") {
-    x.reluctance_ripple = {true, get("pitch_m"), get("relative_amplitude"), get("phase_rad")};
-  } else if (e.name == "grinding_force") {
-    x.grinding_force = {true, get("gain_Ns_per_m"), get("stiffness_N_per_m"), get("contact_position_m")};
-  } else if (e.name == "spring_force") {
-    x.spring_force = {true, get("stiffness_N_per_m"), get("rest_position_m")};
-  } else if (e.name == "mass_error") {
-    x.mass_error = {true, get("mass_kg")};
-  } else if (e.name == "input_delay") {
-    x.input_delay = {true, get("delay_s")};
-  } else {
-    throw std::invalid_argument("unknown effect '" + e.name + "'");
-  }
-}
-
-std::vector<Effect> effects_of(const plant::PlantParams& p) {
-  const auto& x = p.effects;
-  std::vector<Effect> out;
-  if (x.constant_force.enabled) out.push_back({"constant_force", {{"force_N", x.constant_force.force_N}}});
-  if (x.coulomb_friction.enabled) out.push_back({"coulomb_friction", {{"coulomb_N", x.coulomb_friction.coulomb_N}}});
-  if (x.viscous_friction.enabled)
-    out.push_back({"viscous_friction", {{"viscous_Ns_per_m", x.viscous_friction.viscous_Ns_per_m}}});
-  if (x.stribeck_friction.enabled)
-    out.push_back({"stribeck_friction",
-                   {{"static_N", x.stribeck_friction.static_N},
-                    {"coulomb_N", x.stribeck_friction.coulomb_N},
-                    {"stribeck_velocity_mps", x.stribeck_friction.stribeck_velocity_mps}}});
-  if (x.presliding.enabled)
-    out.push_back({"presliding",
-                   {{"bristle_stiffness_N_per_m", x.presliding.bristle_stiffness_N_per_m},
-                    {"bristle_damping_Ns_per_m", x.presliding.bristle_damping_Ns_per_m}}});
-  if (x.cogging_ripple.enabled)
-    out.push_back({"cogging_ripple",
-                   {{"pitch_m", x.cogging_ripple.pitch_m},
-                    {"amplitude_N", x.cogging_ripple.amplitude_N},
-                    {"phase_rad", x.cogging_ripple.phase_rad},
-                    {"third_harmonic_N", x.cogging_ripple.third_harmonic_N},
-                    {"third_phase_rad", x.cogging_ripple.third_phase_rad}}});
-  if (x.reluctance_ripple.enabled)
-    out.push_back({"reluctance_ripple",
-                   {{"pitch_m", x.reluctance_ripple.pitch_m},
-                    {"relative_amplitude", x.reluctance_ripple.relative_amplitude},
-                    {"phase_rad", x.reluctance_ripple.phase_rad}}});
-  if (x.grinding_force.enabled)
-    out.push_back({"grinding_force",
-                   {{"gain_Ns_per_m", x.grinding_force.gain_Ns_per_m},
-                    {"stiffness_N_per_m", x.grinding_force.stiffness_N_per_m},
-                    {"contact_position_m", x.grinding_force.contact_position_m}}});
-  if (x.spring_force.enabled)
-    out.push_back({"spring_force",
-                   {{"stiffness_N_per_m", x.spring_force.stiffness_N_per_m},
-                    {"rest_position_m", x.spring_force.rest_position_m}}});
-  if (x.mass_error.enabled) out.push_back({"mass_error", {{"mass_kg", x.mass_error.mass_kg}}});
-  if (x.input_delay.enabled) out.push_back({"input_delay", {{"delay_s", x.input_delay.delay_s}}});
-  // vocabulary order
-  std::sort(out.begin(), out.end(), [](const Effect& a, const Effect& b) {
-    const auto& n = effect_names();
-    return std::find(n.begin(), n.end(), a.name) < std::find(n.begin(), n.end(), b.name);
-  });
-  return out;
-}
-
 double bic(const Eigen::VectorXd& r, int k, long n_active) {
   const double n = static_cast<double>(n_active > 0 ? n_active : r.size());
   const double rss = std::max(r.squaredNorm(), 1e-300);
@@ -464,8 +363,6 @@ double bic(const Eigen::VectorXd& r, int k, long n_active) {
 
 CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
                            const Eigen::VectorXd& residual0) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const long ev0 = evaluations;
   const Spec& s = spec(name);
   const Ctx ctx{rec, model, &residual0, x_mean_of(rec)};
   const std::vector<Block> blocks{{&s, 0}};
@@ -535,14 +432,12 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
   }
   out.effect = s.to_effect(best.theta, ctx);
   plant::PlantParams p = model;
-  apply_effect(out.effect, p);
+  plant::set_effect(p.effects, out.effect);
   const Eigen::VectorXd r = force_residual(rec, p);
   out.rss = r.squaredNorm();
   out.bic = bic(r, s.dim, rec.active_points());
   out.score = bic(residual0, 0, rec.active_points()) - out.bic;
   out.converged = best.converged;
-  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.evaluations = evaluations - ev0;
   if (!std::isfinite(out.score)) out.score = -std::numeric_limits<double>::infinity();
   return out;
 }
@@ -550,9 +445,9 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
 std::vector<CandidateFit> rank_candidates(const Record& rec, const plant::PlantParams& model) {
   const Eigen::VectorXd r0 = force_residual(rec, model);
   std::vector<std::string> enabled;
-  for (const Effect& e : effects_of(model)) enabled.push_back(e.name);
+  for (const Effect& e : plant::enabled_effects(model.effects)) enabled.push_back(e.name);
   std::vector<CandidateFit> out;
-  for (const std::string& name : effect_names()) {
+  for (const std::string& name : plant::effect_names()) {
     if (std::find(enabled.begin(), enabled.end(), name) != enabled.end()) continue;
     out.push_back(fit_candidate(rec, model, name, r0));
   }
@@ -573,7 +468,7 @@ std::vector<CandidateFit> rank_candidates(const Record& rec, const plant::PlantP
 }
 
 plant::PlantParams refine_jointly(const Record& rec, const plant::PlantParams& model) {
-  const std::vector<Effect> effects = effects_of(model);
+  const std::vector<Effect> effects = plant::enabled_effects(model.effects);
   if (effects.empty()) return model;
   const Eigen::VectorXd r0 = force_residual(rec, model);
   const Ctx ctx{rec, model, &r0, x_mean_of(rec)};
@@ -592,7 +487,7 @@ plant::PlantParams refine_jointly(const Record& rec, const plant::PlantParams& m
   plant::PlantParams out = base;
   for (const Block& b : blocks) {
     const Theta t(sol.theta.begin() + b.offset, sol.theta.begin() + b.offset + b.spec->dim);
-    apply_effect(b.spec->to_effect(t, ctx), out);
+    plant::set_effect(out.effects, b.spec->to_effect(t, ctx));
   }
   return out;
 }

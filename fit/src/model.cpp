@@ -22,7 +22,7 @@ Record prepare(const MeasuredData& d, const RecordOptions& opt) {
     throw DataError(d.source + ": " + std::to_string(d.size()) + " samples: too few for the motion estimate");
   r.motion = estimate_motion(d.t, d.x, M);
   try {
-    r.bank = make_filter_bank(d.t, d.x, r.motion, L);
+    r.bank = make_filter_bank(d.t, d.x, L);
   } catch (const std::invalid_argument& e) {
     throw DataError(d.source + ": " + e.what() + " (too few samples for the fit)");
   }

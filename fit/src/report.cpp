@@ -24,7 +24,7 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
   }
   if (!root["plant"]) root["plant"] = YAML::Node(YAML::NodeType::Map);
   YAML::Node effects = root["plant"]["effects"];
-  for (const Effect& e : effects_of(fitted)) {
+  for (const Effect& e : plant::enabled_effects(fitted.effects)) {
     YAML::Node m(YAML::NodeType::Map);
     for (const auto& [k, v] : e.parameters) m[k] = v;
     effects[e.name] = m;

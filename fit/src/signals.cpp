@@ -89,9 +89,7 @@ Motion estimate_motion(const std::vector<double>& t, const std::vector<double>& 
   return m;
 }
 
-FilterBank make_filter_bank(const std::vector<double>& t, const std::vector<double>& x, const Motion& m,
-                            double half_width) {
-  (void)m;
+FilterBank make_filter_bank(const std::vector<double>& t, const std::vector<double>& x, double half_width) {
   const double L = half_width;
   const long n = static_cast<long>(t.size());
   FilterBank b;

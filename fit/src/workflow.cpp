@@ -50,7 +50,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     for (const CandidateFit& c : st.ranking) {
       if (!(c.score >= opt.score_threshold)) break;
       trial = current;
-      apply_effect(c.effect, trial);
+      plant::set_effect(trial.effects, c.effect);
       trial = refine_jointly(rec, trial);
       try {
         trial.validate();
@@ -107,7 +107,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   out.final_localisation = localise(rec, r, rp);
   // the added effects, in the order found, with their final parameters
   for (const std::string& name : added)
-    for (const Effect& e : effects_of(current))
+    for (const Effect& e : plant::enabled_effects(current.effects))
       if (e.name == name) out.effects.push_back(e);
   if (added.empty()) {
     out.conclusion = "no significant effect: the model explains the data to within its noise";

@@ -1,32 +1,15 @@
 #include "feeddrive/plant/params.hpp"
 
+#include "feeddrive/common/validate.hpp"
+
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 namespace feeddrive::plant {
-namespace {
-
-[[noreturn]] void fail(const std::string& key, double value, const std::string& why) {
-  std::ostringstream os;
-  os.precision(17);
-  os << key << " = " << value << ": " << why;
-  throw std::invalid_argument(os.str());
-}
-
-void require_finite(const std::string& key, double v) {
-  if (!std::isfinite(v)) fail(key, v, "must be a finite number");
-}
-void require_positive(const std::string& key, double v) {
-  require_finite(key, v);
-  if (!(v > 0.0)) fail(key, v, "must be > 0");
-}
-void require_non_negative(const std::string& key, double v) {
-  require_finite(key, v);
-  if (v < 0.0) fail(key, v, "must be >= 0");
-}
-
-}  // namespace
+using validate::fail;
+using validate::require_finite;
+using validate::require_non_negative;
+using validate::require_positive;
 
 std::string to_string(FrictionModel m) {
   switch (m) {

@@ -15,12 +15,6 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     const sim::Scenario s = sim::load_scenario(scenario_path);
     service::TrajectoryNode node(s, opt);
-    try {
-      node.run();
-    } catch (const service::RunFailure& e) {
-      node.announce_failure(e.what());
-      throw;
-    }
-    return 0;
+    return service::run_node(node);
   });
 }

@@ -103,4 +103,18 @@ bool Node::monitor_done() const {
   return m != nullptr && (m->state == "done" || m->state == "failed");
 }
 
+void Node::linger(const std::function<void()>& every_100ms) {
+  set_state("done");
+  const std::int64_t start = mono_us();
+  std::int64_t last_sent = start;
+  while (!monitor_done() && mono_us() - start < us(opt_.linger_s)) {
+    if (every_100ms && mono_us() - last_sent > 100000) {
+      every_100ms();
+      last_sent = mono_us();
+    }
+    bus_.poll(std::chrono::microseconds(20000));
+    heartbeat();
+  }
+}
+
 }  // namespace feeddrive::service

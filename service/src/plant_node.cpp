@@ -86,7 +86,11 @@ void PlantNode::run() {
   } else {
     run_lockstep();
   }
-  linger();
+  if (options().monitor_window > 0) {
+    linger([this] { states_.republish(steps_); });  // the end-of-run marker must not get lost
+  } else {
+    set_state("done");  // no monitor to wait for
+  }
 }
 
 void PlantNode::run_lockstep() {
@@ -182,18 +186,5 @@ void PlantNode::run_realtime() {
   publish_state(steps_);
 }
 
-void PlantNode::linger() {
-  set_state("done");
-  const std::int64_t start = mono_us();
-  std::int64_t last_sent = start;
-  while (!monitor_done() && mono_us() - start < us(options().linger_s) && options().monitor_window > 0) {
-    if (mono_us() - last_sent > 100000) {  // the end-of-run marker must not get lost
-      states_.republish(steps_);
-      last_sent = mono_us();
-    }
-    bus().poll(std::chrono::microseconds(20000));
-    heartbeat();
-  }
-}
 
 }  // namespace feeddrive::service

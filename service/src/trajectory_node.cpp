@@ -64,12 +64,7 @@ void TrajectoryNode::run() {
     check_peers();
     heartbeat();
   }
-  set_state("done");
-  const std::int64_t start = mono_us();
-  while (!monitor_done() && mono_us() - start < us(options().linger_s)) {
-    bus().poll(std::chrono::microseconds(20000));
-    heartbeat();
-  }
+  linger();
 }
 
 }  // namespace feeddrive::service

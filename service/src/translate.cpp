@@ -30,15 +30,6 @@ control_command_t to_message(std::int64_t seq, double t, const controller::Comma
   return m;
 }
 
-controller::Command to_command(const control_command_t& m) {
-  controller::Command c;
-  c.u = m.u;
-  c.u_unsaturated = m.u_unsaturated;
-  c.sliding = m.sliding;
-  c.z_estimate = m.z_estimate;
-  return c;
-}
-
 plant::Measurement to_measurement(const drive_state_t& m) { return {m.t, m.x_measured, m.v_measured}; }
 
 drive_truth_t to_truth_message(const plant::State& s) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::sim {
@@ -97,64 +98,19 @@ void read_initial(MapReader r, plant::InitialState& p) {
 }
 
 // plant.effects.<name>: listing an effect enables it (an optional `enabled: false` switches it
-// off again); the parameters not given keep the struct's defaults.
-template <typename Effect, typename Read>
-void read_effect(MapReader& effects, const std::string& name, Effect& e, Read read) {
-  const bool listed = effects.has(name);
-  MapReader r = effects.child(name);  // marks the name as known, for finish()'s hints
-  if (!listed) return;
-  e.enabled = true;
-  r.boolean("enabled", e.enabled);
-  read(r, e);
-  r.finish();
-}
-
+// off again); the parameters not given keep the struct's defaults. Names: plant/effects.hpp.
 void read_effects(MapReader r, plant::EffectsParams& p) {
-  read_effect(r, "constant_force", p.constant_force, [](MapReader& m, plant::ConstantForceEffect& e) {
-    m.number("force_N", e.force_N);
-  });
-  read_effect(r, "coulomb_friction", p.coulomb_friction, [](MapReader& m, plant::CoulombFrictionEffect& e) {
-    m.number("coulomb_N", e.coulomb_N);
-  });
-  read_effect(r, "viscous_friction", p.viscous_friction, [](MapReader& m, plant::ViscousFrictionEffect& e) {
-    m.number("viscous_Ns_per_m", e.viscous_Ns_per_m);
-  });
-  read_effect(r, "stribeck_friction", p.stribeck_friction, [](MapReader& m, plant::StribeckFrictionEffect& e) {
-    m.number("static_N", e.static_N);
-    m.number("coulomb_N", e.coulomb_N);
-    m.number("stribeck_velocity_mps", e.stribeck_velocity_mps);
-  });
-  read_effect(r, "presliding", p.presliding, [](MapReader& m, plant::PreslidingEffect& e) {
-    m.number("bristle_stiffness_N_per_m", e.bristle_stiffness_N_per_m);
-    m.number("bristle_damping_Ns_per_m", e.bristle_damping_Ns_per_m);
-  });
-  read_effect(r, "cogging_ripple", p.cogging_ripple, [](MapReader& m, plant::CoggingRippleEffect& e) {
-    m.number("pitch_m", e.pitch_m);
-    m.number("amplitude_N", e.amplitude_N);
-    m.number("phase_rad", e.phase_rad);
-    m.number("third_harmonic_N", e.third_harmonic_N);
-    m.number("third_phase_rad", e.third_phase_rad);
-  });
-  read_effect(r, "reluctance_ripple", p.reluctance_ripple, [](MapReader& m, plant::ReluctanceRippleEffect& e) {
-    m.number("pitch_m", e.pitch_m);
-    m.number("relative_amplitude", e.relative_amplitude);
-    m.number("phase_rad", e.phase_rad);
-  });
-  read_effect(r, "grinding_force", p.grinding_force, [](MapReader& m, plant::GrindingForceEffect& e) {
-    m.number("gain_Ns_per_m", e.gain_Ns_per_m);
-    m.number("stiffness_N_per_m", e.stiffness_N_per_m);
-    m.number("contact_position_m", e.contact_position_m);
-  });
-  read_effect(r, "spring_force", p.spring_force, [](MapReader& m, plant::SpringForceEffect& e) {
-    m.number("stiffness_N_per_m", e.stiffness_N_per_m);
-    m.number("rest_position_m", e.rest_position_m);
-  });
-  read_effect(r, "mass_error", p.mass_error, [](MapReader& m, plant::MassErrorEffect& e) {
-    m.number("mass_kg", e.mass_kg);
-  });
-  read_effect(r, "input_delay", p.input_delay, [](MapReader& m, plant::InputDelayEffect& e) {
-    m.number("delay_s", e.delay_s);
-  });
+  for (const std::string& name : plant::effect_names()) {
+    const bool listed = r.has(name);
+    MapReader m = r.child(name);  // marks the name as known, for finish()'s hints
+    if (!listed) continue;
+    bool& enabled = plant::effect_enabled(p, name);
+    enabled = true;
+    m.boolean("enabled", enabled);
+    for (const std::string& param : plant::effect_parameter_names(name))
+      m.number(param, plant::effect_parameter(p, name, param));
+    m.finish();
+  }
   r.finish();
 }
 

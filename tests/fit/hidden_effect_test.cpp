@@ -72,7 +72,7 @@ class HiddenEffect : public ::testing::TestWithParam<Case> {};
 TEST_P(HiddenEffect, IsNamedRecoveredAndShrinksTheGap) {
   const Case& c = GetParam();
   plant::PlantParams truth = c.model;
-  apply_effect(c.truth, truth);
+  plant::set_effect(truth.effects, c.truth);
   test::Recording rec_opt;
   rec_opt.seed = 11;
   const MeasuredData data = test::record(truth, rec_opt, test::temp_dir());
@@ -120,7 +120,7 @@ TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
   for (const Effect& e : effects) {
     const plant::PlantParams model = test::base_model();
     plant::PlantParams truth = model;
-    apply_effect(e, truth);
+    plant::set_effect(truth.effects, e);
     test::Recording ro;
     ro.period = 2e-4;
     ro.quantization = 100e-9;

@@ -14,11 +14,10 @@ namespace {
 TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   const plant::PlantParams model = test::base_model();
   plant::PlantParams truth = model;
-  apply_effect({"constant_force", {{"force_N", 15.0}}}, truth);
-  apply_effect({"cogging_ripple",
-                {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7}, {"third_harmonic_N", 0.0},
-                 {"third_phase_rad", 0.0}}},
-               truth);
+  plant::set_effect(truth.effects, {"constant_force", {{"force_N", 15.0}}});
+  plant::set_effect(truth.effects, {"cogging_ripple",
+                                    {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7},
+                                     {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}});
   test::Recording ro;
   ro.seed = 5;
   const MeasuredData data = test::record(truth, ro, test::temp_dir());
@@ -39,7 +38,7 @@ TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
 TEST(FitSignificance, ForceInputFindsTheSameEffect) {
   const plant::PlantParams model = test::base_model();
   plant::PlantParams truth = model;
-  apply_effect({"constant_force", {{"force_N", -12.0}}}, truth);
+  plant::set_effect(truth.effects, {"constant_force", {{"force_N", -12.0}}});
   test::Recording ro;
   ro.seed = 8;
   ro.duration = 5.0;

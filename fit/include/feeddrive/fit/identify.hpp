@@ -14,23 +14,14 @@
 #include <vector>
 
 #include "feeddrive/fit/model.hpp"
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/plant/params.hpp"
 
 namespace feeddrive::fit {
 
-/// The vocabulary, in the order of the issue.
-const std::vector<std::string>& effect_names();
-
-/// An effect with its vocabulary parameters (SI units, names as in the vocabulary).
-struct Effect {
-  std::string name;
-  std::map<std::string, double> parameters;
-};
-
-/// Enables `e` in p with its parameters. Throws std::invalid_argument for an unknown name.
-void apply_effect(const Effect& e, plant::PlantParams& p);
-/// The enabled effects of p, in vocabulary order.
-std::vector<Effect> effects_of(const plant::PlantParams& p);
+/// An effect of the vocabulary with its parameters (plant/effects.hpp: names, set_effect,
+/// enabled_effects).
+using Effect = plant::NamedEffect;
 
 struct CandidateFit {
   Effect effect;
@@ -39,8 +30,6 @@ struct CandidateFit {
   double bic{0.0};
   double score{0.0};        ///< BIC(without) - BIC(with); > 0 favours the effect
   bool converged{false};
-  double wall_time_s{0.0};   ///< time the fit took
-  long evaluations{0};       ///< force-residual evaluations
 };
 
 struct IdentifyOptions {

@@ -46,8 +46,7 @@ struct FilterBank {
 };
 /// Builds the bank for samples t, x; throws std::invalid_argument if the record holds fewer
 /// than 4 filter windows.
-FilterBank make_filter_bank(const std::vector<double>& t, const std::vector<double>& x, const Motion& m,
-                            double half_width);
+FilterBank make_filter_bank(const std::vector<double>& t, const std::vector<double>& x, double half_width);
 
 /// Filtered series of per-interval values f_j (size n-1): out_i = sum_j w(i,j) f_j.
 Eigen::VectorXd apply(const FilterBank& b, const Eigen::VectorXd& f);

@@ -23,6 +23,10 @@
 //     with sgn_eps(v) = tanh(v/eps), eps = friction.static_smoothing_velocity, and
 //     delta = friction.stribeck_exponent.
 
+#include <map>
+#include <string>
+#include <vector>
+
 #include "feeddrive/plant/params.hpp"
 
 namespace feeddrive::plant {
@@ -48,5 +52,25 @@ ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v
 bool folds_into_params(const EffectsParams& e);
 /// True if any additive effect (a term of extra_force()) is on; extra_force() is 0 otherwise.
 bool has_extra_force(const EffectsParams& e);
+
+/// The vocabulary by name: an effect and its parameters, named as in params.hpp (SI units).
+/// The one mapping between names and EffectsParams fields, for the scenario reader and the fit.
+struct NamedEffect {
+  std::string name;
+  std::map<std::string, double> parameters;
+};
+
+/// The effect names, in vocabulary order.
+const std::vector<std::string>& effect_names();
+/// The parameter names of effect `name`. Throws std::invalid_argument for an unknown name.
+const std::vector<std::string>& effect_parameter_names(const std::string& name);
+/// The field of parameter `param` of effect `name` and the effect's enabled flag, in e.
+double& effect_parameter(EffectsParams& e, const std::string& name, const std::string& param);
+bool& effect_enabled(EffectsParams& e, const std::string& name);
+/// Enables effect.name in e with effect.parameters (parameters not given keep their values).
+/// Throws std::invalid_argument for an unknown effect or parameter name.
+void set_effect(EffectsParams& e, const NamedEffect& effect);
+/// The enabled effects of e with all their parameters, in vocabulary order.
+std::vector<NamedEffect> enabled_effects(const EffectsParams& e);
 
 }  // namespace feeddrive::plant

@@ -17,7 +17,19 @@ void add_node_options(CLI::App& app, NodeOptions& opt);
 
 /// Parses the arguments and runs body(). body returns the exit code; std::invalid_argument
 /// (bad input) gives 2, RunFailure and other exceptions 1, each as one line on stderr.
-/// `announce` is called with the failure message before exiting on a RunFailure.
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body);
+
+/// Runs node.run() and returns 0; a RunFailure is first announced on <prefix>_STATUS (so the
+/// other processes stop at once) and then passed on to run_process.
+template <typename NodeType>
+int run_node(NodeType& node) {
+  try {
+    node.run();
+  } catch (const RunFailure& e) {
+    node.announce_failure(e.what());
+    throw;
+  }
+  return 0;
+}
 
 }  // namespace feeddrive::service

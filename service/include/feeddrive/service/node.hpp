@@ -68,6 +68,10 @@ class Node {
   /// alive and running its own timeouts, so a wait on it is not yet its fault to report.
   bool peer_alive(const std::string& role, double seconds) const;
   bool monitor_done() const;
+  /// After the end: state "done", then keep answering resend requests and sending heartbeats
+  /// until the monitor is done or --linger seconds have passed. `every_100ms` (if given) runs
+  /// about every 100 ms meanwhile (the plant re-publishes its end-of-run state).
+  void linger(const std::function<void()>& every_100ms = {});
 
   std::int64_t resends{0};
   std::int64_t duplicates{0};

@@ -40,7 +40,6 @@ class PlantNode : public Node {
   /// Applies u over step k and advances the drive.
   void apply(std::int64_t k, double u);
   void wait_for_monitor(std::int64_t k);
-  void linger();
 
   sim::Scenario s_;
   std::int64_t steps_;

@@ -18,7 +18,6 @@ reference_t to_message(std::int64_t seq, double t, const trajectory::Sample& s);
 trajectory::Sample to_sample(const reference_t& m);
 
 control_command_t to_message(std::int64_t seq, double t, const controller::Command& c);
-controller::Command to_command(const control_command_t& m);
 
 plant::Measurement to_measurement(const drive_state_t& m);
 /// The truth fields a simulated plant sends (valid = true).
