@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <ctime>
 #include <stdexcept>
 
 namespace feeddrive::service {
@@ -30,21 +31,58 @@ std::int64_t mono_us() {
       .count();
 }
 
-Bus::Bus(const std::string& url) : url_(url), lcm_(url) {
+Bus::Bus(const std::string& url, Receive receive, std::chrono::microseconds batch_interval)
+    : url_(url), lcm_(url), batch_interval_(batch_interval) {
   if (!lcm_.good())
     throw std::runtime_error("cannot open LCM at '" + url +
                              "' (is there a multicast route? see docs/lcm-contract.md)");
+  // Batched: liblcm only publishes (it opens its receive socket and thread on the first
+  // subscribe or handle, which then never come); our reader takes the group's datagrams.
+  if (receive == Receive::kBatched)
+    if (const std::optional<UdpmAddress> a = parse_udpm_url(url)) reader_ = std::make_unique<UdpmReader>(*a);
 }
 
 void Bus::subscribe_raw(const std::string& channel,
                         std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f) {
   raws_.push_back(std::make_unique<Raw>(Raw{std::move(f)}));
+  if (reader_) {
+    batched_subs_[channel].push_back(raws_.back().get());
+    return;
+  }
   lcm::Subscription* sub = lcm_.subscribe(channel, &Raw::handle, raws_.back().get());
   // LCM drops silently when a subscription's queue overflows (default 30 messages).
   if (sub != nullptr) sub->setQueueCapacity(100000);
 }
 
+void Bus::rethrow_handler_error() {
+  if (!error_) return;
+  std::exception_ptr e = error_;
+  error_ = nullptr;
+  std::rethrow_exception(e);
+}
+
 bool Bus::poll(std::chrono::microseconds timeout) {
+  return reader_ ? poll_batched(timeout) : poll_event(timeout);
+}
+
+bool Bus::poll_batched(std::chrono::microseconds timeout) {
+  // Sleep first, never on the socket: datagrams queue meanwhile without waking anyone.
+  const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, batch_interval_).count(), 0);
+  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+  ::nanosleep(&ts, nullptr);  // EINTR (a signal): drain what is there and return
+  std::string channel;
+  const std::size_t n = reader_->drain([&](std::string_view ch, const std::uint8_t* d, std::size_t size, std::int64_t utime) {
+    channel.assign(ch);
+    const auto it = batched_subs_.find(channel);
+    if (it == batched_subs_.end()) return;
+    lcm::ReceiveBuffer rbuf{const_cast<std::uint8_t*>(d), static_cast<std::uint32_t>(size), utime};
+    for (Raw* r : it->second) r->handle(&rbuf, channel);
+  });
+  rethrow_handler_error();
+  return n > 0;
+}
+
+bool Bus::poll_event(std::chrono::microseconds timeout) {
   const int fd = lcm_.getFileno();
   bool handled = false;
   const std::int64_t deadline = mono_us() + timeout.count();
@@ -61,11 +99,7 @@ bool Bus::poll(std::chrono::microseconds timeout) {
     if (r == 0) return handled;  // nothing (more) waiting
     if (lcm_.handle() != 0) throw std::runtime_error("lcm handle() failed");
     handled = true;
-    if (error_) {
-      std::exception_ptr e = error_;
-      error_ = nullptr;
-      std::rethrow_exception(e);
-    }
+    rethrow_handler_error();
   }
 }
 

@@ -26,8 +26,8 @@ std::string seconds_text(double s) {
   return buf;
 }
 
-Node::Node(std::string role, const NodeOptions& opt)
-    : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url), ch_(opt.prefix) {
+Node::Node(std::string role, const NodeOptions& opt, Receive receive)
+    : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive), ch_(opt.prefix) {
   bus_.subscribe<process_status_t>(ch_.status, [this](const process_status_t& m, std::int64_t recv_us) {
     if (m.role == role_) return;
     peers_[m.role] = m;

@@ -5,7 +5,7 @@
 namespace feeddrive::service {
 
 TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
-    : Node("trajectory", opt), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
+    : Node("trajectory", opt, Receive::kBatched), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
     if (m.end_of_run) {
       end_ = true;
@@ -20,12 +20,14 @@ TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
     highest_state_ = m.seq;
     last_progress_us_ = now;
     set_seq(m.seq);
-    // Keep at least half a block of references ahead of the newest state.
-    send_block(m.seq / kBlock, false);
-    send_block((m.seq + kBlock / 2) / kBlock, false);
+    send_ahead(m.seq);
   });
   on_resend_request = [this](const resend_request_t& r) {
-    if (r.channel == blocks_.channel() && r.seq >= 0) send_block(r.seq / kBlock, true);
+    if (r.channel != blocks_.channel() || r.seq < 0) return;
+    // The requester lacks block seq/kBlock, and probably the blocks published after it too (it
+    // started late, or its socket overflowed): send them all again, not one request each.
+    send_block(r.seq / kBlock, true);
+    for (std::int64_t b = r.seq / kBlock + 1; b < next_block_; ++b) send_block(b, true);
   };
 }
 
@@ -46,9 +48,15 @@ void TrajectoryNode::send_block(std::int64_t b, bool resend) {
   blocks_.publish(b, m);
 }
 
+void TrajectoryNode::send_ahead(std::int64_t k) {
+  for (; next_block_ <= (k + kLead) / kBlock && next_block_ * kBlock < s_.steps(); ++next_block_) send_block(next_block_, false);
+}
+
 void TrajectoryNode::run() {
   set_state("running");
+  // Block 0 now; the look-ahead once the plant's first state shows that the run has started.
   send_block(0, false);
+  next_block_ = 1;
   last_progress_us_ = mono_us();
   while (!end_) {
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));

@@ -19,7 +19,7 @@ grep -q 'constant_force: {force_N: 15.0}' "$TMP/truth.yaml" || fail "truth.yaml:
 prio=(chrt -f 20)
 "${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority available; logging without it"; prio=(); }
 "${prio[@]}" timeout 300 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
-sleep 0.5
+wait_on_bus $lg
 timeout 300 feeddrive-launch "$TMP/truth.yaml" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
 sleep 0.5
 kill -INT $lg; wait $lg || true

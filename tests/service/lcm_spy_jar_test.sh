@@ -19,7 +19,7 @@ done
 
 scen=$SRC/tests/service/scenarios/short_jerk.yaml
 lcm-logger --lcm-url="$URL" --channel='SPY_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
-sleep 0.5
+wait_on_bus $lg
 timeout 120 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --prefix SPY --lcm-url "$URL"
 sleep 0.3
 kill -INT $lg; wait $lg || true

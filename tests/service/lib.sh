@@ -20,6 +20,21 @@ export PATH="$BIN:$PATH"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
 pass() { echo "PASS: $*"; }
+# wait_on_bus PID: waits until process PID (or a child of it: timeout, chrt) has a UDP socket on
+# the URL's port, i.e. has joined the LCM bus, so it cannot miss the start of what follows. A
+# fixed sleep is not enough on a loaded machine. Fails after 10 s.
+wait_on_bus() {
+  local port=${URL#udpm://*:} pids pid
+  port=${port%%\?*}
+  for _ in $(seq 100); do
+    pids="$1 $(pgrep -P "$1" | tr "\n" " " || true)"
+    for pid in $pids; do
+      ss -Huanp "sport = :$port" 2>/dev/null | grep -q "pid=$pid," && return 0
+    done
+    sleep 0.1
+  done
+  fail "process $1 did not join the LCM bus on port $port within 10 s"
+}
 # json FILE JQ-FILTER
 json() { jq -r "$2" "$1"; }
 # Runs feeddrive-sim on a scenario into DIR (the in-process reference result).

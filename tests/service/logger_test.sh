@@ -10,7 +10,7 @@ scen=$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml
 prio=(chrt -f 20)
 "${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority available; logging without it"; prio=(); }
 "${prio[@]}" lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
-sleep 0.5
+wait_on_bus $lg
 timeout 300 feeddrive-launch "$scen" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
 sleep 0.5
 kill -INT $lg; wait $lg || true
@@ -21,7 +21,7 @@ rows=$(( $(wc -l < "$TMP/conv/timeseries.csv") - 1 ))
 pass "lcm-logger log converted: $rows rows, identical to the monitor's"
 
 timeout 120 feeddrive-monitor "$scen" --out "$TMP/replay" --no-plots -q --attach --step-timeout 3 --lcm-url "$URL" & m=$!
-sleep 0.5
+wait_on_bus $m
 timeout 120 lcm-logplayer --lcm-url="$URL" "$TMP/run.lcmlog" > /dev/null 2>&1
 wait $m || fail "the attached monitor failed"
 same_csv "$TMP/mon/timeseries.csv" "$TMP/replay/timeseries.csv"

@@ -3,6 +3,11 @@
 // and drop undecodable messages (wrong type or fingerprint) instead of crashing, and publishers
 // that keep their recent messages so a lost one can be re-published on request.
 //
+// Two ways to receive: kEvent (liblcm's: woken by each message, for the step's critical path,
+// the plant and the controller) and kBatched (udpm_reader.hpp: sleep for a batch interval,
+// then take everything queued, for the monitor and the trajectory). Both publish with liblcm,
+// and both see the same messages: the choice changes when a process wakes, not what it gets.
+//
 // Nothing here knows about drives: the nodes (plant_node.hpp, ...) hold the protocol logic.
 
 #include <lcm/lcm-cpp.hpp>
@@ -15,7 +20,10 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
+
+#include "feeddrive/service/udpm_reader.hpp"
 
 namespace feeddrive::service {
 
@@ -34,10 +42,17 @@ struct Channels {
 std::int64_t wall_utime();
 std::int64_t mono_us();
 
+enum class Receive {
+  kEvent,    ///< liblcm's receive thread: a wake-up per message, lowest latency
+  kBatched,  ///< drained every batch interval, no wake-up per message (udpm:// URLs only)
+};
+
 class Bus {
  public:
-  /// Throws std::runtime_error naming the URL when LCM cannot be initialised.
-  explicit Bus(const std::string& url);
+  /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kBatched falls
+  /// back to kEvent for URLs other than udpm:// (memq://, file://).
+  explicit Bus(const std::string& url, Receive receive = Receive::kEvent,
+               std::chrono::microseconds batch_interval = std::chrono::microseconds(1000));
   Bus(const Bus&) = delete;
   Bus& operator=(const Bus&) = delete;
 
@@ -53,7 +68,9 @@ class Bus {
 
   /// Dispatches the messages that arrive within `timeout` (at least one wait). Returns true if
   /// at least one message was handled. Rethrows the first exception a handler threw.
+  /// kBatched: sleeps min(timeout, batch interval), then dispatches everything queued.
   bool poll(std::chrono::microseconds timeout);
+  bool batched() const { return reader_ != nullptr; }
 
   std::int64_t invalid() const { return invalid_; }
   std::int64_t send_errors() const { return send_errors_; }
@@ -66,10 +83,16 @@ class Bus {
   };
   void subscribe_raw(const std::string& channel,
                      std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f);
+  bool poll_event(std::chrono::microseconds timeout);
+  bool poll_batched(std::chrono::microseconds timeout);
+  void rethrow_handler_error();
 
   std::string url_;
   lcm::LCM lcm_;
   std::vector<std::unique_ptr<Raw>> raws_;
+  std::unique_ptr<UdpmReader> reader_;  ///< kBatched only
+  std::chrono::microseconds batch_interval_;
+  std::unordered_map<std::string, std::vector<Raw*>> batched_subs_;
   std::int64_t invalid_{0};
   std::int64_t send_errors_{0};
   std::int64_t last_invalid_log_us_{-1};

@@ -43,7 +43,9 @@ struct RunFailure : std::runtime_error {
 
 class Node {
  public:
-  Node(std::string role, const NodeOptions& opt);
+  /// `receive`: kEvent for the roles on a step's critical path (plant, controller), kBatched
+  /// for the others (monitor, trajectory): see bus.hpp.
+  Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kEvent);
   virtual ~Node() = default;
 
   const std::string& role() const { return role_; }

@@ -1,9 +1,12 @@
 #pragma once
 // The reference-generator process: a feeddrive::trajectory::Trajectory behind the message
 // contract. Publishes the references in aligned blocks of kBlock steps (reference_block_t),
-// always at least half a block ahead of the newest state, so a reference is never on a step's
-// critical path; re-publishes the block(s) covering state k when state k is repeated, and any
-// block asked for on <prefix>_RESEND.
+// kLead steps ahead of the newest state it has seen, so a reference is never on a step's
+// critical path although the trajectory reads the bus in batches (Receive::kBatched, every
+// millisecond: 256 steps cover 10 ms at 25,000 steps/s); re-publishes the block(s) covering
+// state k when state k is repeated, and on a request on <prefix>_RESEND for step k, the
+// block of k and every later block already published (a late or overflowed subscriber lacks
+// them all).
 
 #include <memory>
 #include <set>
@@ -19,17 +22,21 @@ namespace feeddrive::service {
 class TrajectoryNode : public Node {
  public:
   static constexpr std::int64_t kBlock = 16;
+  static constexpr std::int64_t kLead = 256;
   TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt);
   void run();
 
  private:
   /// Publishes block b (steps b*kBlock ..) unless sent already; resend = publish again.
   void send_block(std::int64_t b, bool resend);
+  /// Publishes every block not yet sent up to step k + kLead.
+  void send_ahead(std::int64_t k);
 
   sim::Scenario s_;
   std::unique_ptr<trajectory::Trajectory> reference_;
   Outbox<reference_block_t> blocks_;
   std::int64_t highest_state_{-1};
+  std::int64_t next_block_{0};  ///< the first block not yet published
   std::int64_t last_progress_us_{0};
   bool end_{false};
 };
