@@ -35,7 +35,14 @@ void TrajectoryNode::send_block(std::int64_t b, bool resend) {
   const std::int64_t first = b * kBlock;
   if (first < 0 || first >= s_.steps()) return;
   if (blocks_.has(b)) {
-    if (resend && blocks_.republish(b)) ++resends;
+    // Several requesters (controller, monitor, a repeated state) asking for the same block
+    // within one resend interval get one copy.
+    auto& last = last_resent_us_[b];
+    const std::int64_t now = mono_us();
+    if (resend && now - last >= us(options().resend_interval_s) && blocks_.republish(b)) {
+      ++resends;
+      last = now;
+    }
     return;
   }
   reference_block_t m;

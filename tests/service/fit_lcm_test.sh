@@ -18,17 +18,17 @@ grep -q 'constant_force: {force_N: 15.0}' "$TMP/truth.yaml" || fail "truth.yaml:
 
 prio=(chrt -f 20)
 "${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority available; logging without it"; prio=(); }
-"${prio[@]}" timeout 300 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
+"${prio[@]}" timeout 300 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 300 feeddrive-launch "$TMP/truth.yaml" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
 sleep 0.5
 kill -INT $lg; wait $lg || true
-[ -s "$TMP/run.lcmlog" ] || { cat "$TMP/logger.err" >&2; fail "lcm-logger wrote no log"; }
+[ -s "$LOGDIR/run.lcmlog" ] || { cat "$TMP/logger.err" >&2; fail "lcm-logger wrote no log"; }
 rows=$(( $(wc -l < "$TMP/mon/timeseries.csv") - 1 ))
-pass "recorded $(stat -c %s "$TMP/run.lcmlog") bytes of LCM log; the monitor has $rows rows"
+pass "recorded $(stat -c %s "$LOGDIR/run.lcmlog") bytes of LCM log; the monitor has $rows rows"
 
 set +e
-timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$TMP/run.lcmlog" --out "$TMP/fit" -q --no-plots \
+timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$LOGDIR/run.lcmlog" --out "$TMP/fit" -q --no-plots \
   > "$TMP/fit.out" 2> "$TMP/fit.err"; rc=$?
 set -e
 [ $rc = 0 ] || { cat "$TMP/fit.out" "$TMP/fit.err" >&2; fail "feeddrive-fit on the log: exit $rc"; }
@@ -47,8 +47,8 @@ pass "fit of the log: constant_force = $force N, gap $(json "$f" .gap_initial) -
 
 # A log cut in the middle of an event (60 % of it plus an odd 7 bytes: an event boundary there
 # would be a coincidence; checked below) is refused: exit 2, one line naming the file.
-size=$(stat -c %s "$TMP/run.lcmlog")
-head -c $(( size * 6 / 10 + 7 )) "$TMP/run.lcmlog" > "$TMP/cut.lcmlog"
+size=$(stat -c %s "$LOGDIR/run.lcmlog")
+head -c $(( size * 6 / 10 + 7 )) "$LOGDIR/run.lcmlog" > "$TMP/cut.lcmlog"
 set +e
 timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$TMP/cut.lcmlog" --out "$TMP/cut" -q --no-plots \
   > "$TMP/cut.out" 2> "$TMP/cut.err"; rc=$?

@@ -18,7 +18,7 @@ for t in "$SRC"/lcmtypes/*.lcm; do
 done
 
 scen=$SRC/tests/service/scenarios/short_jerk.yaml
-lcm-logger --lcm-url="$URL" --channel='SPY_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
+lcm-logger --lcm-url="$URL" --channel='SPY_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 120 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --prefix SPY --lcm-url "$URL"
 sleep 0.3
@@ -66,7 +66,7 @@ public class SpyDecode {
 JAVA
 javac -nowarn -cp "$JAR:$LCM_JAR" -d "$TMP/java" "$TMP/java/SpyDecode.java" 2> "$TMP/javac.err" ||
   { cat "$TMP/javac.err" >&2; fail "javac failed on the decoder"; }
-out=$(timeout 120 java -cp "$TMP/java:$JAR:$LCM_JAR" SpyDecode "$JAR" "$TMP/run.lcmlog") ||
+out=$(timeout 120 java -cp "$TMP/java:$JAR:$LCM_JAR" SpyDecode "$JAR" "$LOGDIR/run.lcmlog") ||
   { echo "$out" >&2; fail "the jar does not decode every message of the run"; }
 for ch in SPY_STATE SPY_CMD SPY_REF SPY_STATUS SPY_SUMMARY; do
   printf '%s\n' "$out" | grep -q "$ch " || fail "no decoded message on $ch: $out"

@@ -9,12 +9,12 @@ source "$(dirname "$0")/lib.sh" "$@"
 scen=$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml
 prio=(chrt -f 20)
 "${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority available; logging without it"; prio=(); }
-"${prio[@]}" lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$TMP/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
+"${prio[@]}" lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 300 feeddrive-launch "$scen" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
 sleep 0.5
 kill -INT $lg; wait $lg || true
-timeout 120 feeddrive-log2csv "$TMP/run.lcmlog" --scenario "$scen" --out "$TMP/conv" -q
+timeout 120 feeddrive-log2csv "$LOGDIR/run.lcmlog" --scenario "$scen" --out "$TMP/conv" -q
 same_csv "$TMP/mon/timeseries.csv" "$TMP/conv/timeseries.csv"
 rows=$(( $(wc -l < "$TMP/conv/timeseries.csv") - 1 ))
 [ "$rows" = 10000 ] || fail "$rows rows, expected 10000"
@@ -22,15 +22,15 @@ pass "lcm-logger log converted: $rows rows, identical to the monitor's"
 
 timeout 120 feeddrive-monitor "$scen" --out "$TMP/replay" --no-plots -q --attach --step-timeout 3 --lcm-url "$URL" & m=$!
 wait_on_bus $m
-timeout 120 lcm-logplayer --lcm-url="$URL" "$TMP/run.lcmlog" > /dev/null 2>&1
+timeout 120 lcm-logplayer --lcm-url="$URL" "$LOGDIR/run.lcmlog" > /dev/null 2>&1
 wait $m || fail "the attached monitor failed"
 same_csv "$TMP/mon/timeseries.csv" "$TMP/replay/timeseries.csv"
 pass "lcm-logplayer playback recorded by an attached monitor: identical"
 
 # A corrupt log gets a one-line error naming the file, and exit 2.
-head -c 100000 "$TMP/run.lcmlog" > "$TMP/bad.lcmlog"
+head -c 100000 "$LOGDIR/run.lcmlog" > "$TMP/bad.lcmlog"
 printf 'garbage-garbage-garbage' >> "$TMP/bad.lcmlog"
-head -c 50000 "$TMP/run.lcmlog" | tail -c 20000 >> "$TMP/bad.lcmlog"
+head -c 50000 "$LOGDIR/run.lcmlog" | tail -c 20000 >> "$TMP/bad.lcmlog"
 set +e
 feeddrive-log2csv "$TMP/bad.lcmlog" --scenario "$scen" --out "$TMP/bad" -q 2> "$TMP/bad.err"; rc=$?
 set -e
