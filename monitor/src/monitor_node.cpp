@@ -145,8 +145,8 @@ void MonitorNode::finish(bool completed, const std::string& failure) {
   summary_.latency_state_to_command_p99_us = lat(rec_.latency_state_to_command(), 0.99);
   summary_.latency_command_to_state_p50_us = lat(rec_.latency_command_to_state(), 0.5);
   summary_.latency_command_to_state_p99_us = lat(rec_.latency_command_to_state(), 0.99);
-  summary_.latency_state_to_reference_p50_us = lat(rec_.latency_state_to_reference(), 0.5);
-  summary_.latency_state_to_reference_p99_us = lat(rec_.latency_state_to_reference(), 0.99);
+  summary_.reference_lead_p50_us = lat(rec_.reference_lead(), 0.5);
+  summary_.reference_lead_p1_us = lat(rec_.reference_lead(), 0.01);
 
   nlohmann::ordered_json j;
   auto& l = j["lockstep"];
@@ -179,10 +179,12 @@ void MonitorNode::finish(bool completed, const std::string& failure) {
   };
   hop("state_to_command", rec_.latency_state_to_command());
   hop("command_to_state", rec_.latency_command_to_state());
-  hop("state_to_reference", rec_.latency_state_to_reference());
-  for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["latency_us"]["state_to_reference"]})
-    for (const char* q : {"p50", "p99"})
-      if (std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
+  l["reference_lead_us"] = {{"p50", lat(rec_.reference_lead(), 0.5)},
+                            {"p1", lat(rec_.reference_lead(), 0.01)},
+                            {"samples", rec_.reference_lead().size()}};
+  for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
+    for (const char* q : {"p50", "p99", "p1"})
+      if (v->contains(q) && std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
 
   try {
     sim::write_results(mopt_.out_dir, r, sum, s_, mopt_.plots && !r.records.empty(), j.dump());

@@ -27,6 +27,7 @@ void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
     return;
   }
   states_[m.seq] = {m, recv_us};
+  if (const auto r = refs_.find(m.seq); r != refs_.end()) lead_.push_back(static_cast<double>(recv_us - r->second.recv_us));
   maybe_start();
   const auto c = cmds_.find(m.seq - 1);
   if (c != cmds_.end() && recv_us >= c->second.recv_us) lat_cs_.push_back(static_cast<double>(recv_us - c->second.recv_us));
@@ -40,8 +41,7 @@ void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
   refs_[m.seq] = {m, recv_us};
   if (first_ref_seq_ < 0) first_ref_seq_ = m.seq;
   maybe_start();
-  const auto s = states_.find(m.seq - 1);
-  if (s != states_.end() && recv_us >= s->second.recv_us) lat_sr_.push_back(static_cast<double>(recv_us - s->second.recv_us));
+  if (const auto s = states_.find(m.seq); s != states_.end()) lead_.push_back(static_cast<double>(s->second.recv_us - recv_us));
 }
 
 void Recorder::on_command(const control_command_t& m, std::int64_t recv_us) {

@@ -58,11 +58,12 @@ class Recorder {
   std::int64_t missed_deadlines() const { return missed_; }
   bool safe_state() const { return safe_state_; }
 
-  /// Per-hop latencies from receive times [us]: state k -> command k, command k -> state k+1,
-  /// state k -> reference k+1 (only when the reference came after the state).
+  /// Per-hop latencies from receive times [us]: state k -> command k, command k -> state k+1.
   const std::vector<double>& latency_state_to_command() const { return lat_sc_; }
   const std::vector<double>& latency_command_to_state() const { return lat_cs_; }
-  const std::vector<double>& latency_state_to_reference() const { return lat_sr_; }
+  /// How long before state k its reference k arrived [us]: the trajectory's lead. Negative:
+  /// the reference came after the state, and the step waited for it.
+  const std::vector<double>& reference_lead() const { return lead_; }
 
  private:
   template <typename Msg>
@@ -88,7 +89,7 @@ class Recorder {
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
   bool safe_state_{false};
-  std::vector<double> lat_sc_, lat_cs_, lat_sr_;
+  std::vector<double> lat_sc_, lat_cs_, lead_;
 };
 
 /// p-quantile (0..1) of a sample, NaN when empty.
