@@ -5,6 +5,9 @@
 // plant <-> controller exchange.
 //   lcm-pingpong server [--lcm-url URL] [--prefix P]
 //   lcm-pingpong client --count N [--lcm-url URL] [--prefix P]   -> prints "pingpong_rate <per s>"
+//   lcm-pingpong listen [--batched] --seconds S [--lcm-url URL]  -> sits on the group for S seconds,
+//       subscribed to a channel nobody publishes: what another process on the group costs the
+//       ping-pong, with liblcm's receive or with the batched one (service/udpm_reader.hpp).
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -20,12 +23,22 @@ int main(int argc, char** argv) {
   CLI::App app{"lcm-pingpong: raw LCM round trips between two processes", "lcm-pingpong"};
   std::string mode, url = default_lcm_url(), prefix = "PP";
   long count = 20000;
-  app.add_option("mode", mode)->required()->check(CLI::IsMember({"server", "client"}));
+  double seconds = 10.0;
+  bool batched = false;
+  app.add_option("mode", mode)->required()->check(CLI::IsMember({"server", "client", "listen"}));
+  app.add_option("--seconds", seconds, "listen: how long");
+  app.add_flag("--batched", batched, "listen: read the group in batches instead of with liblcm's receive thread");
   app.add_option("--lcm-url", url);
   app.add_option("--prefix", prefix);
   app.add_option("--count", count);
   CLI11_PARSE(app, argc, argv);
-  Bus bus(url);
+  Bus bus(url, batched ? Receive::kBatched : Receive::kEvent);
+  if (mode == "listen") {
+    bus.subscribe<control_command_t>(prefix + "_NOBODY", [](const control_command_t&, std::int64_t) {});
+    const std::int64_t end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    while (mono_us() < end) bus.poll(std::chrono::milliseconds(100));
+    return 0;
+  }
   const std::string ping = prefix + "_PING", pong = prefix + "_PONG";
   if (mode == "server") {
     bool stop = false;

@@ -7,6 +7,8 @@
 # Each is run ROUNDS times (default 3), alternating; medians and their ratio are printed, for
 # two placements: free (the scheduler's) and one core (all processes of both pinned to CPU 0).
 # Target: lockstep >= 0.8 x ping-pong. Message sizes are printed too (target < 1 KB per step).
+# Last, what other processes on the multicast group cost a ping-pong round trip (the reason the
+# monitor and the trajectory read in batches; docs/lcm-contract.md, "Receiving in batches").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -38,4 +40,29 @@ bench() {
 }
 bench free
 bench one-core
+# What other processes on the multicast group cost a round trip (one core): none, two liblcm
+# subscribers to a channel nobody publishes, two batched readers (the monitor's and the
+# trajectory's way of receiving, service/udpm_reader.hpp).
+group() {
+  local bare=() lcm=() batched=()
+  for r in $(seq "$ROUNDS"); do
+    for extra in none lcm batched; do
+      local listeners=()
+      if [ "$extra" != none ]; then
+        local flag=(); [ "$extra" = batched ] && flag=(--batched)
+        for i in 1 2; do taskset -c 0 "$BUILD/bin/lcm-pingpong" listen "${flag[@]}" --seconds 60 --lcm-url "$URL" --prefix "G$i" & listeners+=($!); done
+        sleep 0.2
+      fi
+      taskset -c 0 "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PG$extra$r" & srv=$!
+      rate=$(taskset -c 0 "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PG$extra$r" |
+             awk '/pingpong_rate/ { print $2 }')
+      wait $srv
+      [ ${#listeners[@]} -gt 0 ] && { kill "${listeners[@]}"; wait "${listeners[@]}" 2>/dev/null || true; }
+      case $extra in none) bare+=("$rate") ;; lcm) lcm+=("$rate") ;; batched) batched+=("$rate") ;; esac
+    done
+  done
+  echo "ping-pong on one core with other processes on the group, medians [round trips/s]:" \
+       "none $(median "${bare[@]}"), two liblcm subscribers $(median "${lcm[@]}"), two batched readers $(median "${batched[@]}")"
+}
+group
 echo "bytes per step on the wire: $(jq -r .lockstep.bytes_per_step "$TMP/runfree1/summary.json") (target < 1024)"
