@@ -9,7 +9,7 @@ and follows the same message protocol as build/bin/feeddrive-controller
 
 Channels (<P> = --prefix, default FD):
   <P>_STATE   drive_state_t      from the plant, one per step k (repeated until command k comes)
-  <P>_REF     reference_block_t  from the trajectory: 16 reference_t, half a block or more ahead
+  <P>_REF     reference_block_t  from the trajectory: 16 reference_t, up to 256 steps ahead
   <P>_CMD     control_command_t  published here, one per step
   <P>_STATUS  process_status_t   heartbeats of every process (this one: role "controller")
   <P>_RESEND  resend_request_t   "please re-publish message seq of channel C"

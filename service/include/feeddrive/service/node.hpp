@@ -5,8 +5,8 @@
 // Protocol (docs/lcm-contract.md): the plant publishes drive_state_t k and waits for
 // control_command_t k; it re-publishes state k every resend interval until the command comes.
 // The controller answers state k once it also has reference_t k, and answers a repeated state k
-// with the same command. The trajectory publishes reference k+1 when it sees state k, and
-// re-publishes k and k+1 when it sees state k repeated. The monitor records every step and
+// with the same command. The trajectory keeps references 256 steps ahead of the newest state it
+// has seen, and re-publishes k's block when it sees state k repeated. The monitor records every step and
 // asks for what it missed on <prefix>_RESEND; the plant stays within a window of the monitor's
 // acknowledged step, so nothing is lost. Every wait has a timeout that names the missing role.
 
