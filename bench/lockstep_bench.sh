@@ -40,29 +40,31 @@ bench() {
 }
 bench free
 bench one-core
-# What other processes on the multicast group cost a round trip (one core): none, two liblcm
-# subscribers to a channel nobody publishes, two batched readers (the monitor's and the
-# trajectory's way of receiving, service/udpm_reader.hpp).
+# What other processes on the multicast group cost a round trip, for both placements: none, two
+# liblcm subscribers to a channel nobody publishes, two batched readers (the monitor's and the
+# trajectory's way of receiving, service/udpm_reader.hpp). A lockstep run has two such processes.
 group() {
-  local bare=() lcm=() batched=()
+  local placement=$1 pin=() bare=() lcm=() batched=()
+  if [ "$placement" = one-core ]; then pin=(taskset -c 0); fi
   for r in $(seq "$ROUNDS"); do
     for extra in none lcm batched; do
       local listeners=()
       if [ "$extra" != none ]; then
         local flag=(); [ "$extra" = batched ] && flag=(--batched)
-        for i in 1 2; do taskset -c 0 "$BUILD/bin/lcm-pingpong" listen "${flag[@]}" --seconds 60 --lcm-url "$URL" --prefix "G$i" & listeners+=($!); done
+        for i in 1 2; do "${pin[@]}" "$BUILD/bin/lcm-pingpong" listen "${flag[@]}" --seconds 60 --lcm-url "$URL" --prefix "G$i" & listeners+=($!); done
         sleep 0.2
       fi
-      taskset -c 0 "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PG$extra$r" & srv=$!
-      rate=$(taskset -c 0 "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PG$extra$r" |
+      "${pin[@]}" "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PG$placement$extra$r" & srv=$!
+      rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PG$placement$extra$r" |
              awk '/pingpong_rate/ { print $2 }')
       wait $srv
       [ ${#listeners[@]} -gt 0 ] && { kill "${listeners[@]}"; wait "${listeners[@]}" 2>/dev/null || true; }
       case $extra in none) bare+=("$rate") ;; lcm) lcm+=("$rate") ;; batched) batched+=("$rate") ;; esac
     done
   done
-  echo "ping-pong on one core with other processes on the group, medians [round trips/s]:" \
+  echo "$placement: ping-pong with other processes on the group, medians [round trips/s]:" \
        "none $(median "${bare[@]}"), two liblcm subscribers $(median "${lcm[@]}"), two batched readers $(median "${batched[@]}")"
 }
-group
+group free
+group one-core
 echo "bytes per step on the wire: $(jq -r .lockstep.bytes_per_step "$TMP/runfree1/summary.json") (target < 1024)"
