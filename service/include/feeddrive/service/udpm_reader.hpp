@@ -7,8 +7,8 @@
 // its channel, then wakes the main thread through a pipe for the subscribed ones. Every process
 // on the group therefore pays a wake-up for each of a step's datagrams. Measured on the 2-core
 // development VM, where a switch between processes is expensive: two LCM processes that merely
-// sit on the group cut a two-process ping-pong from 22,700 to 16,000 round trips/s on one core;
-// two processes that drain the same group in batches (this class) leave it at 21,600
+// sit on the group cut a two-process ping-pong from 20,600 to 14,400 round trips/s on one core;
+// two processes that drain the same group in batches (this class) leave it at 19,800
 // (bench/lockstep_bench.sh; docs/lcm-contract.md, "Receiving in batches"). A recorder does not need a wake-up per
 // datagram: it sleeps for a batch interval and then takes everything queued, so the kernel
 // only queues the datagrams on its socket and nobody is woken.
