@@ -22,8 +22,11 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
       ++duplicates;
       return;
     }
+    // Waiting for a reference since the first unanswered state, not the newest: in real-time
+    // mode a newer state replaces the pending one every period, and a request timed from the
+    // newest would never go out.
+    if (!pending_) pending_since_us_ = now;
     pending_ = m;
-    pending_since_us_ = now;
     try_answer();
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t) {

@@ -25,9 +25,11 @@ TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
   on_resend_request = [this](const resend_request_t& r) {
     if (r.channel != blocks_.channel() || r.seq < 0) return;
     // The requester lacks block seq/kBlock, and probably the blocks published after it too (it
-    // started late, or its socket overflowed): send them all again, not one request each.
-    send_block(r.seq / kBlock, true);
-    for (std::int64_t b = r.seq / kBlock + 1; b < next_block_; ++b) send_block(b, true);
+    // started late, or its socket overflowed): send them again, not one request each, up to
+    // one lead's worth (a monitor far behind asks again as it catches up).
+    const std::int64_t first = r.seq / kBlock;
+    send_block(first, true);
+    for (std::int64_t b = first + 1; b < std::min(next_block_, first + 1 + kLead / kBlock); ++b) send_block(b, true);
   };
 }
 

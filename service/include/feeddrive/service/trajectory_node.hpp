@@ -5,8 +5,8 @@
 // critical path although the trajectory reads the bus in batches (Receive::kBatched, every
 // millisecond: 256 steps cover 10 ms at 25,000 steps/s); re-publishes the block(s) covering
 // state k when state k is repeated, and on a request on <prefix>_RESEND for step k, the
-// block of k and every later block already published (a late or overflowed subscriber lacks
-// them all).
+// block of k and the later blocks already published, up to kLead steps (a late or overflowed
+// subscriber lacks them all).
 
 #include <memory>
 #include <set>
