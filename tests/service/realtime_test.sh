@@ -14,8 +14,10 @@ rows=$(( $(wc -l < "$TMP/rt/timeseries.csv") - 1 ))
 misses=$(json "$TMP/rt/summary.json" .lockstep.deadline_misses)
 # Paced by the clock: 0.5 s of simulated time cannot take less than 0.5 s of wall time.
 awk -v w="$wall" 'BEGIN { exit !(w >= 0.5) }' || fail "ran in ${wall}s: not paced"
-# On a shared 2-core machine some periods are missed; most must not be.
-[ "$misses" -lt 250 ] || fail "$misses of 500 deadlines missed"
+# On a shared 2-core machine a few periods are missed (0 to 5 of 500 measured, also next to a
+# CPU hog); a start in which the controller lacks the first 256 steps of references (the bug
+# this bound caught) misses about 256. 50 leaves room for load and fails on that.
+[ "$misses" -lt 50 ] || fail "$misses of 500 deadlines missed"
 pass "real time at 1 kHz: 500 steps in ${wall}s, $misses deadline misses"
 
 timeout 60 feeddrive-launch "$scen" --out "$TMP/safe" --no-plots --realtime --external controller \
