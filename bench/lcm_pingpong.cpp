@@ -5,7 +5,7 @@
 // plant <-> controller exchange.
 //   lcm-pingpong server [--lcm-url URL] [--prefix P]
 //   lcm-pingpong client --count N [--lcm-url URL] [--prefix P]   -> prints "pingpong_rate <per s>"
-//   lcm-pingpong listen [--batched [--batch-ms MS]] --seconds S [--lcm-url URL]  -> sits on the group for S seconds,
+//   lcm-pingpong listen [--batched] --seconds S [--lcm-url URL]  -> sits on the group for S seconds,
 //       subscribed to a channel nobody publishes: what another process on the group costs the
 //       ping-pong, with liblcm's receive or with the batched one (service/udpm_reader.hpp).
 #include <CLI/CLI.hpp>
@@ -28,14 +28,11 @@ int main(int argc, char** argv) {
   app.add_option("mode", mode)->required()->check(CLI::IsMember({"server", "client", "listen"}));
   app.add_option("--seconds", seconds, "listen: how long");
   app.add_flag("--batched", batched, "listen: read the group in batches instead of with liblcm's receive thread");
-  double batch_ms = 1.0;
-  app.add_option("--batch-ms", batch_ms, "listen --batched: the batch interval [ms]");
   app.add_option("--lcm-url", url);
   app.add_option("--prefix", prefix);
   app.add_option("--count", count);
   CLI11_PARSE(app, argc, argv);
-  Bus bus(url, batched ? Receive::kBatched : Receive::kEvent,
-          std::chrono::microseconds(static_cast<std::int64_t>(batch_ms * 1000)));
+  Bus bus(url, batched ? Receive::kBatched : Receive::kEvent);
   if (mode == "listen") {
     bus.subscribe<control_command_t>(prefix + "_NOBODY", [](const control_command_t&, std::int64_t) {});
     const std::int64_t end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);

@@ -14,7 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libbenchmark-dev libceres-dev
   gnuplot-nox jq python3 python3-yaml
-  iproute2 nftables util-linux
+  iproute2 nftables util-linux procps
   lua5.2 liblcm-lua
 )
 missing=()

@@ -31,8 +31,7 @@ std::int64_t mono_us() {
       .count();
 }
 
-Bus::Bus(const std::string& url, Receive receive, std::chrono::microseconds batch_interval)
-    : url_(url), lcm_(url), batch_interval_(batch_interval) {
+Bus::Bus(const std::string& url, Receive receive) : url_(url), lcm_(url) {
   if (!lcm_.good())
     throw std::runtime_error("cannot open LCM at '" + url +
                              "' (is there a multicast route? see docs/lcm-contract.md)");
@@ -67,7 +66,7 @@ bool Bus::poll(std::chrono::microseconds timeout) {
 
 bool Bus::poll_batched(std::chrono::microseconds timeout) {
   // Sleep first, never on the socket: datagrams queue meanwhile without waking anyone.
-  const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, batch_interval_).count(), 0);
+  const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, kBatchInterval).count(), 0);
   struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
   ::nanosleep(&ts, nullptr);  // EINTR (a signal): drain what is there and return
   std::string channel;

@@ -39,12 +39,7 @@ void TrajectoryNode::send_block(std::int64_t b, bool resend) {
   if (blocks_.has(b)) {
     // Several requesters (controller, monitor, a repeated state) asking for the same block
     // within one resend interval get one copy.
-    auto& last = last_resent_us_[b];
-    const std::int64_t now = mono_us();
-    if (resend && now - last >= us(options().resend_interval_s) && blocks_.republish(b)) {
-      ++resends;
-      last = now;
-    }
+    if (resend && blocks_.republish(b, us(options().resend_interval_s))) ++resends;
     return;
   }
   reference_block_t m;

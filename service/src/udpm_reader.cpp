@@ -66,11 +66,11 @@ std::optional<UdpmAddress> parse_udpm_url(const std::string& url) {
   return a;
 }
 
-void Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime,
+bool Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime,
                        const MessageSink& sink) {
   if (n < kShortHeader) {
     ++malformed_;
-    return;
+    return false;
   }
   const std::uint32_t magic = be32(d);
   if (magic == kMagicShort) {
@@ -78,15 +78,15 @@ void Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sende
     const auto* nul = static_cast<const std::uint8_t*>(std::memchr(name, 0, n - kShortHeader));
     if (nul == nullptr) {
       ++malformed_;
-      return;
+      return false;
     }
     const std::string_view channel(reinterpret_cast<const char*>(name), static_cast<std::size_t>(nul - name));
     sink(channel, nul + 1, static_cast<std::size_t>(d + n - (nul + 1)), recv_utime);
-    return;
+    return true;
   }
   if (magic != kMagicLong || n < kLongHeader) {
     ++malformed_;
-    return;
+    return false;
   }
   const std::uint32_t seqno = be32(d + 4);
   const std::uint32_t size = be32(d + 8);
@@ -100,7 +100,7 @@ void Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sende
     const auto* nul = static_cast<const std::uint8_t*>(std::memchr(body, 0, body_n));
     if (nul == nullptr) {
       ++malformed_;
-      return;
+      return false;
     }
     channel.assign(reinterpret_cast<const char*>(body), static_cast<std::size_t>(nul - body));
     body_n -= static_cast<std::size_t>(nul + 1 - body);
@@ -108,7 +108,7 @@ void Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sende
   }
   if (count == 0 || no >= count || size > kMaxPayload || offset > size || body_n > size - offset) {
     ++malformed_;
-    return;
+    return false;
   }
   const auto key = std::make_pair(sender, seqno);
   auto it = partial_.find(key);
@@ -126,17 +126,18 @@ void Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sende
   if (p.data.size() != size || p.have.size() != count) {
     ++malformed_;
     partial_.erase(it);
-    return;
+    return false;
   }
-  if (p.have[no]) return;  // a duplicate fragment
+  if (p.have[no]) return false;  // a duplicate fragment
   p.have[no] = true;
   ++p.received;
   if (no == 0) p.channel = std::move(channel);
   if (body_n > 0) std::memcpy(p.data.data() + offset, body, body_n);
-  if (p.received < count) return;
+  if (p.received < count) return false;
   const Partial done = std::move(p);
   partial_.erase(it);
   sink(done.channel, done.data.data(), done.data.size(), recv_utime);
+  return true;
 }
 
 UdpmReader::UdpmReader(const UdpmAddress& a) : buf_(kBatch * kMaxDatagram) {
@@ -186,10 +187,6 @@ UdpmReader::~UdpmReader() {
 
 std::size_t UdpmReader::drain(const MessageSink& sink) {
   std::size_t delivered = 0;
-  const MessageSink counting = [&](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t t) {
-    ++delivered;
-    sink(ch, d, n, t);
-  };
   mmsghdr msgs[kBatch];
   iovec iov[kBatch];
   sockaddr_in from[kBatch];
@@ -221,7 +218,8 @@ std::size_t UdpmReader::drain(const MessageSink& sink) {
         }
       }
       const std::uint64_t sender = (std::uint64_t{from[i].sin_addr.s_addr} << 16) | from[i].sin_port;
-      reassembler_.feed(static_cast<const std::uint8_t*>(iov[i].iov_base), msgs[i].msg_len, sender, utime, counting);
+      if (reassembler_.feed(static_cast<const std::uint8_t*>(iov[i].iov_base), msgs[i].msg_len, sender, utime, sink))
+        ++delivered;
     }
     if (static_cast<std::size_t>(got) < kBatch) return delivered;
   }

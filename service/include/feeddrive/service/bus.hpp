@@ -51,8 +51,9 @@ class Bus {
  public:
   /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kBatched falls
   /// back to kEvent for URLs other than udpm:// (memq://, file://).
-  explicit Bus(const std::string& url, Receive receive = Receive::kEvent,
-               std::chrono::microseconds batch_interval = std::chrono::microseconds(1000));
+  explicit Bus(const std::string& url, Receive receive = Receive::kEvent);
+  /// kBatched: how long poll() sleeps before it takes what is queued.
+  static constexpr std::chrono::microseconds kBatchInterval{1000};
   Bus(const Bus&) = delete;
   Bus& operator=(const Bus&) = delete;
 
@@ -72,7 +73,9 @@ class Bus {
   bool poll(std::chrono::microseconds timeout);
   bool batched() const { return reader_ != nullptr; }
 
-  std::int64_t invalid() const { return invalid_; }
+  /// Messages that did not decode as their channel's type, and (kBatched) datagrams that are
+  /// not LCM's framing.
+  std::int64_t invalid() const { return invalid_ + (reader_ ? reader_->malformed() : 0); }
   std::int64_t send_errors() const { return send_errors_; }
   const std::string& url() const { return url_; }
 
@@ -91,7 +94,6 @@ class Bus {
   lcm::LCM lcm_;
   std::vector<std::unique_ptr<Raw>> raws_;
   std::unique_ptr<UdpmReader> reader_;  ///< kBatched only
-  std::chrono::microseconds batch_interval_;
   std::unordered_map<std::string, std::vector<Raw*>> batched_subs_;
   std::int64_t invalid_{0};
   std::int64_t send_errors_{0};
@@ -100,14 +102,15 @@ class Bus {
 };
 
 /// Remembers the last `capacity` messages published on one channel, by step number, and
-/// re-publishes one on request.
+/// re-publishes one on request, if it was not re-published within `min_interval_us`.
 template <typename Msg>
 class Outbox {
  public:
   Outbox(Bus& bus, std::string channel, std::size_t capacity = 65536)
       : bus_(bus), channel_(std::move(channel)), capacity_(capacity) {}
   void publish(std::int64_t seq, const Msg& msg) {
-    auto [it, inserted] = sent_.insert_or_assign(seq, msg);
+    // No clock read here: publish() is on every step's path; only re-publications are timed.
+    auto [it, inserted] = sent_.insert_or_assign(seq, Sent{msg, kNever});
     (void)it;
     if (inserted) order_.push_back(seq);
     while (order_.size() > capacity_) {
@@ -116,11 +119,16 @@ class Outbox {
     }
     bus_.publish(channel_, msg);
   }
-  /// Re-publishes message `seq` if it is still kept; returns whether it was.
-  bool republish(std::int64_t seq) {
+  /// Re-publishes message `seq` if it is still kept and was not re-published within the last
+  /// `min_interval_us` (several requesters asking within one resend interval get one copy);
+  /// returns whether it was re-published.
+  bool republish(std::int64_t seq, std::int64_t min_interval_us = 0) {
     const auto it = sent_.find(seq);
     if (it == sent_.end()) return false;
-    bus_.publish(channel_, it->second);
+    const std::int64_t now = mono_us();
+    if (it->second.resent_us != kNever && now - it->second.resent_us < min_interval_us) return false;
+    bus_.publish(channel_, it->second.msg);
+    it->second.resent_us = now;
     ++resends_;
     return true;
   }
@@ -132,7 +140,12 @@ class Outbox {
   Bus& bus_;
   std::string channel_;
   std::size_t capacity_;
-  std::map<std::int64_t, Msg> sent_;
+  static constexpr std::int64_t kNever = -1;
+  struct Sent {
+    Msg msg;
+    std::int64_t resent_us;  ///< when it was last re-published (mono_us), or kNever
+  };
+  std::map<std::int64_t, Sent> sent_;
   std::deque<std::int64_t> order_;
   std::int64_t resends_{0};
 };

@@ -10,7 +10,6 @@
 
 #include <memory>
 #include <set>
-#include <unordered_map>
 
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
@@ -38,7 +37,6 @@ class TrajectoryNode : public Node {
   Outbox<reference_block_t> blocks_;
   std::int64_t highest_state_{-1};
   std::int64_t next_block_{0};  ///< the first block not yet published
-  std::unordered_map<std::int64_t, std::int64_t> last_resent_us_;  ///< block -> when it was last re-published
   std::int64_t last_progress_us_{0};
   bool end_{false};
 };

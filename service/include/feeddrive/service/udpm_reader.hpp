@@ -54,7 +54,8 @@ using MessageSink = std::function<void(std::string_view channel, const std::uint
 /// header, no channel terminator, inconsistent fragment) are counted and dropped.
 class Reassembler {
  public:
-  void feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime, const MessageSink& sink);
+  /// Returns true if the datagram completed a message (passed to `sink`).
+  bool feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime, const MessageSink& sink);
   std::int64_t malformed() const { return malformed_; }
   std::size_t pending() const { return partial_.size(); }
 
