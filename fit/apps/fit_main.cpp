@@ -3,11 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/workflow.hpp"
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 int main(int argc, char** argv) {
@@ -22,14 +26,46 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("--out,-o", out_dir, "output folder (written atomically)")->required();
   app.add_option("--max-effects", opt.max_effects, "most effects to add")->capture_default_str()->check(CLI::Range(0, 11));
-  app.add_option("--score-threshold", opt.score_threshold, "least BIC score of a significant effect")->capture_default_str();
+  // A finite number in [lo, hi] (CLI::Range lets NaN through), or exactly 0 where `zero` says so.
+  const auto within = [](double lo, double hi, bool zero) {
+    return CLI::Validator(
+        [=](std::string& s) -> std::string {
+          char* end = nullptr;
+          const double v = std::strtod(s.c_str(), &end);
+          if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return "'" + s + "' is not a finite number";
+          if (zero && v == 0.0) return "";
+          if (v < lo || v > hi)
+            return "'" + s + "' is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + (zero ? " (or 0)" : "");
+          return "";
+        },
+        "");
+  };
+  app.add_option("--score-threshold", opt.score_threshold, "least BIC score of a significant effect")->capture_default_str()
+      ->check(within(0.0, 1e9, false));
   app.add_option("--min-gap-reduction", opt.min_gap_reduction, "least fraction by which an effect must shrink the replay gap")
-      ->capture_default_str();
-  app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")->capture_default_str();
+      ->capture_default_str()
+      ->check(within(0.0, 0.99, false));
+  app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")->capture_default_str()
+      ->check(within(1e-3, 1e3, true));
   app.add_option("--filter-half-width", opt.record.filter_half_width, "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(within(1e-5, 10.0, true));
   app.add_option("--prefix", prefix, "channel prefix of an LCM log (ignored for CSV)")->capture_default_str();
-  app.add_option("--position-column", csv.position_column, "CSV column with the measured position")->capture_default_str();
+  app.add_option("--time-column", csv.time_column, "CSV column with the time [s]")->capture_default_str();
+  app.add_option("--position-column", csv.position_column, "CSV column with the measured position [m]")->capture_default_str();
+  app.add_option("--command-column", csv.command_column, "CSV column with the command (thrust = Ka*Kf*u)")->capture_default_str();
+  app.add_option("--force-column", csv.force_column, "CSV column with the thrust [N] (if the command column is absent)")
+      ->capture_default_str();
+  app.add_option("--reference-column", csv.reference_column, "CSV column with the position reference [m] (optional)")
+      ->capture_default_str();
+  std::vector<std::string> ask;
+  app.add_option("--effects", ask, "also consider these effects where the scenario does not describe them "
+                                   "(grinding_force: a grinding process)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(plant::effect_names()));
+  app.add_option("--cv-folds", opt.cv_folds, "blocks of time of the out-of-sample check")->capture_default_str()
+      ->check(CLI::Range(2, 50));
+  app.add_flag("--no-form-fit", [&](std::int64_t) { opt.fit_form = false; }, "keep the model's Coulomb transition velocity");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only the result table and errors");
   try {
@@ -47,6 +83,8 @@ int main(int argc, char** argv) {
     // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.
     fit::check_output_dir(out_dir);
     const sim::Scenario scenario = sim::load_scenario(scenario_path);
+    opt.plausibility.grinding_process =
+        scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();
     const fit::MeasuredData data = fit::load_data(data_path, prefix, csv);
     const fit::Record rec = fit::prepare(data, opt.record);
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),

@@ -98,19 +98,20 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
       throw DataError(origin + ": missing column '" + name + "' (header: " + short_value(line) + hint + ")");
     return it->second;
   };
-  const std::size_t ct = require("t");
+  const std::size_t ct = require(opt.time_column);
   const std::size_t cx = require(opt.position_column);
   std::size_t cu;
-  if (col.count("u")) {
-    cu = col["u"];
+  if (col.count(opt.command_column)) {
+    cu = col[opt.command_column];
     d.input_kind = InputKind::kCommand;
-  } else if (col.count("force_N")) {
-    cu = col["force_N"];
+  } else if (col.count(opt.force_column)) {
+    cu = col[opt.force_column];
     d.input_kind = InputKind::kForce;
   } else {
-    throw DataError(origin + ": missing column 'u' or 'force_N' (the input; header: " + short_value(line) + hint + ")");
+    throw DataError(origin + ": missing column '" + opt.command_column + "' or '" + opt.force_column +
+                    "' (the input; header: " + short_value(line) + hint + ")");
   }
-  const long cxd = col.count("xd") ? static_cast<long>(col["xd"]) : -1;
+  const long cxd = col.count(opt.reference_column) ? static_cast<long>(col[opt.reference_column]) : -1;
   const long cv = col.count("v") ? static_cast<long>(col["v"]) : -1;
 
   std::string previous_t;
@@ -134,7 +135,7 @@ MeasuredData parse_csv(const std::string& text, const std::string& origin, const
     };
     const double t = number(ct);
     if (!d.t.empty() && !(t > d.t.back()))
-      throw DataError(origin + ": line " + std::to_string(line_no) + ", column t: " + cells[ct] +
+      throw DataError(origin + ": line " + std::to_string(line_no) + ", column " + header[ct] + ": " + cells[ct] +
                       (t == d.t.back() ? " repeats the previous time" : " is before the previous time " + previous_t) +
                       " (times must increase)");
     previous_t = cells[ct];

@@ -15,6 +15,7 @@ namespace feeddrive::fit {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kSmoothing = "friction.static_smoothing_velocity";
 
 struct Ctx {
   const Record& rec;
@@ -53,8 +54,11 @@ std::vector<std::array<double, 3>> pitch_periodogram(const Ctx& c, bool times_th
   const Motion& m = rec.motion;
   const long ni = static_cast<long>(m.x_mid.size());
   const double range = std::max(rec.x_max - rec.x_min, 1e-4);
-  const double p_max = range;
-  const double p_min = std::min(0.5 * p_max, std::max(1e-3, 4.0 * rec.v_max_abs * rec.bank.half_width));
+  // The pitches plausibility.hpp admits: two periods within the travel, resolved by the samples
+  // and the filter at the peak speed.
+  const double p_max = 0.5 * range;
+  const double p_min = std::max({1e-3, 8.0 * rec.v_max_abs * rec.period, 4.0 * rec.v_max_abs * rec.bank.half_width});
+  if (p_min > p_max) return {};
   const double k_lo = 2 * kPi / p_max, k_hi = 2 * kPi / p_min, dk = 2 * kPi / (8.0 * range);
   const double gain = thrust_per_input(rec, c.model);
   const Eigen::VectorXd& r0 = *c.r0;
@@ -266,6 +270,18 @@ const std::vector<Spec>& specs() {
       sp.upper = [](const Ctx& c) { return std::vector<std::pair<int, double>>{{0, c.rec.bank.half_width}}; };
       s.push_back(sp);
     }
+    {
+      // Not an effect: the model-form parameter eps of sgn_eps(v) = tanh(v/eps), as ln eps,
+      // between 1 um/s and 2 % of the peak speed (a wider band would stand in for viscous friction).
+      Spec sp;
+      sp.name = kSmoothing;
+      sp.dim = 1;
+      sp.lower = {{0, std::log(1e-6)}};
+      sp.upper = [](const Ctx& c) {
+        return std::vector<std::pair<int, double>>{{0, std::log(std::max(2e-6, 0.02 * c.rec.v_max_abs))}};
+      };
+      s.push_back(sp);
+    }
     return s;
   }();
   return all;
@@ -287,7 +303,11 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
   plant::PlantParams p = base;
   for (const Block& b : blocks) {
     const Theta t(th + b.offset, th + b.offset + b.spec->dim);
-    plant::set_effect(p.effects, b.spec->to_effect(t, c));
+    if (b.spec->name == kSmoothing) {
+      p.friction.static_smoothing_velocity = std::exp(t[0]);
+    } else {
+      plant::set_effect(p.effects, b.spec->to_effect(t, c));
+    }
   }
   return p;
 }
@@ -297,12 +317,13 @@ struct ResidualFunctor {
   const plant::PlantParams* base;
   std::vector<Block> blocks;
   const Ctx* ctx;
+  const std::vector<double>* weights;  // per point, nullptr: all 1
   bool operator()(double const* const* params, double* residuals) const {
     const plant::PlantParams p = with_theta(*base, blocks, params[0], *ctx);
     const Eigen::VectorXd r = force_residual(*rec, p);
     for (long i = 0; i < r.size(); ++i) {
       if (!std::isfinite(r[i])) return false;
-      residuals[i] = r[i];
+      residuals[i] = weights ? (*weights)[static_cast<std::size_t>(i)] * r[i] : r[i];
     }
     return true;
   }
@@ -315,9 +336,9 @@ struct Solved {
 };
 
 Solved solve(const Record& rec, const plant::PlantParams& base, const std::vector<Block>& blocks, Theta theta,
-             const Ctx& ctx, int max_iterations) {
+             const Ctx& ctx, int max_iterations, const std::vector<double>* weights = nullptr) {
   const int dim = static_cast<int>(theta.size());
-  auto* functor = new ResidualFunctor{&rec, &base, blocks, &ctx};
+  auto* functor = new ResidualFunctor{&rec, &base, blocks, &ctx, weights};
   auto* cost = new ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::CENTRAL>(functor);
   cost->AddParameterBlock(dim);
   cost->SetNumResiduals(static_cast<int>(rec.bank.tau.size()));
@@ -442,54 +463,107 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
   return out;
 }
 
-std::vector<CandidateFit> rank_candidates(const Record& rec, const plant::PlantParams& model) {
-  const Eigen::VectorXd r0 = force_residual(rec, model);
-  std::vector<std::string> enabled;
-  for (const Effect& e : plant::enabled_effects(model.effects)) enabled.push_back(e.name);
-  std::vector<CandidateFit> out;
-  for (const std::string& name : plant::effect_names()) {
-    if (std::find(enabled.begin(), enabled.end(), name) != enabled.end()) continue;
-    out.push_back(fit_candidate(rec, model, name, r0));
+bool has_coulomb_term(const plant::PlantParams& model) {
+  return model.friction.model == plant::FrictionModel::kStatic || model.effects.coulomb_friction.enabled ||
+         model.effects.stribeck_friction.enabled;
+}
+
+int FreeSet::parameters(const plant::PlantParams& model) const {
+  int k = 0;
+  for (const std::string& n : effects) k += spec(n).dim;
+  if (form && has_coulomb_term(model)) k += 1;
+  return k;
+}
+
+namespace {
+
+// The blocks and start vector of a joint fit of `free` on `model`.
+std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& model, const FreeSet& free, const Ctx& ctx) {
+  std::vector<Block> blocks;
+  Theta theta;
+  for (const std::string& name : free.effects) {
+    const Spec& s = spec(name);
+    blocks.push_back({&s, static_cast<int>(theta.size())});
+    Effect e{name, {}};
+    for (const Effect& en : plant::enabled_effects(model.effects))
+      if (en.name == name) e = en;
+    const Theta t = s.from_effect(e, ctx);
+    theta.insert(theta.end(), t.begin(), t.end());
   }
-  std::stable_sort(out.begin(), out.end(), [](const CandidateFit& a, const CandidateFit& b) { return a.score > b.score; });
-  // Parsimony: a candidate within kParsimony of the best score is not distinguishable from it
-  // (a BIC difference below 10 is not "very strong" evidence, Kass & Raftery 1995); among those
-  // the one with the fewest parameters goes first (e.g. a constant force before a spring with
-  // a negligible stiffness, viscous friction before a grinding force that acts like one).
-  if (!out.empty()) {
-    constexpr double kParsimony = 10.0;
-    const double top = out.front().score;
-    std::size_t pick = 0;
-    for (std::size_t i = 1; i < out.size() && out[i].score >= top - kParsimony; ++i)
-      if (out[i].parameters < out[pick].parameters) pick = i;
-    std::rotate(out.begin(), out.begin() + static_cast<long>(pick), out.begin() + static_cast<long>(pick) + 1);
+  if (free.form && has_coulomb_term(model)) {
+    blocks.push_back({&spec(kSmoothing), static_cast<int>(theta.size())});
+    theta.push_back(std::log(model.friction.static_smoothing_velocity));
+  }
+  return {blocks, theta};
+}
+
+// Ceres keeps a bounded parameter inside its bounds only if it starts there.
+void clamp_to_bounds(Theta& theta, const std::vector<Block>& blocks, const Ctx& ctx) {
+  for (const Block& b : blocks) {
+    for (auto [i, v] : b.spec->lower) theta[b.offset + i] = std::max(theta[b.offset + i], v);
+    if (b.spec->upper)
+      for (auto [i, v] : b.spec->upper(ctx)) theta[b.offset + i] = std::min(theta[b.offset + i], v);
+  }
+}
+
+}  // namespace
+
+JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
+                     const std::vector<double>* weights, int max_iterations) {
+  const Eigen::VectorXd r0 = force_residual(rec, model);
+  const Ctx ctx{rec, model, &r0, x_mean_of(rec)};
+  auto [blocks, theta] = joint_blocks(model, free, ctx);
+  JointFit out;
+  out.params = model;
+  out.parameters = free.parameters(model);
+  const auto weighted_rss = [&](const Eigen::VectorXd& r) {
+    if (!weights) return r.squaredNorm();
+    double s = 0.0;
+    for (long i = 0; i < r.size(); ++i) s += (*weights)[static_cast<std::size_t>(i)] * r[i] * r[i];
+    return s;
+  };
+  out.rss = weighted_rss(r0);
+  out.converged = true;
+  if (blocks.empty()) return out;
+  clamp_to_bounds(theta, blocks, ctx);
+  const Solved sol = solve(rec, model, blocks, theta, ctx, max_iterations, weights);
+  if (!(sol.rss < out.rss)) return out;
+  out.params = with_theta(model, blocks, sol.theta.data(), ctx);
+  out.rss = sol.rss;
+  out.converged = sol.converged;
+  return out;
+}
+
+std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& model, const FreeSet& free, int folds) {
+  std::vector<long> active;
+  for (long i = 0; i < static_cast<long>(rec.bank.tau.size()); ++i)
+    if (rec.masked.empty() || !rec.masked[static_cast<std::size_t>(i)]) active.push_back(i);
+  std::vector<double> out(static_cast<std::size_t>(folds), 0.0);
+  const long n = static_cast<long>(active.size());
+  for (int f = 0; f < folds; ++f) {
+    const long lo = n * f / folds, hi = n * (f + 1) / folds;
+    std::vector<double> w(rec.bank.tau.size(), 0.0);
+    for (long a = 0; a < n; ++a)
+      if (a < lo || a >= hi) w[static_cast<std::size_t>(active[a])] = 1.0;
+    // a warm start from the full fit converges in a few iterations
+    const JointFit jf = fit_jointly(rec, model, free, &w, 20);
+    const Eigen::VectorXd r = force_residual(rec, jf.params);
+    for (long a = lo; a < hi; ++a) out[static_cast<std::size_t>(f)] += r[active[a]] * r[active[a]];
   }
   return out;
 }
 
-plant::PlantParams refine_jointly(const Record& rec, const plant::PlantParams& model) {
-  const std::vector<Effect> effects = plant::enabled_effects(model.effects);
-  if (effects.empty()) return model;
-  const Eigen::VectorXd r0 = force_residual(rec, model);
-  const Ctx ctx{rec, model, &r0, x_mean_of(rec)};
-  plant::PlantParams base = model;
-  base.effects = plant::EffectsParams{};
-  std::vector<Block> blocks;
-  Theta theta;
-  for (const Effect& e : effects) {
-    const Spec& s = spec(e.name);
-    blocks.push_back({&s, static_cast<int>(theta.size())});
-    const Theta t = s.from_effect(e, ctx);
-    theta.insert(theta.end(), t.begin(), t.end());
-  }
-  const Solved sol = solve(rec, base, blocks, theta, ctx, 100);
-  if (!(sol.rss < r0.squaredNorm())) return model;
-  plant::PlantParams out = base;
-  for (const Block& b : blocks) {
-    const Theta t(sol.theta.begin() + b.offset, sol.theta.begin() + b.offset + b.spec->dim);
-    plant::set_effect(out.effects, b.spec->to_effect(t, ctx));
-  }
-  return out;
+Effect canonical(const Effect& e) {
+  if (e.name != "cogging_ripple") return e;
+  const auto& p = e.parameters;
+  const double a1 = std::abs(p.at("amplitude_N")), a3 = std::abs(p.at("third_harmonic_N"));
+  if (!(a3 > 0.0) || a1 >= 0.1 * a3) return e;
+  return Effect{e.name,
+                {{"pitch_m", p.at("pitch_m") / 3.0},
+                 {"amplitude_N", a3},
+                 {"phase_rad", p.at("third_phase_rad")},
+                 {"third_harmonic_N", 0.0},
+                 {"third_phase_rad", 0.0}}};
 }
 
 std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, const Effect& e) {

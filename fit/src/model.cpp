@@ -44,10 +44,13 @@ long Record::active_points() const {
   return n;
 }
 
+double stick_velocity(const plant::PlantParams& model) {
+  return std::max(1e-4, 20.0 * model.friction.static_smoothing_velocity);
+}
+
 void mask_stiction(Record& r, const plant::PlantParams& model) {
   r.masked.assign(r.bank.tau.size(), 0);
-  if (model.friction.model != plant::FrictionModel::kStatic) return;
-  const double vs = std::max(1e-4, 20.0 * model.friction.static_smoothing_velocity);
+  const double vs = stick_velocity(model);
   const auto& v = r.motion.v;
   for (int i = 0; i < r.bank.w.outerSize(); ++i)
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(r.bank.w, i); it; ++it) {

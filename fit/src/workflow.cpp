@@ -1,121 +1,276 @@
 #include "feeddrive/fit/workflow.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
+#include <numeric>
 
 namespace feeddrive::fit {
 
 namespace {
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf, f, a, b, c, d);
   return buf;
 }
+
+double bic_of(double rss, int k, long n) {
+  const double nn = static_cast<double>(n);
+  return nn * std::log(std::max(rss, 1e-300) / nn) + k * std::log(nn);
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+Effect effect_of(const plant::PlantParams& p, const std::string& name) {
+  for (const Effect& e : plant::enabled_effects(p.effects))
+    if (e.name == name) return e;
+  return {name, {}};
+}
+
+// Out-of-sample check of adding an effect (the one-standard-error rule: Breiman, Friedman, Olshen
+// & Stone 1984; Hastie, Tibshirani & Friedman 2009, sec. 7.10): the mean per-block reduction of
+// the held-out squared residual must exceed its standard error over the blocks.
+struct CvVerdict {
+  bool confirmed{false};
+  double mean{0.0}, se{0.0};
+};
+CvVerdict cv_verdict(const std::vector<double>& without, const std::vector<double>& with) {
+  const double K = static_cast<double>(without.size());
+  std::vector<double> d(without.size());
+  for (std::size_t k = 0; k < d.size(); ++k) d[k] = without[k] - with[k];
+  CvVerdict v;
+  v.mean = std::accumulate(d.begin(), d.end(), 0.0) / K;
+  double ss = 0.0;
+  for (double x : d) ss += (x - v.mean) * (x - v.mean);
+  v.se = K > 1 ? std::sqrt(ss / (K - 1) / K) : 0.0;
+  v.confirmed = v.mean > 0.0 && v.mean > v.se;
+  return v;
+}
+
+double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+
 }  // namespace
 
 FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const FitOptions& opt, const Log& log) {
   Record rec = rec_in;
   mask_stiction(rec, model);
+  const long n = rec.active_points();
   const auto say = [&](const std::string& s) {
     if (log) log(s);
   };
   FitResult out;
   out.initial = model;
+  out.envelope = envelope(rec, model);
+  out.smoothing_initial = model.friction.static_smoothing_velocity;
+  FreeSet free{{}, opt.fit_form};
   plant::PlantParams current = model;
+  // 0. Model form: a static friction's transition velocity is fitted before anything is added.
+  if (free.form && has_coulomb_term(current)) current = fit_jointly(rec, current, free).params;
   Eigen::VectorXd r = force_residual(rec, current);
+  double cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
   Replay rp = replay(rec, current, opt.replay_window);
-  out.replay_initial = rp;
-  out.force_rms_initial = rms(r, rec.active_points());
-  say("initial model: gap " + fmt("%.4g um, force residual RMS %.4g N", rp.gap * 1e6, rms(r, rec.active_points())));
-  std::vector<std::string> added;
-  for (int it = 0; it < opt.max_effects; ++it) {
+  out.replay_initial = replay(rec, model, opt.replay_window);
+  out.force_rms_initial = rms(force_residual(rec, model), n);
+  say("initial model: gap " + fmt("%.4g um, force residual RMS %.4g N", out.replay_initial.gap * 1e6, out.force_rms_initial));
+  std::vector<std::string> added;  // in the order found; removed ones are taken out
+  int additions = 0;
+  for (int it = 0; additions < opt.max_effects && it < 2 * opt.max_effects + 2; ++it) {
     StepResult st;
     st.localisation = localise(rec, r, rp);
     st.gap_before = rp.gap;
-    st.force_rms_before = rms(r, rec.active_points());
+    st.force_rms_before = rms(r, n);
     st.residual_before = r;
-    st.ranking = rank_candidates(rec, current);
-    if (st.ranking.empty()) break;
-    // The best candidate that is significant, valid (its parameters pass the plant's
-    // validate()) and confirmed by the replay; stop at the first significant one that is not
-    // confirmed.
-    const CandidateFit* best = &st.ranking.front();
-    st.effect = best->effect;
-    st.score = best->score;
-    say("step " + std::to_string(it + 1) + ": best candidate " + best->effect.name + fmt(" (score %.4g)", best->score));
-    plant::PlantParams trial;
-    Eigen::VectorXd r2;
-    Replay rp2;
-    bool found = false;
-    std::string why;
-    for (const CandidateFit& c : st.ranking) {
-      if (!(c.score >= opt.score_threshold)) break;
-      trial = current;
-      plant::set_effect(trial.effects, c.effect);
-      trial = refine_jointly(rec, trial);
+    // 1. forward: every candidate, fitted alone (the start) and then jointly
+    for (const std::string& name : plant::effect_names()) {
+      if (contains(free.effects, name)) continue;
+      CandidateFit c;
+      c.effect = {name, {}};
+      c.score = -std::numeric_limits<double>::infinity();
+      c.passed_over = prerequisite(out.envelope, current, name, opt.plausibility);
+      if (!c.passed_over.empty()) {
+        st.ranking.push_back(c);
+        continue;
+      }
+      const CandidateFit single = fit_candidate(rec, current, name, r);
+      plant::PlantParams trial = current;
+      plant::set_effect(trial.effects, single.effect);
+      FreeSet fs = free;
+      fs.effects.push_back(name);
+      JointFit jf = fit_jointly(rec, trial, fs);
+      const Effect canon = canonical(effect_of(jf.params, name));
+      if (canon.parameters != effect_of(jf.params, name).parameters) {
+        plant::PlantParams p = jf.params;
+        plant::set_effect(p.effects, canon);
+        const JointFit jc = fit_jointly(rec, p, fs);
+        // the canonical form has two parameters fewer in effect; keep it unless the BIC says otherwise
+        if (bic_of(jc.rss, fs.parameters(jc.params) - 2, n) <= bic_of(jf.rss, fs.parameters(jf.params), n)) jf = jc;
+      }
+      c.effect = effect_of(jf.params, name);
+      c.joint = jf.params;
+      c.rss = jf.rss;
+      c.converged = jf.converged;
+      c.parameters = fs.parameters(jf.params) - free.parameters(current);
+      c.bic = bic_of(jf.rss, fs.parameters(jf.params), n);
+      c.score = cur_bic - c.bic;
+      if (!std::isfinite(c.score)) c.score = -std::numeric_limits<double>::infinity();
       try {
-        trial.validate();
+        jf.params.validate();
       } catch (const std::invalid_argument& e) {
-        why += (why.empty() ? "" : "; ") + c.effect.name + " fitted to invalid values (" + e.what() + ")";
+        c.passed_over = std::string("fitted to invalid values (") + e.what() + ")";
+      }
+      for (const Effect& e : plant::enabled_effects(jf.params.effects)) {
+        if (!c.passed_over.empty()) break;
+        const std::string why = implausible(out.envelope, jf.params, e);
+        if (!why.empty()) c.passed_over = e.name == name ? why : "refitted with it, " + e.name + " becomes implausible: " + why;
+      }
+      st.ranking.push_back(c);
+    }
+    std::stable_sort(st.ranking.begin(), st.ranking.end(),
+                     [](const CandidateFit& a, const CandidateFit& b) { return a.score > b.score; });
+    // Parsimony: an eligible candidate within kParsimony of the best eligible score is not
+    // distinguishable from it (a BIC difference below 10 is not "very strong" evidence, Kass &
+    // Raftery 1995); among those the one with the fewest parameters goes first.
+    {
+      constexpr double kParsimony = 10.0;
+      std::vector<std::size_t> eligible;
+      for (std::size_t i = 0; i < st.ranking.size(); ++i)
+        if (st.ranking[i].passed_over.empty()) eligible.push_back(i);
+      if (!eligible.empty()) {
+        const double top = st.ranking[eligible.front()].score;
+        std::size_t pick = eligible.front();
+        for (std::size_t i : eligible)
+          if (st.ranking[i].score >= top - kParsimony && st.ranking[i].parameters < st.ranking[pick].parameters) pick = i;
+        const auto first = st.ranking.begin() + static_cast<long>(eligible.front());
+        std::rotate(first, st.ranking.begin() + static_cast<long>(pick), st.ranking.begin() + static_cast<long>(pick) + 1);
+      }
+    }
+    // 2. the best eligible candidate that is significant, confirmed out of sample and by the replay
+    std::vector<double> cv_without;
+    const CandidateFit* chosen = nullptr;
+    FreeSet chosen_free;
+    Replay rp2;
+    std::string why_not;
+    for (CandidateFit& c : st.ranking) {
+      if (!c.passed_over.empty()) continue;
+      if (!(c.score >= opt.score_threshold)) break;
+      FreeSet fs = free;
+      fs.effects.push_back(c.effect.name);
+      if (cv_without.empty()) cv_without = cross_validate(rec, current, free, opt.cv_folds);
+      const std::vector<double> cv_with = cross_validate(rec, c.joint, fs, opt.cv_folds);
+      const CvVerdict v = cv_verdict(cv_without, cv_with);
+      if (!v.confirmed) {
+        c.passed_over = fmt("not confirmed out of sample: held-out squared residual %.4g -> %.4g N^2 "
+                            "(mean reduction per block %.3g, standard error %.3g)",
+                            total(cv_without), total(cv_with), v.mean, v.se);
+        why_not += (why_not.empty() ? "" : "; ") + c.effect.name + " " + c.passed_over;
         continue;
       }
       try {
-        r2 = force_residual(rec, trial);
-        rp2 = replay(rec, trial, opt.replay_window);
+        rp2 = replay(rec, c.joint, opt.replay_window);
       } catch (const std::runtime_error& e) {  // e.g. CVODE cannot integrate the fitted model
-        why += (why.empty() ? "" : "; ") + c.effect.name + " cannot be replayed (" + e.what() + ")";
+        c.passed_over = std::string("cannot be replayed (") + e.what() + ")";
+        why_not += (why_not.empty() ? "" : "; ") + c.effect.name + " " + c.passed_over;
         continue;
       }
-      best = &c;
-      st.effect = c.effect;
-      st.score = c.score;
-      st.gap_after = rp2.gap;
-      st.force_rms_after = rms(r2, rec.active_points());
-      st.residual_after = r2;
-      found = true;
+      if (!(rp2.gap <= (1.0 - opt.min_gap_reduction) * rp.gap)) {
+        c.passed_over = fmt("does not shrink the replay gap by %.3g %% (%.4g -> %.4g um)", 100 * opt.min_gap_reduction,
+                            rp.gap * 1e6, rp2.gap * 1e6);
+        why_not += (why_not.empty() ? "" : "; ") + c.effect.name + " " + c.passed_over;
+        continue;
+      }
+      st.cv_without = cv_without;
+      st.cv_with = cv_with;
+      chosen = &c;
+      chosen_free = fs;
       break;
     }
-    if (!found) {
-      st.verdict = "no significant effect: the best candidate, " + st.ranking.front().effect.name +
-                   fmt(", scores %.3g (threshold %.3g)", st.ranking.front().score, opt.score_threshold) +
-                   (why.empty() ? "" : "; " + why);
+    if (!chosen) {
+      const CandidateFit* best = nullptr;
+      for (const CandidateFit& c : st.ranking)
+        if (!best && std::isfinite(c.score)) best = &c;
+      st.verdict = best ? "no significant effect: the best candidate, " + best->effect.name +
+                              fmt(", scores %.3g (threshold %.3g)", best->score, opt.score_threshold)
+                        : std::string("no significant effect: no candidate is eligible");
+      if (!why_not.empty()) st.verdict += "; passed over: " + why_not;
       st.gap_after = st.gap_before;
       st.force_rms_after = st.force_rms_before;
       st.residual_after = r;
-      out.steps.push_back(st);
-      break;
-    }
-    if (!(rp2.gap <= (1.0 - opt.min_gap_reduction) * rp.gap)) {
-      st.verdict = "no significant effect: " + best->effect.name +
-                   fmt(" scores %.3g but does not shrink the replay gap (%.4g -> %.4g um)", best->score,
-                       rp.gap * 1e6, rp2.gap * 1e6);
+      say(st.verdict);
       out.steps.push_back(st);
       break;
     }
     st.accepted = true;
-    st.verdict = "added " + best->effect.name + fmt(": gap %.4g -> %.4g um", rp.gap * 1e6, rp2.gap * 1e6) +
-                 (why.empty() ? "" : " (passed over: " + why + ")");
-    say(st.verdict);
-    out.steps.push_back(st);
-    current = trial;
-    r = r2;
+    st.effect = chosen->effect;
+    st.score = chosen->score;
+    const std::string name = chosen->effect.name;
+    current = chosen->joint;
+    free = chosen_free;
+    added.push_back(name);
+    ++additions;
+    r = force_residual(rec, current);
+    cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
     rp = rp2;
-    added.push_back(best->effect.name);
+    st.verdict = "added " + name + fmt(" (score %.4g): gap %.4g -> %.4g um", st.score, st.gap_before * 1e6, rp.gap * 1e6);
+    if (!why_not.empty()) st.verdict += " (passed over: " + why_not + ")";
+    say(st.verdict);
+    // 3. backward: remove the earlier effect that costs least, while it costs less than the threshold
+    for (;;) {
+      std::string drop;
+      JointFit best_without;
+      double least = opt.score_threshold;
+      for (const std::string& e : free.effects) {
+        if (e == name) continue;
+        FreeSet fr = free;
+        fr.effects.erase(std::find(fr.effects.begin(), fr.effects.end(), e));
+        plant::PlantParams p = current;
+        plant::effect_enabled(p.effects, e) = false;
+        const JointFit jf = fit_jointly(rec, p, fr);
+        const double loss = bic_of(jf.rss, fr.parameters(jf.params), n) - cur_bic;
+        if (loss < least) {
+          least = loss;
+          drop = e;
+          best_without = jf;
+        }
+      }
+      if (drop.empty()) break;
+      current = best_without.params;
+      free.effects.erase(std::find(free.effects.begin(), free.effects.end(), drop));
+      added.erase(std::find(added.begin(), added.end(), drop));
+      r = force_residual(rec, current);
+      cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
+      rp = replay(rec, current, opt.replay_window);
+      st.removed.push_back(drop);
+      const std::string line = "removed " + drop + ": with " + name + " in," +
+                               fmt(" it is worth only %.3g in BIC; gap now %.4g um", least, rp.gap * 1e6);
+      st.verdict += "; " + line;
+      say(line);
+    }
+    st.gap_after = rp.gap;
+    st.force_rms_after = rms(r, n);
+    st.residual_after = r;
+    out.steps.push_back(st);
   }
   out.fitted = current;
+  out.smoothing_final = current.friction.static_smoothing_velocity;
+  out.smoothing_fitted = out.smoothing_final != out.smoothing_initial;
   out.replay_final = rp;
-  out.force_rms_final = rms(r, rec.active_points());
+  out.force_rms_final = rms(r, n);
   out.final_localisation = localise(rec, r, rp);
-  // the added effects, in the order found, with their final parameters
-  for (const std::string& name : added)
-    for (const Effect& e : plant::enabled_effects(current.effects))
-      if (e.name == name) out.effects.push_back(e);
+  for (const std::string& name : added) out.effects.push_back(effect_of(current, name));
   if (added.empty()) {
     out.conclusion = "no significant effect: the model explains the data to within its noise";
   } else {
     out.conclusion = "found " + std::to_string(added.size()) + " effect(s):";
-    for (const auto& n : added) out.conclusion += " " + n;
+    for (const auto& a : added) out.conclusion += " " + a;
     out.conclusion += fmt("; gap %.4g -> %.4g um", out.replay_initial.gap * 1e6, rp.gap * 1e6);
   }
+  if (out.smoothing_fitted)
+    out.conclusion += fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s", out.smoothing_initial * 1e3,
+                          out.smoothing_final * 1e3);
   say(out.conclusion);
   return out;
 }

@@ -289,7 +289,11 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   if (s.control_period > s.duration)
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
 
-  read_plant(top.child("plant"), s.plant, true);
+  {
+    MapReader plant = top.child("plant");
+    s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
+    read_plant(plant, s.plant, true);
+  }
 
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");

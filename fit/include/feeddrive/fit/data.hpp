@@ -41,8 +41,13 @@ struct MeasuredData {
 /// Fewest samples accepted.
 constexpr std::size_t kMinSamples = 50;
 
+/// The CSV columns of each role (a drive's own export names them as it likes).
 struct CsvOptions {
-  std::string position_column{"x"};  ///< the column holding the measured position
+  std::string time_column{"t"};          ///< time [s]
+  std::string position_column{"x"};      ///< the measured position [m]
+  std::string command_column{"u"};       ///< the command in the model's unit (thrust = Ka*Kf*u)
+  std::string force_column{"force_N"};   ///< or the thrust [N] (used when the command column is absent)
+  std::string reference_column{"xd"};    ///< optional position reference [m]
 };
 
 /// Reads a CSV file (see above). Throws DataError.

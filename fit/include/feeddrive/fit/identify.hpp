@@ -24,30 +24,58 @@ namespace feeddrive::fit {
 using Effect = plant::NamedEffect;
 
 struct CandidateFit {
-  Effect effect;
-  int parameters{0};        ///< k in the BIC
-  double rss{0.0};          ///< sum of squared filtered residuals [N^2]
+  Effect effect;            ///< as fitted jointly with the effects already added
+  int parameters{0};        ///< k of the candidate in the BIC
+  double rss{0.0};          ///< sum of squared filtered residuals of the joint fit [N^2]
   double bic{0.0};
-  double score{0.0};        ///< BIC(without) - BIC(with); > 0 favours the effect
+  double score{0.0};        ///< BIC(model) - BIC(model + candidate, joint fit); > 0 favours the effect
   bool converged{false};
-};
-
-struct IdentifyOptions {
-  double score_threshold{10.0};  ///< least score for a significant effect
+  std::string passed_over;  ///< empty if eligible; else why not (prerequisite, implausible values, ...)
+  plant::PlantParams joint; ///< the model plus the candidate, every free parameter jointly refitted
 };
 
 /// BIC of a residual vector with k parameters over n_active points (0: all of r).
 double bic(const Eigen::VectorXd& r, int k, long n_active = 0);
 
-/// Fits one candidate added to `model`. `residual0` is force_residual(rec, model).
+/// Fits one candidate added to `model` alone (the model's own parameters held), by nonlinear
+/// least squares from the candidate's starts; `residual0` is force_residual(rec, model). The
+/// start of the joint fit.
 CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
                            const Eigen::VectorXd& residual0);
 
-/// Fits every candidate not yet enabled in `model`; sorted by score, best first.
-std::vector<CandidateFit> rank_candidates(const Record& rec, const plant::PlantParams& model);
+/// What a joint fit refits: the named effects (enabled in the model) and, if `form` and the model
+/// has a Coulomb-type term (static friction, coulomb_friction or stribeck_friction), the
+/// smoothing velocity eps of sgn_eps(v) = tanh(v/eps) (friction.static_smoothing_velocity), a
+/// model-form parameter: real friction changes sign over a finite velocity band.
+struct FreeSet {
+  std::vector<std::string> effects;
+  bool form{false};
+  int parameters(const plant::PlantParams& model) const;  ///< k of the BIC
+};
+bool has_coulomb_term(const plant::PlantParams& model);
 
-/// Refits the parameters of every enabled effect of `model` jointly; returns the refined model.
-plant::PlantParams refine_jointly(const Record& rec, const plant::PlantParams& model);
+struct JointFit {
+  plant::PlantParams params;  ///< the refitted model
+  double rss{0.0};            ///< over the points with weight 1 [N^2]
+  int parameters{0};
+  bool converged{false};
+};
+/// Refits every free parameter of `model` jointly (Ceres, Levenberg-Marquardt) starting from its
+/// values. `weights` (0 or 1 per filter point, nullptr: all 1) leaves points out of the fit.
+JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
+                     const std::vector<double>* weights = nullptr, int max_iterations = 100);
+
+/// Out-of-sample evidence: the active filter points are cut into `folds` contiguous blocks of
+/// time; for each block the free parameters are refitted on the other blocks (warm start from
+/// `model`) and the squared residual on the block itself is summed. Returns the per-block sums
+/// [N^2] (with nothing free: the model's residual per block).
+std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
+                                   int folds = 5);
+
+/// The canonical form of a fitted effect: a cogging ripple whose fundamental is below a tenth
+/// of its third harmonic is the ripple of a third of the pitch (its "third harmonic" is its
+/// fundamental): sin(6 pi x/p + phi3) = sin(2 pi x/(p/3) + phi3).
+Effect canonical(const Effect& e);
 
 /// The x-axis of the plot of the residual against the effect's own regressor, at filter point
 /// i: e.g. position modulo the pitch for a ripple, velocity for friction. Returns {label, values}.

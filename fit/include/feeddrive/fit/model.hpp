@@ -60,8 +60,14 @@ struct RecordOptions {
 /// Prepares a record (motion estimates, filter bank). Throws DataError if it is too short.
 Record prepare(const MeasuredData& d, const RecordOptions& opt = {});
 
-/// For a model with static (Coulomb + Stribeck) friction: masks the filter points whose window
-/// holds an interval with |v^| < max(1e-4, 20*eps) m/s at both ends (stiction). No-op otherwise.
+/// Below this |v^| [m/s] the drive counts as sticking: max(0.1 mm/s, 20 eps), eps the model's
+/// Coulomb smoothing velocity (friction.static_smoothing_velocity).
+double stick_velocity(const plant::PlantParams& model);
+
+/// Masks the filter points whose window holds an interval with |v^| below stick_velocity() at
+/// both ends (stiction): there a static friction (of the model or of a candidate effect) balances
+/// the other forces and is not a function of v, so those windows cannot tell candidates apart.
+/// The same points are masked for every candidate, so their BIC scores stay comparable.
 void mask_stiction(Record& r, const plant::PlantParams& model);
 
 /// Thrust [N] per unit of the record's input.

@@ -1,8 +1,16 @@
 #pragma once
-// The model-discrepancy loop of feeddrive-fit (docs/fit.md):
-//   replay -> localise -> rank every candidate effect -> add the winner (refit all added effects
-//   jointly) -> confirm by replay -> repeat, until no candidate scores above the threshold, the
-//   winner does not shrink the replay gap, or max_effects effects are in.
+// The model-discrepancy loop of feeddrive-fit (docs/fit.md, "Naming the effects"): bidirectional
+// stepwise selection (Efroymson 1960) with joint refits.
+//   0. model form: the Coulomb transition velocity of a static friction model is refitted;
+//   1. forward: every candidate whose prerequisites hold (plausibility.hpp) is fitted alone, then
+//      jointly with every effect added so far; it is scored by BIC(model) - BIC(model + it);
+//      candidates with implausible fitted values are passed over, with the reason;
+//   2. the best eligible candidate (fewest parameters among those within 10 of the best score)
+//      is added if its score is >= the threshold, it is confirmed out of sample (blocked
+//      cross-validation, one-standard-error rule) and it shrinks the replay gap;
+//   3. backward: every earlier effect whose removal (the others refitted) costs less than the
+//      threshold in BIC is removed, the least costly first;
+//   repeat until no candidate is added or max_effects effects are in.
 // Pure computation: no files are read or written here.
 
 #include <functional>
@@ -11,12 +19,16 @@
 
 #include "feeddrive/fit/identify.hpp"
 #include "feeddrive/fit/model.hpp"
+#include "feeddrive/fit/plausibility.hpp"
 #include "feeddrive/fit/replay.hpp"
 
 namespace feeddrive::fit {
 
 struct FitOptions {
   int max_effects{4};
+  int cv_folds{5};                  ///< blocks of time of the cross-validation
+  bool fit_form{true};              ///< refit the Coulomb transition velocity (model form)
+  PlausibilityOptions plausibility;
   double score_threshold{10.0};     ///< least BIC score of a significant effect
   double min_gap_reduction{0.05};   ///< the replay gap must shrink by at least this fraction
   double replay_window{0.0};        ///< W [s] of the replay (0: default)
@@ -28,8 +40,12 @@ struct StepResult {
   Localisation localisation;           ///< of the model before the step
   bool accepted{false};
   std::string verdict;                 ///< one line: what was decided and why
-  Effect effect;                       ///< the winner as fitted alone
+  Effect effect;                       ///< the winner as fitted jointly when it was added
   double score{0.0};
+  /// Out-of-sample evidence of the winner: per block of time, the squared residual [N^2] of the
+  /// model without and with it, each refitted on the other blocks.
+  std::vector<double> cv_without, cv_with;
+  std::vector<std::string> removed;    ///< effects removed by the backward step after the addition
   double gap_before{0.0}, gap_after{0.0};              ///< replay gap [m]
   double force_rms_before{0.0}, force_rms_after{0.0};  ///< filtered force residual RMS [N]
   Eigen::VectorXd residual_before, residual_after;     ///< at the filter points [N]
@@ -42,6 +58,9 @@ struct FitResult {
   std::vector<StepResult> steps;       ///< every step, the last one may be rejected
   std::vector<Effect> effects;         ///< the added effects with their final (jointly refitted) parameters
   Localisation final_localisation;
+  Envelope envelope;                   ///< what the record spans (plausibility rules)
+  double smoothing_initial{0.0}, smoothing_final{0.0};  ///< eps of sgn_eps [m/s], before and after
+  bool smoothing_fitted{false};
   std::string conclusion;
 };
 

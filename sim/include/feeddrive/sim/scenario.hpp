@@ -63,6 +63,9 @@ struct Scenario {
   ControllerConfig controller;
   ReferenceConfig reference;
   AnalysisConfig analysis;
+  /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
+  /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
+  bool grinding_process{false};
 
   /// Number of control steps: round(duration / control_period).
   long steps() const;

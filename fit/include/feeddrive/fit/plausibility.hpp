@@ -1,0 +1,57 @@
+#pragma once
+// Physical plausibility of an effect on a given record (docs/fit.md, "Plausibility").
+//
+// Two checks, each one rule per effect, stated in the doc's table:
+//   * prerequisite(): may the effect be a candidate at all on this record and model? (e.g. a
+//     grinding force only where a grinding process is described or asked for; presliding only
+//     where the data has stick phases and the model has a friction to make dynamic; a ripple
+//     only where the travel spans two periods of the shortest pitch the data resolves);
+//   * implausible(): are the fitted values physically possible for this drive on this record?
+//     (e.g. a ripple pitch resolved by the data -- at least two periods within the travel and
+//     enough filter windows per period -- and an amplitude below a fifth of the peak thrust; a
+//     spring's rest position within one travel of the travelled range; a mass within a factor
+//     of two of the nominal one).
+// Both return an empty string when the effect passes, otherwise the reason in one sentence, which
+// the report prints where the effect was passed over.
+
+#include <string>
+
+#include "feeddrive/fit/model.hpp"
+#include "feeddrive/plant/effects.hpp"
+#include "feeddrive/plant/params.hpp"
+
+namespace feeddrive::fit {
+
+/// What the record spans, for the plausibility rules.
+struct Envelope {
+  double x_min{0.0}, x_max{0.0}, travel{0.0};  ///< travelled range [m]
+  double v_max{0.0};                           ///< peak |v^| [m/s]
+  double peak_thrust{0.0};                     ///< peak |thrust| [N]
+  double period{0.0};                          ///< median sample period [s]
+  double filter_half_width{0.0};               ///< L [s]
+  double stick_velocity{0.0};                  ///< below this |v^| the drive counts as sticking [m/s]
+  int stick_phases{0};                         ///< stick phases (>= 5 consecutive samples below it)
+  double stick_fraction{0.0};                  ///< fraction of samples in stick phases
+  double nominal_mass{0.0};                    ///< the model's mass [kg]
+  double duration{0.0};                        ///< [s]
+  /// Shortest ripple pitch the data resolves [m]: at the peak speed a period must span at least
+  /// 8 samples and 4 filter half-widths (the filter passes it), and at least 1 mm.
+  double min_pitch() const;
+  /// Longest ripple pitch: two periods within the travel.
+  double max_pitch() const { return 0.5 * travel; }
+};
+
+Envelope envelope(const Record& rec, const plant::PlantParams& model);
+
+struct PlausibilityOptions {
+  bool grinding_process{false};  ///< the scenario describes a grinding process (or the user asks for grinding_force)
+};
+
+/// Empty if effect `name` may be a candidate on this record and model, else why not.
+std::string prerequisite(const Envelope& env, const plant::PlantParams& model, const std::string& name,
+                         const PlausibilityOptions& opt);
+
+/// Empty if the fitted effect is physically plausible on this record, else why not.
+std::string implausible(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e);
+
+}  // namespace feeddrive::fit

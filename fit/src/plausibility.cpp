@@ -1,0 +1,159 @@
+#include "feeddrive/fit/plausibility.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace feeddrive::fit {
+namespace {
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+double par(const plant::NamedEffect& e, const char* k) {
+  const auto it = e.parameters.find(k);
+  return it == e.parameters.end() ? 0.0 : it->second;
+}
+
+std::string ripple_pitch(const Envelope& env, double p) {
+  if (p > env.max_pitch())
+    return fmt("pitch %.3g mm: fewer than two periods within the %.3g mm travelled", p * 1e3, env.travel * 1e3);
+  if (p < env.min_pitch())
+    return fmt("pitch %.3g mm: shorter than the %.3g mm the data resolves at %.3g mm/s", p * 1e3, env.min_pitch() * 1e3,
+               env.v_max * 1e3);
+  return "";
+}
+
+}  // namespace
+
+double Envelope::min_pitch() const {
+  return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width});
+}
+
+Envelope envelope(const Record& rec, const plant::PlantParams& model) {
+  Envelope e;
+  const MeasuredData& d = *rec.data;
+  e.x_min = rec.x_min;
+  e.x_max = rec.x_max;
+  e.travel = rec.x_max - rec.x_min;
+  e.v_max = rec.v_max_abs;
+  e.period = rec.period;
+  e.filter_half_width = rec.bank.half_width;
+  e.nominal_mass = plant::effective_params(model).mass;
+  e.duration = d.t.back() - d.t.front();
+  const double gain = thrust_per_input(rec, model);
+  for (double u : d.input) e.peak_thrust = std::max(e.peak_thrust, std::abs(gain * u));
+  e.stick_velocity = stick_velocity(model);
+  long run = 0, in_stick = 0;
+  for (std::size_t k = 0; k <= d.size(); ++k) {
+    if (k < d.size() && std::abs(rec.motion.v[k]) < e.stick_velocity) {
+      ++run;
+      continue;
+    }
+    if (run >= 5) {
+      ++e.stick_phases;
+      in_stick += run;
+    }
+    run = 0;
+  }
+  e.stick_fraction = static_cast<double>(in_stick) / static_cast<double>(d.size());
+  return e;
+}
+
+std::string prerequisite(const Envelope& env, const plant::PlantParams& model, const std::string& name,
+                         const PlausibilityOptions& opt) {
+  if (name == "grinding_force" && !opt.grinding_process)
+    return "the scenario describes no grinding process (plant.grinding) and --effects does not ask for it";
+  if (name == "presliding") {
+    if (model.friction.model == plant::FrictionModel::kNone)
+      return "the model has no friction (friction.model: none) whose presliding regime could be missing";
+    if (env.stick_phases < 3 || env.stick_fraction < 0.01)
+      return fmt("the data has too few stick phases to show presliding (%.0f phases, %.2g %% of the samples, below %.3g mm/s)",
+                 env.stick_phases, 100 * env.stick_fraction, env.stick_velocity * 1e3);
+  }
+  if ((name == "cogging_ripple" || name == "reluctance_ripple") && env.min_pitch() > env.max_pitch())
+    return fmt("the travel (%.3g mm) spans no two periods of the shortest pitch the data resolves (%.3g mm)",
+               env.travel * 1e3, env.min_pitch() * 1e3);
+  // k (x - x_rest) + F is the spring k (x - x_rest + F/k): a spring and a constant force in one
+  // model cannot be told apart; the spring's rest position carries the constant.
+  if (name == "spring_force" && model.effects.constant_force.enabled)
+    return "a constant force is in the model: with a spring, their sum is one spring with another rest position";
+  if (name == "constant_force" && model.effects.spring_force.enabled)
+    return "a spring is in the model: its rest position already carries a constant force";
+  if (name == "spring_force" && env.travel < 1e-4)
+    return fmt("the travel (%.3g um) is too short to show a position-dependent force", env.travel * 1e6);
+  return "";
+}
+
+std::string implausible(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e) {
+  const std::string& n = e.name;
+  const double F = env.peak_thrust;
+  const auto above = [&](const char* what, double value) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf, "%s %.4g N exceeds the peak thrust of the record (%.4g N)", what, value, F);
+    return std::string(buf);
+  };
+  if (n == "constant_force" && std::abs(par(e, "force_N")) > F) return above("force", std::abs(par(e, "force_N")));
+  if (n == "coulomb_friction" && par(e, "coulomb_N") > F) return above("Coulomb level", par(e, "coulomb_N"));
+  if (n == "viscous_friction" && par(e, "viscous_Ns_per_m") * env.v_max > F)
+    return above("viscous force at the peak speed", par(e, "viscous_Ns_per_m") * env.v_max);
+  if (n == "stribeck_friction") {
+    if (par(e, "static_N") > F) return above("static level", par(e, "static_N"));
+    const double vs = par(e, "stribeck_velocity_mps");
+    if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
+      return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
+                 0.5 * env.stick_velocity * 1e3, 0.5 * env.v_max * 1e3);
+  }
+  if (n == "presliding") {
+    const double d = model.friction.coulomb_force / std::max(par(e, "bristle_stiffness_N_per_m"), 1e-300);
+    if (d < 1e-8 || d > 1e-3)
+      return fmt("presliding displacement Fc/sigma0 = %.3g um is outside 0.01 um .. 1 mm", d * 1e6);
+  }
+  if (n == "cogging_ripple") {
+    const std::string p = ripple_pitch(env, par(e, "pitch_m"));
+    if (!p.empty()) return p;
+    const double a = std::abs(par(e, "amplitude_N")) + std::abs(par(e, "third_harmonic_N"));
+    if (a > 0.2 * F) return fmt("ripple amplitude %.3g N exceeds a fifth of the peak thrust (%.3g N)", a, F);
+  }
+  if (n == "reluctance_ripple") {
+    const std::string p = ripple_pitch(env, par(e, "pitch_m"));
+    if (!p.empty()) return p;
+    if (std::abs(par(e, "relative_amplitude")) > 0.2)
+      return fmt("relative ripple amplitude %.3g exceeds 0.2", std::abs(par(e, "relative_amplitude")));
+  }
+  if (n == "grinding_force") {
+    const double xc = par(e, "contact_position_m");
+    if (xc > env.x_max) return fmt("contact position %.4g mm lies beyond the travel", xc * 1e3);
+    const double tau = par(e, "gain_Ns_per_m") / std::max(par(e, "stiffness_N_per_m"), 1e-300);
+    if (tau < env.period || tau > 0.25 * env.duration)
+      return fmt("time constant C/ke = %.3g ms is not resolved by the record (%.3g ms .. %.3g s)", tau * 1e3,
+                 env.period * 1e3, 0.25 * env.duration);
+    if (par(e, "gain_Ns_per_m") * env.v_max > 2.0 * F)
+      return above("grinding force at the peak speed", par(e, "gain_Ns_per_m") * env.v_max);
+  }
+  if (n == "spring_force") {
+    const double rest = par(e, "rest_position_m");
+    if (rest < env.x_min - env.travel || rest > env.x_max + env.travel)
+      return fmt("rest position %.4g mm lies more than one travel (%.3g mm) outside the travelled range", rest * 1e3,
+                 env.travel * 1e3);
+    if (par(e, "stiffness_N_per_m") * env.travel > F)
+      return above("spring force over the travel", par(e, "stiffness_N_per_m") * env.travel);
+  }
+  if (n == "mass_error") {
+    const double m = par(e, "mass_kg");
+    if (m < 0.5 * env.nominal_mass || m > 2.0 * env.nominal_mass)
+      return fmt("mass %.4g kg is not within a factor of two of the nominal %.4g kg", m, env.nominal_mass);
+  }
+  if (n == "input_delay") {
+    const double d = par(e, "delay_s");
+    if (d >= 0.999 * env.filter_half_width)
+      return fmt("delay %.3g ms reaches the filter half-width (%.3g ms): longer delays are not resolved", d * 1e3,
+                 env.filter_half_width * 1e3);
+  }
+  return "";
+}
+
+}  // namespace feeddrive::fit
