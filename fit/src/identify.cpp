@@ -464,8 +464,9 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
 }
 
 bool has_coulomb_term(const plant::PlantParams& model) {
-  return model.friction.model == plant::FrictionModel::kStatic || model.effects.coulomb_friction.enabled ||
-         model.effects.stribeck_friction.enabled;
+  // presliding makes a static friction LuGre, which has no eps
+  return (model.friction.model == plant::FrictionModel::kStatic && !model.effects.presliding.enabled) ||
+         model.effects.coulomb_friction.enabled || model.effects.stribeck_friction.enabled;
 }
 
 int FreeSet::parameters(const plant::PlantParams& model) const {

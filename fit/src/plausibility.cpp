@@ -60,6 +60,13 @@ Envelope envelope(const Record& rec, const plant::PlantParams& model) {
     run = 0;
   }
   e.stick_fraction = static_cast<double>(in_stick) / static_cast<double>(d.size());
+  int sign = 0;
+  for (double v : rec.motion.v) {
+    if (std::abs(v) < e.stick_velocity) continue;
+    const int s = v > 0 ? 1 : -1;
+    if (sign != 0 && s != sign) ++e.reversals;
+    sign = s;
+  }
   return e;
 }
 
@@ -70,9 +77,10 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
   if (name == "presliding") {
     if (model.friction.model == plant::FrictionModel::kNone)
       return "the model has no friction (friction.model: none) whose presliding regime could be missing";
-    if (env.stick_phases < 3 || env.stick_fraction < 0.01)
-      return fmt("the data has too few stick phases to show presliding (%.0f phases, %.2g %% of the samples, below %.3g mm/s)",
-                 env.stick_phases, 100 * env.stick_fraction, env.stick_velocity * 1e3);
+    if (env.stick_phases + env.reversals < 3)
+      return fmt("the data has too few stick phases or reversals to show presliding (%.0f stick phases below %.3g mm/s, "
+                 "%.0f reversals)",
+                 env.stick_phases, env.stick_velocity * 1e3, env.reversals);
   }
   if ((name == "cogging_ripple" || name == "reluctance_ripple") && env.min_pitch() > env.max_pitch())
     return fmt("the travel (%.3g mm) spans no two periods of the shortest pitch the data resolves (%.3g mm)",

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -30,6 +31,11 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
     effects[e.name] = m;
   }
   root["plant"]["effects"] = effects;
+  // the model-form parameter the fit refits with any Coulomb-type term (workflow.hpp)
+  if (has_coulomb_term(fitted)) {
+    if (!root["plant"]["friction"]) root["plant"]["friction"] = YAML::Node(YAML::NodeType::Map);
+    root["plant"]["friction"]["static_smoothing_velocity"] = fitted.friction.static_smoothing_velocity;
+  }
   YAML::Emitter em;
   em.SetDoublePrecision(15);
   em << root;
@@ -75,13 +81,23 @@ std::string findings_json(const FitResult& r) {
                             {"gap_after", st.gap_after}});
   }
   j["conclusion"] = r.conclusion;
+  j["model_form"] = {{"coulomb_transition_velocity_initial_mps", r.smoothing_initial},
+                     {"coulomb_transition_velocity_final_mps", r.smoothing_final},
+                     {"fitted", r.smoothing_fitted}};
+  const Envelope& env = r.envelope;
+  j["record"] = {{"travel_m", env.travel}, {"peak_speed_mps", env.v_max}, {"peak_thrust_N", env.peak_thrust},
+                 {"ripple_pitch_range_m", {env.min_pitch(), env.max_pitch()}}, {"stick_phases", env.stick_phases}, {"reversals", env.reversals},
+                 {"stick_fraction", env.stick_fraction}};
   nlohmann::json steps = nlohmann::json::array();
   for (const StepResult& st : r.steps) {
     nlohmann::json rk = nlohmann::json::array();
     for (const CandidateFit& c : st.ranking)
-      rk.push_back({{"name", c.effect.name}, {"score", c.score}, {"parameters", params_json(c.effect)},
-                    {"k", c.parameters}, {"rss_N2", c.rss}});
-    steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk},
+      rk.push_back({{"name", c.effect.name}, {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
+                    {"parameters", params_json(c.effect)}, {"k", c.parameters}, {"rss_N2", c.rss},
+                    {"passed_over", c.passed_over}});
+    steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk}, {"removed", st.removed},
+                     {"cross_validation", {{"held_out_sq_residual_without_N2", st.cv_without},
+                                           {"held_out_sq_residual_with_N2", st.cv_with}}},
                      {"localisation", {{"summary", st.localisation.summary},
                                        {"time", bins_json(st.localisation.time)},
                                        {"velocity", bins_json(st.localisation.velocity)},
@@ -206,16 +222,44 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     md << "\n## Effects found\n\n";
     if (r.effects.empty()) md << "None: no candidate is significant.\n";
     for (const Effect& e : r.effects) md << "- `" << e.name << "`: " << params_text(e) << "\n";
+    if (r.smoothing_fitted) {
+      std::snprintf(buf, sizeof buf,
+                    "\nModel form (not an effect): the Coulomb transition velocity eps of tanh(v/eps) was refitted, "
+                    "%.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity).\n",
+                    r.smoothing_initial * 1e3, r.smoothing_final * 1e3);
+      md << buf;
+    }
+    {
+      const Envelope& env = r.envelope;
+      std::snprintf(buf, sizeof buf,
+                    "\nWhat this record can show (plausibility rules, docs/fit.md): travel %.4g mm, peak speed %.4g "
+                    "mm/s, peak thrust %.4g N; ripple pitches %.3g-%.3g mm; %d stick phases (%.2g %% of the samples "
+                    "below %.3g mm/s), %d reversals.\n",
+                    env.travel * 1e3, env.v_max * 1e3, env.peak_thrust, env.min_pitch() * 1e3, env.max_pitch() * 1e3,
+                    env.stick_phases, 100 * env.stick_fraction, env.stick_velocity * 1e3, env.reversals);
+      md << buf;
+    }
     k = 0;
     for (std::size_t s = 0; s < r.steps.size(); ++s) {
       const StepResult& st = r.steps[s];
       md << "\n## Step " << s + 1 << ": " << st.verdict << "\n\n" << st.localisation.summary << ".\n\n";
-      md << "Candidates (score = BIC without - BIC with the effect; significant above the threshold):\n\n"
-         << "| rank | effect | score | k | parameters |\n|---|---|---|---|---|\n";
+      if (!st.cv_with.empty()) {
+        double a = 0, b = 0;
+        for (double v : st.cv_without) a += v;
+        for (double v : st.cv_with) b += v;
+        std::snprintf(buf, sizeof buf,
+                      "Out of sample (%zu blocks of time, each predicted by a fit to the others): held-out squared "
+                      "force residual %.4g -> %.4g N^2.\n\n",
+                      st.cv_with.size(), a, b);
+        md << buf;
+      }
+      md << "Candidates (score = BIC of the model - BIC of the model with the effect, every free parameter "
+            "refitted jointly; significant above the threshold):\n\n"
+         << "| rank | effect | score | k | parameters | passed over because |\n|---|---|---|---|---|---|\n";
       for (std::size_t i = 0; i < st.ranking.size(); ++i) {
         std::snprintf(buf, sizeof buf, "| %zu | %s | %.4g | %d | ", i + 1, st.ranking[i].effect.name.c_str(),
                       st.ranking[i].score, st.ranking[i].parameters);
-        md << buf << params_text(st.ranking[i].effect) << " |\n";
+        md << buf << params_text(st.ranking[i].effect) << " | " << st.ranking[i].passed_over << " |\n";
       }
       md << "\nWhere the residual was (before this step):\n\n"
          << "Velocity regimes\n\n" << table(st.localisation.velocity) << "\nAcceleration phases\n\n"

@@ -254,6 +254,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     st.residual_after = r;
     out.steps.push_back(st);
   }
+  // eps means nothing to a model without a Coulomb-type term (e.g. once presliding made it LuGre)
+  if (!has_coulomb_term(current)) current.friction.static_smoothing_velocity = model.friction.static_smoothing_velocity;
   out.fitted = current;
   out.smoothing_final = current.friction.static_smoothing_velocity;
   out.smoothing_fitted = out.smoothing_final != out.smoothing_initial;

@@ -4,7 +4,8 @@
 // Two checks, each one rule per effect, stated in the doc's table:
 //   * prerequisite(): may the effect be a candidate at all on this record and model? (e.g. a
 //     grinding force only where a grinding process is described or asked for; presliding only
-//     where the data has stick phases and the model has a friction to make dynamic; a ripple
+//     where the data has stick phases or reversals (where bristles deflect) and the model has a
+//     friction to make dynamic; a ripple
 //     only where the travel spans two periods of the shortest pitch the data resolves);
 //   * implausible(): are the fitted values physically possible for this drive on this record?
 //     (e.g. a ripple pitch resolved by the data -- at least two periods within the travel and
@@ -32,6 +33,7 @@ struct Envelope {
   double stick_velocity{0.0};                  ///< below this |v^| the drive counts as sticking [m/s]
   int stick_phases{0};                         ///< stick phases (>= 5 consecutive samples below it)
   double stick_fraction{0.0};                  ///< fraction of samples in stick phases
+  int reversals{0};                            ///< sign changes of v^ between |v^| above the stick velocity
   double nominal_mass{0.0};                    ///< the model's mass [kg]
   double duration{0.0};                        ///< [s]
   /// Shortest ripple pitch the data resolves [m]: at the peak speed a period must span at least
