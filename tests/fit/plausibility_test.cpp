@@ -1,0 +1,103 @@
+// The plausibility rules of feeddrive-fit (fit/plausibility.hpp, docs/fit.md "Plausibility") and
+// the canonical ripple form, on hand-made records and effects.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "feeddrive/fit/identify.hpp"
+#include "feeddrive/fit/plausibility.hpp"
+
+namespace feeddrive::fit {
+namespace {
+
+Envelope drive() {  // 100 mm of travel at up to 100 mm/s, 1 kHz, L = 10 ms, 200 N peak thrust
+  Envelope e;
+  e.x_min = 0.0;
+  e.x_max = 0.1;
+  e.travel = 0.1;
+  e.v_max = 0.1;
+  e.peak_thrust = 200.0;
+  e.period = 1e-3;
+  e.filter_half_width = 0.01;
+  e.stick_velocity = 1e-4;
+  e.nominal_mass = 100.0;
+  e.duration = 10.0;
+  return e;
+}
+
+TEST(Plausibility, RipplePitchMustBeResolvedByTheData) {
+  const Envelope e = drive();
+  // two periods within the travel: at most 50 mm; resolved at 100 mm/s by 4 L: at least 4 mm
+  EXPECT_DOUBLE_EQ(e.max_pitch(), 0.05);
+  EXPECT_DOUBLE_EQ(e.min_pitch(), 0.004);
+  const plant::PlantParams m;
+  const auto cog = [](double p, double a) {
+    return plant::NamedEffect{"cogging_ripple", {{"pitch_m", p}, {"amplitude_N", a}, {"phase_rad", 0.0},
+                                                 {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}};
+  };
+  EXPECT_EQ(implausible(e, m, cog(0.024, 5.0)), "");
+  EXPECT_NE(implausible(e, m, cog(2.7, 5.0)).find("fewer than two periods"), std::string::npos);
+  EXPECT_NE(implausible(e, m, cog(0.002, 5.0)).find("shorter than"), std::string::npos);
+  // 378 N on a 200 N drive
+  EXPECT_NE(implausible(e, m, cog(0.024, 378.0)).find("fifth of the peak thrust"), std::string::npos);
+}
+
+TEST(Plausibility, SpringRestWithinReachAndGrindingOnlyWhereDescribed) {
+  const Envelope e = drive();
+  const plant::PlantParams m;
+  const auto spring = [](double rest) {
+    return plant::NamedEffect{"spring_force", {{"stiffness_N_per_m", 100.0}, {"rest_position_m", rest}}};
+  };
+  EXPECT_EQ(implausible(e, m, spring(0.05)), "");
+  EXPECT_EQ(implausible(e, m, spring(-0.09)), "");  // within one travel of the range
+  EXPECT_NE(implausible(e, m, spring(5.0)).find("rest position"), std::string::npos);
+  EXPECT_NE(prerequisite(e, m, "grinding_force", {}).find("no grinding process"), std::string::npos);
+  PlausibilityOptions g;
+  g.grinding_process = true;
+  EXPECT_EQ(prerequisite(e, m, "grinding_force", g), "");
+  // a spring and a constant force in one model are one spring
+  plant::PlantParams with_constant = m;
+  with_constant.effects.constant_force.enabled = true;
+  EXPECT_NE(prerequisite(e, with_constant, "spring_force", {}), "");
+}
+
+TEST(Plausibility, PreslidingNeedsFrictionAndStickPhasesOrReversals) {
+  Envelope e = drive();
+  plant::PlantParams none;
+  none.friction.model = plant::FrictionModel::kNone;
+  EXPECT_NE(prerequisite(e, none, "presliding", {}).find("no friction"), std::string::npos);
+  plant::PlantParams stat;
+  stat.friction.model = plant::FrictionModel::kStatic;
+  EXPECT_NE(prerequisite(e, stat, "presliding", {}).find("too few stick phases"), std::string::npos);
+  e.reversals = 12;
+  EXPECT_EQ(prerequisite(e, stat, "presliding", {}), "");
+}
+
+TEST(Plausibility, MassWithinAFactorOfTwo) {
+  const Envelope e = drive();
+  const plant::PlantParams m;
+  EXPECT_EQ(implausible(e, m, {"mass_error", {{"mass_kg", 120.0}}}), "");
+  EXPECT_NE(implausible(e, m, {"mass_error", {{"mass_kg", 400.0}}}), "");
+}
+
+// The case the issue reports: a pure 28.3 N ripple of pitch 42.4 mm fitted as the "third harmonic"
+// of a 127.2 mm pitch with a 0.02 N fundamental. The same force, sin(6 pi x/p + phi3) =
+// sin(2 pi x/(p/3) + phi3), is reported at its physical pitch.
+TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
+  const Effect raw{"cogging_ripple",
+                   {{"pitch_m", 0.1272}, {"amplitude_N", 0.02}, {"phase_rad", 0.5}, {"third_harmonic_N", 28.3},
+                    {"third_phase_rad", -0.7}}};
+  const Effect c = canonical(raw);
+  EXPECT_NEAR(c.parameters.at("pitch_m"), 0.0424, 1e-12);
+  EXPECT_DOUBLE_EQ(c.parameters.at("amplitude_N"), 28.3);
+  EXPECT_DOUBLE_EQ(c.parameters.at("phase_rad"), -0.7);
+  EXPECT_DOUBLE_EQ(c.parameters.at("third_harmonic_N"), 0.0);
+  // a real fundamental with a third harmonic is left alone
+  const Effect both{"cogging_ripple",
+                    {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7}, {"third_harmonic_N", 1.0},
+                     {"third_phase_rad", -0.4}}};
+  EXPECT_EQ(canonical(both).parameters, both.parameters);
+}
+
+}  // namespace
+}  // namespace feeddrive::fit
