@@ -11,6 +11,7 @@
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/workflow.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   app.add_option("--scenario,-s", scenario_path, "the model: a feeddrive scenario YAML")->required();
   app.add_option("--data,-d", data_path, "measured data: CSV (t, x, u or force_N[, xd, v]) or an lcm-logger log (.lcm, .lcmlog, .log)")
       ->required();
-  app.add_option("--out,-o", out_dir, "output folder (written atomically)")->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_option("--max-effects", opt.max_effects, "most effects to add")->capture_default_str()->check(CLI::Range(0, 11));
   // A finite number in [lo, hi] (CLI::Range lets NaN through), or exactly 0 where `zero` says so.
   const auto within = [](double lo, double hi, bool zero) {
@@ -81,7 +82,7 @@ int main(int argc, char** argv) {
   try {
     // Bad input (scenario, data, too short a record, an --out that must not be replaced) is a
     // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.
-    fit::check_output_dir(out_dir);
+    output::check_output_dir(out_dir);
     const sim::Scenario scenario = sim::load_scenario(scenario_path);
     opt.plausibility.grinding_process =
         scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();

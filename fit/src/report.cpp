@@ -1,17 +1,17 @@
 #include "feeddrive/fit/report.hpp"
 
 #include <yaml-cpp/yaml.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/output/folder.hpp"
+#include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::fit {
 namespace fs = std::filesystem;
@@ -39,7 +39,10 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
   YAML::Emitter em;
   em.SetDoublePrecision(15);
   em << root;
-  return std::string("# feeddrive-fit: ") + scenario_path + " plus the fitted effects under plant.effects\n" +
+  std::string shown_path = scenario_path;  // a comment: one line, whatever the path holds
+  for (char& c : shown_path)
+    if (c == '\n' || c == '\r') c = '?';
+  return std::string("# feeddrive-fit: ") + shown_path + " plus the fitted effects under plant.effects\n" +
          em.c_str() + "\n";
 }
 
@@ -138,31 +141,13 @@ std::string params_text(const Effect& e) {
   return s;
 }
 
-void run_gnuplot(const fs::path& dir, const std::string& script) {
-  write_file(dir / "plots.gp", script);
-  const std::string cmd = "cd '" + dir.string() + "' && gnuplot plots.gp > gnuplot.log 2>&1";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("gnuplot failed (see " + (dir / "gnuplot.log").string() + ")");
-  fs::remove(dir / "gnuplot.log");
-}
-
 }  // namespace
-
-void check_output_dir(const std::string& out_dir) {
-  std::error_code ec;
-  const fs::path d(out_dir);
-  if (fs::exists(d, ec) && !(fs::is_directory(d, ec) && (fs::is_empty(d, ec) || fs::exists(d / "findings.json", ec))))
-    throw std::invalid_argument("--out " + out_dir +
-                                ": exists and is not an earlier feeddrive-fit output (no findings.json); not replacing it");
-}
 
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
                    const FitResult& r, bool plots) {
-  check_output_dir(out_dir);
-  const fs::path final_dir = fs::absolute(out_dir);
-  const fs::path tmp = final_dir.parent_path() / (final_dir.filename().string() + ".tmp-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
-  try {
+  output::StagedFolder out(out_dir, "feeddrive-fit");
+  const fs::path tmp = out.dir();
+  {
     write_file(tmp / "findings.json", findings_json(r));
     write_file(tmp / "model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
     const MeasuredData& d = *rec.data;
@@ -273,7 +258,8 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     write_file(tmp / "report.md", md.str());
     if (plots) {
       std::ostringstream gp;
-      gp << "set datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\nset grid\n"
+      // Fixed data file names; every other text through output::gnuplot_string.
+      gp << "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\nset grid\n"
          << "set key outside top center horizontal\n";
       gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
             "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
@@ -289,22 +275,18 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
         if (!st.accepted) continue;
         ++k;
         const auto label = effect_regressor(rec, st.effect).first;
-        gp << "set output 'effect" << k << ".png'\nset title 'step " << k << ": " << st.effect.name
-           << " -- filtered force residual against its regressor'\nset xlabel '" << label
-           << "'\nset ylabel 'force [N]'\nplot 'effect" << k
+        gp << "set output 'effect" << k << ".png'\nset title "
+           << output::gnuplot_string("step " + std::to_string(k) + ": " + st.effect.name +
+                                     " -- filtered force residual against its regressor")
+           << "\nset xlabel " << output::gnuplot_string(label) << "\nset ylabel 'force [N]'\nplot 'effect" << k
            << ".csv' every ::1 using 1:2 with points pt 7 ps 0.4 title 'residual before (-r)', '' every ::1 using "
               "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
               "ps 0.3 title 'residual after'\n";
       }
-      run_gnuplot(tmp, gp.str());
+      output::run_gnuplot(tmp, gp.str());
     }
-    if (fs::exists(final_dir)) fs::remove_all(final_dir);
-    fs::rename(tmp, final_dir);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
   }
+  out.commit();
 }
 
 }  // namespace feeddrive::fit

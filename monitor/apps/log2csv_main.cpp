@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "feeddrive/monitor/log_reader.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -19,19 +20,19 @@ int main(int argc, char** argv) {
   service::NodeOptions opt;  // only --prefix and --quiet matter here
   app.add_option("log", log_path, "LCM log file written by lcm-logger")->required();
   app.add_option("--scenario,-s", scenario_path, "the run's scenario YAML (control period, name)")->required();
-  app.add_option("--out,-o", out_dir, "output folder (replaced atomically)")->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_option("--prefix", opt.prefix, "channel prefix of the run")->capture_default_str();
   app.add_flag("--plots", plots, "also draw the PNG plots");
   app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
   return service::run_process(app, argc, argv, opt, [&] {
     const sim::Scenario s = sim::load_scenario(scenario_path);
-    sim::check_output_dir(out_dir);
+    output::check_output_dir(out_dir);
     const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix);
     const monitor::Recorder& rec = c.recorder;
     sim::RunResult r;
     r.records = rec.records();
     const sim::Summary sum = sim::summarize(r, s);
-    sim::write_results(out_dir, r, sum, s, plots && !r.records.empty());
+    sim::write_results(out_dir, r, sum, s, plots && !r.records.empty(), "", "feeddrive-log2csv");
     const bool complete = rec.complete();
     spdlog::info("{}: {} events, {} rows{}, {} undecodable, {} on other channels -> {}", log_path, c.events,
                  r.records.size(), complete ? " (complete run)" : "", c.undecodable, c.foreign_events, out_dir);

@@ -1,8 +1,8 @@
 // feeddrive-monitor: records a run from its LCM channels into DIR/{timeseries.csv, summary.json,
 // *.png} (feeddrive-sim's format plus lockstep statistics). Wiring only: scenario -> MonitorNode.
 #include "feeddrive/monitor/monitor_node.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/service/cli.hpp"
-#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 int main(int argc, char** argv) {
@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   monitor::MonitorOptions mopt;
   bool no_plots = false;
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", mopt.out_dir, "output folder (replaced atomically)")->required();
+  app.add_option("--out,-o", mopt.out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--attach", mopt.attach,
                "join a running system or an lcm-logplayer playback: record from the first state seen, "
@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     mopt.plots = !no_plots;
     const sim::Scenario s = sim::load_scenario(scenario_path);
-    sim::check_output_dir(mopt.out_dir);
+    output::check_output_dir(mopt.out_dir);  // before the run
     monitor::MonitorNode node(s, opt, mopt);
     return node.run() ? 0 : 1;
   });

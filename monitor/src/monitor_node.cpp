@@ -9,6 +9,7 @@
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/summary.hpp"
 
@@ -103,11 +104,11 @@ bool MonitorNode::run() {
     failure = e.what();
   }
   progress(true);
-  finish(failure.empty(), failure);
-  return failure.empty();
+  // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.
+  return finish(failure.empty(), failure) && failure.empty();
 }
 
-void MonitorNode::finish(bool completed, const std::string& failure) {
+bool MonitorNode::finish(bool completed, const std::string& failure) {
   sim::RunResult r;
   r.records = rec_.records();
   r.wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
@@ -186,22 +187,30 @@ void MonitorNode::finish(bool completed, const std::string& failure) {
     for (const char* q : {"p50", "p99", "p1"})
       if (v->contains(q) && std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
 
+  bool written = true;
+  std::string why = failure;
   try {
-    sim::write_results(mopt_.out_dir, r, sum, s_, mopt_.plots && !r.records.empty(), j.dump());
+    sim::write_results(mopt_.out_dir, r, sum, s_, mopt_.plots && !r.records.empty(), j.dump(),
+                       mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
   } catch (const std::exception& e) {
-    spdlog::error("monitor: writing {} failed: {}", mopt_.out_dir, e.what());
+    spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
+    written = false;
     completed = false;
+    if (why.empty()) why = std::string("results not written: ") + e.what();
+    summary_.completed = false;
+    summary_.failure = why;
   }
   bus().publish(channels().summary, summary_);
   if (completed) {
     set_state("done");
   } else {
-    announce_failure(failure);
+    announce_failure(why);
   }
   if (!options().quiet)
     spdlog::info("monitor: {} steps recorded{} -> {}", r.records.size(),
-                 completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + failure + ")",
-                 mopt_.out_dir);
+                 completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",
+                 output::shown(mopt_.out_dir));
+  return written;
 }
 
 }  // namespace feeddrive::monitor

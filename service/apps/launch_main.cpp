@@ -1,13 +1,14 @@
 // feeddrive-launch: runs a scenario as four LCM processes (plant, controller, trajectory,
 // monitor) in lockstep and collects the results in DIR. Wiring only: options -> launch().
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
 
-#include <nlohmann/json.hpp>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/service/launch.hpp"
-#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 int main(int argc, char** argv) {
@@ -20,7 +21,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> external;
   bool no_plots = false;
   app.add_option("scenario", lo.scenario, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", lo.out_dir, "output folder (replaced atomically)")->required();
+  app.add_option("--out,-o", lo.out_dir, "output folder (written atomically by the monitor; replaces only an earlier feeddrive output)")->required();
   app.add_option("--external", external, "leave ROLE (controller, plant or trajectory) to a process you start")
       ->type_name("ROLE");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
@@ -33,8 +34,14 @@ int main(int argc, char** argv) {
     lo.plots = !no_plots;
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
     const sim::Scenario s = sim::load_scenario(lo.scenario);  // bad input fails here, before any process starts
-    sim::check_output_dir(lo.out_dir);
+    const auto out = output::check_output_dir(lo.out_dir);  // and this, before any process starts
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);
+    // The monitor's marker before the run: a successful run leaves a new one (a new file).
+    const auto marker_id = [&] {
+      struct stat st {};
+      return ::lstat((out / output::kMarkerFile).c_str(), &st) == 0 ? st.st_ino : ino_t{0};
+    };
+    const ino_t before = marker_id();
     const service::LaunchResult r = service::launch(lo, opt);
     std::ifstream in(lo.out_dir + "/summary.json");
     if (in) {
@@ -46,6 +53,12 @@ int main(int argc, char** argv) {
                      j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(), lo.out_dir);
     }
     for (const auto& f : r.failed) spdlog::error("failed: {}", f);
-    return r.exit_code;
+    if (r.exit_code != 0) return r.exit_code;
+    // Every process exited 0: the monitor's new results must be there.
+    if (!output::is_feeddrive_output(out) || marker_id() == before) {
+      spdlog::error("--out {}: the monitor wrote no results", output::shown(lo.out_dir));
+      return 1;
+    }
+    return 0;
   });
 }

@@ -8,6 +8,7 @@
 
 #include <cstdio>
 
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
@@ -18,7 +19,7 @@ int main(int argc, char** argv) {
   std::string scenario_path, out_dir;
   bool no_plots = false, quiet = false;
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", out_dir, "output folder (replaced atomically)")->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only errors");
   try {
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   feeddrive::sim::Scenario scenario;
   try {
     scenario = feeddrive::sim::load_scenario(scenario_path);
-    feeddrive::sim::check_output_dir(out_dir);
+    feeddrive::output::check_output_dir(out_dir);  // before any work
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

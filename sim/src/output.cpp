@@ -1,11 +1,13 @@
 #include "feeddrive/sim/output.hpp"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
+
+#include "feeddrive/output/folder.hpp"
+#include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::sim {
 namespace fs = std::filesystem;
@@ -35,74 +37,47 @@ int column(const std::string& name) {
 }  // namespace
 
 void write_plots(const std::string& dir, const std::string& title) {
-  const std::string script = dir + "/plots.gp";
-  {
-    std::ofstream gp(script);
-    auto c = [](const char* n) { return std::to_string(column(n)); };
-    gp << "set datafile separator ','\n"
-       << "set terminal pngcairo size 1000,700 noenhanced\n"
-       << "set grid\nset key outside top center horizontal\n"
-       << "data = 'timeseries.csv'\n"
-       << "set xlabel 't [s]'\n";
-    gp << "set output 'position.png'\nset multiplot layout 2,1 title '" << title << "'\n"
-       << "set ylabel 'position [mm]'\n"
-       << "plot data every ::1 using " << c("t") << ":($" << c("xd") << "*1e3) with lines lw 2 title 'x_d',"
-       << " '' every ::1 using " << c("t") << ":($" << c("x") << "*1e3) with lines title 'x'\n"
-       << "set ylabel 'error x_d - x [um]'\n"
-       << "plot data every ::1 using " << c("t") << ":(($" << c("xd") << "-$" << c("x")
-       << ")*1e6) with lines title 'e'\nunset multiplot\n";
-    gp << "set output 'velocity_error.png'\nset title '" << title << "'\nset ylabel 'velocity error v_d - v [um/s]'\n"
-       << "plot data every ::1 using " << c("t") << ":(($" << c("vd") << "-$" << c("v")
-       << ")*1e6) with lines title 'e_v'\n";
-    gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n"
-       << "plot data every ::1 using " << c("t") << ":" << c("u") << " with lines title 'u'\n";
-    gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
-       << "plot data every ::1 using " << c("t") << ":" << c("f_friction") << " with lines title 'friction',"
-       << " '' every ::1 using " << c("t") << ":" << c("f_ripple") << " with lines title 'ripple',"
-       << " '' every ::1 using " << c("t") << ":" << c("f_grinding") << " with lines title 'grinding'\n";
-    if (!gp) throw std::runtime_error(script + ": write failed");
-  }
-  const std::string cmd = "cd '" + dir + "' && gnuplot plots.gp > gnuplot.log 2>&1";
-  if (std::system(cmd.c_str()) != 0)
-    throw std::runtime_error("gnuplot failed; see " + dir + "/gnuplot.log");
-  fs::remove(dir + "/gnuplot.log");
-}
-
-void check_output_dir(const std::string& out_dir) {
-  const fs::path p(out_dir);
-  std::error_code ec;
-  if (!fs::exists(p, ec)) return;
-  if (!fs::is_directory(p, ec))
-    throw std::invalid_argument("--out " + out_dir + ": exists and is not a folder");
-  if (fs::is_empty(p, ec) || fs::exists(p / "summary.json", ec)) return;
-  throw std::invalid_argument("--out " + out_dir +
-                              ": folder exists and is not a feeddrive output (no summary.json); refusing to replace it");
+  // Fixed data file name, the title through the one escaping rule (feeddrive/output/gnuplot.hpp).
+  const std::string t = output::gnuplot_string(title);
+  std::ostringstream gp;
+  auto c = [](const char* n) { return std::to_string(column(n)); };
+  gp << "set encoding utf8\nset datafile separator ','\n"
+     << "set terminal pngcairo size 1000,700 noenhanced\n"
+     << "set grid\nset key outside top center horizontal\n"
+     << "data = 'timeseries.csv'\n"
+     << "set xlabel 't [s]'\n";
+  gp << "set output 'position.png'\nset multiplot layout 2,1 title " << t << "\n"
+     << "set ylabel 'position [mm]'\n"
+     << "plot data every ::1 using " << c("t") << ":($" << c("xd") << "*1e3) with lines lw 2 title 'x_d',"
+     << " '' every ::1 using " << c("t") << ":($" << c("x") << "*1e3) with lines title 'x'\n"
+     << "set ylabel 'error x_d - x [um]'\n"
+     << "plot data every ::1 using " << c("t") << ":(($" << c("xd") << "-$" << c("x")
+     << ")*1e6) with lines title 'e'\nunset multiplot\n";
+  gp << "set output 'velocity_error.png'\nset title " << t << "\nset ylabel 'velocity error v_d - v [um/s]'\n"
+     << "plot data every ::1 using " << c("t") << ":(($" << c("vd") << "-$" << c("v")
+     << ")*1e6) with lines title 'e_v'\n";
+  gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n"
+     << "plot data every ::1 using " << c("t") << ":" << c("u") << " with lines title 'u'\n";
+  gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
+     << "plot data every ::1 using " << c("t") << ":" << c("f_friction") << " with lines title 'friction',"
+     << " '' every ::1 using " << c("t") << ":" << c("f_ripple") << " with lines title 'ripple',"
+     << " '' every ::1 using " << c("t") << ":" << c("f_grinding") << " with lines title 'grinding'\n";
+  output::run_gnuplot(dir, gp.str());
 }
 
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots, const std::string& extra_json) {
-  const fs::path target = fs::absolute(out_dir).lexically_normal();
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  check_output_dir(target.string());
-  fs::create_directories(parent);
-  const fs::path tmp = parent / ("." + target.filename().string() + ".partial-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
-  try {
-    write_timeseries_csv((tmp / "timeseries.csv").string(), r.records);
-    {
-      std::ofstream js(tmp / "summary.json");
-      js << summary_json(sum, s, extra_json);
-      if (!js) throw std::runtime_error((tmp / "summary.json").string() + ": write failed");
-    }
-    if (plots) write_plots(tmp.string(), s.name);
-    fs::remove_all(target);
-    fs::rename(tmp, target);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
+                   bool plots, const std::string& extra_json, const std::string& tool) {
+  output::StagedFolder out(out_dir, tool);
+  const fs::path tmp = out.dir();
+  write_timeseries_csv((tmp / "timeseries.csv").string(), r.records);
+  {
+    std::ofstream js(tmp / "summary.json");
+    js << summary_json(sum, s, extra_json);
+    js.close();
+    if (!js) throw std::runtime_error((tmp / "summary.json").string() + ": write failed");
   }
+  if (plots) write_plots(tmp.string(), s.name);
+  out.commit();
 }
 
 }  // namespace feeddrive::sim

@@ -1,6 +1,6 @@
 #pragma once
-// Writing feeddrive-fit's results into DIR, atomically (a sibling temporary folder renamed when
-// complete): findings.json, model.fitted.yaml, report.md and its PNG plots (gnuplot).
+// Writing feeddrive-fit's results into DIR, atomically (a sibling temporary folder swapped into
+// place when complete): findings.json, model.fitted.yaml, report.md and its PNG plots (gnuplot).
 
 #include <string>
 
@@ -16,10 +16,9 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
 /// gap_after}], ...}.
 std::string findings_json(const FitResult& r);
 
-/// Throws std::invalid_argument unless out_dir is absent, empty, or an earlier feeddrive-fit
-/// output (holds findings.json): an unrelated folder is never replaced.
-void check_output_dir(const std::string& out_dir);
-
+/// Writes the results into out_dir through output::StagedFolder (feeddrive/output/folder.hpp:
+/// check --out before the work with output::check_output_dir). Throws std::invalid_argument if
+/// out_dir must not be replaced, std::runtime_error if writing fails; a previous output is kept.
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
                    const FitResult& r, bool plots);
 

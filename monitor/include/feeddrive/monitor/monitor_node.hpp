@@ -28,14 +28,16 @@ struct MonitorOptions {
 class MonitorNode : public service::Node {
  public:
   MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt);
-  /// Returns true if the run completed; writes the results in every case.
+  /// Returns true if the run completed and its results were written; tries to write the
+  /// results in every case.
   bool run();
   const run_summary_t& summary() const { return summary_; }
 
  private:
   void request_missing();
   void progress(bool force);
-  void finish(bool completed, const std::string& failure);
+  /// Writes the results and announces the end; false if the results could not be written.
+  bool finish(bool completed, const std::string& failure);
 
   sim::Scenario s_;
   MonitorOptions mopt_;

@@ -1,7 +1,8 @@
 #pragma once
 // Writing a run's results: DIR/timeseries.csv, DIR/summary.json and PNG plots (gnuplot).
-// All files go to a sibling temporary folder that is renamed to DIR only when complete, so DIR
-// is never half-written.
+// The folder is checked, staged and swapped into place by feeddrive::output (output/folder.hpp):
+// DIR is never half-written, and only an earlier feeddrive output (or an empty folder) is
+// replaced. Check --out before the run with feeddrive::output::check_output_dir.
 
 #include <string>
 
@@ -14,16 +15,15 @@ namespace feeddrive::sim {
 void write_timeseries_csv(const std::string& path, const std::vector<Record>& records);
 
 /// Plots position+error, velocity error, control and forces with gnuplot into dir
-/// (position.png, velocity_error.png, control.png, forces.png). Throws on failure.
+/// (position.png, velocity_error.png, control.png, forces.png, plots.gp), from dir/timeseries.csv.
+/// `title` is any text (it goes through output::gnuplot_string). Throws on failure.
 void write_plots(const std::string& dir, const std::string& title);
 
-/// Throws std::invalid_argument unless out_dir is absent, empty, or a previous feeddrive output
-/// (holds summary.json): an unrelated folder is never replaced.
-void check_output_dir(const std::string& out_dir);
-
 /// Writes timeseries.csv, summary.json (with the keys of extra_json appended) and the plots into
-/// out_dir atomically.
+/// out_dir atomically (output::StagedFolder, marked as written by `tool`). Throws
+/// std::invalid_argument if out_dir must not be replaced, std::runtime_error if writing fails;
+/// a previous output is kept in both cases.
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots = true, const std::string& extra_json = "");
+                   bool plots = true, const std::string& extra_json = "", const std::string& tool = "feeddrive-sim");
 
 }  // namespace feeddrive::sim

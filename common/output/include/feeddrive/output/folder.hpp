@@ -1,0 +1,82 @@
+#pragma once
+// The output folder of every feeddrive tool (feeddrive-sim, -monitor, -launch, -log2csv, -fit):
+// the one implementation of "--out DIR is checked before any work, written atomically, and never
+// replaces anything feeddrive did not write".
+//
+//   check_output_dir(out)  before any work: normalises the path ("prev/" is "prev") and throws
+//                          std::invalid_argument "--out DIR: why" (one line; the tools exit 2) if
+//                          DIR names no folder of its own ("", "/", ".", ".."), is too long,
+//                          lies under a file, cannot be written, or exists and is neither empty
+//                          nor a feeddrive output.
+//   StagedFolder           the writer: a new sibling folder ".NAME.partial-PID-N" (marked from
+//                          the start) that commit() swaps into place. A failure before or during
+//                          commit never deletes the previous output or anything else.
+//
+// A folder is a feeddrive output only if it holds the marker file `.feeddrive-output` that a
+// StagedFolder wrote (first line "feeddrive-output", then "format: 1" and "tool: NAME"). Outputs
+// of feeddrive versions without the marker are refused like any other folder.
+
+#include <filesystem>
+#include <string>
+
+namespace feeddrive::output {
+
+inline constexpr const char* kMarkerFile = ".feeddrive-output";
+inline constexpr int kFormatVersion = 1;
+
+/// The marker's text for `tool`.
+std::string marker_text(const std::string& tool);
+
+/// True if `dir` is a folder (not a symbolic link) holding a well-formed marker.
+bool is_feeddrive_output(const std::filesystem::path& dir);
+
+/// `value` as the tools show it in a message: control characters and bytes that are not
+/// printable ASCII become '?', an empty value is "".
+std::string shown(const std::string& value);
+
+/// The lexically normal form of `out` without trailing separators. Throws std::invalid_argument
+/// ("<option> <value>: ...") for a path that names no folder of its own: "", "/", ".", "..",
+/// "a/..".
+std::filesystem::path normalise(const std::string& out, const std::string& option = "--out");
+
+/// Everything that can be checked before the work: see the top of this file. Returns the
+/// normalised path. Throws std::invalid_argument, one line naming the option and the value.
+std::filesystem::path check_output_dir(const std::string& out, const std::string& option = "--out");
+
+/// A new output folder written in a sibling temporary folder and swapped into place by commit().
+class StagedFolder {
+ public:
+  /// Runs check_output_dir (std::invalid_argument), creates missing parent folders and the
+  /// temporary folder with its marker (std::runtime_error on failure).
+  StagedFolder(const std::string& out, const std::string& tool, const std::string& option = "--out");
+  /// Removes the temporary folder unless commit() succeeded or kept it.
+  ~StagedFolder();
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+
+  /// Where to write the files (absolute).
+  const std::filesystem::path& dir() const { return staging_; }
+  /// The final folder (absolute, normalised).
+  const std::filesystem::path& target() const { return target_; }
+
+  /// Puts the folder in place: renames it to the target if there is none, else exchanges the two
+  /// atomically (renameat2 RENAME_EXCHANGE; where the file system lacks it, the old folder is
+  /// renamed to a sibling backup first and restored if the second rename fails), then removes
+  /// the old folder, which is a feeddrive output or empty (checked again). If the target has
+  /// become something else meanwhile, nothing is replaced: throws std::runtime_error naming the
+  /// temporary folder, which is kept with the results.
+  void commit();
+
+ private:
+  std::string value_;   // as the user gave it, for messages
+  std::string option_;
+  std::filesystem::path target_;
+  std::filesystem::path staging_;
+  bool done_{false};
+};
+
+/// Removes `dir` with everything in it only if it is a feeddrive output or an empty folder;
+/// returns false (and removes nothing) otherwise or on failure.
+bool remove_output(const std::filesystem::path& dir) noexcept;
+
+}  // namespace feeddrive::output

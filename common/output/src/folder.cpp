@@ -1,0 +1,241 @@
+#include "feeddrive/output/folder.hpp"
+
+#include <fcntl.h>
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (_GNU_SOURCE)
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace feeddrive::output {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Room the temporary siblings need beyond the name: "." + NAME + ".partial-PID-N".
+constexpr std::size_t kSiblingExtra = 40;
+constexpr std::size_t kMaxName = NAME_MAX - kSiblingExtra;
+constexpr std::size_t kMaxPath = PATH_MAX - kSiblingExtra;
+
+[[noreturn]] void refuse(const std::string& option, const std::string& value, const std::string& why) {
+  throw std::invalid_argument(option + " " + shown(value) + ": " + why);
+}
+
+std::string error_text(int err) { return std::strerror(err); }
+
+// A fresh sibling of `target` named ".NAME.<kind>-PID-N" that does not exist yet.
+fs::path unused_sibling(const fs::path& target, const std::string& kind) {
+  for (int n = 0;; ++n) {
+    const fs::path p = target.parent_path() / ("." + target.filename().string() + "." + kind + "-" +
+                                                std::to_string(::getpid()) + "-" + std::to_string(n));
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(p, ec))) return p;
+  }
+}
+
+// Can this process create entries in folder `dir`? access() first (it knows read-only file
+// systems, and permission bits for anyone but root), then a real probe: a folder made and removed.
+int writable(const fs::path& dir) {
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) return errno;
+  const fs::path probe = unused_sibling(dir / "probe", "feeddrive-probe");
+  if (::mkdir(probe.c_str(), 0700) != 0) return errno;
+  ::rmdir(probe.c_str());
+  return 0;
+}
+
+bool empty_folder(const fs::path& dir) {
+  std::error_code ec;
+  const bool e = fs::is_empty(dir, ec);
+  return !ec && e;
+}
+
+bool exchange(const fs::path& a, const fs::path& b, int& err) {
+  if (::renameat2(AT_FDCWD, a.c_str(), AT_FDCWD, b.c_str(), RENAME_EXCHANGE) == 0) return true;
+  err = errno;
+  return false;
+}
+
+}  // namespace
+
+std::string marker_text(const std::string& tool) {
+  return "feeddrive-output\nformat: " + std::to_string(kFormatVersion) + "\ntool: " + tool + "\n";
+}
+
+bool is_feeddrive_output(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) return false;
+  const fs::path marker = dir / kMarkerFile;
+  const auto st = fs::symlink_status(marker, ec);
+  if (ec || !fs::is_regular_file(st) || fs::file_size(marker, ec) > 4096 || ec) return false;
+  std::ifstream in(marker, std::ios::binary);
+  std::string magic, format, tool;
+  if (!std::getline(in, magic) || !std::getline(in, format) || !std::getline(in, tool)) return false;
+  if (magic != "feeddrive-output" || format.rfind("format: ", 0) != 0 || tool.rfind("tool: ", 0) != 0) return false;
+  const std::string version = format.substr(8);
+  return !version.empty() && version.find_first_not_of("0123456789") == std::string::npos && tool.size() > 6;
+}
+
+std::string shown(const std::string& value) {
+  if (value.empty()) return "\"\"";
+  std::string s = value;
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return s;
+}
+
+fs::path normalise(const std::string& out, const std::string& option) {
+  if (out.empty()) refuse(option, out, "empty path; name the output folder, e.g. out/run");
+  fs::path p = fs::path(out).lexically_normal();
+  while (!p.empty() && !p.has_filename() && p.has_relative_path()) p = p.parent_path();  // "prev/" -> "prev"
+  if (p.empty() || !p.has_filename() || p.filename() == "." || p.filename() == "..")
+    refuse(option, out, "names no folder of its own (the current folder, a parent or the root); name the output folder, e.g. out/run");
+  return p;
+}
+
+fs::path check_output_dir(const std::string& out, const std::string& option) {
+  const fs::path p = normalise(out, option);
+  const std::size_t name = p.filename().string().size();
+  if (name > kMaxName)
+    refuse(option, out, "the folder name is too long (" + std::to_string(name) + " bytes; at most " + std::to_string(kMaxName) + ")");
+  std::error_code ec;
+  const fs::path abs = fs::absolute(p, ec);
+  if (ec) refuse(option, out, "cannot resolve the path: " + ec.message());
+  if (abs.string().size() > kMaxPath)
+    refuse(option, out, "the path is too long (" + std::to_string(abs.string().size()) + " bytes; at most " + std::to_string(kMaxPath) + ")");
+
+  const auto st = fs::symlink_status(abs, ec);
+  if (!ec && fs::exists(st)) {
+    if (fs::is_symlink(st)) refuse(option, out, "is a symbolic link; name the folder itself");
+    if (!fs::is_directory(st)) refuse(option, out, "exists and is not a folder");
+    std::error_code ec2;
+    const bool empty = fs::is_empty(abs, ec2);
+    if (ec2) refuse(option, out, "cannot read the folder: " + ec2.message());
+    if (!empty && !is_feeddrive_output(abs))
+      refuse(option, out, std::string("folder exists, is not empty and is not a feeddrive output (no ") + kMarkerFile +
+                              " marker); refusing to replace it");
+  } else if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+    refuse(option, out, "cannot be checked: " + ec.message());
+  }
+
+  // The nearest folder that exists above it: every name on the way is created later, so none
+  // may be a file, and the folder must take new entries.
+  fs::path up = abs.parent_path();
+  for (;;) {
+    const auto s = fs::status(up, ec);
+    if (!ec && fs::exists(s)) {
+      if (!fs::is_directory(s)) refuse(option, out, up.string() + " is not a folder");
+      break;
+    }
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+      refuse(option, out, "cannot check " + up.string() + ": " + ec.message());
+    if (!up.has_relative_path()) refuse(option, out, "no existing folder above it");
+    up = up.parent_path();
+  }
+  if (const int err = writable(up); err != 0) refuse(option, out, "cannot write in " + up.string() + ": " + error_text(err));
+  return p;
+}
+
+bool remove_output(const fs::path& dir) noexcept {
+  try {
+    std::error_code ec;
+    if (!fs::is_directory(fs::symlink_status(dir, ec))) return false;
+    if (!is_feeddrive_output(dir) && !empty_folder(dir)) return false;
+    fs::remove_all(dir, ec);
+    return !ec;
+  } catch (...) {
+    return false;
+  }
+}
+
+StagedFolder::StagedFolder(const std::string& out, const std::string& tool, const std::string& option)
+    : value_(out), option_(option) {
+  target_ = fs::absolute(check_output_dir(out, option));
+  std::error_code ec;
+  fs::create_directories(target_.parent_path(), ec);
+  if (ec)
+    throw std::runtime_error(option_ + " " + shown(value_) + ": cannot create " + target_.parent_path().string() + ": " +
+                             ec.message());
+  for (;;) {
+    staging_ = unused_sibling(target_, "partial");
+    if (::mkdir(staging_.c_str(), 0777) == 0) break;
+    if (errno != EEXIST)
+      throw std::runtime_error(option_ + " " + shown(value_) + ": cannot create " + staging_.string() + ": " +
+                               error_text(errno));
+  }
+  std::ofstream m(staging_ / kMarkerFile, std::ios::binary);
+  m << marker_text(tool);
+  m.close();
+  if (!m) {
+    ::unlink((staging_ / kMarkerFile).c_str());
+    ::rmdir(staging_.c_str());
+    done_ = true;
+    throw std::runtime_error(option_ + " " + shown(value_) + ": cannot write in " + staging_.string());
+  }
+}
+
+StagedFolder::~StagedFolder() {
+  if (!done_) remove_output(staging_);
+}
+
+void StagedFolder::commit() {
+  if (done_) throw std::logic_error("StagedFolder::commit called twice");
+  const std::string what = option_ + " " + shown(value_) + ": ";
+  const std::string kept = "; the results are in " + staging_.string();
+  // From here on the staging folder is kept on failure: it holds finished results.
+  done_ = true;
+  std::error_code ec;
+  const auto st = fs::symlink_status(target_, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory)
+    throw std::runtime_error(what + "cannot check it: " + ec.message() + kept);
+  if (!fs::exists(st)) {
+    if (::rename(staging_.c_str(), target_.c_str()) != 0)
+      throw std::runtime_error(what + "cannot rename the results into place: " + error_text(errno) + kept);
+    return;
+  }
+  const auto ours = [](const fs::path& d) { return is_feeddrive_output(d) || empty_folder(d); };
+  if (!fs::is_directory(st) || !ours(target_))
+    throw std::runtime_error(what + "changed during the run and is no longer a feeddrive output; not replaced" + kept);
+
+  int err = 0;
+  if (exchange(staging_, target_, err)) {
+    // staging_ now holds the previous output. Check it again: a folder that is not ours goes back.
+    if (!ours(staging_)) {
+      int err2 = 0;
+      if (exchange(staging_, target_, err2))
+        throw std::runtime_error(what + "changed during the run and is no longer a feeddrive output; not replaced" + kept);
+      throw std::runtime_error(what + "changed during the run; the folder found there was moved to " + staging_.string() +
+                               " and could not be moved back (" + error_text(err2) + ")");
+    }
+    if (!remove_output(staging_))
+      std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),
+                   staging_.c_str());
+    return;
+  }
+  if (err != EINVAL && err != ENOSYS && err != EOPNOTSUPP)
+    throw std::runtime_error(what + "cannot swap the results into place: " + error_text(err) + kept);
+
+  // No atomic exchange on this file system: previous output to a backup, new into place, backup
+  // removed; the previous output is restored if the second rename fails.
+  const fs::path backup = unused_sibling(target_, "previous");
+  if (::rename(target_.c_str(), backup.c_str()) != 0)
+    throw std::runtime_error(what + "cannot move the previous output aside: " + error_text(errno) + kept);
+  if (::rename(staging_.c_str(), target_.c_str()) != 0) {
+    const int e = errno;
+    if (::rename(backup.c_str(), target_.c_str()) != 0)
+      throw std::runtime_error(what + "cannot rename the results into place (" + error_text(e) +
+                               "); the previous output is in " + backup.string() + kept);
+    throw std::runtime_error(what + "cannot rename the results into place: " + error_text(e) + kept);
+  }
+  if (!remove_output(backup))
+    std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),
+                 backup.c_str());
+}
+
+}  // namespace feeddrive::output

@@ -1,0 +1,136 @@
+#include "feeddrive/output/gnuplot.hpp"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace feeddrive::output {
+namespace fs = std::filesystem;
+
+namespace {
+
+bool safe_ascii(unsigned char c) {
+  if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9')) return true;
+  static constexpr std::string_view kPunctuation = " _-.,:;+/()[]=#%*!?<>|~^&";
+  return kPunctuation.find(static_cast<char>(c)) != std::string_view::npos;
+}
+
+// Length of the well-formed UTF-8 sequence at s[i] encoding a character from U+00A0 up
+// (no overlong forms, no surrogates, at most U+10FFFF), or 0.
+std::size_t utf8_char(std::string_view s, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
+  const unsigned char c = b(0);
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+    if (c == 0xC2) lo = 0xA0;  // U+0080..U+009F are C1 control characters
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    if (c == 0xE0) lo = 0xA0;  // overlong
+    if (c == 0xED) hi = 0x9F;  // surrogates
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    if (c == 0xF0) lo = 0x90;  // overlong
+    if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  if (b(1) < lo || b(1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k)
+    if (b(k) < 0x80 || b(k) > 0xBF) return 0;
+  return n;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The last non-empty line of gnuplot's output, printable, for a one-line message.
+std::string last_message(const std::string& log) {
+  std::string last, line;
+  std::istringstream in(log);
+  while (std::getline(in, line)) {
+    bool blank = true;
+    for (char c : line) blank = blank && (c == ' ' || c == '\t' || c == '^' || c == '\r');
+    if (!blank) last = line;
+  }
+  for (char& c : last)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+  if (last.size() > 300) last = last.substr(0, 300) + "...";
+  return last;
+}
+
+}  // namespace
+
+std::string gnuplot_string(std::string_view text, std::size_t max_bytes) {
+  std::string out = "\"";
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    std::size_t n = 1;
+    std::string_view piece = "?";
+    if (safe_ascii(c)) {
+      piece = text.substr(i, 1);
+    } else if (const std::size_t u = utf8_char(text, i); u > 0) {
+      n = u;
+      piece = text.substr(i, u);
+    }
+    if (kept + piece.size() > max_bytes) {
+      out += "...";
+      break;
+    }
+    out += piece;
+    kept += piece.size();
+    i += n;
+  }
+  return out + "\"";
+}
+
+void run_gnuplot(const fs::path& dir, const std::string& script) {
+  const fs::path script_path = dir / "plots.gp", log_path = dir / "gnuplot.log";
+  {
+    std::ofstream gp(script_path, std::ios::binary);
+    gp << script;
+    if (!gp) throw std::runtime_error(script_path.string() + ": write failed");
+  }
+  // Everything the child needs, prepared before fork: it only makes system calls.
+  const std::string cwd = dir.string();
+  char arg0[] = "gnuplot", arg1[] = "plots.gp";
+  char* const argv[] = {arg0, arg1, nullptr};
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error(std::string("gnuplot: fork failed: ") + std::strerror(errno));
+  if (pid == 0) {
+    if (::chdir(cwd.c_str()) != 0) ::_exit(126);
+    const int log = ::open("gnuplot.log", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int null = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (log < 0 || null < 0 || ::dup2(null, 0) < 0 || ::dup2(log, 1) < 0 || ::dup2(log, 2) < 0) ::_exit(126);
+    ::execvp(arg0, argv);
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
+  }
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  if (code == 127) throw std::runtime_error("cannot run gnuplot (not installed? use --no-plots to skip the plots)");
+  if (code != 0) {
+    const std::string why = last_message(slurp(log_path));
+    throw std::runtime_error("gnuplot failed (exit " + std::to_string(code) + ")" + (why.empty() ? "" : ": " + why));
+  }
+  std::error_code ec;
+  fs::remove(log_path, ec);
+}
+
+}  // namespace feeddrive::output
