@@ -1,14 +1,18 @@
-// feeddrive-sim end to end: outputs, exit codes, and no half-written output folder.
+// feeddrive-sim end to end: outputs, exit codes, no half-written output folder, --out checked
+// before the run and never replacing a folder feeddrive did not write, names never run as code.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace {
 namespace fs = std::filesystem;
@@ -35,6 +39,17 @@ struct ProcResult {
 ProcResult run_sim(const std::string& args) {
   const fs::path err = scratch() / "sim_stderr.txt";
   const std::string cmd = kSim + " " + args + " --quiet 2> " + err.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+// Runs a shell command line in folder `cwd`, capturing stderr.
+ProcResult run(const std::string& command, const fs::path& cwd) {
+  const fs::path err = scratch() / "run_stderr.txt";
+  const std::string cmd = "cd " + cwd.string() + " && " + command + " 2> " + err.string();
   const int status = std::system(cmd.c_str());
   std::ifstream in(err);
   std::stringstream ss;
@@ -115,15 +130,52 @@ TEST(Cli, UnreadableScenarioAndMissingArguments) {
   EXPECT_EQ(run_sim("").code, 2);
 }
 
-TEST(Cli, ExistingOutputIsReplacedWhole) {
+// Quoted for the shell of std::system: any text is one word.
+std::string sh(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::vector<std::string> names(const fs::path& dir) {
+  std::vector<std::string> v;
+  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void expect_one_line_about_out(const ProcResult& r, const std::string& value) {
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  EXPECT_EQ(r.err.rfind("error: --out " + value, 0), 0u) << r.err;
+}
+
+TEST(Cli, EarlierOutputIsReplacedWholeAlsoWithATrailingSlash) {
   const fs::path scen = write_file("good2.yaml", kGood);
-  const fs::path out = scratch() / "cli_replace";
-  fs::create_directories(out);
-  std::ofstream(out / "stale.txt") << "old";
-  std::ofstream(out / "summary.json") << "{}";
+  const fs::path base = scratch() / "replace_base";
+  fs::remove_all(base);
+  fs::create_directories(base);
+  const fs::path out = base / "prev";
   ASSERT_EQ(run_sim(scen.string() + " --out " + out.string() + " --no-plots").code, 0);
+  EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
+  std::ofstream(out / "stale.txt") << "old";
+  std::ofstream(base / "neighbour.txt") << "mine";
+  // "prev/" is "prev": replaced in place (the old bug wrote the temporary folder inside it and
+  // then deleted both)
+  const ProcResult r = run_sim(scen.string() + " --out " + out.string() + "/ --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_FALSE(fs::exists(out / "stale.txt"));
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_EQ(names(base), (std::vector<std::string>{"neighbour.txt", "prev"})) << "no temporary folder left";
+  EXPECT_EQ(slurp(base / "neighbour.txt"), "mine");
 }
 
 TEST(Cli, RefusesToReplaceAnUnrelatedFolder) {
@@ -132,9 +184,101 @@ TEST(Cli, RefusesToReplaceAnUnrelatedFolder) {
   fs::create_directories(out);
   std::ofstream(out / "thesis.tex") << "keep me";
   const ProcResult r = run_sim(scen.string() + " --out " + out.string());
-  EXPECT_EQ(r.code, 2);
+  expect_one_line_about_out(r, out.string());
   EXPECT_NE(r.err.find("not a feeddrive output"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(out / "thesis.tex"));
+}
+
+TEST(Cli, AFakeSummaryDoesNotMakeAFolderAnOutput) {
+  const fs::path scen = write_file("good4.yaml", kGood);
+  const fs::path base = scratch() / "fake_base";
+  fs::remove_all(base);
+  const fs::path out = base / "results";
+  fs::create_directories(out);
+  std::ofstream(out / "thesis.tex") << "keep me";
+  std::ofstream(out / "summary.json") << "this is not JSON";
+  for (const std::string& value : {out.string(), out.string() + "/", out.string() + "//"}) {
+    const ProcResult r = run_sim(scen.string() + " --out " + value);
+    expect_one_line_about_out(r, value);
+    EXPECT_NE(r.err.find("not a feeddrive output"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(names(out), (std::vector<std::string>{"summary.json", "thesis.tex"}));
+  EXPECT_EQ(slurp(out / "thesis.tex"), "keep me");
+  EXPECT_EQ(slurp(out / "summary.json"), "this is not JSON");
+  EXPECT_EQ(names(base), std::vector<std::string>{"results"}) << "nothing created next to it";
+}
+
+// Every --out that cannot be written is refused with exit 2 and one line before the run: the
+// scenario here would run for hours.
+TEST(Cli, UnwritableOutRefusedBeforeAnyWork) {
+  std::string s = kGood;
+  s.replace(s.find("duration: 0.05"), 14, "duration: 1e4");
+  const fs::path scen = write_file("endless.yaml", s);
+  const fs::path base = scratch() / "unwritable";
+  fs::remove_all(base);
+  fs::create_directories(base);
+  std::ofstream(base / "file") << "a file";
+  const std::string long_name(300, 'n');
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"", "empty path"},
+      {"/", "names no folder"},
+      {".", "names no folder"},
+      {"..", "names no folder"},
+      {(base / "file").string(), "not a folder"},
+      {(base / "file" / "out").string(), "is not a folder"},
+      {(base / "file" / "a" / "b/").string(), "is not a folder"},
+      {(base / long_name).string(), "too long"},
+  };
+  for (const auto& [value, why] : cases) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ProcResult r = run_sim(scen.string() + " --out " + sh(value));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    expect_one_line_about_out(r, value.empty() ? "\"\"" : value.substr(0, 40));
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_LT(seconds, 30.0) << "refused before the run";
+  }
+  EXPECT_EQ(names(base), std::vector<std::string>{"file"});
+  EXPECT_EQ(slurp(base / "file"), "a file");
+  if (::geteuid() != 0) {  // root writes into read-only folders: permission bits cannot test it
+    fs::create_directories(base / "ro");
+    fs::permissions(base / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    const ProcResult r = run_sim(scen.string() + " --out " + (base / "ro" / "out").string());
+    fs::permissions(base / "ro", fs::perms::owner_all);
+    expect_one_line_about_out(r, (base / "ro" / "out").string());
+    EXPECT_NE(r.err.find("cannot write in"), std::string::npos) << r.err;
+  }
+}
+
+// A scenario name, a scenario file name or an --out value is never gnuplot or shell code: the
+// run succeeds, the title shows the sanitised name, and nothing else runs.
+TEST(Cli, NamesAreNeverRunAsCommands) {
+  const fs::path base = scratch() / "inject";
+  fs::remove_all(base);
+  fs::create_directories(base);
+  const fs::path mark = base / "MARK";
+  std::string named = kGood;
+  named.replace(named.find("name: cli-check"), 15,
+                "name: \"x'; system 'touch " + mark.string() + "'; print '`touch " + mark.string() + "`@x\"");
+  const fs::path scen1 = base / "named.yaml";
+  std::ofstream(scen1) << named;
+  std::string unnamed = kGood;
+  unnamed.erase(unnamed.find("name: cli-check"), 15);
+  const fs::path scen2 = base / "a'; system 'touch MARK'; print '.yaml";  // the name is the file's stem
+  std::ofstream(scen2) << unnamed;
+  const fs::path scen3 = base / "`touch MARK`.yaml";
+  std::ofstream(scen3) << unnamed;
+  int k = 0;
+  for (const fs::path& scen : {scen1, scen2, scen3}) {
+    const fs::path out = base / ("o'; touch MARK; echo '" + std::to_string(k++));
+    const ProcResult r = run(kSim + " " + sh(scen.string()) + " --out " + sh(out.string()) + " --quiet", base);
+    ASSERT_EQ(r.code, 0) << scen << ": " << r.err;
+    for (const char* f : {"position.png", "velocity_error.png", "control.png", "forces.png"})
+      EXPECT_TRUE(fs::exists(out / f)) << f;
+    EXPECT_FALSE(fs::exists(mark)) << scen;
+    EXPECT_FALSE(fs::exists(out / "MARK")) << scen;
+  }
+  EXPECT_NE(slurp(base / "o'; touch MARK; echo '1" / "plots.gp").find("title \"a?; system ?touch MARK?; print ?\""),
+            std::string::npos);
 }
 
 }  // namespace
