@@ -12,6 +12,9 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "feeddrive/sim/scenario.hpp"
 
@@ -312,13 +315,89 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   EXPECT_EQ(left, std::vector<std::string>{"thesis.tex"});
   EXPECT_EQ(slurp(precious / "thesis.tex"), "keep me");
 
-  // An earlier feeddrive-fit output (it has findings.json) is replaced whole.
+  // A folder with a fake findings.json (even valid JSON) is not an output: refused, untouched.
+  const fs::path fake = scratch() / "fake";
+  fs::create_directories(fake);
+  std::ofstream(fake / "findings.json") << "{}";
+  std::ofstream(fake / "notes.txt") << "mine";
+  const ProcResult fk = run_fit("--scenario " + model.string() + " --data " + data.string() + " --out " +
+                                fake.string() + "/ --position-column x_measured --no-plots -q");
+  EXPECT_EQ(fk.code, 2) << fk.err;
+  EXPECT_EQ(std::count(fk.err.begin(), fk.err.end(), '\n'), 1) << fk.err;
+  EXPECT_NE(fk.err.find("not a feeddrive output"), std::string::npos) << fk.err;
+  EXPECT_EQ(slurp(fake / "notes.txt"), "mine");
+  EXPECT_EQ(slurp(fake / "findings.json"), "{}");
+
+  // An earlier feeddrive-fit output (it has the marker) is replaced whole, also as "DIR/".
+  EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
   std::ofstream(out / "stale.txt") << "old";
   const ProcResult again = run_fit("--scenario " + model.string() + " --data " + data.string() + " --out " +
-                                   out.string() + " --position-column x_measured --no-plots -q --max-effects 1");
+                                   out.string() + "/ --position-column x_measured --no-plots -q --max-effects 1");
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_FALSE(fs::exists(out / "stale.txt"));
   EXPECT_TRUE(fs::exists(out / "findings.json"));
+  for (const auto& e : fs::directory_iterator(scratch()))
+    EXPECT_EQ(e.path().filename().string().find(".fit_out."), std::string::npos) << "left behind: " << e.path();
+}
+
+// Quoted for the shell of std::system: any text is one word.
+std::string sh(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// --out is checked first: every value that cannot be written is refused with exit 2 and one line
+// naming it, before the scenario or the data are read (the data file does not even exist).
+TEST(FitCli, UnwritableOutRefusedBeforeAnyWork) {
+  const fs::path base = scratch() / "unwritable";
+  fs::create_directories(base);
+  std::ofstream(base / "file") << "a file";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"", "empty path"},
+      {"/", "names no folder"},
+      {".", "names no folder"},
+      {(base / "file" / "out").string(), "is not a folder"},
+      {(base / std::string(300, 'n')).string(), "too long"},
+  };
+  for (const auto& [value, why] : cases) {
+    const ProcResult r = run_fit("--scenario " + model_scenario().string() + " --data " +
+                                 (scratch() / "not_there.csv").string() + " --out " + sh(value) + " -q");
+    EXPECT_EQ(r.code, 2) << value << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("error: --out " + (value.empty() ? std::string("\"\"") : value.substr(0, 40)), 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("not_there.csv"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(slurp(base / "file"), "a file");
+}
+
+// File names, column names and --out values are never gnuplot or shell code: a fit with plots
+// on data, a model and an output folder named to run a command succeeds and runs nothing.
+TEST(FitCli, NamesAreNeverRunAsCommands) {
+  const fs::path base = scratch() / "inject";
+  fs::create_directories(base);
+  const fs::path mark = base / "MARK";
+  const fs::path model = base / "m'; system 'touch MARK'; print '.yaml";
+  std::ofstream(model) << short_scenario("");
+  // the data with its position column renamed
+  std::string data = slurp(simulated_data());
+  const auto at = data.find("x_measured");
+  ASSERT_NE(at, std::string::npos);
+  data.replace(at, 10, "pos'; system 'touch MARK'; print '");
+  const fs::path data_file = base / "d'; system 'touch MARK'; print '.csv";
+  std::ofstream(data_file) << data;
+  const fs::path out = base / "o'; touch MARK; echo '";
+  // in base, where a relative "touch MARK" would land
+  const std::string args = "--scenario " + sh(model.string()) + " --data " + sh(data_file.string()) + " --out " +
+                           sh(out.string()) + " --position-column " + sh("pos'; system 'touch MARK'; print '") +
+                           " --max-effects 1 -q";
+  const ProcResult r = run("sh", "-c " + sh("cd " + sh(base.string()) + " && exec " + kFit + " " + args));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  for (const char* f : {"findings.json", "report.md", "replay.png", "gap.png", "plots.gp"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_FALSE(fs::exists(mark));
+  EXPECT_FALSE(fs::exists(out / "MARK"));
+  EXPECT_FALSE(fs::exists(fs::path(FEEDDRIVE_BINARY_DIR) / "MARK"));
 }
 
 }  // namespace
