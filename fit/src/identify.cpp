@@ -405,7 +405,7 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
   if (starts.size() > 4 || !best.converged) {
     best.rss = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < first.size() && i < 2; ++i) {
-      const Solved s2 = solve(rec, model, blocks, first[i].theta, ctx, 100);
+      const Solved s2 = solve(rec, model, blocks, first[i].theta, ctx, 50);
       if (s2.rss < best.rss) best = s2;
     }
   }

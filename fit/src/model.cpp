@@ -103,7 +103,7 @@ bool same(const plant::GrindingParams& a, const plant::GrindingParams& b) {
 // state at the samples. Friction and grinding depend on v through fast internal states (and,
 // for the static model, on sgn v), so they are averaged over S sub-steps with v^ and x^
 // interpolated by the parabola through the interval's ends and midpoint; 32 sub-steps where
-// v^ is small or changes sign (a reversal inside the interval), 4 elsewhere.
+// v^ changes sign (a reversal inside the interval), 8 where it is small, 4 elsewhere.
 void internal_force(const Record& r, const plant::PlantParams& pe, int part, Eigen::VectorXd& force,
                     std::vector<double>& state) {
   const Motion& m = r.motion;
@@ -122,8 +122,9 @@ void internal_force(const Record& r, const plant::PlantParams& pe, int part, Eig
     const double x = m.x_mid[j], v = m.v_mid[j], h = m.dt[j];
     const double v0 = m.v[j], v1 = m.v[j + 1];
     const double x0 = m.x[j], x1 = m.x[j + 1];
-    const bool slow = (v0 > 0) != (v1 > 0) || std::min(std::abs(v0), std::abs(v1)) < slow_velocity;
-    const int S = slow ? 32 : 4;
+    const bool reversal = (v0 > 0) != (v1 > 0);
+    const bool slow = std::min(std::abs(v0), std::abs(v1)) < slow_velocity;
+    const int S = reversal ? 32 : slow ? 8 : 4;
     const double hs = h / S;
     double fsum = 0.0;
     for (int q = 0; q < S; ++q) {

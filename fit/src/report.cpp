@@ -97,7 +97,7 @@ std::string findings_json(const FitResult& r) {
     for (const CandidateFit& c : st.ranking)
       rk.push_back({{"name", c.effect.name}, {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
                     {"parameters", params_json(c.effect)}, {"k", c.parameters}, {"rss_N2", c.rss},
-                    {"passed_over", c.passed_over}});
+                    {"passed_over", c.passed_over}, {"fit_seconds", c.seconds}});
     steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk}, {"removed", st.removed},
                      {"cross_validation", {{"held_out_sq_residual_without_N2", st.cv_without},
                                            {"held_out_sq_residual_with_N2", st.cv_with}}},

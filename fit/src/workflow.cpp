@@ -1,9 +1,11 @@
 #include "feeddrive/fit/workflow.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numeric>
 
 namespace feeddrive::fit {
@@ -66,10 +68,18 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   out.initial = model;
   out.envelope = envelope(rec, model);
   out.smoothing_initial = model.friction.static_smoothing_velocity;
-  FreeSet free{{}, opt.fit_form};
+  // The effects added so far. The model-form parameter eps is refitted with them at the start and
+  // after every addition (recalibrate), and held in the many candidate, cross-validation and
+  // backward fits between: with a static friction model every change of eps recomputes the
+  // friction along the whole record.
+  FreeSet free{{}, false};
   plant::PlantParams current = model;
+  const auto recalibrate = [&](const plant::PlantParams& p) {
+    if (!opt.fit_form || !has_coulomb_term(p)) return p;
+    return fit_jointly(rec, p, FreeSet{free.effects, true}).params;
+  };
   // 0. Model form: a static friction's transition velocity is fitted before anything is added.
-  if (free.form && has_coulomb_term(current)) current = fit_jointly(rec, current, free).params;
+  current = recalibrate(current);
   Eigen::VectorXd r = force_residual(rec, current);
   double cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
   Replay rp = replay(rec, current, opt.replay_window);
@@ -95,17 +105,19 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         st.ranking.push_back(c);
         continue;
       }
+      const auto t0 = std::chrono::steady_clock::now();
       const CandidateFit single = fit_candidate(rec, current, name, r);
       plant::PlantParams trial = current;
       plant::set_effect(trial.effects, single.effect);
       FreeSet fs = free;
       fs.effects.push_back(name);
-      JointFit jf = fit_jointly(rec, trial, fs);
+      // the single fit is a good start: the joint fit converges in a few tens of iterations
+      JointFit jf = fit_jointly(rec, trial, fs, nullptr, 40);
       const Effect canon = canonical(effect_of(jf.params, name));
       if (canon.parameters != effect_of(jf.params, name).parameters) {
         plant::PlantParams p = jf.params;
         plant::set_effect(p.effects, canon);
-        const JointFit jc = fit_jointly(rec, p, fs);
+        const JointFit jc = fit_jointly(rec, p, fs, nullptr, 40);
         // the canonical form has two parameters fewer in effect; keep it unless the BIC says otherwise
         if (bic_of(jc.rss, fs.parameters(jc.params) - 2, n) <= bic_of(jf.rss, fs.parameters(jf.params), n)) jf = jc;
       }
@@ -127,6 +139,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         const std::string why = implausible(out.envelope, jf.params, e);
         if (!why.empty()) c.passed_over = e.name == name ? why : "refitted with it, " + e.name + " becomes implausible: " + why;
       }
+      c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       st.ranking.push_back(c);
     }
     std::stable_sort(st.ranking.begin(), st.ranking.end(),
@@ -154,13 +167,42 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     FreeSet chosen_free;
     Replay rp2;
     std::string why_not;
+    // Close calls: BIC scores within kCloseCall of the best eligible one are decided out of
+    // sample, by the lower held-out squared residual (e.g. a reluctance ripple against a mass
+    // error, both proportional to the thrust while it accelerates).
+    constexpr double kCloseCall = 50.0;
+    std::map<std::string, std::vector<double>> cv_cache;
+    const auto cv_of = [&](const CandidateFit& c) -> const std::vector<double>& {
+      auto it = cv_cache.find(c.effect.name);
+      if (it != cv_cache.end()) return it->second;
+      FreeSet fs = free;
+      fs.effects.push_back(c.effect.name);
+      return cv_cache[c.effect.name] = cross_validate(rec, c.joint, fs, opt.cv_folds);
+    };
+    {
+      std::vector<std::size_t> close;
+      for (std::size_t i = 0; i < st.ranking.size(); ++i) {
+        const CandidateFit& c = st.ranking[i];
+        if (!c.passed_over.empty() || !(c.score >= opt.score_threshold)) continue;
+        if (!close.empty() && c.score < st.ranking[close.front()].score - kCloseCall) break;
+        if (close.size() < 3) close.push_back(i);
+      }
+      if (close.size() > 1) {
+        std::vector<CandidateFit> picked;
+        for (std::size_t i : close) picked.push_back(st.ranking[i]);
+        std::stable_sort(picked.begin(), picked.end(), [&](const CandidateFit& a, const CandidateFit& b) {
+          return total(cv_of(a)) < total(cv_of(b));
+        });
+        for (std::size_t k = 0; k < close.size(); ++k) st.ranking[close[k]] = picked[k];
+      }
+    }
     for (CandidateFit& c : st.ranking) {
       if (!c.passed_over.empty()) continue;
-      if (!(c.score >= opt.score_threshold)) break;
+      if (!(c.score >= opt.score_threshold)) continue;
       FreeSet fs = free;
       fs.effects.push_back(c.effect.name);
       if (cv_without.empty()) cv_without = cross_validate(rec, current, free, opt.cv_folds);
-      const std::vector<double> cv_with = cross_validate(rec, c.joint, fs, opt.cv_folds);
+      const std::vector<double> cv_with = cv_of(c);
       const CvVerdict v = cv_verdict(cv_without, cv_with);
       if (!v.confirmed) {
         c.passed_over = fmt("not confirmed out of sample: held-out squared residual %.4g -> %.4g N^2 "
@@ -207,13 +249,15 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     st.effect = chosen->effect;
     st.score = chosen->score;
     const std::string name = chosen->effect.name;
-    current = chosen->joint;
     free = chosen_free;
+    current = recalibrate(chosen->joint);
     added.push_back(name);
     ++additions;
     r = force_residual(rec, current);
     cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
-    rp = rp2;
+    rp = current.friction.static_smoothing_velocity == chosen->joint.friction.static_smoothing_velocity
+             ? rp2
+             : replay(rec, current, opt.replay_window);
     st.verdict = "added " + name + fmt(" (score %.4g): gap %.4g -> %.4g um", st.score, st.gap_before * 1e6, rp.gap * 1e6);
     if (!why_not.empty()) st.verdict += " (passed over: " + why_not + ")";
     say(st.verdict);

@@ -32,6 +32,7 @@ struct CandidateFit {
   bool converged{false};
   std::string passed_over;  ///< empty if eligible; else why not (prerequisite, implausible values, ...)
   plant::PlantParams joint; ///< the model plus the candidate, every free parameter jointly refitted
+  double seconds{0.0};      ///< wall time of its fits
 };
 
 /// BIC of a residual vector with k parameters over n_active points (0: all of r).

@@ -1,0 +1,450 @@
+#include "drivegen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace fdgen {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Rng {
+  std::mt19937_64 g;
+  double u(double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
+  bool coin(double p) { return u(0.0, 1.0) < p; }
+  double sign() { return coin(0.5) ? 1.0 : -1.0; }
+};
+
+// ---- the reference: piecewise segments, each gives x, v, a at a time inside it ----------------
+struct Segment {
+  double t0, t1;
+  std::function<void(double, double&, double&, double&)> eval;  // time since t0 -> x, v, a
+};
+
+// Trapezoidal (or triangular) move of signed distance d from x0 with speed vm and acceleration am.
+Segment move(double t0, double x0, double d, double vm, double am) {
+  const double D = std::abs(d), s = d < 0 ? -1.0 : 1.0;
+  double ta = vm / am;
+  if (am * ta * ta > D) {  // triangle
+    ta = std::sqrt(D / am);
+    vm = am * ta;
+  }
+  const double tc = (D - am * ta * ta) / vm;
+  const double T = 2 * ta + tc;
+  return {t0, t0 + T, [=](double t, double& x, double& v, double& a) {
+            double p, q, r;
+            if (t < ta) {
+              p = 0.5 * am * t * t, q = am * t, r = am;
+            } else if (t < ta + tc) {
+              p = 0.5 * am * ta * ta + vm * (t - ta), q = vm, r = 0;
+            } else if (t < T) {
+              const double u = T - t;
+              p = D - 0.5 * am * u * u, q = am * u, r = -am;
+            } else {
+              p = D, q = 0, r = 0;
+            }
+            x = x0 + s * p, v = s * q, a = s * r;
+          }};
+}
+
+Segment dwell(double t0, double x0, double T) {
+  return {t0, t0 + T, [=](double, double& x, double& v, double& a) { x = x0, v = 0, a = 0; }};
+}
+
+// x0 + A (1 - cos(2 pi f t)) / 2 over whole periods: starts and ends at rest.
+Segment cosine(double t0, double x0, double A, double f, int periods) {
+  const double w = 2 * kPi * f;
+  return {t0, t0 + periods / f, [=](double t, double& x, double& v, double& a) {
+            x = x0 + 0.5 * A * (1 - std::cos(w * t)), v = 0.5 * A * w * std::sin(w * t), a = 0.5 * A * w * w * std::cos(w * t);
+          }};
+}
+
+struct Reference {
+  std::vector<Segment> seg;
+  void at(double t, double& x, double& v, double& a) const {
+    auto it = std::upper_bound(seg.begin(), seg.end(), t, [](double tt, const Segment& s) { return tt < s.t1; });
+    if (it == seg.end()) it = seg.end() - 1;
+    it->eval(std::clamp(t - it->t0, 0.0, it->t1 - it->t0), x, v, a);
+  }
+};
+
+Reference make_reference(Rng& r, double duration, double travel) {
+  Reference ref;
+  double t = 0.0, x = 0.0;
+  const auto end_of = [](const Segment& s) {
+    double xe, ve, ae;
+    s.eval(s.t1 - s.t0, xe, ve, ae);
+    return xe;
+  };
+  const auto push = [&](Segment s) {
+    x = end_of(s);
+    t = s.t1;
+    ref.seg.push_back(std::move(s));
+  };
+  push(dwell(0.0, 0.0, r.u(0.1, 0.3)));
+  bool long_move = true;
+  while (t < duration) {
+    if (long_move) {  // across most of the travel: ripples, springs and contacts are passed over
+      const double target = x < 0.5 * travel ? r.u(0.8, 1.0) * travel : r.u(0.0, 0.2) * travel;
+      push(move(t, x, target - x, r.u(0.02, 0.2), r.u(0.5, 5.0)));
+    } else {
+      const double k = r.u(0.0, 1.0);
+      if (k < 0.3) {
+        push(dwell(t, x, r.u(0.1, 0.8)));
+      } else if (k < 0.55) {  // back-and-forth reversals
+        const double d = r.u(0.5e-3, 5e-3) * (x > 0.5 * travel ? -1 : 1);
+        const int n = 2 + static_cast<int>(r.u(0, 3));
+        for (int i = 0; i < n; ++i) push(move(t, x, (i % 2 ? -d : d), r.u(0.01, 0.08), r.u(0.5, 3.0)));
+      } else if (k < 0.8) {  // creeping: 0.05-0.5 mm/s over 0.1-1 mm, reaching speed in 10 ms
+        const double vc = r.u(0.05e-3, 0.5e-3), d = std::min(r.u(0.1e-3, 1e-3), vc * 2.0);
+        push(move(t, x, d * (x > 0.5 * travel ? -1 : 1), vc, vc / 0.01));
+      } else {
+        const double A = r.u(2e-3, 20e-3) * (x > 0.5 * travel ? -1 : 1);
+        push(cosine(t, x, A, r.u(0.5, 3.0), 1 + static_cast<int>(r.u(0, 2))));
+      }
+    }
+    long_move = !long_move;
+  }
+  return ref;
+}
+
+// ---- the drive ---------------------------------------------------------------------------------
+struct Truth {
+  double m{80.0};
+  // base friction (known to the model), truth form
+  bool base_static{false};
+  double Fc{0}, Fs{0}, vs{1e-3}, s2{0};
+  // form deviations
+  double vt{1e-5}, asym{0.0}, delta{2.0};
+  // hidden effects
+  double F0{0};                                        // constant
+  double hc{0};                                        // coulomb
+  double hv{0};                                        // viscous
+  bool strib{false};
+  double sFs{0}, sFc{0}, svs{1e-3};                    // stribeck
+  bool pres{false};
+  double sig0{0}, sig1{0};                             // presliding
+  double cp{0}, ca{0}, cphi{0}, cb{0}, cphi3{0};       // cogging
+  double rp{0}, rA{0}, rphi{0};                        // reluctance
+  bool grind{false};
+  double C{0}, ke{0}, xc{0};                           // grinding
+  double k{0}, xr{0};                                  // spring
+  double delay{0};                                     // input delay
+};
+
+double sgn_t(const Truth& T, double v) { return v / std::sqrt(v * v + T.vt * T.vt); }
+double asym(const Truth& T, double v) { return 1.0 + (v > 0 ? T.asym : v < 0 ? -T.asym : 0.0); }
+double stribeck_level(double Fc, double Fs, double vs, double delta, double v) {
+  return Fc + (Fs - Fc) * std::exp(-std::pow(std::abs(v / vs), delta));
+}
+
+// State y = {x, v, z, fg}; derivative under acting thrust F.
+struct Deriv {
+  double dx, dv, dz, dfg;
+};
+Deriv derivative(const Truth& T, const double y[4], double F) {
+  const double x = y[0], v = y[1], z = y[2], fg = y[3];
+  double friction = 0.0, dz = 0.0;
+  if (T.pres) {  // LuGre-type bristles on the base friction levels
+    const double g = stribeck_level(T.Fc, T.Fs, T.vs, T.delta, v) * asym(T, v);
+    dz = v - T.sig0 * std::abs(v) * z / g;
+    friction = T.sig0 * z + T.sig1 * dz + T.s2 * v;
+  } else if (T.base_static) {
+    friction = stribeck_level(T.Fc, T.Fs, T.vs, T.delta, v) * sgn_t(T, v) * asym(T, v) + T.s2 * v;
+  }
+  double hidden = T.F0 + T.hc * sgn_t(T, v) * asym(T, v) + T.hv * v + T.k * (x - T.xr);
+  if (T.strib) hidden += stribeck_level(T.sFc, T.sFs, T.svs, T.delta, v) * sgn_t(T, v) * asym(T, v);
+  if (T.cp > 0) hidden += T.ca * std::sin(2 * kPi * x / T.cp + T.cphi) + T.cb * std::sin(6 * kPi * x / T.cp + T.cphi3);
+  if (T.rp > 0) hidden += F * T.rA * std::sin(2 * kPi * x / T.rp + T.rphi);
+  double dfg = 0.0;
+  if (T.grind) {
+    const bool contact = x > T.xc;
+    dfg = (contact ? T.ke * v : 0.0) - (T.ke / T.C) * fg;
+    if (contact) hidden += fg;
+  }
+  return {v, (F - friction - hidden) / T.m, dz, dfg};
+}
+
+// Fastest decay rate of the internal states (for the RK4 step size).
+// Bristles: dz/dt decays at sigma0 |v| / g(v) (g >= 0.9 Fc here), and the bristle spring and
+// damper act on the mass at sigma1/m. A Coulomb-type term L v/sqrt(v^2 + vt^2) has the slope L/vt
+// at v = 0, a decay rate L/(vt m) of the velocity. Grinding: ke/C.
+double stiffness(const Truth& T, double v) {
+  double r = 0.0;
+  if (T.pres) r = std::max({r, T.sig0 * std::max(std::abs(v), 1e-3) / (0.9 * T.Fc), T.sig1 / T.m});
+  const double coulomb = (T.base_static && !T.pres ? T.Fs : 0.0) + T.hc + (T.strib ? T.sFs : 0.0);
+  if (coulomb > 0) r = std::max(r, 1.03 * coulomb / (T.vt * T.m));
+  if (T.grind) r = std::max(r, T.ke / T.C);
+  return r;
+}
+
+void rk4(const Truth& T, double y[4], double F, double h) {
+  double k[4][4], tmp[4];
+  const auto d = [&](const double* s, double* out) {
+    const Deriv q = derivative(T, s, F);
+    out[0] = q.dx, out[1] = q.dv, out[2] = q.dz, out[3] = q.dfg;
+  };
+  d(y, k[0]);
+  for (int i = 0; i < 4; ++i) tmp[i] = y[i] + 0.5 * h * k[0][i];
+  d(tmp, k[1]);
+  for (int i = 0; i < 4; ++i) tmp[i] = y[i] + 0.5 * h * k[1][i];
+  d(tmp, k[2]);
+  for (int i = 0; i < 4; ++i) tmp[i] = y[i] + h * k[2][i];
+  d(tmp, k[3]);
+  for (int i = 0; i < 4; ++i) y[i] += h / 6.0 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
+}
+
+// Integrates over [t0, t1] with the thrust held at F: at least `min_sub` RK4 steps, more where
+// the internal states are stiff (h * rate <= 1).
+void advance(const Truth& T, double y[4], double F, double t0, double t1, int min_sub) {
+  const double H = t1 - t0;
+  if (!(H > 0)) return;
+  const int n = std::min(20000, std::max(min_sub, static_cast<int>(std::ceil(H * stiffness(T, y[1]) / 1.0))));
+  for (int i = 0; i < n; ++i) rk4(T, y, F, H / n);
+}
+
+std::string num(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+}  // namespace
+
+const std::vector<std::string>& vocabulary() {
+  static const std::vector<std::string> v{"constant_force", "coulomb_friction", "viscous_friction", "stribeck_friction",
+                                          "presliding",     "cogging_ripple",   "reluctance_ripple", "grinding_force",
+                                          "spring_force",   "mass_error",       "input_delay"};
+  return v;
+}
+
+std::string Generated::csv() const {
+  std::string out = "t,x,force_N,xd\n";
+  char b[128];
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    std::snprintf(b, sizeof b, "%.17g,%.17g,%.17g,%.17g\n", t[k], x[k], force_N[k], xd[k]);
+    out += b;
+  }
+  return out;
+}
+
+Generated generate(const CaseSpec& spec) {
+  for (const auto& h : spec.hidden)
+    if (std::find(vocabulary().begin(), vocabulary().end(), h) == vocabulary().end())
+      throw std::invalid_argument("drivegen: unknown effect '" + h + "'");
+  const auto hidden = [&](const char* n) { return std::find(spec.hidden.begin(), spec.hidden.end(), n) != spec.hidden.end(); };
+  Rng r{std::mt19937_64(spec.seed * 0x9E3779B97F4A7C15ULL + 12345)};
+  Generated out;
+  Truth T;
+  const double m_nom = r.u(40.0, 120.0);
+  T.m = m_nom;
+  // position-dependent effects need travel: at least three ripple pitches, a contact passed often
+  const bool positional = hidden("cogging_ripple") || hidden("reluctance_ripple") || hidden("spring_force") ||
+                          hidden("grinding_force");
+  const double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
+  const double Ts = 1.0 / spec.sample_rate;
+  T.base_static = hidden("presliding") || r.coin(0.5);
+  if (T.base_static) {
+    T.Fc = r.u(10, 30), T.Fs = T.Fc * r.u(1.1, 1.5), T.vs = r.u(1e-3, 5e-3), T.s2 = r.u(20, 150);
+  }
+  if (spec.form_deviation) {
+    T.vt = r.u(20e-6, 300e-6), T.asym = r.u(-0.02, 0.02), T.delta = 2.0 + r.u(-0.3, 0.3);
+  } else {
+    r.u(0, 1), r.u(0, 1), r.u(0, 1);  // the same draws follow either way
+  }
+  const bool grinding = spec.grinding_process || hidden("grinding_force");
+  const double v_typ = 0.05;  // m/s, a typical move speed of the reference below
+  // hidden effects, in the vocabulary's parametrisation
+  if (hidden("constant_force")) {
+    T.F0 = r.sign() * r.u(3, 20);
+    out.truth.push_back({"constant_force", {{"force_N", T.F0}}});
+  }
+  if (hidden("coulomb_friction")) {
+    T.hc = r.u(5, 30);
+    out.truth.push_back({"coulomb_friction", {{"coulomb_N", T.hc}}});
+  }
+  if (hidden("viscous_friction")) {
+    T.hv = r.u(50, 300);
+    out.truth.push_back({"viscous_friction", {{"viscous_Ns_per_m", T.hv}}});
+  }
+  if (hidden("stribeck_friction")) {
+    T.strib = true;
+    T.sFc = r.u(5, 20), T.sFs = T.sFc + r.u(5, 20), T.svs = r.u(1e-3, 10e-3);
+    out.truth.push_back({"stribeck_friction", {{"static_N", T.sFs}, {"coulomb_N", T.sFc}, {"stribeck_velocity_mps", T.svs}}});
+  }
+  if (hidden("presliding")) {
+    T.pres = true;
+    T.sig0 = std::exp(r.u(std::log(1e5), std::log(1e7)));
+    T.sig1 = 2 * r.u(0.05, 0.5) * std::sqrt(T.sig0 * T.m);
+    out.truth.push_back({"presliding", {{"bristle_stiffness_N_per_m", T.sig0}, {"bristle_damping_Ns_per_m", T.sig1}}});
+  }
+  if (hidden("cogging_ripple")) {
+    T.cp = r.u(0.01, std::min(0.04, travel / 3)), T.ca = r.u(2, 10), T.cphi = r.u(-kPi, kPi);
+    T.cb = T.ca * r.u(0, 0.4), T.cphi3 = r.u(-kPi, kPi);
+    out.truth.push_back({"cogging_ripple", {{"pitch_m", T.cp}, {"amplitude_N", T.ca}, {"phase_rad", T.cphi},
+                                            {"third_harmonic_N", T.cb}, {"third_phase_rad", T.cphi3}}});
+  }
+  if (hidden("reluctance_ripple")) {
+    T.rp = r.u(0.01, std::min(0.04, travel / 3)), T.rA = r.u(0.03, 0.08), T.rphi = r.u(-kPi, kPi);
+    out.truth.push_back({"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
+  }
+  if (hidden("grinding_force")) {
+    T.grind = true;
+    T.xc = r.u(0.2, 0.8) * travel;
+    T.C = r.u(20, 100) / v_typ;
+    T.ke = T.C / r.u(2e-3, 50e-3);
+    out.truth.push_back({"grinding_force", {{"gain_Ns_per_m", T.C}, {"stiffness_N_per_m", T.ke}, {"contact_position_m", T.xc}}});
+  }
+  if (hidden("spring_force")) {
+    T.k = r.u(200, 2000), T.xr = r.u(0.0, 1.0) * travel;
+    out.truth.push_back({"spring_force", {{"stiffness_N_per_m", T.k}, {"rest_position_m", T.xr}}});
+  }
+  if (hidden("mass_error")) {
+    T.m = m_nom * (1.0 + r.sign() * r.u(0.1, 0.3));
+    out.truth.push_back({"mass_error", {{"mass_kg", T.m}}});
+  }
+  if (hidden("input_delay")) {
+    T.delay = r.u(0.5e-3, 3e-3);
+    out.truth.push_back({"input_delay", {{"delay_s", T.delay}}});
+  }
+  // controller and sensor
+  const bool pid = r.coin(0.5);
+  const bool ff = r.coin(0.5);
+  const int cmd_delay = r.coin(0.3) ? 1 : 0;
+  // Bandwidths a 1 kHz loop with a differenced velocity holds without a limit cycle: the PID's
+  // triple pole at 15-40 Hz; the cascade's velocity loop at 30-60 Hz (with the one-sample
+  // delay: 0.4 and 0.6 of these), its position loop at a quarter of that.
+  const double bw = (pid ? r.u(15, 40) : r.u(30, 60) / 4.0) * (cmd_delay ? (pid ? 0.4 : 0.6) : 1.0), w = 2 * kPi * bw;
+  const double wv = 4 * w, wp = w;
+  const double q = r.u(50e-9, 200e-9), noise = r.u(0.0, 20e-9);
+  const double jitter = 0.02 * Ts;
+  const Reference ref = make_reference(r, spec.duration, travel);
+  // closed loop
+  const long N = static_cast<long>(std::lround(spec.duration * spec.sample_rate)) + 1;
+  std::vector<double> t_true(static_cast<std::size_t>(N));
+  for (long k = 0; k < N; ++k) t_true[k] = k * Ts + (k > 0 && k + 1 < N ? r.u(-jitter, jitter) : 0.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  double y[4] = {0.0, 0.0, 0.0, 0.0};
+  double integ = 0.0, e_prev = 0.0, d_filt = 0.0, x_prev = 0.0, v_filt = 0.0;
+  double pending = 0.0;                          // computed, waiting one sample
+  std::vector<double> applied(static_cast<std::size_t>(N), 0.0);
+  const double F_max = 1500.0;
+  const double tf = 1.0 / (5.0 * w);             // derivative / velocity filter time constant
+  for (long k = 0; k < N; ++k) {
+    const double tk = t_true[k];
+    const double dt = k > 0 ? tk - t_true[k - 1] : Ts;
+    double xd, vd, ad;
+    ref.at(tk, xd, vd, ad);
+    const double xm = q * std::round((y[0] + noise * gauss(r.g)) / q);
+    const double e = xd - xm;
+    double F;
+    if (pid) {  // triple pole at -w: Kp = 3 m w^2, Ki = m w^3, Kd = 3 m w
+      const double de = k > 0 ? (e - e_prev) / dt : 0.0;
+      d_filt += (de - d_filt) * dt / (tf + dt);
+      F = m_nom * (3 * w * w * e + 3 * w * d_filt + w * w * w * integ) + (ff ? m_nom * ad : 0.0);
+      const double Fs = std::clamp(F, -F_max, F_max);
+      if (Fs == F || (F > F_max) != (e > 0)) integ += e * dt;  // anti-windup: no integration into saturation
+      F = Fs;
+    } else {  // PI velocity loop at wv (integral corner wv/4) around a P position loop at wv/4
+      const double vm = k > 0 ? (xm - x_prev) / dt : 0.0;
+      v_filt += (vm - v_filt) * dt / (tf + dt);
+      const double ev = wp * e + vd - v_filt;
+      F = m_nom * wv * (ev + 0.25 * wv * integ) + (ff ? m_nom * ad : 0.0);
+      const double Fs = std::clamp(F, -F_max, F_max);
+      if (Fs == F || (F > F_max) != (ev > 0)) integ += ev * dt;
+      F = Fs;
+    }
+    e_prev = e;
+    x_prev = xm;
+    double act = F;
+    if (cmd_delay) {
+      act = pending;
+      pending = F;
+    }
+    applied[k] = act;
+    out.t.push_back(tk + (k > 0 && k + 1 < N ? r.u(-1e-6, 1e-6) : 0.0));
+    out.x.push_back(xm);
+    out.force_N.push_back(act);
+    out.xd.push_back(xd);
+    if (k + 1 == N) break;
+    // integrate to the next sample: the thrust acting at t is the one applied at t - delay
+    const double t1 = t_true[k + 1];
+    std::vector<double> cuts{tk};
+    for (long j = std::max(0L, k - 10); j <= k + 1; ++j) {
+      const double s = t_true[j] + T.delay;
+      if (T.delay > 0 && s > tk && s < t1) cuts.push_back(s);
+    }
+    cuts.push_back(t1);
+    std::sort(cuts.begin(), cuts.end());
+    for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+      const double mid = 0.5 * (cuts[c] + cuts[c + 1]) - T.delay;
+      double Fa = 0.0;
+      if (mid >= 0.0) {
+        const long j = std::upper_bound(t_true.begin(), t_true.begin() + k + 1, mid) - t_true.begin() - 1;
+        Fa = applied[static_cast<std::size_t>(std::max(0L, j))];
+      }
+      advance(T, y, Fa, cuts[c], cuts[c + 1], 10);
+    }
+    if (!std::isfinite(y[0]) || !std::isfinite(y[1])) throw std::runtime_error("drivegen: the simulation diverged");
+  }
+  // the model the fit starts from
+  std::ostringstream yaml;
+  yaml << "name: drivegen_" << spec.seed << "\nduration: " << num(spec.duration) << "\ncontrol_period: " << num(Ts)
+       << "\nplant:\n  mass: " << num(m_nom) << "\n";
+  if (T.base_static)
+    yaml << "  friction: {model: static, static_force: " << num(T.Fs) << ", coulomb_force: " << num(T.Fc)
+         << ", stribeck_velocity: " << num(T.vs) << ", stribeck_exponent: 2, viscous: " << num(T.s2) << "}\n";
+  else
+    yaml << "  friction: {model: none}\n";
+  if (grinding) yaml << "  grinding: {enabled: false}\n";
+  yaml << "controller: {type: cascade}\nreference: {type: step}\n";
+  out.scenario_yaml = yaml.str();
+  long saturated = 0;
+  for (double f : out.force_N) saturated += std::abs(f) >= F_max ? 1 : 0;
+  out.knobs = {{"saturated_fraction", static_cast<double>(saturated) / static_cast<double>(N)},
+               {"mass_nominal_kg", m_nom},    {"travel_m", travel},          {"controller", pid ? 0.0 : 1.0},
+               {"bandwidth_hz", bw},          {"feedforward", ff ? 1.0 : 0.0}, {"command_delay_samples", cmd_delay},
+               {"quantization_m", q},         {"noise_m", noise},            {"jitter_s", jitter},
+               {"coulomb_transition_mps", T.vt}, {"asymmetry", T.asym},      {"stribeck_exponent", T.delta},
+               {"base_static_friction", T.base_static ? 1.0 : 0.0}};
+  char b[512];
+  std::snprintf(b, sizeof b,
+                "m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm, %s friction, vt=%.0f um/s, asym %.3f, %.1f %% saturated",
+                m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "", cmd_delay ? " +1-sample delay" : "", q * 1e9,
+                travel * 1e3, T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
+                100.0 * static_cast<double>(saturated) / static_cast<double>(N));
+  out.description = b;
+  return out;
+}
+
+std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed) {
+  Rng r{std::mt19937_64(seed * 7919 + 1)};
+  std::vector<CaseSpec> out;
+  const auto& v = vocabulary();
+  const int free_n = std::max(1, static_cast<int>(std::lround(0.12 * n)));
+  const int per = std::max(1, n / 20);
+  for (int i = 0; i < free_n; ++i) out.push_back({});
+  for (int k = 0; k < per; ++k)
+    for (const auto& e : v) out.push_back({0, {e}});
+  while (static_cast<int>(out.size()) < n) {
+    const std::string a = v[static_cast<std::size_t>(r.u(0, v.size()))], b = v[static_cast<std::size_t>(r.u(0, v.size()))];
+    if (a == b) continue;
+    const std::set<std::string> p{a, b};
+    if (p.count("coulomb_friction") && p.count("stribeck_friction")) continue;
+    out.push_back({0, {a, b}});
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i].seed = seed * 1000003ULL + i;
+    const auto& h = out[i].hidden;
+    out[i].grinding_process = std::find(h.begin(), h.end(), "grinding_force") != h.end();
+  }
+  return out;
+}
+
+}  // namespace fdgen
