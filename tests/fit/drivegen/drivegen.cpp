@@ -423,6 +423,15 @@ Generated generate(const CaseSpec& spec) {
   return out;
 }
 
+std::pair<double, double> integrate_mass(double m, double F, double c, double v0, double duration, int steps) {
+  Truth T;
+  T.m = m;
+  T.hv = c;
+  double y[4] = {0.0, v0, 0.0, 0.0};
+  for (int i = 0; i < steps; ++i) rk4(T, y, F, duration / steps);
+  return {y[0], y[1]};
+}
+
 std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed) {
   Rng r{std::mt19937_64(seed * 7919 + 1)};
   std::vector<CaseSpec> out;

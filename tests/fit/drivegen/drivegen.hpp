@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fdgen {
@@ -61,5 +62,10 @@ std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed);
 
 /// The vocabulary, in the order of docs/fit.md.
 const std::vector<std::string>& vocabulary();
+
+/// The generator's own integrator on a bare mass m with a viscous friction c under a constant
+/// thrust F, from x = 0, v = v0, over `duration` in `steps` RK4 steps: {x, v} at the end (for
+/// its analytic tests).
+std::pair<double, double> integrate_mass(double m, double F, double c, double v0, double duration, int steps);
 
 }  // namespace fdgen
