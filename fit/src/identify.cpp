@@ -16,12 +16,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kSmoothing = "friction.static_smoothing_velocity";
+constexpr const char* kOffset = "form.direction_asymmetry";
 
 struct Ctx {
   const Record& rec;
   const plant::PlantParams& model;
   const Eigen::VectorXd* r0;  // residual of the model without the candidate (may be null)
   double x_mean;
+  double offset_bound{0.0};   // |F| bound of the model-form offset (FreeSet::offset_bound)
 };
 
 double x_mean_of(const Record& rec) {
@@ -282,6 +284,14 @@ const std::vector<Spec>& specs() {
       };
       s.push_back(sp);
     }
+    {
+      // Not an effect: the model-form offset of a direction asymmetry of the friction, carried
+      // by constant_force, F = bound * tanh(theta) within +-bound.
+      Spec sp;
+      sp.name = kOffset;
+      sp.dim = 1;
+      s.push_back(sp);
+    }
     return s;
   }();
   return all;
@@ -305,6 +315,8 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
     const Theta t(th + b.offset, th + b.offset + b.spec->dim);
     if (b.spec->name == kSmoothing) {
       p.friction.static_smoothing_velocity = std::exp(t[0]);
+    } else if (b.spec->name == kOffset) {
+      plant::set_effect(p.effects, Effect{"constant_force", {{"force_N", c.offset_bound * std::tanh(t[0])}}});
     } else {
       plant::set_effect(p.effects, b.spec->to_effect(t, c));
     }
@@ -495,6 +507,11 @@ std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& mode
     blocks.push_back({&spec(kSmoothing), static_cast<int>(theta.size())});
     theta.push_back(std::log(model.friction.static_smoothing_velocity));
   }
+  if (free.offset_bound > 0.0) {
+    blocks.push_back({&spec(kOffset), static_cast<int>(theta.size())});
+    const double f = model.effects.constant_force.enabled ? model.effects.constant_force.force_N : 0.0;
+    theta.push_back(std::atanh(std::clamp(f / free.offset_bound, -0.999, 0.999)));
+  }
   return {blocks, theta};
 }
 
@@ -512,7 +529,7 @@ void clamp_to_bounds(Theta& theta, const std::vector<Block>& blocks, const Ctx& 
 JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
                      const std::vector<double>* weights, int max_iterations) {
   const Eigen::VectorXd r0 = force_residual(rec, model);
-  const Ctx ctx{rec, model, &r0, x_mean_of(rec)};
+  const Ctx ctx{rec, model, &r0, x_mean_of(rec), free.offset_bound};
   auto [blocks, theta] = joint_blocks(model, free, ctx);
   JointFit out;
   out.params = model;

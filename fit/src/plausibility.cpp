@@ -7,7 +7,7 @@
 namespace feeddrive::fit {
 namespace {
 
-constexpr double kAsymmetry = 0.03;  // direction asymmetry of Coulomb friction not told from a constant force
+constexpr double kAsymmetry = kAsymmetryTolerance;
 
 std::string fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[320];
@@ -29,16 +29,15 @@ std::string ripple_pitch(const Envelope& env, double p) {
   return "";
 }
 
-// The Coulomb friction level of a model: its static friction's and its Coulomb-type effects'.
-double coulomb_level(const plant::PlantParams& m) {
+}  // namespace
+
+double friction_level(const plant::PlantParams& m) {
   double c = 0.0;
-  if (m.friction.model != plant::FrictionModel::kNone) c += m.friction.coulomb_force;
+  if (m.friction.model != plant::FrictionModel::kNone) c += std::max(m.friction.static_force, m.friction.coulomb_force);
   if (m.effects.coulomb_friction.enabled) c += m.effects.coulomb_friction.coulomb_N;
-  if (m.effects.stribeck_friction.enabled) c += m.effects.stribeck_friction.coulomb_N;
+  if (m.effects.stribeck_friction.enabled) c += m.effects.stribeck_friction.static_N;
   return c;
 }
-
-}  // namespace
 
 double Envelope::min_pitch() const {
   return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width});
@@ -98,7 +97,10 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
                env.travel * 1e3, env.min_pitch() * 1e3);
   // k (x - x_rest) + F is the spring k (x - x_rest + F/k): a spring and a constant force in one
   // model cannot be told apart; the spring's rest position carries the constant.
-  if (name == "spring_force" && model.effects.constant_force.enabled)
+  const bool named_constant = model.effects.constant_force.enabled &&
+                              std::abs(model.effects.constant_force.force_N) >
+                                  kAsymmetry * friction_level(model) * (1.0 + 1e-9);
+  if (name == "spring_force" && named_constant)
     return "a constant force is in the model: with a spring, their sum is one spring with another rest position";
   if (name == "constant_force" && model.effects.spring_force.enabled)
     return "a spring is in the model: its rest position already carries a constant force";
@@ -121,7 +123,7 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     // between the directions are the same force (they differ only in stick phases, which the fit
     // leaves out). Real friction is asymmetric by a few per cent; a smaller force is not told
     // from that.
-    const double level = coulomb_level(model);
+    const double level = friction_level(model);
     if (level > 0 && std::abs(par(e, "force_N")) < kAsymmetry * level)
       return fmt("force %.3g N is within a %.0f %% direction asymmetry of the %.4g N Coulomb friction, from which "
                  "moving data cannot tell it",
@@ -132,6 +134,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     return above("viscous force at the peak speed", par(e, "viscous_Ns_per_m") * env.v_max);
   if (n == "stribeck_friction") {
     if (par(e, "static_N") > F) return above("static level", par(e, "static_N"));
+    if (par(e, "static_N") - par(e, "coulomb_N") < 0.05 * par(e, "coulomb_N"))
+      return fmt("no Stribeck hump: the static level %.4g N is within 5 %% of the Coulomb level %.4g N (that is Coulomb "
+                 "friction)",
+                 par(e, "static_N"), par(e, "coulomb_N"));
     const double vs = par(e, "stribeck_velocity_mps");
     if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
       return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
@@ -171,7 +177,7 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
                  env.travel * 1e3);
     if (par(e, "stiffness_N_per_m") * env.travel > F)
       return above("spring force over the travel", par(e, "stiffness_N_per_m") * env.travel);
-    const double level = coulomb_level(model);
+    const double level = friction_level(model);
     if (level > 0 && par(e, "stiffness_N_per_m") * env.travel < kAsymmetry * level)
       return fmt("its force changes by only %.3g N over the travel, within a %.0f %% direction asymmetry of the "
                  "%.4g N Coulomb friction: a constant force in disguise",

@@ -75,8 +75,13 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   FreeSet free{{}, false};
   plant::PlantParams current = model;
   const auto recalibrate = [&](const plant::PlantParams& p) {
-    if (!opt.fit_form || !has_coulomb_term(p)) return p;
-    return fit_jointly(rec, p, FreeSet{free.effects, true}).params;
+    if (!opt.fit_form) return p;
+    FreeSet f{free.effects, true, 0.0};
+    // a friction's direction asymmetry, carried as a bounded constant force (model form)
+    if (!contains(free.effects, "constant_force") && !p.effects.spring_force.enabled)
+      f.offset_bound = kAsymmetryTolerance * friction_level(p);
+    if (!has_coulomb_term(p) && f.offset_bound == 0.0) return p;
+    return fit_jointly(rec, p, f).params;
   };
   // 0. Model form: a static friction's transition velocity is fitted before anything is added.
   current = recalibrate(current);
@@ -111,6 +116,10 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       plant::set_effect(trial.effects, single.effect);
       FreeSet fs = free;
       fs.effects.push_back(name);
+      // A Coulomb-type candidate on a model without static friction brings its own transition
+      // velocity: eps is fitted with it (cheap: no friction along the record is recomputed).
+      fs.form = opt.fit_form && current.friction.model != plant::FrictionModel::kStatic &&
+                (name == "coulomb_friction" || name == "stribeck_friction");
       // the single fit is a good start: the joint fit converges in a few tens of iterations
       JointFit jf = fit_jointly(rec, trial, fs, nullptr, 40);
       const Effect canon = canonical(effect_of(jf.params, name));
@@ -125,6 +134,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       c.joint = jf.params;
       c.rss = jf.rss;
       c.converged = jf.converged;
+      fs.form = false;  // eps is a model-form parameter, counted in no score (it is fitted for every model alike)
       c.parameters = fs.parameters(jf.params) - free.parameters(current);
       c.bic = bic_of(jf.rss, fs.parameters(jf.params), n);
       c.score = cur_bic - c.bic;
@@ -188,11 +198,21 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         if (close.size() < 3) close.push_back(i);
       }
       if (close.size() > 1) {
+        // the one-standard-error rule in its original form: the lowest held-out error, unless
+        // a candidate with fewer parameters is within one standard error of it
+        std::size_t best = close.front();
+        for (std::size_t i : close)
+          if (total(cv_of(st.ranking[i])) < total(cv_of(st.ranking[best]))) best = i;
+        std::size_t pick = best;
+        for (std::size_t i : close) {
+          if (st.ranking[i].parameters >= st.ranking[pick].parameters) continue;
+          const CvVerdict v = cv_verdict(cv_of(st.ranking[i]), cv_of(st.ranking[best]));
+          if (v.mean <= v.se) pick = i;
+        }
         std::vector<CandidateFit> picked;
-        for (std::size_t i : close) picked.push_back(st.ranking[i]);
-        std::stable_sort(picked.begin(), picked.end(), [&](const CandidateFit& a, const CandidateFit& b) {
-          return total(cv_of(a)) < total(cv_of(b));
-        });
+        picked.push_back(st.ranking[pick]);
+        for (std::size_t i : close)
+          if (i != pick) picked.push_back(st.ranking[i]);
         for (std::size_t k = 0; k < close.size(); ++k) st.ranking[close[k]] = picked[k];
       }
     }
@@ -300,6 +320,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   }
   // eps means nothing to a model without a Coulomb-type term (e.g. once presliding made it LuGre)
   if (!has_coulomb_term(current)) current.friction.static_smoothing_velocity = model.friction.static_smoothing_velocity;
+  if (current.effects.constant_force.enabled && !contains(added, "constant_force"))
+    out.asymmetry_offset = current.effects.constant_force.force_N;
   out.fitted = current;
   out.smoothing_final = current.friction.static_smoothing_velocity;
   out.smoothing_fitted = out.smoothing_final != out.smoothing_initial;
@@ -314,6 +336,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     for (const auto& a : added) out.conclusion += " " + a;
     out.conclusion += fmt("; gap %.4g -> %.4g um", out.replay_initial.gap * 1e6, rp.gap * 1e6);
   }
+  if (out.asymmetry_offset != 0.0)
+    out.conclusion += fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
   if (out.smoothing_fitted)
     out.conclusion += fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s", out.smoothing_initial * 1e3,
                           out.smoothing_final * 1e3);

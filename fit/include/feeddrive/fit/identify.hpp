@@ -51,6 +51,9 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
 struct FreeSet {
   std::vector<std::string> effects;
   bool form{false};
+  /// > 0: also a model-form offset |F| <= offset_bound, carried by constant_force (not named):
+  /// a direction asymmetry of the friction, which moving data cannot tell from a constant force.
+  double offset_bound{0.0};
   int parameters(const plant::PlantParams& model) const;  ///< k of the BIC
 };
 bool has_coulomb_term(const plant::PlantParams& model);

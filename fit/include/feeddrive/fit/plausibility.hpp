@@ -45,6 +45,14 @@ struct Envelope {
 
 Envelope envelope(const Record& rec, const plant::PlantParams& model);
 
+/// A direction asymmetry of friction up to this fraction of its level is model form: while the
+/// drive moves it is a constant force of up to that size, which the fit carries as such (not
+/// named as an effect; docs/fit.md, "Model form").
+constexpr double kAsymmetryTolerance = 0.03;
+/// The friction level a direction asymmetry scales: the static levels of the model's static
+/// friction and of its Coulomb-type effects [N].
+double friction_level(const plant::PlantParams& model);
+
 struct PlausibilityOptions {
   bool grinding_process{false};  ///< the scenario describes a grinding process (or the user asks for grinding_force)
 };

@@ -61,6 +61,9 @@ struct FitResult {
   Envelope envelope;                   ///< what the record spans (plausibility rules)
   double smoothing_initial{0.0}, smoothing_final{0.0};  ///< eps of sgn_eps [m/s], before and after
   bool smoothing_fitted{false};
+  /// The model-form offset of a friction direction asymmetry (within kAsymmetryTolerance of the
+  /// friction level), carried by constant_force in `fitted` but not named as an effect [N].
+  double asymmetry_offset{0.0};
   std::string conclusion;
 };
 
