@@ -146,6 +146,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       }
       for (const Effect& e : plant::enabled_effects(jf.params.effects)) {
         if (!c.passed_over.empty()) break;
+        if (!contains(fs.effects, e.name)) continue;  // the model's own, or model form (asymmetry offset)
         const std::string why = implausible(out.envelope, jf.params, e);
         if (!why.empty()) c.passed_over = e.name == name ? why : "refitted with it, " + e.name + " becomes implausible: " + why;
       }
