@@ -81,7 +81,13 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     if (!contains(free.effects, "constant_force") && !p.effects.spring_force.enabled)
       f.offset_bound = kAsymmetryTolerance * friction_level(p);
     if (!has_coulomb_term(p) && f.offset_bound == 0.0) return p;
-    return fit_jointly(rec, p, f).params;
+    plant::PlantParams q = fit_jointly(rec, p, f, nullptr, 200).params;
+    try {
+      q.validate();
+    } catch (const std::invalid_argument&) {
+      return p;
+    }
+    return q;
   };
   // 0. Model form: a static friction's transition velocity is fitted before anything is added.
   current = recalibrate(current);
@@ -94,6 +100,16 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   std::vector<std::string> added;  // in the order found; removed ones are taken out
   int additions = 0;
   for (int it = 0; additions < opt.max_effects && it < 2 * opt.max_effects + 2; ++it) {
+    // Polish: the effects already in are refitted to convergence first, so that no candidate's
+    // joint fit gets credit for merely finishing the optimisation of the others.
+    if (!free.effects.empty()) {
+      const JointFit polished = fit_jointly(rec, current, free, nullptr, 200);
+      if (polished.rss < r.squaredNorm()) {
+        current = polished.params;
+        r = force_residual(rec, current);
+        cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
+      }
+    }
     StepResult st;
     st.localisation = localise(rec, r, rp);
     st.gap_before = rp.gap;
@@ -234,7 +250,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       }
       try {
         rp2 = replay(rec, c.joint, opt.replay_window);
-      } catch (const std::runtime_error& e) {  // e.g. CVODE cannot integrate the fitted model
+      } catch (const std::exception& e) {  // e.g. CVODE cannot integrate the fitted model
         c.passed_over = std::string("cannot be replayed (") + e.what() + ")";
         why_not += (why_not.empty() ? "" : "; ") + c.effect.name + " " + c.passed_over;
         continue;
@@ -276,9 +292,14 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     ++additions;
     r = force_residual(rec, current);
     cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
-    rp = current.friction.static_smoothing_velocity == chosen->joint.friction.static_smoothing_velocity
-             ? rp2
-             : replay(rec, current, opt.replay_window);
+    try {
+      rp = replay(rec, current, opt.replay_window);
+    } catch (const std::exception&) {  // the recalibrated model cannot be replayed: keep the candidate's
+      current = chosen->joint;
+      r = force_residual(rec, current);
+      cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
+      rp = rp2;
+    }
     st.verdict = "added " + name + fmt(" (score %.4g): gap %.4g -> %.4g um", st.score, st.gap_before * 1e6, rp.gap * 1e6);
     if (!why_not.empty()) st.verdict += " (passed over: " + why_not + ")";
     say(st.verdict);
@@ -302,12 +323,19 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         }
       }
       if (drop.empty()) break;
+      Replay rp_without;
+      try {
+        best_without.params.validate();
+        rp_without = replay(rec, best_without.params, opt.replay_window);
+      } catch (const std::exception&) {  // the model without it cannot be replayed: keep it
+        break;
+      }
       current = best_without.params;
       free.effects.erase(std::find(free.effects.begin(), free.effects.end(), drop));
       added.erase(std::find(added.begin(), added.end(), drop));
       r = force_residual(rec, current);
       cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
-      rp = replay(rec, current, opt.replay_window);
+      rp = rp_without;
       st.removed.push_back(drop);
       const std::string line = "removed " + drop + ": with " + name + " in," +
                                fmt(" it is worth only %.3g in BIC; gap now %.4g um", least, rp.gap * 1e6);
