@@ -351,7 +351,7 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
              const Ctx& ctx, int max_iterations, const std::vector<double>* weights = nullptr) {
   const int dim = static_cast<int>(theta.size());
   auto* functor = new ResidualFunctor{&rec, &base, blocks, &ctx, weights};
-  auto* cost = new ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::CENTRAL>(functor);
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::FORWARD>(functor);
   cost->AddParameterBlock(dim);
   cost->SetNumResiduals(static_cast<int>(rec.bank.tau.size()));
   ceres::Problem problem;
@@ -411,10 +411,10 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
   }
   // Stage 1: a few iterations from every start; stage 2: the best two to convergence.
   std::vector<Solved> first;
-  for (const Theta& t : starts) first.push_back(solve(rec, model, blocks, t, ctx, starts.size() > 4 ? 6 : 50));
+  for (const Theta& t : starts) first.push_back(solve(rec, model, blocks, t, ctx, starts.size() >= 4 ? 6 : 50));
   std::sort(first.begin(), first.end(), [](const Solved& a, const Solved& b) { return a.rss < b.rss; });
   Solved best = first.front();
-  if (starts.size() > 4 || !best.converged) {
+  if (starts.size() >= 4 || !best.converged) {
     best.rss = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < first.size() && i < 2; ++i) {
       const Solved s2 = solve(rec, model, blocks, first[i].theta, ctx, 50);
@@ -440,7 +440,7 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
     const auto probe = [&](double v) {
       Theta t = best.theta;
       t[static_cast<std::size_t>(f)] = v;
-      return solve(rec, model, blocks, t, ctx, 15);
+      return solve(rec, model, blocks, t, ctx, 10);
     };
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     double a = hi - g * (hi - lo), b = lo + g * (hi - lo);

@@ -97,10 +97,7 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
                env.travel * 1e3, env.min_pitch() * 1e3);
   // k (x - x_rest) + F is the spring k (x - x_rest + F/k): a spring and a constant force in one
   // model cannot be told apart; the spring's rest position carries the constant.
-  const bool named_constant = model.effects.constant_force.enabled &&
-                              std::abs(model.effects.constant_force.force_N) >
-                                  kAsymmetry * friction_level(model) * (1.0 + 1e-9);
-  if (name == "spring_force" && named_constant)
+  if (name == "spring_force" && model.effects.constant_force.enabled)
     return "a constant force is in the model: with a spring, their sum is one spring with another rest position";
   if (name == "constant_force" && model.effects.spring_force.enabled)
     return "a spring is in the model: its rest position already carries a constant force";

@@ -121,7 +121,11 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       CandidateFit c;
       c.effect = {name, {}};
       c.score = -std::numeric_limits<double>::infinity();
-      c.passed_over = prerequisite(out.envelope, current, name, opt.plausibility);
+      // the prerequisites see the named effects: a model-form offset carried by constant_force
+      // is no constant force that would rule out a spring
+      plant::PlantParams named = current;
+      if (!contains(free.effects, "constant_force")) named.effects.constant_force.enabled = false;
+      c.passed_over = prerequisite(out.envelope, named, name, opt.plausibility);
       if (!c.passed_over.empty()) {
         st.ranking.push_back(c);
         continue;
