@@ -35,8 +35,9 @@ TEST(IndependentRecords, SeededSubsetIsNamedRightWithoutSpuriousEffects) {
               free_named, free);
   // The targets on 100+ records are >= 90 % right, <= 5 % spurious, <= 5 % of the
   // effect-free records naming an effect; the sweep of bench/fit_bench.sh measures them (94 %,
-  // 5 %, 0 %: docs/fit.md). This fixed subset of 24 is a regression guard at its measured
-  // figures: 21 right (one miss is 4 % here), 1 spurious, no effect-free record naming one.
+  // 5 %, 0 %: docs/fit.md). This fixed subset of 24 is a regression guard near its measured
+  // figures (22 right, 0 spurious, no effect-free record naming one): it allows one more miss
+  // (4 % here) and one spurious effect.
   EXPECT_GE(right, n - 3);
   EXPECT_LE(spurious, 1);
   EXPECT_EQ(free_named, 0);
