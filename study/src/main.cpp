@@ -9,6 +9,7 @@
 
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/study/session.hpp"
 #include "feeddrive/study/spec.hpp"
 #include "feeddrive/study/transport.hpp"
@@ -42,6 +43,8 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   o.plots = !no_plots;
+  // Ctrl-C / SIGTERM: the running cases stop, the finished ones stay in DIR/cases.
+  feeddrive::interrupt::install_handlers();
   o.command = command;
   if (transport && transport->rank() != 0) return feeddrive::study::serve(*transport, o.jobs);
   return feeddrive::study::run_study(o, transport.get());

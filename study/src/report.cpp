@@ -8,7 +8,7 @@
 #include <set>
 #include <sstream>
 
-#include "feeddrive/common/validate.hpp"
+#include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::study {
@@ -130,7 +130,7 @@ std::string results_csv(const Study& s, const std::vector<CaseRecord>& cases) {
     for (const std::string& m : metrics) {
       out << ',';
       for (const auto& [k, v] : c.outcome.metrics)
-        if (k == m) out << validate::format_number(v);
+        if (k == m) out << output::number_text(v);
     }
     out << '\n';
   }
@@ -147,8 +147,8 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
   const std::string limit_line =
       std::isnan(s.report.limit)
           ? std::string()
-          : "set arrow 1 from graph 0, first " + validate::format_number(s.report.limit) + " to graph 1, first " +
-                validate::format_number(s.report.limit) + " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
+          : "set arrow 1 from graph 0, first " + output::number_text(s.report.limit) + " to graph 1, first " +
+                output::number_text(s.report.limit) + " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
 
   // Box plots: one box per family and controller, grouped by family.
   const auto t = table(s, cases);
@@ -160,21 +160,21 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
       long n = 0;
       for (double v : t[f][c].values)
         if (v > 0.0) {
-          data << validate::format_number(v) << '\n';
+          data << output::number_text(v) << '\n';
           ++n;
         }
       if (n == 0) continue;
       const std::string file = "box_" + std::to_string(f) + "_" + std::to_string(c) + ".dat";
       write_text(dir / file, data.str());
       const double x = static_cast<double>(f + 1) + (static_cast<double>(c) - 0.5 * static_cast<double>(nc - 1)) * width;
-      items.push_back("'" + file + "' using (" + validate::format_number(x) + "):1:(" + validate::format_number(0.9 * width) +
+      items.push_back("'" + file + "' using (" + output::number_text(x) + "):1:(" + output::number_text(0.9 * width) +
                       ") with boxplot linecolor " + std::to_string(c + 1) + " notitle");
     }
   }
   if (!items.empty()) {
     gp << "set output 'box.png'\nset title " << output::gnuplot_string(s.name + ": " + s.report.metric + " per family and controller")
        << "\nset ylabel " << ylabel << "\nset style fill solid 0.35 border -1\nset style boxplot outliers pointtype 7\n"
-       << "set xrange [0.4:" << validate::format_number(static_cast<double>(nf) + 0.6) << "]\nset xtics (";
+       << "set xrange [0.4:" << output::number_text(static_cast<double>(nf) + 0.6) << "]\nset xtics (";
     for (std::size_t f = 0; f < nf; ++f) gp << (f ? ", " : "") << output::gnuplot_string(s.families[f].name, 40) << ' ' << f + 1;
     gp << ") rotate by -25\n" << limit_line << "plot ";
     for (std::size_t i = 0; i < items.size(); ++i) gp << (i ? ", \\\n  " : "") << items[i];
@@ -198,7 +198,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
         double x = 0.0;
         const double y = shown_metric(s, r);
         if (it == r.resolved.parameters.end() || !parse_number(it->second, x) || !(y > 0.0)) continue;
-        data << validate::format_number(x) << ' ' << validate::format_number(y) << '\n';
+        data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
         ++n;
       }
       if (n == 0) continue;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/summary.hpp"
@@ -19,14 +20,20 @@ Outcome run_case(const std::string& yaml) {
   const auto start = std::chrono::steady_clock::now();
   try {
     const sim::Scenario s = sim::parse_scenario(yaml, ".", "case");
-    const sim::RunResult r = sim::run(s);
-    const sim::Summary sum = sim::summarize(r, s);
+    // Streamed: the online summary keeps no records (memory independent of the run's length).
+    sim::SummaryBuilder builder(s);
+    const sim::RunStats st = sim::run(s, [&builder](const sim::Record& q) { builder.add(q); });
+    const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(sim::summary_json(sum, s));
     for (auto it = j.begin(); it != j.end(); ++it) {
       if (!it.value().is_number() || is_timing_metric(it.key())) continue;
       o.metrics.emplace_back(it.key(), it.value().get<double>());
     }
     o.ok = true;
+  } catch (const interrupt::Interrupted& e) {
+    o.ok = false;
+    o.interrupted = true;
+    o.error = e.what();
   } catch (const std::exception& e) {
     o.ok = false;
     o.error = e.what();

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/study/cases.hpp"
 #include "feeddrive/study/report.hpp"
@@ -162,6 +163,7 @@ int run_study(const Options& o, Transport* t) {
   double case_time = 0.0;
   std::size_t remaining = pending.size();
   const auto record = [&](std::size_t i, Outcome out) {
+    if (out.interrupted) return;  // not an outcome: the case runs again next time
     CaseRecord& c = cases[i];
     c.outcome = std::move(out);
     case_time += c.outcome.wall_s;
@@ -173,6 +175,17 @@ int run_study(const Options& o, Transport* t) {
     Pool pool(jobs, [&cases](std::size_t i) { return run_case(cases[i].resolved.yaml); });
     int released = 0;  // ranks told there is no more work
     while (remaining > 0 || (t && released < t->size() - 1)) {
+      if (interrupt::interrupted()) {
+        // Ctrl-C or SIGTERM: the running cases stop at their next poll; what finished is kept.
+        while (pool.in_flight() > 0)
+          if (auto r = pool.pop(std::chrono::milliseconds(100))) record(r->first, std::move(r->second));
+        progress.finish();
+        const int sig = interrupt::signal_number();
+        std::fprintf(stderr, "interrupted by %s: %zu of %zu cases finished and kept in %s; run the same command to go on\n",
+                     interrupt::signal_name(sig).c_str(), cases.size() - remaining, cases.size(), dir.c_str());
+        if (t) t->abort(128 + sig);
+        return 128 + sig;
+      }
       while (pool.in_flight() < static_cast<std::size_t>(jobs) && !pending.empty()) {
         pool.push(pending.front());
         pending.pop_front();

@@ -23,13 +23,15 @@ struct Outcome {
   std::string error;
   std::vector<std::pair<std::string, double>> metrics;
   double wall_s{0.0};  ///< time of this case (not a result: kept out of results.csv)
+  bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
 };
 
 /// summary.json keys that measure the computer, not the drive: never in results.csv.
 bool is_timing_metric(const std::string& key);
 
-/// Loads the resolved scenario YAML, runs it in-process (sim::run) and summarises it (the
-/// summary.json metrics). Never throws: a failure is an Outcome with its one-line error.
+/// Loads the resolved scenario YAML, runs it in-process (sim::run, streamed into the online
+/// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
+/// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
 Outcome run_case(const std::string& yaml);
 
 /// The case file DIR/cases/<hash>.json: the outcome, keyed by the case's hash.
