@@ -97,12 +97,16 @@ BENCHMARK(BM_JerkLimitedRun_Beyond10kHz)->Unit(benchmark::kMillisecond)->MinTime
 
 // Authentication of the bus (--key, docs/security.md): one HMAC-SHA256 to sign a drive_state_t
 // (the largest message of a step) and one to verify it, as Bus::publish and subscribe do.
-static void BM_SignDriveState(benchmark::State& state) {
-  const feeddrive::service::MessageAuth auth("0123456789abcdef0123456789abcdef");
+static std::vector<std::uint8_t> encoded_state() {
   drive_state_t m{};
   const int n = m.getEncodedSize();
   std::vector<std::uint8_t> buf(static_cast<std::size_t>(n) + feeddrive::service::MessageAuth::kMacSize);
   m.encode(buf.data(), 0, n);
+  return buf;
+}
+static void BM_SignDriveState(benchmark::State& state) {
+  const feeddrive::service::MessageAuth auth("0123456789abcdef0123456789abcdef");
+  std::vector<std::uint8_t> buf = encoded_state();
   for (auto _ : state) {
     auth.sign("FD_STATE", buf.data(), buf.size());
     benchmark::DoNotOptimize(buf.data());
@@ -112,10 +116,7 @@ static void BM_SignDriveState(benchmark::State& state) {
 BENCHMARK(BM_SignDriveState)->MinTime(1.0);
 static void BM_VerifyDriveState(benchmark::State& state) {
   const feeddrive::service::MessageAuth auth("0123456789abcdef0123456789abcdef");
-  drive_state_t m{};
-  const int n = m.getEncodedSize();
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(n) + feeddrive::service::MessageAuth::kMacSize);
-  m.encode(buf.data(), 0, n);
+  std::vector<std::uint8_t> buf = encoded_state();
   auth.sign("FD_STATE", buf.data(), buf.size());
   for (auto _ : state) benchmark::DoNotOptimize(auth.verify("FD_STATE", buf.data(), buf.size()));
 }

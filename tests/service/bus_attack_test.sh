@@ -81,35 +81,27 @@ done
 [ "$(json "$TMP/clean/summary.json" .lockstep.run_id)" -gt 0 ] || fail "clean: no run id in summary.json"
 pass "clean run: identical to feeddrive-sim, run id $(json "$TMP/clean/summary.json" .lockstep.run_id), 0 foreign/conflicts/unauthenticated"
 
-# 1. Forged commands.
-peer forge-controller
-launch forged_cmd
-wait $peer_pid || true
-conflict_failure forged_cmd FD_CMD
-pass "forged commands without a key: the run failed on the conflict"
-
-peer forge-controller
-launch forged_cmd_key --key "$KEY"
-wait $peer_pid || true
-completed_identical forged_cmd_key
-n=$(json "$TMP/forged_cmd_key/summary.json" .lockstep.unauthenticated_messages)
-[ "$n" -gt 100 ] || fail "forged_cmd_key: only $n unauthenticated messages counted ($(tail -n 1 "$TMP/peer.log"))"
-pass "forged commands with --key: $n rejected as unauthenticated ($(tail -n 1 "$TMP/peer.log")); identical to feeddrive-sim"
-
-# 2. Forged reference blocks.
-peer forge-reference
-launch forged_ref
-wait $peer_pid || true
-conflict_failure forged_ref FD_REF
-pass "forged reference blocks without a key: the run failed on the conflict"
-
-peer forge-reference
-launch forged_ref_key --key "$KEY"
-wait $peer_pid || true
-completed_identical forged_ref_key
-n=$(json "$TMP/forged_ref_key/summary.json" .lockstep.unauthenticated_messages)
-[ "$n" -gt 10 ] || fail "forged_ref_key: only $n unauthenticated messages counted ($(tail -n 1 "$TMP/peer.log"))"
-pass "forged reference blocks with --key: $n rejected as unauthenticated; identical to feeddrive-sim"
+# forged WHAT MODE CHANNEL MIN: the attacker MODE against a run without a key (a conflict on
+# CHANNEL fails the run) and with --key (at least MIN forgeries rejected; identical run).
+forged() {
+  local what=$1 mode=$2 channel=$3 min=$4 n
+  peer "$mode"
+  launch "$mode"
+  wait $peer_pid || true
+  conflict_failure "$mode" "$channel"
+  pass "forged $what without a key: the run failed on the conflict"
+  peer "$mode"
+  launch "$mode-key" --key "$KEY"
+  wait $peer_pid || true
+  completed_identical "$mode-key"
+  n=$(json "$TMP/$mode-key/summary.json" .lockstep.unauthenticated_messages)
+  [ "$n" -ge "$min" ] || fail "$mode-key: only $n unauthenticated messages counted ($(tail -n 1 "$TMP/peer.log"))"
+  pass "forged $what with --key: $n rejected as unauthenticated ($(tail -n 1 "$TMP/peer.log")); identical to feeddrive-sim"
+}
+# 1. Forged commands: one per step, 10000.
+forged commands forge-controller FD_CMD 5000
+# 2. Forged reference blocks: one per 16 steps up to 512 before the end, 593.
+forged "reference blocks" forge-reference FD_REF 300
 
 # 3. A replayed log, started once the new run's plant is up (before, the launch would refuse:
 # another run's plant is on the group, case 4).
