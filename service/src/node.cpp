@@ -38,6 +38,10 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
           return;
         }
         if (m.role == role_) return;
+        // A heartbeat older than the newest one of that role is a replay (or overtaken): the
+        // view of a peer (its acknowledged step, its state) never goes back.
+        const auto seen = peers_.find(m.role);
+        if (seen != peers_.end() && m.utime < seen->second.utime) return;
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
       },
@@ -94,7 +98,12 @@ bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char*
   const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +
                            " for one step (" + diff + " differ); another publisher on the bus? (docs/security.md)";
   if (opt_.on_conflict == ConflictPolicy::kFail) throw RunFailure(what);
-  spdlog::error("{}: {}; kept the first ({} conflicts so far)", role_, what, conflicts);
+  // keep-first: every conflict is counted; the log names the first ten, then one a second.
+  const std::int64_t now = mono_us();
+  if (conflicts <= 10 || now - last_conflict_log_us_ > 1000000) {
+    last_conflict_log_us_ = now;
+    spdlog::error("{}: {}; kept the first ({} conflicts so far)", role_, what, conflicts);
+  }
   return false;
 }
 
