@@ -38,10 +38,6 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
           return;
         }
         if (m.role == role_) return;
-        // A heartbeat older than the newest one of that role is a replay (or overtaken): the
-        // view of a peer (its acknowledged step, its state) never goes back.
-        const auto seen = peers_.find(m.role);
-        if (seen != peers_.end() && m.utime < seen->second.utime) return;
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
       },
