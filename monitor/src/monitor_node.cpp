@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/control_command_t.hpp"
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -102,6 +103,14 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+  } catch (const interrupt::Interrupted& e) {
+    // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
+    // Ctrl-C stops that too; then the process exits as interrupted (130 / 143).
+    progress(true);
+    interrupt::g_signal = 0;
+    mopt_.plots = false;
+    finish(false, e.what());
+    throw interrupt::Interrupted(e.signal());
   }
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
@@ -45,6 +46,8 @@ int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, co
   install_signal_handlers();
   try {
     return body();
+  } catch (const interrupt::Interrupted& e) {
+    return interrupt::report(e);
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

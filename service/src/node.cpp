@@ -1,24 +1,14 @@
 #include "feeddrive/service/node.hpp"
 
-#include <csignal>
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::service {
-namespace {
-volatile std::sig_atomic_t g_signal = 0;
-extern "C" void on_signal(int sig) { g_signal = sig; }
-}  // namespace
 
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: a blocking poll returns EINTR
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
+void install_signal_handlers() { interrupt::install(); }
 
-int interrupted_by() { return g_signal; }
+int interrupted_by() { return interrupt::signal_number(); }
 
 std::string seconds_text(double s) {
   char buf[32];
@@ -81,7 +71,7 @@ void Node::request_resend(const std::string& channel, std::int64_t seq) {
 }
 
 void Node::check_peers() const {
-  if (g_signal != 0) throw RunFailure(std::string("interrupted by ") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM"));
+  interrupt::check();
   for (const auto& [role, st] : peers_)
     if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
 }

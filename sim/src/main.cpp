@@ -2,12 +2,14 @@
 //
 //   scenario.yaml --> load_scenario --> run (reference -> controller -> CVODE plant) --> write_results
 //
-// Exit codes: 0 ok, 2 bad input (scenario or arguments), 1 runtime failure.
+// Exit codes: 0 ok, 2 bad input (scenario or arguments), 1 runtime failure, 130 (143) interrupted
+// by SIGINT (SIGTERM) in any phase, with nothing written.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -29,11 +31,15 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  feeddrive::interrupt::install();
 
   feeddrive::sim::Scenario scenario;
   try {
     scenario = feeddrive::sim::load_scenario(scenario_path);
     feeddrive::output::check_output_dir(out_dir);  // before any work
+    feeddrive::interrupt::check();
+  } catch (const feeddrive::interrupt::Interrupted& e) {
+    return feeddrive::interrupt::report(e);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
@@ -46,6 +52,8 @@ int main(int argc, char** argv) {
     spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",
                  summary.position_error_max_abs_m, summary.position_error_rms_m, summary.control_min,
                  summary.control_max, summary.wall_time_s, out_dir);
+  } catch (const feeddrive::interrupt::Interrupted& e) {
+    return feeddrive::interrupt::report(e);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

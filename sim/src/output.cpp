@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
@@ -18,8 +19,12 @@ void write_timeseries_csv(const std::string& path, const std::vector<Record>& re
   const auto& cols = record_columns();
   for (std::size_t c = 0; c < cols.size(); ++c) std::fprintf(f, c ? ",%s" : "%s", cols[c].c_str());
   std::fputc('\n', f);
-  for (const Record& r : records) {
-    const std::vector<double> v = record_values(r);
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    if (k % 4096 == 0 && interrupt::requested()) {
+      std::fclose(f);
+      interrupt::check();
+    }
+    const std::vector<double> v = record_values(records[k]);
     for (std::size_t c = 0; c < v.size(); ++c) std::fprintf(f, c ? ",%.17g" : "%.17g", v[c]);
     std::fputc('\n', f);
   }

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/plant/command.hpp"
 #include "feeddrive/plant/plant.hpp"
 
@@ -29,6 +30,7 @@ RunResult run(const Scenario& s, const std::function<void(long, long)>& progress
   RunResult result;
   result.records.reserve(static_cast<std::size_t>(n));
   for (long k = 0; k < n; ++k) {
+    interrupt::check();
     const double t = s.time_of(k);
     const trajectory::Sample ref = reference->sample(t);
     const plant::Measurement meas = drive.measure();

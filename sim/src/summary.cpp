@@ -20,6 +20,7 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   if (rec.empty()) return m;
 
   double se = 0.0, sev = 0.0, se_settled = 0.0;
+  double e_settled = 0.0, ev_settled = 0.0, ev_after_first = 0.0;
   long n_settled = 0;
   std::vector<double> abs_e;
   abs_e.reserve(rec.size());
@@ -32,12 +33,12 @@ Summary summarize(const RunResult& r, const Scenario& s) {
     abs_e.push_back(std::abs(e));
     m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
     m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
-    if (k > 0) m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
+    if (k > 0) ev_after_first = std::max(ev_after_first, std::abs(ev));
     se += e * e;
     sev += ev * ev;
     if (q.t >= s.analysis.settled_after) {
-      m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
-      m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
+      e_settled = std::max(e_settled, std::abs(e));
+      ev_settled = std::max(ev_settled, std::abs(ev));
       se_settled += e * e;
       ++n_settled;
     }
@@ -51,7 +52,13 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   const double n = static_cast<double>(rec.size());
   m.position_error_rms_m = std::sqrt(se / n);
   m.velocity_error_rms_mps = std::sqrt(sev / n);
-  if (n_settled > 0) m.position_error_rms_settled_m = std::sqrt(se_settled / static_cast<double>(n_settled));
+  if (rec.size() > 1) m.velocity_error_max_abs_after_first_mps = ev_after_first;
+  m.settled_steps = n_settled;
+  if (n_settled > 0) {
+    m.position_error_max_abs_settled_m = e_settled;
+    m.position_error_rms_settled_m = std::sqrt(se_settled / static_cast<double>(n_settled));
+    m.velocity_error_max_abs_settled_mps = ev_settled;
+  }
   const std::size_t i95 = std::min(abs_e.size() - 1, static_cast<std::size_t>(0.95 * n));
   std::nth_element(abs_e.begin(), abs_e.begin() + static_cast<long>(i95), abs_e.end());
   m.position_error_p95_abs_m = abs_e[i95];
@@ -65,6 +72,9 @@ Summary summarize(const RunResult& r, const Scenario& s) {
 
 std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
   nlohmann::ordered_json j;
+  // Metrics over an empty window are null (summary.hpp), never 0.
+  const auto opt = [](const std::optional<double>& v) { return v ? nlohmann::ordered_json(*v) : nlohmann::ordered_json(); };
+  const auto val = [&](double v) { return m.steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
   j["scenario"] = s.name;
   j["scenario_path"] = s.path;
   j["control_period_s"] = s.control_period;
@@ -72,26 +82,26 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["sim_time_s"] = m.sim_time_s;
   j["wall_time_s"] = m.wall_time_s;
   j["realtime_factor"] = m.wall_time_s > 0.0 ? m.sim_time_s / m.wall_time_s : 0.0;
-  j["position_error_max_abs_m"] = m.position_error_max_abs_m;
-  j["position_error_rms_m"] = m.position_error_rms_m;
-  j["position_error_p95_abs_m"] = m.position_error_p95_abs_m;
-  j["velocity_error_max_abs_mps"] = m.velocity_error_max_abs_mps;
-  j["velocity_error_max_abs_after_first_mps"] = m.velocity_error_max_abs_after_first_mps;
-  j["velocity_error_rms_mps"] = m.velocity_error_rms_mps;
+  j["position_error_max_abs_m"] = val(m.position_error_max_abs_m);
+  j["position_error_rms_m"] = val(m.position_error_rms_m);
+  j["position_error_p95_abs_m"] = val(m.position_error_p95_abs_m);
+  j["velocity_error_max_abs_mps"] = val(m.velocity_error_max_abs_mps);
+  j["velocity_error_max_abs_after_first_mps"] = opt(m.velocity_error_max_abs_after_first_mps);
+  j["velocity_error_rms_mps"] = val(m.velocity_error_rms_mps);
   j["settled_after_s"] = m.settled_after_s;
-  j["position_error_max_abs_settled_m"] = m.position_error_max_abs_settled_m;
-  j["position_error_rms_settled_m"] = m.position_error_rms_settled_m;
-  j["velocity_error_max_abs_settled_mps"] = m.velocity_error_max_abs_settled_mps;
-  j["control_min"] = m.control_min;
-  j["control_max"] = m.control_max;
-  j["control_total_variation"] = m.control_total_variation;
+  j["position_error_max_abs_settled_m"] = opt(m.position_error_max_abs_settled_m);
+  j["position_error_rms_settled_m"] = opt(m.position_error_rms_settled_m);
+  j["velocity_error_max_abs_settled_mps"] = opt(m.velocity_error_max_abs_settled_mps);
+  j["control_min"] = val(m.control_min);
+  j["control_max"] = val(m.control_max);
+  j["control_total_variation"] = val(m.control_total_variation);
   j["control_saturated_steps"] = m.control_saturated_steps;
-  j["final_position_m"] = m.final_position_m;
-  j["final_velocity_mps"] = m.final_velocity_mps;
-  j["final_bristle_m"] = m.final_bristle_m;
-  j["final_friction_N"] = m.final_friction_N;
-  j["max_position_m"] = m.max_position_m;
-  j["min_position_m"] = m.min_position_m;
+  j["final_position_m"] = val(m.final_position_m);
+  j["final_velocity_mps"] = val(m.final_velocity_mps);
+  j["final_bristle_m"] = val(m.final_bristle_m);
+  j["final_friction_N"] = val(m.final_friction_N);
+  j["max_position_m"] = val(m.max_position_m);
+  j["min_position_m"] = val(m.min_position_m);
   j["integrator_steps"] = m.integrator_steps;
   j["integrator_rhs_evals"] = m.integrator_rhs_evals;
   j["integrator_jac_evals"] = m.integrator_jac_evals;
@@ -100,7 +110,9 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
     const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
     for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();
   }
-  return j.dump(2) + "\n";
+  // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
+  // exception after the run.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace feeddrive::sim

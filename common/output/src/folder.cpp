@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::output {
 namespace fs = std::filesystem;
 
@@ -186,6 +188,7 @@ StagedFolder::~StagedFolder() {
 
 void StagedFolder::commit() {
   if (done_) throw std::logic_error("StagedFolder::commit called twice");
+  interrupt::check();  // an interrupted tool replaces nothing; the destructor removes the staging
   const std::string what = option_ + " " + shown(value_) + ": ";
   const std::string kept = "; the results are in " + staging_.string();
   // From here on the staging folder is kept on failure: it holds finished results.

@@ -11,6 +11,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/text.hpp"
+
 namespace feeddrive::output {
 namespace fs = std::filesystem;
 
@@ -20,34 +23,6 @@ bool safe_ascii(unsigned char c) {
   if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9')) return true;
   static constexpr std::string_view kPunctuation = " _-.,:;+/()[]=#%*!?<>|~^&";
   return kPunctuation.find(static_cast<char>(c)) != std::string_view::npos;
-}
-
-// Length of the well-formed UTF-8 sequence at s[i] encoding a character from U+00A0 up
-// (no overlong forms, no surrogates, at most U+10FFFF), or 0.
-std::size_t utf8_char(std::string_view s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
-  const unsigned char c = b(0);
-  std::size_t n = 0;
-  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-    if (c == 0xC2) lo = 0xA0;  // U+0080..U+009F are C1 control characters
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0) lo = 0xA0;  // overlong
-    if (c == 0xED) hi = 0x9F;  // surrogates
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0) lo = 0x90;  // overlong
-    if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
-  } else {
-    return 0;
-  }
-  if (i + n > s.size()) return 0;
-  if (b(1) < lo || b(1) > hi) return 0;
-  for (std::size_t k = 2; k < n; ++k)
-    if (b(k) < 0x80 || b(k) > 0xBF) return 0;
-  return n;
 }
 
 std::string slurp(const fs::path& p) {
@@ -83,7 +58,7 @@ std::string gnuplot_string(std::string_view text, std::size_t max_bytes) {
     std::string_view piece = "?";
     if (safe_ascii(c)) {
       piece = text.substr(i, 1);
-    } else if (const std::size_t u = utf8_char(text, i); u > 0) {
+    } else if (const std::size_t u = text::utf8_char(text, i); u > 0) {
       n = u;
       piece = text.substr(i, u);
     }
@@ -122,6 +97,12 @@ void run_gnuplot(const fs::path& dir, const std::string& script) {
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
+    if (interrupt::requested()) {  // Ctrl-C: gnuplot goes too, at once (it may be drawing for minutes)
+      ::kill(pid, SIGKILL);
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      interrupt::check();
+    }
   }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   if (code == 127) throw std::runtime_error("cannot run gnuplot (not installed? use --no-plots to skip the plots)");

@@ -62,7 +62,7 @@ class Node {
 
   void request_resend(const std::string& channel, std::int64_t seq);
 
-  /// Throws RunFailure if another role announced a failure.
+  /// Throws RunFailure if another role announced a failure, interrupt::Interrupted on a signal.
   void check_peers() const;
   /// The latest status of a role, if any was seen.
   const process_status_t* peer(const std::string& role) const;
@@ -96,7 +96,8 @@ class Node {
   std::map<std::string, std::int64_t> peer_seen_us_;
 };
 
-/// Installs SIGINT/SIGTERM handlers that make every wait end with RunFailure("interrupted").
+/// Installs the SIGINT/SIGTERM handlers of feeddrive/common/interrupt.hpp: every wait then ends
+/// with interrupt::Interrupted (exit 130 / 143).
 void install_signal_handlers();
 /// The signal that interrupted the process, or 0.
 int interrupted_by();
