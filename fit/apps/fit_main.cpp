@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
   }
   spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
-  interrupt::install();
+  interrupt::install_handlers();
   try {
     // Bad input (scenario, data, too short a record, an --out that must not be replaced) is a
     // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.

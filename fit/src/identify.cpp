@@ -380,7 +380,7 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
   // Ctrl-C ends the fit within an iteration (interrupt.hpp).
   struct StopOnInterrupt : ceres::IterationCallback {
     ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-      return interrupt::requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+      return interrupt::interrupted() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
     }
   } stop;
   opt.callbacks.push_back(&stop);

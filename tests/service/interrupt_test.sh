@@ -27,7 +27,7 @@ interrupt() {
   # (RUN_SERIAL in tests/CMakeLists.txt).
   [ "$ms" -lt 1000 ] || fail "$name: took $ms ms to exit after SIGINT"
   [ "$(wc -l < "$TMP/$name.err")" = 1 ] || fail "$name: stderr is not one line: $(cat "$TMP/$name.err")"
-  grep -qx "error: interrupted by SIGINT" "$TMP/$name.err" || fail "$name: stderr: $(cat "$TMP/$name.err")"
+  grep -q "^error: interrupted by SIGINT" "$TMP/$name.err" || fail "$name: stderr: $(cat "$TMP/$name.err")"
   [ -z "$(find "$TMP" -maxdepth 2 -name '.*.partial-*')" ] || fail "$name: a staging folder remains"
   pass "$name: exit 130 after $ms ms, one line, nothing half-written"
 }

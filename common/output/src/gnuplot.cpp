@@ -1,6 +1,7 @@
 #include "feeddrive/output/gnuplot.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -97,7 +98,7 @@ void run_gnuplot(const fs::path& dir, const std::string& script) {
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
-    if (interrupt::requested()) {  // Ctrl-C: gnuplot goes too, at once (it may be drawing for minutes)
+    if (interrupt::interrupted()) {  // Ctrl-C or SIGTERM: stop gnuplot at once, then unwind
       ::kill(pid, SIGKILL);
       while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
       }

@@ -1,15 +1,11 @@
 #pragma once
-// The one interrupt flag of every feeddrive process (issue 13, point 8: Ctrl-C ends any phase
-// within a second).
+// The one interrupt flag of every feeddrive process: SIGINT and SIGTERM set it, long loops poll
+// it (interrupted()) and unwind, so destructors run: a staged output folder is removed
+// (output::StagedFolder), a child gnuplot is stopped (output::run_gnuplot).
 //
-// install() sets SIGINT/SIGTERM handlers (without SA_RESTART, so a blocking wait returns EINTR)
-// that only record the signal. Every long loop (simulating, writing, plotting, fitting, reading
-// a log, waiting on the bus) calls check(), which throws Interrupted once a signal came. The
-// process then removes what it had begun (a staged output folder), prints one line
-//   error: interrupted by SIGINT
-// and exits with exit_code(): 128 + the signal number (130 for SIGINT, 143 for SIGTERM), the
-// shell's convention for a process ended by a signal. docs/deployment.md, "Exit codes".
-// Header-only (C++17 inline variables), shared by every library and tool.
+// The handler only stores the signal number (async-signal-safe). It is installed without
+// SA_RESTART, so a blocking system call (poll, nanosleep, waitpid) returns EINTR at once and the
+// caller sees the flag.
 
 #include <signal.h>
 
@@ -21,59 +17,63 @@
 
 namespace feeddrive::interrupt {
 
-/// The signal received (0: none). Written only by the handler.
+namespace detail {
 inline volatile std::sig_atomic_t g_signal = 0;
-
 extern "C" inline void on_signal(int sig) { g_signal = sig; }
+}  // namespace detail
 
-/// Installs the handlers for SIGINT and SIGTERM. Idempotent.
-inline void install() {
+/// Installs the SIGINT/SIGTERM handlers (idempotent).
+inline void install_handlers() {
   struct sigaction sa {};
-  sa.sa_handler = on_signal;
+  sa.sa_handler = detail::on_signal;
   sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: a blocking poll, read or waitpid returns EINTR
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking call returns EINTR
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 }
 
 /// The signal that interrupted the process, or 0.
-inline int signal_number() { return g_signal; }
-inline bool requested() { return g_signal != 0; }
+inline int signal_number() { return detail::g_signal; }
+inline bool interrupted() { return detail::g_signal != 0; }
 
+/// "SIGINT", "SIGTERM" or "signal N".
 inline std::string signal_name(int sig) {
-  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal " + std::to_string(sig);
+  if (sig == SIGINT) return "SIGINT";
+  if (sig == SIGTERM) return "SIGTERM";
+  return "signal " + std::to_string(sig);
 }
 
-/// Thrown by check() once a signal came: the process stops what it does, cleans up, prints
-/// what() and exits with exit_code().
+/// Thrown by a loop that saw the flag; the tools exit 128 + signal.
 class Interrupted : public std::runtime_error {
  public:
   explicit Interrupted(int sig) : std::runtime_error("interrupted by " + signal_name(sig)), sig_(sig) {}
   int signal() const { return sig_; }
+  int exit_code() const { return 128 + sig_; }
 
  private:
   int sig_;
 };
 
-/// Throws Interrupted if a signal came. Cheap (one load): call it in every long loop.
+/// Throws Interrupted if a signal came.
 inline void check() {
-  if (g_signal != 0) throw Interrupted(g_signal);
+  if (const int s = detail::g_signal; s != 0) throw Interrupted(s);
 }
 
-/// The exit code of a process ended by signal `sig`: 128 + sig (130 for SIGINT).
-inline int exit_code(int sig) { return 128 + (sig > 0 ? sig : SIGINT); }
+/// Forgets the signal: for a tool that, once interrupted, still finishes a short job it must not
+/// lose (the monitor writing the steps it recorded); a second signal then stops that too.
+inline void clear() { detail::g_signal = 0; }
 
 /// Set (to "1") by feeddrive-launch for the processes it starts: the launcher reports the
 /// interrupt once, its children stay silent about it.
 inline constexpr const char* kQuietEnv = "FEEDDRIVE_INTERRUPT_QUIET";
 
-/// The end of an interrupted tool: prints the one line "error: interrupted by SIGINT" (unless
-/// started by feeddrive-launch) and returns the exit code. Usage: `catch (const Interrupted& e)
-/// { return interrupt::report(e); }`.
-inline int report(const Interrupted& e) {
+/// The end of an interrupted tool (docs/scenario.md, "Exit codes and Ctrl-C"): prints the one
+/// line "error: interrupted by SIGINT<detail>" (unless started by feeddrive-launch) and returns
+/// the exit code 128 + signal. Usage: `catch (const Interrupted& e) { return report(e); }`.
+inline int report(const Interrupted& e, const std::string& detail = "") {
   const char* quiet = std::getenv(kQuietEnv);
-  if (quiet == nullptr || std::string(quiet) != "1") std::fprintf(stderr, "error: %s\n", e.what());
-  return exit_code(e.signal());
+  if (quiet == nullptr || std::string(quiet) != "1") std::fprintf(stderr, "error: %s%s\n", e.what(), detail.c_str());
+  return e.exit_code();
 }
 
 }  // namespace feeddrive::interrupt
