@@ -197,13 +197,18 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["steps_without_command"] = rec_.commandless_rows();
   l["steps_per_second"] = rec_.steps_per_second();
   {
-    // One step on the wire: state + command + 1/16 of a reference block, each an LCM datagram of
-    // an 8-byte header, the channel name and its NUL, and the encoded message.
-    const auto packet = [](const std::string& channel, int payload) {
-      return 8 + static_cast<int>(channel.size()) + 1 + payload;
+    // One step on the wire: state + command + 1/16 of a block of 16 references, each an LCM
+    // datagram of an 8-byte header, the channel name and its NUL, and the encoded message (with
+    // its 32-byte mac when the run is authenticated).
+    const int mac = bus().authenticated() ? static_cast<int>(service::MessageAuth::kMacSize) : 0;
+    const auto packet = [mac](const std::string& channel, int payload) {
+      return 8 + static_cast<int>(channel.size()) + 1 + payload + mac;
     };
+    reference_block_t block{};
+    block.count = 16;
+    block.refs.resize(16);
     l["bytes_per_step"] = packet(channels().state, drive_state_t().getEncodedSize()) +
-                          (packet(channels().reference, 12) + 16 * reference_t().getEncodedSize()) / 16 +
+                          packet(channels().reference, block.getEncodedSize()) / 16 +
                           packet(channels().command, control_command_t().getEncodedSize());
   }
   l["safe_state"] = rec_.safe_state();

@@ -94,7 +94,12 @@ bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char*
   const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +
                            " for one step (" + diff + " differ); another publisher on the bus? (docs/security.md)";
   if (opt_.on_conflict == ConflictPolicy::kFail) throw RunFailure(what);
-  spdlog::error("{}: {}; kept the first ({} conflicts so far)", role_, what, conflicts);
+  // keep-first: every conflict is counted; the log names the first ten, then one a second.
+  const std::int64_t now = mono_us();
+  if (conflicts <= 10 || now - last_conflict_log_us_ > 1000000) {
+    last_conflict_log_us_ = now;
+    spdlog::error("{}: {}; kept the first ({} conflicts so far)", role_, what, conflicts);
+  }
   return false;
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../../examples/c/fd_sign.h"
 #include "feeddrive/service/bus.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/node.hpp"
@@ -101,6 +102,23 @@ TEST(MessageAuth, SignsChannelAndEncodingAndVerifies) {
   c.encode(plain.data(), 0, static_cast<int>(plain.size()));
   EXPECT_FALSE(auth.verify("FD_CMD", plain.data(), plain.size()));
   EXPECT_FALSE(auth.verify("FD_CMD", buf.data(), 10));
+}
+
+// The C example for external programs (examples/c/fd_sign.h) signs exactly as the processes do,
+// and verifies what they sign.
+TEST(MessageAuth, CExampleSignsLikeTheProcesses) {
+  const std::string key = "0123456789abcdef0123456789abcdef";
+  const auto* k = reinterpret_cast<const unsigned char*>(key.data());
+  const control_command_t c = command(11, -0.75);
+  std::vector<std::uint8_t> ours = encode_for_signing(c);
+  MessageAuth(key).sign("FD_CMD", ours.data(), ours.size());
+  std::vector<std::uint8_t> theirs = encode_for_signing(c);
+  ASSERT_EQ(fd_sign(k, static_cast<int>(key.size()), "FD_CMD", theirs.data(), theirs.size() - 32), theirs.size());
+  EXPECT_EQ(theirs, ours);
+  EXPECT_EQ(fd_verify(k, static_cast<int>(key.size()), "FD_CMD", ours.data(), ours.size()), 1);
+  EXPECT_EQ(fd_verify(k, static_cast<int>(key.size()), "FD_REF", ours.data(), ours.size()), 0);
+  ours[20] ^= 0x40;
+  EXPECT_EQ(fd_verify(k, static_cast<int>(key.size()), "FD_CMD", ours.data(), ours.size()), 0);
 }
 
 TEST(DifferingFields, NamesEveryDifferentFieldAndNothingElse) {

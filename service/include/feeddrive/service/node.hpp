@@ -112,6 +112,7 @@ class Node {
   std::string state_{"starting"};
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
+  std::int64_t last_conflict_log_us_{-1};
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;
 };
