@@ -239,9 +239,9 @@ ControllerEntry read_controller(const std::string& where, const YAML::Node& n, c
     const std::string text = read_file(path, where + ".scenario");
     YAML::Node s;
     try {
-      s = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-      fail(where + ".scenario", " = '" + file + "': line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+      s = sim::load_yaml_strict(text);
+    } catch (const sim::ScenarioError& e) {
+      fail(where + ".scenario", " = '" + file + "': " + e.what());
     }
     if (!s.IsMap() || !s["controller"].IsMap()) fail(where + ".scenario", " = '" + file + "': has no controller map");
     YAML::Emitter em;
@@ -315,12 +315,7 @@ void Study::validate() const {
 
 Study parse_study(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
   try {
-    YAML::Node root;
-    try {
-      root = YAML::Load(yaml_text);
-    } catch (const YAML::Exception& e) {
-      throw StudyError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-    }
+    const YAML::Node root = sim::load_yaml_strict(yaml_text);  // the scenario's strict YAML rules
     if (!root.IsMap()) throw StudyError("a study must be a YAML map with keys name, base, controllers, families");
     Study s;
     MapReader top(root, "");
