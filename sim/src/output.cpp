@@ -3,6 +3,7 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -103,7 +104,11 @@ void RunWriter::add(const Record& r) {
 void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json) {
   csv_->close();
   folder_.write_text("summary.json", summary_json(sum, s_, extra_json));
-  if (plots && summary_.steps() > 0) write_plots(folder_, plot_, s_.name);
+  if (plots && summary_.steps() > 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    write_plots(folder_, plot_, s_.name);
+    plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   folder_.commit();
 }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "feeddrive/common/validate.hpp"
+#include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -197,7 +198,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model)
   p.thrust_gain = model.thrust_gain();
 }
 
-void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::string& base_dir) {
+void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_enum(r, "kind", p.kind, controller::open_loop_kind_from_string, controller::to_string(p.kind));
   r.number("amplitude", p.amplitude);
   r.number("frequency", p.frequency);
@@ -207,8 +208,9 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::stri
   r.number("start_time", p.start_time);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  r.string("file", p.file);
-  if (!p.file.empty() && fs::path(p.file).is_relative()) p.file = (fs::path(base_dir) / p.file).string();
+  r.string("file", file);
+  if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
+  if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
 // --- reference -----------------------------------------------------------------------------
@@ -280,7 +282,7 @@ void validate_reference(const ReferenceConfig& c) {
     case ReferenceType::kAccelLimited: c.accel_limited.validate("reference"); break;
     case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
     case ReferenceType::kRamp: c.ramp.validate("reference"); break;
-    case ReferenceType::kWaypoints: trajectory::read_waypoints_csv(c.waypoints_file); break;
+    case ReferenceType::kWaypoints: break;  // read and checked in parse_node
   }
 }
 
@@ -324,7 +326,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
     s.controller.cascade.period = s.control_period;
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
-    read_open_loop(c, s.controller.open_loop, base_dir);
+    read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
     s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
   } else {
     c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop");
@@ -357,8 +359,11 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   top.finish();
   if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
 
-  // Component validation: each validate() names its key and value.
+  // Component validation: each validate() names its key and value; tables come from the files.
   try {
+    if (s.reference.type == ReferenceType::kWaypoints) s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
+    if (s.controller.type == ControllerType::kOpenLoop && s.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
+      read_open_loop_file(s.controller.open_loop_file, s.controller.open_loop);
     s.plant.validate("plant");
     switch (s.controller.type) {
       case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
@@ -376,6 +381,27 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
 }
 
 }  // namespace
+
+std::vector<trajectory::Waypoint> read_waypoints_file(const std::string& path) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"x"}}};
+  o.increasing = 0;
+  o.limits.min_rows = 2;  // a spline needs one interval
+  const csv::Table t = csv::read_file(path, o);
+  std::vector<trajectory::Waypoint> points(t.rows());
+  for (std::size_t i = 0; i < t.rows(); ++i) points[i] = {t.values[0][i], t.values[1][i]};
+  return points;
+}
+
+void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"force_N", "u"}}};  // force_N when the file has both
+  o.increasing = 0;
+  csv::Table t = csv::read_file(path, o);
+  p.table_t = std::move(t.values[0]);
+  p.table_value = std::move(t.values[1]);
+  p.table_is_force = t.used[1] == "force_N";
+}
 
 long Scenario::steps() const { return std::lround(duration / control_period); }
 
@@ -419,7 +445,7 @@ std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {
     case ReferenceType::kSCurve: return trajectory::make_scurve(c.scurve);
     case ReferenceType::kRamp: return trajectory::make_ramp(c.ramp);
     case ReferenceType::kWaypoints:
-      return trajectory::make_waypoints(trajectory::read_waypoints_csv(c.waypoints_file));
+      return trajectory::make_waypoints(c.waypoints);
   }
   return nullptr;
 }

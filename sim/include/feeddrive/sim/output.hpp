@@ -49,6 +49,8 @@ class RunWriter {
   /// extra_json) and the plots (when asked and there is at least one record), and swaps the
   /// folder into place. On failure the previous output is kept and the staged folder removed.
   void finish(const Summary& sum, bool plots, const std::string& extra_json = "");
+  /// Wall time finish() spent on the plots [s] (0 without plots).
+  double plot_seconds() const { return plot_seconds_; }
 
  private:
   const Scenario& s_;
@@ -58,6 +60,7 @@ class RunWriter {
   long every_;
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
+  double plot_seconds_{0.0};
 };
 
 /// Plots position+error, velocity error, control and forces into the staged folder (position.png,
