@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
@@ -111,6 +112,14 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+  } catch (const interrupt::Interrupted& e) {
+    // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
+    // Ctrl-C stops that too; then the process exits as interrupted (128 + signal).
+    progress(true);
+    interrupt::clear();
+    mopt_.plots = false;
+    finish(false, e.what());
+    throw interrupt::Interrupted(e.signal());
   } catch (const std::runtime_error& e) {  // writing a row failed (disk full, ...)
     failure = e.what();
   }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
@@ -58,6 +59,8 @@ int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, co
   install_signal_handlers();
   try {
     return body();
+  } catch (const interrupt::Interrupted& e) {
+    return interrupt::report(e);
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

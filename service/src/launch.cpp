@@ -18,6 +18,8 @@
 #include "feeddrive/service/integrity.hpp"
 #include <stdexcept>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::service {
 namespace {
 
@@ -57,6 +59,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
       for (int c : cpus) CPU_SET(c, &set);
       if (::sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "warning: sched_setaffinity failed\n");
     }
+    ::setenv(interrupt::kQuietEnv, "1", 1);  // an interrupt is reported once, by the launcher
     ::execv(exe.c_str(), argv.data());
     std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
     ::_exit(127);
@@ -192,6 +195,8 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     }
     ::usleep(20000);
   }
+  // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
+  interrupt::check();
   result.exit_code = result.failed.empty() ? 0 : 1;
   return result;
 }

@@ -104,7 +104,7 @@ bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char*
 }
 
 void Node::check_peers() const {
-  if (const int sig = interrupt::signal_number(); sig != 0) throw RunFailure("interrupted by " + interrupt::signal_name(sig));
+  interrupt::check();
   for (const auto& [role, st] : peers_)
     if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
 }

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "feeddrive/common/text.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
@@ -286,11 +288,27 @@ void validate_reference(const ReferenceConfig& c) {
   }
 }
 
+// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length
+// (a 50 MB name once made the plots take 4.8 GB).
+void check_name(const std::string& name, const std::string& what) {
+  if (name.size() > kMaxNameBytes)
+    throw ScenarioError(what + ": " + std::to_string(name.size()) + " bytes: too long (at most " +
+                        std::to_string(kMaxNameBytes) + ")");
+  const std::size_t bad = text::first_unprintable(name);
+  if (bad < name.size()) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(name[bad])));
+    throw ScenarioError(what + ": byte " + std::to_string(bad + 1) + " (" + hex +
+                        ") is not printable UTF-8 (control character or malformed sequence)");
+  }
+}
+
 Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   MapReader top(root, "");
   Scenario s;
   top.string("name", s.name);
+  check_name(s.name, "name");
   if (!top.has("duration")) top.fail("duration", ": missing (required)");
   if (!top.has("control_period")) top.fail("control_period", ": missing (required)");
   top.number("duration", s.duration);
@@ -407,12 +425,7 @@ long Scenario::steps() const { return std::lround(duration / control_period); }
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
   try {
-    YAML::Node root;
-    try {
-      root = YAML::Load(yaml_text);
-    } catch (const YAML::Exception& e) {
-      throw ScenarioError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-    }
+    const YAML::Node root = load_yaml_strict(yaml_text);
     Scenario s = parse_node(root, base_dir);
     return s;
   } catch (const ScenarioError& e) {
@@ -431,7 +444,10 @@ Scenario load_scenario(const std::string& path) {
   const fs::path p(path);
   Scenario s = parse_scenario(buf.str(), p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;
-  if (s.name.empty()) s.name = p.stem().string();
+  if (s.name.empty()) {
+    s.name = p.stem().string();
+    check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
+  }
   return s;
 }
 

@@ -68,8 +68,11 @@ struct OutputConfig {
 /// "Limits"): 1e10 steps are about a day of wall time at the fastest measured 7 us per step.
 inline constexpr double kMaxSteps = 1e10;
 
+/// Longest scenario name accepted [bytes].
+inline constexpr std::size_t kMaxNameBytes = 256;
+
 struct Scenario {
-  std::string name;
+  std::string name;  ///< printable UTF-8, at most kMaxNameBytes
   std::string path;  ///< file it was loaded from ("" if parsed from a string)
   double duration{1.0};        ///< [s]
   double control_period{1e-4}; ///< [s]
