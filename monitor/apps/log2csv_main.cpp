@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     l["undecodable_events"] = c.undecodable;
     l["non_finite_messages"] = c.non_finite;
     l["foreign_events"] = c.foreign_events;
-    out.finish(out.summary().summary(0.0, {}), plots, j.dump());
+    out.finish(out.summary(0.0, {}), plots, j.dump());
     spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
                  log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
                  out_dir);
