@@ -13,6 +13,7 @@
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/plant/cvode_integrator.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
@@ -90,6 +91,7 @@ int main(int argc, char** argv) {
         scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();
     const fit::MeasuredData data = fit::load_data(data_path, prefix, csv);
     const fit::Record rec = fit::prepare(data, opt.record);
+    for (const std::string& n : data.notes) spdlog::warn("{}: {}", data_path, n);
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),
                  scenario_path);
     const fit::FitResult r = fit::run_fit(rec, scenario.plant, opt, [](const std::string& s) { spdlog::info("{}", s); });
@@ -105,6 +107,9 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const interrupt::Interrupted& e) {  // Ctrl-C in any phase: nothing written
     return interrupt::report(e);
+  } catch (const plant::IntegrationError& e) {  // the model cannot be replayed on this record
+    std::fprintf(stderr, "error: %s: %s\n", scenario_path.c_str(), e.what());
+    return 2;
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -94,23 +95,37 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
   monitor::LogConversion c;
   std::vector<sim::Record> rows;
   try {
-    c = monitor::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); });
+    c = monitor::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false);
   } catch (const std::exception& e) {
     throw DataError(e.what());
   }
   if (rows.empty())
     throw DataError(path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +
                     std::to_string(c.events) + " events read; wrong --prefix?)");
+  if (!c.recorder.gaps().empty())
+    throw DataError(path + ": " + monitor::describe_gaps(c.recorder.gaps()) + " of " +
+                    std::to_string(c.recorder.steps()) + "; the fit needs every state (position and applied input); " +
+                    "feeddrive-log2csv writes the complete steps");
   MeasuredData d;
   d.source = path;
   d.input_kind = InputKind::kCommand;
+  bool all_xd = true;
   for (const auto& r : rows) {
     d.t.push_back(r.t);
     d.x.push_back(r.x_measured);
     d.input.push_back(r.u);
     d.xd.push_back(r.xd);
     d.v.push_back(r.v_measured);
+    all_xd = all_xd && std::isfinite(r.xd);
   }
+  if (!all_xd) {
+    d.xd.clear();
+    d.notes.push_back("some reference messages are missing from the log: the record has no xd column");
+  }
+  if (const auto n = c.recorder.commandless_rows(); n > 0)
+    d.notes.push_back(std::to_string(n) + " of " + std::to_string(rows.size()) +
+                      " steps have no command in the log: their input is the one the plant applied (from its next state)");
+  if (c.non_finite > 0) d.notes.push_back(std::to_string(c.non_finite) + " messages with a non-finite value were dropped");
   validate(d);
   return d;
 }
@@ -118,8 +133,20 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
 MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  if (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") return load_lcm_log(path, prefix);
-  return load_csv(path, opt);
+  MeasuredData d = (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") ? load_lcm_log(path, prefix) : load_csv(path, opt);
+  shift_time_origin(d);
+  return d;
+}
+
+void shift_time_origin(MeasuredData& d) {
+  if (d.t.empty() || d.t.front() == 0.0) return;
+  const double t0 = d.t.front();
+  for (double& t : d.t) t -= t0;  // exact for t within a factor 2 of t0 (Sterbenz), close to it otherwise
+  d.time_offset += t0;
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "time stamps shifted by %.17g s to start at 0", -t0);
+  d.notes.push_back(buf);
+  validate(d);  // a shift can merge time stamps that differ in their last bits
 }
 
 }  // namespace feeddrive::fit

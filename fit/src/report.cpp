@@ -65,8 +65,11 @@ nlohmann::json bins_json(const std::vector<Bin>& bins) {
 
 }  // namespace
 
-std::string findings_json(const FitResult& r) {
+std::string findings_json(const FitResult& r, const MeasuredData* data) {
   nlohmann::json j;
+  if (data != nullptr)
+    j["data"] = {{"source", data->source}, {"samples", data->size()}, {"time_offset_s", data->time_offset},
+                 {"notes", data->notes}};
   j["gap_initial"] = r.replay_initial.gap;
   j["gap_final"] = r.replay_final.gap;
   j["gap_unit"] = "m";
@@ -144,9 +147,9 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
                    const FitResult& r, bool plots) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
   {
-    out.write_text("findings.json", findings_json(r));
-    out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
     const MeasuredData& d = *rec.data;
+    out.write_text("findings.json", findings_json(r, &d));
+    out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
     // data behind the plots
     {
       output::CsvWriter f(out.path("replay.csv"), {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
@@ -184,7 +187,9 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
        << "- model: `" << scenario_path << "`\n- data: `" << d.source << "` (" << d.size() << " samples, "
        << d.t.back() - d.t.front() << " s, median period " << rec.period * 1e3 << " ms)\n"
        << "- filter half-width L = " << rec.bank.half_width * 1e3 << " ms, " << rec.bank.tau.size()
-       << " independent force-residual points\n\n"
+       << " independent force-residual points\n";
+    for (const std::string& n : d.notes) md << "- data note: " << n << "\n";
+    md << "\n"
        << "**" << r.conclusion << "**\n\n"
        << "The gap is the RMS position error of the model replayed from the measured state over windows "
           "(docs/fit.md); the force measure is the RMS of the filtered force residual.\n\n"

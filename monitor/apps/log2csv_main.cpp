@@ -1,8 +1,13 @@
 // feeddrive-log2csv: turns an LCM log of a run (stock lcm-logger) into DIR/timeseries.csv and
 // DIR/summary.json, the same files feeddrive-monitor writes. Wiring only: read_log -> RunWriter.
+// Every complete step is written, across gaps (the stock logger drops messages); the steps that
+// are missing are reported in one warning line and in summary.json ("log": missing_steps, gaps).
+// Exit 2 (one line) for a log that cannot be read, is corrupt (the event's byte offset), or holds
+// no complete step.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "feeddrive/monitor/log_reader.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -31,18 +36,28 @@ int main(int argc, char** argv) {
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
     const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
     const monitor::Recorder& rec = c.recorder;
-    const sim::Summary sum = out.summary(0.0, {});
-    out.finish(sum, plots);
-    const bool complete = rec.complete();
-    spdlog::info("{}: {} events, {} rows{}, {} undecodable, {} on other channels -> {}", log_path, c.events,
-                 rec.rows(), complete ? " (complete run)" : "", c.undecodable, c.foreign_events, out_dir);
-    if (!complete) {
-      std::string why = rec.end_seen() ? "" : "; the log has no end-of-run state";
-      for (const auto& m : rec.missing()) why += "; no " + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
-      std::fprintf(stderr, "error: %s: incomplete run: rows stop at step %lld%s\n", log_path.c_str(),
-                   static_cast<long long>(rec.next()), why.c_str());
-      return 1;
-    }
+    if (out.steps() == 0)
+      throw std::invalid_argument(log_path + ": no complete step on channels " + opt.prefix + "_STATE/_REF/_CMD (" +
+                                  std::to_string(c.events) + " events read; wrong --prefix?)");
+    nlohmann::ordered_json j;
+    auto& l = j["log"];
+    l["events"] = c.events;
+    l["steps_expected"] = rec.steps();
+    l["missing_steps"] = rec.missing_steps();
+    l["gaps"] = nlohmann::ordered_json::array();
+    for (const auto& g : rec.gaps()) l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
+    l["steps_without_command"] = rec.commandless_rows();
+    l["end_of_run_seen"] = rec.end_seen();
+    l["undecodable_events"] = c.undecodable;
+    l["non_finite_messages"] = c.non_finite;
+    l["foreign_events"] = c.foreign_events;
+    out.finish(out.summary(0.0, {}), plots, j.dump());
+    spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
+                 log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
+                 out_dir);
+    if (!rec.gaps().empty())
+      spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, monitor::describe_gaps(rec.gaps()),
+                   rec.steps(), out.steps(), out_dir);
     return 0;
   });
 }

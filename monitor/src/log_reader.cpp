@@ -1,5 +1,6 @@
 #include "feeddrive/monitor/log_reader.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <stdexcept>
@@ -81,16 +82,42 @@ class LogParser {
 template <typename Msg, typename F>
 void decode_into(const Event& ev, LogConversion& out, F&& f) {
   Msg m;
-  if (m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) < 0) {
+  bool ok = false;
+  try {
+    ok = m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) >= 0;
+  } catch (const std::exception&) {  // a corrupt array length: lcm-gen's decode allocates it first
+    ok = false;
+  }
+  if (!ok) {
     ++out.undecodable;
     return;
   }
   f(m, ev.timestamp);
 }
 
+// What a row takes from a state and a reference must be finite (a flipped bit in a logged
+// double can make it NaN or 1e308-large: dropped and counted, the step becomes a gap).
+bool finite_state(const drive_state_t& m) {
+  bool ok = std::isfinite(m.t) && std::isfinite(m.x_measured) && std::isfinite(m.v_measured) && m.seq >= 0;
+  if (m.truth.valid)
+    ok = ok && std::isfinite(m.truth.x) && std::isfinite(m.truth.v) && std::isfinite(m.truth.z) &&
+         std::isfinite(m.truth.fg) && std::isfinite(m.truth.i);
+  if (m.previous.seq >= 0) ok = ok && std::isfinite(m.previous.u);
+  if (m.previous.seq >= 0 && m.previous.forces_valid)
+    ok = ok && std::isfinite(m.previous.f_thrust) && std::isfinite(m.previous.f_friction) &&
+         std::isfinite(m.previous.f_ripple) && std::isfinite(m.previous.f_grinding);
+  return ok;
+}
+
+bool finite_reference(const reference_t& m) {
+  return std::isfinite(m.t) && std::isfinite(m.position) && std::isfinite(m.velocity) && std::isfinite(m.acceleration) &&
+         std::isfinite(m.jerk) && m.seq >= 0;
+}
+
 }  // namespace
 
-LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink) {
+LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
+                       bool need_reference) {
   LogParser log(path);
   const service::Channels ch(prefix);
   LogConversion out;
@@ -98,10 +125,19 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
   while (log.next(ev, out.events)) {
     if (++out.events % 1024 == 0) interrupt::check();
     if (ev.channel == ch.state) {
-      decode_into<drive_state_t>(ev, out, [&](const drive_state_t& m, std::int64_t t) { out.recorder.on_state(m, t); });
+      decode_into<drive_state_t>(ev, out, [&](const drive_state_t& m, std::int64_t t) {
+        if (!finite_state(m)) return void(++out.non_finite);
+        out.recorder.on_state(m, t);
+      });
     } else if (ev.channel == ch.reference) {
       decode_into<reference_block_t>(ev, out, [&](const reference_block_t& b, std::int64_t t) {
-        for (const reference_t& m : b.refs) out.recorder.on_reference(m, t);
+        for (const reference_t& m : b.refs) {
+          if (!finite_reference(m)) {
+            ++out.non_finite;
+            continue;
+          }
+          out.recorder.on_reference(m, t);
+        }
       });
     } else if (ev.channel == ch.command) {
       decode_into<control_command_t>(ev, out, [&](const control_command_t& m, std::int64_t t) { out.recorder.on_command(m, t); });
@@ -113,7 +149,7 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
       interrupt::check();        // Ctrl-C: unwind (a staged output folder is removed)
     }
   }
-  out.recorder.flush(sink);
+  out.recorder.flush_final(sink, need_reference);
   return out;
 }
 

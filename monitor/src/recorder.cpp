@@ -9,7 +9,10 @@
 namespace feeddrive::monitor {
 
 void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
-  if (m.steps > 0) steps_ = m.steps;
+  if (m.steps > 0) {
+    steps_ = m.steps;
+    ++steps_votes_[m.steps];
+  }
   if (m.end_of_run) end_seen_ = true;
   rejected_ = std::max<std::int64_t>(rejected_, m.rejected_commands);
   missed_ = std::max<std::int64_t>(missed_, m.missed_deadlines);
@@ -97,6 +100,102 @@ std::size_t Recorder::flush(const sim::RecordSink& sink) {
     ++rows_;
   }
   return added;
+}
+
+void Recorder::add_row(const Seen<drive_state_t>& s, const reference_t* r, const control_command_t* c,
+                       const drive_state_t& s1, const sim::RecordSink& sink) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  control_command_t none{};
+  if (c == nullptr) {
+    none.seq = s.msg.seq;
+    none.t = s.msg.t;
+    none.u = none.u_unsaturated = none.sliding = none.z_estimate = nan;
+    c = &none;
+    ++commandless_;
+  }
+  reference_t no_ref{};
+  if (r == nullptr) {
+    no_ref.seq = s.msg.seq;
+    no_ref.t = s.msg.t;
+    no_ref.position = no_ref.velocity = no_ref.acceleration = no_ref.jerk = nan;
+    r = &no_ref;
+  }
+  sink(service::to_record(s.msg, *r, *c, s1.previous));
+}
+
+std::size_t Recorder::flush_final(const sim::RecordSink& sink, bool need_reference) {
+  std::size_t added = 0;
+  if (attach_ && !started_) return added;
+  // The step count: the value most states carry.
+  std::int64_t steps = -1;
+  long votes = 0;
+  for (const auto& [n, v] : steps_votes_)
+    if (v > votes) steps = n, votes = v;
+  steps_ = steps;
+  // Messages of steps outside the run (a corrupt sequence number) can never make a row.
+  const auto in_run = [&](std::int64_t k) { return steps < 0 || k <= steps; };
+  const auto add_gap = [&](std::int64_t first, std::int64_t last, const std::string& why) {
+    if (!gaps_.empty() && gaps_.back().last + 1 == first) {
+      gaps_.back().last = last;
+    } else {
+      gaps_.push_back({first, last, why});
+    }
+  };
+  for (;;) {
+    if (steps >= 0 && next_ >= steps) break;
+    const auto s = states_.find(next_);
+    const auto s1 = states_.find(next_ + 1);
+    const auto r = refs_.find(next_);
+    const auto c = cmds_.find(next_);
+    const bool have_ref = r != refs_.end();
+    if (s != states_.end() && s1 != states_.end() && (have_ref || !need_reference)) {
+      add_row(s->second, have_ref ? &r->second.msg : nullptr, c == cmds_.end() ? nullptr : &c->second.msg, s1->second.msg, sink);
+      states_.erase(s);
+      if (have_ref) refs_.erase(r);
+      if (c != cmds_.end()) cmds_.erase(c);
+      ++added;
+      ++next_;
+      continue;
+    }
+    // Step next_ cannot be completed. Where does the next step that might start?
+    std::int64_t resume = std::numeric_limits<std::int64_t>::max();
+    const auto after = states_.upper_bound(next_);
+    if (after != states_.end() && in_run(after->first)) resume = after->first;
+    if (s != states_.end() && s1 != states_.end()) resume = next_ + 1;  // only the reference is missing
+    const std::string why = s == states_.end()    ? "no state " + std::to_string(next_) + " from the plant"
+                            : s1 == states_.end() ? "no state " + std::to_string(next_ + 1) + " from the plant"
+                                                  : "no reference " + std::to_string(next_) + " from the trajectory";
+    if (resume == std::numeric_limits<std::int64_t>::max()) {
+      // Nothing after it: the log ends before the run does.
+      if (steps >= 0) add_gap(next_, steps - 1, why + (s == states_.end() ? " (the log ends)" : ""));
+      next_ = steps >= 0 ? steps : next_;
+      break;
+    }
+    add_gap(next_, resume - 1, why);
+    next_ = resume;
+    states_.erase(states_.begin(), states_.lower_bound(next_));
+    refs_.erase(refs_.begin(), refs_.lower_bound(next_));
+    cmds_.erase(cmds_.begin(), cmds_.lower_bound(next_));
+  }
+  return added;
+}
+
+std::int64_t Recorder::missing_steps() const {
+  std::int64_t n = 0;
+  for (const Gap& g : gaps_) n += g.steps();
+  return n;
+}
+
+std::string describe_gaps(const std::vector<Gap>& gaps, std::size_t max_listed) {
+  std::int64_t total = 0;
+  for (const Gap& g : gaps) total += g.steps();
+  std::string out = std::to_string(total) + (total == 1 ? " step" : " steps") + " missing:";
+  for (std::size_t i = 0; i < gaps.size() && i < max_listed; ++i) {
+    const Gap& g = gaps[i];
+    out += (i ? ", " : " ") + std::to_string(g.first) + (g.last > g.first ? "-" + std::to_string(g.last) : "") + " (" + g.why + ")";
+  }
+  if (gaps.size() > max_listed) out += " and " + std::to_string(gaps.size() - max_listed) + " more gaps";
+  return out;
 }
 
 std::vector<Missing> Recorder::missing() const {

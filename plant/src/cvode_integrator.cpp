@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "feeddrive/common/validate.hpp"
+
 namespace feeddrive::plant {
 namespace {
 
@@ -83,8 +85,9 @@ int jac(sunrealtype t, N_Vector y, N_Vector /*fy*/, SUNMatrix J, void* user_data
 }  // namespace
 
 struct CvodeIntegrator::Impl {
-  explicit Impl(const PlantParams& p) : params(p) {}
+  explicit Impl(const PlantParams& p) : params(p), given(p) {}
   EffectiveParams params;
+  PlantParams given;  ///< as the scenario states them: failure messages name these keys
   UserData user;
   SUNContext ctx{nullptr};
   N_Vector y{nullptr};
@@ -197,8 +200,9 @@ void CvodeIntegrator::advance(double u, double t_next) {
   const int flag = CVode(m.mem, t_next, m.y, &t_reached, CV_NORMAL);
   m.accumulate();
   if (flag < 0)
-    throw std::runtime_error("CVODE: CVode failed with flag " + std::to_string(flag) + " (" +
-                             CVodeGetReturnFlagName(flag) + ") at t = " + std::to_string(t_reached));
+    throw IntegrationError("CVODE: CVode failed with flag " + std::to_string(flag) + " (" +
+                             CVodeGetReturnFlagName(flag) + ") at t = " + validate::format_number(t_reached) +
+                             " with u = " + validate::format_number(u) + "; " + m.given.fastest_time_scales());
   y_ = state_of(t_next, m.y, ud).to_vector();
   t_ = t_next;  // exactly the boundary (CV_TSTOP_RETURN stops there)
 }

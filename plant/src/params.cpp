@@ -2,8 +2,11 @@
 
 #include "feeddrive/common/validate.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 namespace feeddrive::plant {
 using validate::fail;
@@ -144,6 +147,11 @@ void EffectsParams::validate(const std::string& prefix) const {
 void SensorParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".quantization", quantization);
   require_non_negative(prefix + ".noise_stddev", noise_stddev);
+  // Beyond these the measurement overflows (a 1e308 noise gave inf measurements) or rounds to
+  // nothing: a step of 1 pm is far below any encoder's, 1 m of noise far above any drive's.
+  if (quantization > 0.0 && quantization < 1e-12) fail(prefix + ".quantization", quantization, "must be 0 or >= 1e-12 m");
+  if (quantization > 1.0) fail(prefix + ".quantization", quantization, "must be <= 1 m");
+  if (noise_stddev > 1.0) fail(prefix + ".noise_stddev", noise_stddev, "must be <= 1 m");
   if (velocity != "auto" && velocity != "true" && velocity != "difference")
     throw std::invalid_argument(prefix + ".velocity = '" + velocity +
                                 "': expected one of auto, true, difference");
@@ -193,6 +201,62 @@ void PlantParams::validate(const std::string& prefix) const {
   require_finite(prefix + ".initial.bristle", initial.bristle);
   require_finite(prefix + ".initial.grinding", initial.grinding);
   require_finite(prefix + ".initial.current", initial.current);
+}
+
+std::string PlantParams::fastest_time_scales(std::size_t n) const {
+  using validate::format_number;
+  struct Scale {
+    double rate;  // [1/s]
+    std::string keys;
+    const char* what;
+  };
+  std::vector<Scale> s;
+  const std::string m = "plant.mass = " + format_number(mass);
+  if (friction.model == FrictionModel::kLuGre) {
+    s.push_back({std::sqrt(friction.bristle_stiffness / mass),
+                 "plant.friction.bristle_stiffness = " + format_number(friction.bristle_stiffness) + " with " + m,
+                 "presliding oscillation"});
+    s.push_back({friction.bristle_damping / mass,
+                 "plant.friction.bristle_damping = " + format_number(friction.bristle_damping) + " with " + m, "bristle damping"});
+  }
+  if (friction.model != FrictionModel::kNone && friction.viscous > 0)
+    s.push_back({friction.viscous / mass, "plant.friction.viscous = " + format_number(friction.viscous) + " with " + m,
+                 "viscous damping"});
+  if (grinding.enabled)
+    s.push_back({1.0 / grinding.time_constant(),
+                 "plant.grinding.stiffness = " + format_number(grinding.stiffness) + ", dullness = " +
+                     format_number(grinding.dullness),
+                 "grinding force lag"});
+  if (electrical.enabled)
+    s.push_back({electrical.resistance / electrical.inductance,
+                 "plant.electrical.resistance = " + format_number(electrical.resistance) + ", inductance = " +
+                     format_number(electrical.inductance),
+                 "current loop"});
+  if (effects.presliding.enabled)
+    s.push_back({std::sqrt(effects.presliding.bristle_stiffness_N_per_m / mass),
+                 "plant.effects.presliding.bristle_stiffness_N_per_m = " +
+                     format_number(effects.presliding.bristle_stiffness_N_per_m) + " with " + m,
+                 "presliding oscillation"});
+  if (effects.spring_force.enabled)
+    s.push_back({std::sqrt(effects.spring_force.stiffness_N_per_m / mass),
+                 "plant.effects.spring_force.stiffness_N_per_m = " + format_number(effects.spring_force.stiffness_N_per_m) +
+                     " with " + m,
+                 "spring oscillation"});
+  if (effects.viscous_friction.enabled)
+    s.push_back({effects.viscous_friction.viscous_Ns_per_m / mass,
+                 "plant.effects.viscous_friction.viscous_Ns_per_m = " +
+                     format_number(effects.viscous_friction.viscous_Ns_per_m) + " with " + m,
+                 "viscous damping"});
+  std::sort(s.begin(), s.end(), [](const Scale& a, const Scale& b) { return a.rate > b.rate; });
+  std::string out;
+  for (std::size_t i = 0; i < s.size() && i < n; ++i) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " (%s: %.3g 1/s, time scale %.3g s)", s[i].what, s[i].rate, 1.0 / s[i].rate);
+    out += (i ? "; " : "") + s[i].keys + buf;
+  }
+  if (out.empty()) out = "no fast dynamics in the model (mass " + format_number(mass) + ")";
+  return "fastest time scales: " + out + "; plant.integrator.max_steps = " + std::to_string(integrator.max_steps) +
+         " per control period, rtol = " + format_number(integrator.rtol);
 }
 
 }  // namespace feeddrive::plant

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/plant/cvode_integrator.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
@@ -61,6 +62,9 @@ int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, co
     return body();
   } catch (const interrupt::Interrupted& e) {
     return interrupt::report(e);
+  } catch (const plant::IntegrationError& e) {  // the scenario's keys make it unintegrable
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

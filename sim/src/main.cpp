@@ -56,6 +56,12 @@ int main(int argc, char** argv) {
   } catch (const feeddrive::interrupt::Interrupted& e) {
     std::fprintf(stderr, "error: %s; nothing written to %s\n", e.what(), feeddrive::output::shown(out_dir).c_str());
     return e.exit_code();
+  } catch (const feeddrive::plant::IntegrationError& e) {  // the scenario's keys make it unintegrable
+    std::fprintf(stderr, "error: %s: %s\n", scenario_path.c_str(), e.what());
+    return 2;
+  } catch (const feeddrive::sim::ScenarioError& e) {  // a non-finite value at run time (check_finite_step)
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -305,6 +305,50 @@ void check_name(const std::string& name, const std::string& what) {
   }
 }
 
+// The reference and an open-loop command are pure functions of t: a NaN or infinity they would
+// produce (waypoints at 1e308, a sine at 1e308 Hz) is found here, before the run, at up to
+// 100000 of the run's step times (every step of a run up to that size). The error names the
+// section's keys and values as written. What depends on the motion is guarded at run time
+// (simulation.cpp).
+void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
+  const long n = s.steps();
+  const long samples = std::min<long>(n + 1, 100000);
+  const auto step_at = [&](long i) {
+    return samples <= 1 ? 0L : static_cast<long>(static_cast<double>(i) * static_cast<double>(n) / static_cast<double>(samples - 1));
+  };
+  const auto section = [&](const char* key) {
+    YAML::Emitter e;
+    e << YAML::Flow << root[key];
+    std::string text = e.c_str();
+    for (char& c : text)
+      if (c == '\n') c = ' ';
+    return text.size() > 200 ? text.substr(0, 200) + "..." : text;
+  };
+  const auto fail = [&](const std::string& what, double v, double t, const char* key, const char* gives) {
+    throw ScenarioError(std::string(key) + ": " + what + " = " + validate::format_number(v) + " at t = " +
+                        validate::format_number(t) + " s: " + key + " " + section(key) + " " + gives);
+  };
+  if (s.reference.type != ReferenceType::kNone) {
+    const auto ref = make_reference(s);
+    for (long i = 0; i < samples; ++i) {
+      const double t = s.time_of(step_at(i));
+      const trajectory::Sample q = ref->sample(t);
+      const std::pair<const char*, double> fields[] = {
+          {"position", q.position}, {"velocity", q.velocity}, {"acceleration", q.acceleration}, {"jerk", q.jerk}};
+      for (const auto& [what, v] : fields)
+        if (!std::isfinite(v)) fail(std::string("the reference's ") + what, v, t, "reference", "gives no finite trajectory");
+    }
+  }
+  if (s.controller.type == ControllerType::kOpenLoop) {
+    const controller::OpenLoopSource src(s.controller.open_loop);
+    for (long i = 0; i < samples; ++i) {
+      const double t = s.time_of(step_at(i));
+      const double f = src.force(t);
+      if (!std::isfinite(f)) fail("the open-loop force", f, t, "controller", "gives no finite command");
+    }
+  }
+}
+
 Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
   if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   MapReader top(root, "", resolved);
@@ -397,6 +441,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   if (s.steps() < 1)
     throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
                         validate::format_number(s.control_period) + " s)");
+  check_functions_of_time(s, root);
   return s;
 }
 

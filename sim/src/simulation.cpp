@@ -1,8 +1,10 @@
 #include "feeddrive/sim/simulation.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/plant/command.hpp"
 #include "feeddrive/plant/plant.hpp"
 
@@ -54,7 +56,35 @@ Record make_record(double t, const trajectory::Sample& ref, const plant::State& 
   return r;
 }
 
+void check_finite_step(const Scenario& s, long k, const Record& r, double command) {
+  const auto fail = [&](const std::string& what, double v, const std::string& source) {
+    throw ScenarioError("step " + std::to_string(k) + " (t = " + validate::format_number(r.t) + " s): " + what + " = " +
+                        validate::format_number(v) + ": " + source);
+  };
+  static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop"};
+  const std::string controller =
+      std::string("from the controller (controller.type = ") + kControllers[static_cast<int>(s.controller.type)] +
+      "; its gains or model make it diverge)";
+  const std::string reference = "from the reference (the reference section)";
+  const std::string sensor = "from the sensor (plant.sensor.quantization = " + validate::format_number(s.plant.sensor.quantization) +
+                             ", noise_stddev = " + validate::format_number(s.plant.sensor.noise_stddev) + ")";
+  const std::string plant = "from the plant, driven to it (" + s.plant.fastest_time_scales(1) + ")";
+  if (!std::isfinite(command)) fail("the command u", command, controller);
+  const std::pair<const char*, double> ref[] = {{"xd", r.xd}, {"vd", r.vd}, {"ad", r.ad}, {"jd", r.jd}};
+  for (const auto& [what, v] : ref)
+    if (!std::isfinite(v)) fail(what, v, reference);
+  const std::pair<const char*, double> meas[] = {{"x_measured", r.x_measured}, {"v_measured", r.v_measured}};
+  for (const auto& [what, v] : meas)
+    if (!std::isfinite(v)) fail(what, v, sensor);
+  const std::pair<const char*, double> state[] = {{"x", r.x}, {"v", r.v}, {"z", r.z}, {"fg", r.fg}, {"i", r.i},
+                                                  {"f_thrust", r.f_thrust}, {"f_friction", r.f_friction},
+                                                  {"f_ripple", r.f_ripple}, {"f_grinding", r.f_grinding}};
+  for (const auto& [what, v] : state)
+    if (!std::isfinite(v)) fail(what, v, plant);
+}
+
 RunStats run(const Scenario& s, const RecordSink& sink) {
+
   const auto wall_start = std::chrono::steady_clock::now();
   plant::Plant drive(s.plant, s.control_period);
   const auto reference = make_reference(s);
@@ -70,7 +100,10 @@ RunStats run(const Scenario& s, const RecordSink& sink) {
     const controller::Truth truth{st.z, st.fg};
     const controller::Command cmd = controller->update(ref, meas, &truth);
     const double u = plant::admit_command(cmd.u, s.plant.input_limit).u;
-    sink(make_record(t, ref, st, meas, cmd, u, drive.forces(u)));
+    const plant::Forces f = drive.forces(u);
+    const Record r = make_record(t, ref, st, meas, cmd, u, f);
+    check_finite_step(s, k, r, cmd.u);
+    sink(r);
     drive.advance(u, s.time_of(k + 1));
   }
   RunStats stats;

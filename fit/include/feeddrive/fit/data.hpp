@@ -33,6 +33,8 @@ struct MeasuredData {
   InputKind input_kind{InputKind::kCommand};
   std::vector<double> xd;           ///< reference [m], empty if absent
   std::vector<double> v;            ///< measured velocity [m/s], empty if absent
+  double time_offset{0.0};          ///< subtracted from the file's time stamps (t[0] is 0) [s]
+  std::vector<std::string> notes;   ///< what the loader did to the record (report.md, findings.json)
   std::size_t size() const { return t.size(); }
   /// Median sample period [s].
   double median_period() const;
@@ -54,10 +56,21 @@ struct CsvOptions {
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt = {});
 /// Parses CSV text; `origin` names it in messages.
 MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt = {});
-/// Reads an LCM log written by lcm-logger (channels <prefix>_STATE/_REF/_CMD). Throws DataError.
+/// Reads an LCM log written by lcm-logger (channels <prefix>_STATE/_REF/_CMD). Every step needs
+/// its state and the next one (position, and the input applied during the step); a step whose
+/// command was lost (the stock logger drops messages) uses the applied input the plant reports
+/// in the next state, and one whose reference was lost costs only the optional xd column; both
+/// are noted. A lost state is a gap the fit cannot bridge: DataError naming how many steps are
+/// missing and where. Throws DataError.
 MeasuredData load_lcm_log(const std::string& path, const std::string& prefix);
-/// Loads by extension: .lcm / .lcmlog / .log -> LCM log, anything else -> CSV.
+/// Loads by extension: .lcm / .lcmlog / .log -> LCM log, anything else -> CSV. Time stamps are
+/// shifted to start at 0 (time_offset): epoch time stamps (t ~ 1e9 s) would leave the
+/// integrator a step size below the resolution of t.
 MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt = {});
+
+/// Subtracts t[0] from every time stamp (adds it to time_offset, with a note). Throws DataError
+/// if two time stamps become equal.
+void shift_time_origin(MeasuredData& d);
 
 /// Checks sizes, finiteness and strictly increasing time (used by the loaders). Throws DataError.
 void validate(const MeasuredData& d);

@@ -13,8 +13,8 @@ namespace feeddrive::fit {
 std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::PlantParams& fitted);
 
 /// findings.json: {"gap_initial", "gap_final", "effects": [{name, parameters, score, gap_before,
-/// gap_after}], ...}.
-std::string findings_json(const FitResult& r);
+/// gap_after}], "data": {source, samples, time_offset_s, notes}, ...}.
+std::string findings_json(const FitResult& r, const MeasuredData* data = nullptr);
 
 /// Writes the results into out_dir through output::StagedFolder (feeddrive/output/folder.hpp:
 /// check --out before the work with output::check_output_dir). Throws std::invalid_argument if

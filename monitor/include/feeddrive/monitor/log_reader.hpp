@@ -13,11 +13,15 @@ struct LogConversion {
   long events{0};                 ///< events read
   long foreign_events{0};         ///< events on channels of other prefixes
   long undecodable{0};            ///< events on our channels that are not our type
+  long non_finite{0};             ///< states or references with a NaN or infinite value (dropped)
 };
 
 /// Converts the events on <prefix>_STATE/_REF/_CMD of log `path`, handing each row to `sink` in
-/// step order as soon as it is complete. Throws std::invalid_argument naming the file when it
-/// cannot be opened or is corrupt (with the event number and offset).
-LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink);
+/// step order: every step that can be completed, across gaps (Recorder::flush_final with
+/// need_reference); the steps that cannot are in recorder.gaps(). A state or reference with a
+/// non-finite value is dropped and counted. Throws std::invalid_argument naming the file when it
+/// cannot be opened or an event is corrupt (with the event number and byte offset).
+LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
+                       bool need_reference = true);
 
 }  // namespace feeddrive::monitor

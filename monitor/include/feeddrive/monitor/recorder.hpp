@@ -30,6 +30,18 @@ struct Missing {
   std::int64_t seq;
 };
 
+/// Steps first..last (inclusive) that have no row: `why` names the first message missing.
+struct Gap {
+  std::int64_t first{0};
+  std::int64_t last{0};
+  std::string why;
+  std::int64_t steps() const { return last - first + 1; }
+};
+
+/// "12 steps missing: 3000 (no command 3000 from the controller), 3500-3510 (...)": the gaps
+/// as one line, at most `max_listed` of them (then "and N more").
+std::string describe_gaps(const std::vector<Gap>& gaps, std::size_t max_listed = 5);
+
 class Recorder {
  public:
   /// attach = false: rows start at step 0 and a gap is never skipped. attach = true: rows start
@@ -43,6 +55,19 @@ class Recorder {
 
   /// Hands every complete row, in order, to `sink`; returns how many.
   std::size_t flush(const sim::RecordSink& sink);
+
+  /// The end of a recorded log: no message will come any more. Records every step that can be
+  /// completed, skipping the ones that cannot (they go to gaps()): a step needs state k, state
+  /// k+1 (the input applied during k) and, if need_reference, reference k; a missing command
+  /// only costs the command's diagnostic fields (NaN; the applied u is in state k+1). With
+  /// need_reference = false a missing reference gives NaN xd, vd, ad, jd. The end of the run
+  /// is the step count most states carry (one corrupt message cannot move it); steps after the
+  /// last message are a gap too. Returns the rows added.
+  std::size_t flush_final(const sim::RecordSink& sink, bool need_reference = true);
+  /// The steps flush_final() could not record, in order.
+  const std::vector<Gap>& gaps() const { return gaps_; }
+  /// Sum of gaps()' steps.
+  std::int64_t missing_steps() const;
 
   std::int64_t next() const { return next_; }             ///< first step not recorded
   std::int64_t steps() const { return steps_; }           ///< steps of the run (-1 until known)
@@ -87,6 +112,10 @@ class Recorder {
   std::int64_t rows_{0};
   std::int64_t duplicates_{0};
   std::int64_t commandless_{0};
+  std::vector<Gap> gaps_;
+  std::map<std::int64_t, long> steps_votes_;  ///< how many states carried each step count
+  void add_row(const Seen<drive_state_t>& s, const reference_t* r, const control_command_t* c, const drive_state_t& s1,
+               const sim::RecordSink& sink);
   std::int64_t first_state_seq_{-1}, first_state_us_{0}, last_state_us_{0};
   std::int64_t first_ref_seq_{-1};
   void maybe_start();

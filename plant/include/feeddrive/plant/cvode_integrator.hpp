@@ -17,10 +17,19 @@
 // Every failed SUNDIALS call becomes a std::runtime_error naming the call and its flag.
 
 #include <memory>
+#include <stdexcept>
 
 #include "feeddrive/plant/dynamics.hpp"
 
 namespace feeddrive::plant {
+
+/// CVODE could not integrate a control period (too stiff, too fast, or a state that runs away):
+/// a property of the scenario's keys, which the message names (PlantParams::fastest_time_scales).
+/// The tools report it as bad input (exit 2).
+class IntegrationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class CvodeIntegrator {
  public:

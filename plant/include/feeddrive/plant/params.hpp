@@ -240,6 +240,11 @@ struct PlantParams {
 
   double thrust_gain() const { return amplifier_gain * force_constant; }  ///< Ka*Kf [N/V]
   void validate(const std::string& prefix = "plant") const;
+  /// For an integrator failure message: the `n` fastest rates of the model [1/s] with the keys
+  /// and values that set them (presliding oscillation sqrt(sigma0/m), bristle damping sigma1/m,
+  /// viscous c/m, grinding lag 1/tau_g, current loop R/L, the effects' springs and dampers),
+  /// and the integrator's limits. One line.
+  std::string fastest_time_scales(std::size_t n = 2) const;
 };
 
 }  // namespace feeddrive::plant

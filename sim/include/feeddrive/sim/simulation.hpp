@@ -70,4 +70,11 @@ struct RunResult {
 };
 RunResult run(const Scenario& s);
 
+/// The run-time guard of issue 13, point 7 (what the load-time checks of scenario.cpp cannot
+/// foresee because it depends on the motion): throws ScenarioError (exit 2) naming the step, the
+/// value and the scenario section that produced it if the controller's command or a value of
+/// step k's record is NaN or infinite. The diagnostic columns u_unsaturated, sliding and
+/// z_estimate may be NaN (a controller without them).
+void check_finite_step(const Scenario& s, long k, const Record& r, double command);
+
 }  // namespace feeddrive::sim
