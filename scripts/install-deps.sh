@@ -12,7 +12,8 @@ PACKAGES=(
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev
   libeigen3-dev libsundials-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
-  libbenchmark-dev libceres-dev
+  libbenchmark-dev libceres-dev libssl-dev
+  libopenmpi-dev openmpi-bin
   gnuplot-nox jq python3 python3-yaml
   iproute2 nftables util-linux procps
   lua5.2 liblcm-lua lua-luaossl

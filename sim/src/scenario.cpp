@@ -212,6 +212,7 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& fi
   r.number("u_max", p.u_max);
   r.string("file", file);
   if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
+  r.record("file", file, true);
   if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
@@ -271,6 +272,7 @@ void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir
       c.waypoints_file = r.required_string("file");
       if (fs::path(c.waypoints_file).is_relative())
         c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
+      r.record("file", c.waypoints_file, true);
       break;
   }
   r.finish();
@@ -303,9 +305,9 @@ void check_name(const std::string& name, const std::string& what) {
   }
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
   if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "");
+  MapReader top(root, "", resolved);
   Scenario s;
   top.string("name", s.name);
   check_name(s.name, "name");
@@ -423,10 +425,12 @@ void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p)
 
 long Scenario::steps() const { return std::lround(duration / control_period); }
 
-Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
+Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
+                        ResolvedKeys* resolved) {
   try {
     const YAML::Node root = load_yaml_strict(yaml_text);
-    Scenario s = parse_node(root, base_dir);
+    if (resolved) resolved->clear();
+    Scenario s = parse_node(root, base_dir, resolved);
     return s;
   } catch (const ScenarioError& e) {
     throw ScenarioError(origin + ": " + e.what());
@@ -449,6 +453,50 @@ Scenario load_scenario(const std::string& path) {
     check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
   }
   return s;
+}
+
+namespace {
+
+// Emits entries [b, e) (split dotted paths, sorted) as a map, grouping the paths that share
+// their part at `depth`: all paths with one prefix are adjacent in sorted order.
+void emit_map(YAML::Emitter& em, const std::vector<std::pair<std::vector<std::string>, const ResolvedValue*>>& items,
+              std::size_t b, std::size_t e, std::size_t depth) {
+  em << YAML::BeginMap;
+  for (std::size_t i = b; i < e;) {
+    const std::string& part = items[i].first[depth];
+    std::size_t j = i;
+    while (j < e && items[j].first[depth] == part) ++j;
+    em << YAML::Key << part << YAML::Value;
+    if (items[i].first.size() == depth + 1) {
+      em << items[i].second->text;
+    } else {
+      emit_map(em, items, i, j, depth + 1);
+    }
+    i = j;
+  }
+  em << YAML::EndMap;
+}
+
+}  // namespace
+
+std::string resolved_yaml(const ResolvedKeys& keys) {
+  std::vector<std::pair<std::vector<std::string>, const ResolvedValue*>> items;
+  for (const auto& [path, value] : keys) {
+    std::vector<std::string> parts;
+    for (std::size_t b = 0;;) {
+      const std::size_t e = path.find('.', b);
+      parts.push_back(path.substr(b, e == std::string::npos ? std::string::npos : e - b));
+      if (e == std::string::npos) break;
+      b = e + 1;
+    }
+    items.emplace_back(std::move(parts), &value);
+  }
+  // Sorted by parts, so every group of one prefix is contiguous ("a.b" and "a-c" interleave as
+  // strings, not as part lists).
+  std::sort(items.begin(), items.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  YAML::Emitter em;
+  emit_map(em, items, 0, items.size(), 0);
+  return std::string(em.c_str()) + "\n";
 }
 
 std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <string_view>
 
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::sim {
@@ -172,7 +173,8 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-MapReader::MapReader(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {
+MapReader::MapReader(const YAML::Node& node, std::string path, ResolvedKeys* resolved)
+    : node_(node), path_(std::move(path)), resolved_(resolved) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap())
     throw ScenarioError(path_ + " = " + describe(node_) + ": expected a map of keys");
 }
@@ -199,13 +201,19 @@ YAML::Node MapReader::scalar(const std::string& key) {
   return n;
 }
 
+void MapReader::record(const std::string& key, const std::string& text, bool is_string) {
+  if (resolved_) (*resolved_)[key_path(key)] = ResolvedValue{text, is_string};
+}
+
 void MapReader::number_or_infinite(const std::string& key, double& out) {
   const YAML::Node n = scalar(key);
-  if (!n.IsDefined()) return;
-  double v = 0.0;
-  if (!parse_double(n.Scalar(), v)) fail(key, " = " + describe(n) + ": not a number");
-  if (std::isnan(v)) fail(key, " = " + describe(n) + ": NaN is not allowed");
-  out = v;
+  if (n.IsDefined()) {
+    double v = 0.0;
+    if (!parse_double(n.Scalar(), v)) fail(key, " = " + describe(n) + ": not a number");
+    if (std::isnan(v)) fail(key, " = " + describe(n) + ": NaN is not allowed");
+    out = v;
+  }
+  record(key, std::isinf(out) ? (out > 0 ? ".inf" : "-.inf") : validate::format_number(out), false);
 }
 
 void MapReader::number(const std::string& key, double& out) {
@@ -217,41 +225,48 @@ void MapReader::number(const std::string& key, double& out) {
 
 void MapReader::integer(const std::string& key, long& out) {
   const YAML::Node n = scalar(key);
-  if (!n.IsDefined()) return;
-  const std::string& s = n.Scalar();
-  char* end = nullptr;
-  const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size()) fail(key, " = " + describe(n) + ": not an integer");
-  out = v;
+  if (n.IsDefined()) {
+    const std::string& s = n.Scalar();
+    char* end = nullptr;
+    const long v = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || end != s.c_str() + s.size()) fail(key, " = " + describe(n) + ": not an integer");
+    out = v;
+  }
+  record(key, std::to_string(out), false);
 }
 
 void MapReader::unsigned_integer(const std::string& key, std::uint64_t& out) {
   const YAML::Node n = scalar(key);
-  if (!n.IsDefined()) return;
-  const std::string& s = n.Scalar();
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || s[0] == '-' || end != s.c_str() + s.size())
-    fail(key, " = " + describe(n) + ": not a non-negative integer");
-  out = v;
+  if (n.IsDefined()) {
+    const std::string& s = n.Scalar();
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+    if (s.empty() || s[0] == '-' || end != s.c_str() + s.size())
+      fail(key, " = " + describe(n) + ": not a non-negative integer");
+    out = v;
+  }
+  record(key, std::to_string(out), false);
 }
 
 void MapReader::boolean(const std::string& key, bool& out) {
   const YAML::Node n = scalar(key);
-  if (!n.IsDefined()) return;
-  const std::string& s = n.Scalar();
-  if (s == "true" || s == "True" || s == "TRUE" || s == "on" || s == "yes") {
-    out = true;
-  } else if (s == "false" || s == "False" || s == "FALSE" || s == "off" || s == "no") {
-    out = false;
-  } else {
-    fail(key, " = " + describe(n) + ": expected true or false");
+  if (n.IsDefined()) {
+    const std::string& s = n.Scalar();
+    if (s == "true" || s == "True" || s == "TRUE" || s == "on" || s == "yes") {
+      out = true;
+    } else if (s == "false" || s == "False" || s == "FALSE" || s == "off" || s == "no") {
+      out = false;
+    } else {
+      fail(key, " = " + describe(n) + ": expected true or false");
+    }
   }
+  record(key, out ? "true" : "false", false);
 }
 
 void MapReader::string(const std::string& key, std::string& out) {
   const YAML::Node n = scalar(key);
   if (n.IsDefined()) out = n.Scalar();
+  record(key, out, true);
 }
 
 void MapReader::string_list(const std::string& key, std::vector<std::string>& out) {
@@ -275,13 +290,14 @@ void MapReader::string_list(const std::string& key, std::vector<std::string>& ou
 std::string MapReader::required_string(const std::string& key) {
   const YAML::Node n = scalar(key);
   if (!n.IsDefined()) fail(key, ": missing (required)");
+  record(key, n.Scalar(), true);
   return n.Scalar();
 }
 
 MapReader MapReader::child(const std::string& key) {
   read_.insert(key);
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
-  return MapReader(n, key_path(key));
+  return MapReader(n, key_path(key), resolved_);
 }
 
 void MapReader::finish() const {

@@ -72,6 +72,36 @@ std::string marker_text(const std::string& tool) {
   return "feeddrive-output\nformat: " + std::to_string(kFormatVersion) + "\ntool: " + tool + "\n";
 }
 
+std::string output_tool(const fs::path& dir) {
+  if (!is_feeddrive_output(dir)) return "";
+  std::ifstream in(dir / kMarkerFile, std::ios::binary);
+  std::string line;
+  std::getline(in, line);
+  std::getline(in, line);
+  std::getline(in, line);
+  return line.substr(6);  // "tool: NAME", checked by is_feeddrive_output
+}
+
+void write_file_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = unused_sibling(path, "tmp");
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    f.close();
+    if (!f) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw std::runtime_error(path.string() + ": write failed");
+    }
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(path.string() + ": cannot rename into place: " + error_text(e));
+  }
+}
+
 bool is_feeddrive_output(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(fs::symlink_status(dir, ec))) return false;

@@ -22,6 +22,7 @@
 #include "feeddrive/controller/open_loop.hpp"
 #include "feeddrive/controller/sliding_mode.hpp"
 #include "feeddrive/plant/params.hpp"
+#include "feeddrive/sim/yaml_reader.hpp"
 #include "feeddrive/trajectory/trajectory.hpp"
 
 namespace feeddrive::sim {
@@ -94,9 +95,16 @@ struct Scenario {
 /// Loads and validates a scenario file. Throws ScenarioError("<file>: <key> = <value>: <why>").
 Scenario load_scenario(const std::string& path);
 /// Parses and validates YAML text; base_dir resolves relative file names; origin names the
-/// source in messages.
+/// source in messages. If `resolved` is given it receives every scalar key the loader read with
+/// its effective value (given or default; file names resolved against base_dir): the complete
+/// description of the run, used by feeddrive-study to vary keys, scale them and key its cases.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
-                        const std::string& origin = "scenario");
+                        const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr);
+
+/// The resolved keys as one YAML document (nested maps, keys in sorted order, so the same keys
+/// always give the same text). parse_scenario reads it back to the same scenario and the same
+/// resolved keys (tests/sim/resolved_keys_test.cpp).
+std::string resolved_yaml(const ResolvedKeys& keys);
 
 /// The tables a scenario names (reference.file, controller.file), read with the one CSV reader
 /// (feeddrive/csv/reader.hpp). Throw csv::CsvError (std::invalid_argument), one line naming

@@ -35,6 +35,15 @@ std::string marker_text(const std::string& tool);
 /// True if `dir` is a folder (not a symbolic link) holding a well-formed marker.
 bool is_feeddrive_output(const std::filesystem::path& dir);
 
+/// The tool named in the marker of `dir` ("feeddrive-sim", ...), or "" if `dir` is not a
+/// feeddrive output.
+std::string output_tool(const std::filesystem::path& dir);
+
+/// Writes `text` to `path` through a sibling temporary file renamed into place: a reader (or a
+/// run that was interrupted) sees the old file or the new one, never half of one. Throws
+/// std::runtime_error on failure (the temporary file is removed).
+void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
 /// `value` as the tools show it in a message: control characters and bytes that are not
 /// printable ASCII become '?', an empty value is "".
 std::string shown(const std::string& value);

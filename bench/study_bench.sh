@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# feeddrive-study speed (issue 10, point 8; not a timed test): a study of CASES cases of the
+# jerk-limited move at 10 kHz (scenarios/paper/smc_bl_jerk_limited.yaml: boundary-layer SMC,
+# 15,000 control periods, mass drawn +-20 %) against its ideal time, measured in the same run:
+#   one case = the median wall time of that scenario run alone, RUNS times before and RUNS times
+#              after the study (feeddrive-sim's own timing of the run: summary.json wall_time_s,
+#              which leaves out process start, loading and writing: the strictest ideal);
+#   ideal    = CASES x one case / cores (nproc);
+#   ratio    = the study's wall time (the whole feeddrive-study command: loading and resolving the
+#              cases, the runs, results.csv, report.md and plots) / ideal   (target <= 1.2).
+# Run it alone: flock /tmp/feeddrive-bench.lock bash bench/study_bench.sh [BUILD_DIR] [CASES] [RUNS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD=${1:-build}
+CASES=${2:-1000}
+RUNS=${3:-5}
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+SCEN=$PWD/scenarios/paper/smc_bl_jerk_limited.yaml
+CORES=$(nproc)
+cat > "$TMP/bench.yaml" <<YAML
+name: bench
+base: $SCEN
+families:
+  - name: mass
+    monte_carlo:
+      draws: $CASES
+      seed: 1
+      parameters:
+        - {key: plant.mass, distribution: uniform, low: 0.8, high: 1.2, scale: true}
+YAML
+one_case() {
+  for r in $(seq "$RUNS"); do
+    "$BUILD/bin/feeddrive-sim" "$SCEN" --out "$TMP/one" --no-plots --quiet
+    jq -r .wall_time_s "$TMP/one/summary.json"
+  done
+}
+median() { sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
+one_case > "$TMP/one.txt"
+s=$(date +%s%N)
+"$BUILD/bin/feeddrive-study" "$TMP/bench.yaml" --out "$TMP/study" -q
+e=$(date +%s%N)
+one_case >> "$TMP/one.txt"
+t1=$(median < "$TMP/one.txt")
+wall=$(awk -v a="$s" -v b="$e" 'BEGIN { printf "%.3f", (b - a) / 1e9 }')
+sum=$(jq -r .case_time_sum_s "$TMP/study/timing.json")
+ok=$(awk -F, 'NR > 1 && $0 ~ /,true,/ { n++ } END { print n + 0 }' "$TMP/study/results.csv")
+echo "one case (jerk-limited move, 10 kHz, 15,000 periods): median $(printf '%.4f' "$t1") s over $((2 * RUNS)) runs alone"
+echo "study: $CASES cases ($ok ok) on $CORES cores: wall $(printf '%.2f' "$wall") s; sum of the cases' own times in the study $(printf '%.2f' "$sum") s"
+awk -v n="$CASES" -v t="$t1" -v c="$CORES" -v w="$wall" -v s="$sum" 'BEGIN {
+  ideal = n * t / c
+  printf "ideal = cases x one case / cores = %d x %.4f / %d = %.2f s\n", n, t, c, ideal
+  printf "ratio = wall / ideal = %.3f (target <= 1.2)\n", w / ideal
+  printf "(wall / (sum of the cases'\'' own times / cores) = %.3f: the runner'\''s own overhead)\n", w / (s / c)
+}'

@@ -1,0 +1,101 @@
+#pragma once
+// A study's cases: expansion (which cases, which variations) and resolution (the one scenario
+// each case runs), as pure functions of the study.
+//
+// Order: controller-major, then family, then grid point (the last axis fastest), then Monte Carlo
+// draw. A case's variations are its grid values and draws; draw j of parameter p of a family is a
+// pure function of (seed, j, p) (draw_value), the same for every controller, so every controller
+// meets the same plants (common random numbers) and no order of evaluation changes a number.
+//
+// Resolution (resolve_case) builds the case's scenario YAML in layers,
+//   base -> study set -> controller block -> controller set -> family set -> variations,
+// and loads it with the scenario loader, which checks every key and value (a misspelt key is the
+// loader's one-line "unknown key" error). A `scale` variation multiplies the key's nominal value:
+// its effective value in the case without variations (defaults included). With the nominal model
+// rule (spec.hpp), the controller's model (controller.model.*) is taken from the case without the
+// plant.* variations except plant.sensor.*: the mismatch is in the plant, while the controller is
+// set up for the encoder it actually has. The case's scenario is then the loader's resolved keys
+// written as one YAML document (sim::resolved_yaml): every key with its effective value, loadable
+// by feeddrive-sim. Its SHA-256 keys the case in the output folder.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/study/spec.hpp"
+
+namespace feeddrive::study {
+
+/// One varied key of a case: a value (YAML scalar text), or a factor on the nominal value.
+struct Variation {
+  std::string key;
+  std::string value;
+  bool scale{false};
+  double factor{1.0};
+};
+
+struct CaseSpec {
+  std::size_t controller{0};
+  std::size_t family{0};
+  long point{0};  ///< grid point within the family (0 without a grid)
+  long draw{-1};  ///< Monte Carlo draw (-1 without)
+  std::vector<Variation> variations;
+};
+
+/// Every case of the study in order. Pure; the study must have passed validate().
+std::vector<CaseSpec> expand(const Study& s);
+
+/// Grid point `point` of family f: one variation per key of every axis.
+std::vector<Variation> grid_point(const Family& f, long point);
+
+/// Draw `draw` of Monte Carlo parameter `param` under `seed`: a pure function of the four, the
+/// same on every machine for the same inputs (own uniform and Box-Muller transforms on a
+/// SplitMix64 stream; no std:: distribution, whose output differs between standard libraries).
+double draw_value(const DrawSpec& d, std::uint64_t seed, long draw, std::size_t param);
+
+/// The uniform number in [0, 1) that a SplitMix64 stream keyed by (seed, a, b, c) gives: 53 bits.
+double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c);
+
+/// Every key a grid axis or a Monte Carlo parameter of the study varies, in order of first
+/// appearance (the parameter columns of results.csv).
+std::vector<std::string> varied_keys(const Study& s);
+
+/// Writes `value` (a YAML scalar) at the dotted `key` of the map `root`, creating maps on the
+/// way. Throws StudyError if a part of the path is not a map.
+void set_key(YAML::Node& root, const std::string& key, const std::string& value);
+
+struct ResolvedCase {
+  std::string yaml;    ///< the complete scenario (loads in feeddrive-sim)
+  std::string hash;    ///< SHA-256 (hex) of the format tag and yaml
+  /// Effective value of every key of varied_keys() that this case's scenario has, by key.
+  std::map<std::string, std::string> parameters;
+};
+
+/// Resolves cases, caching the layered loads shared by cases of one controller and family.
+/// Not thread-safe; the results are.
+class Resolver {
+ public:
+  explicit Resolver(const Study& s);
+  ~Resolver();
+  /// Throws StudyError (one line naming the study, the case and the loader's key and value).
+  ResolvedCase resolve(const CaseSpec& c);
+  /// A label of the case for messages: "controller 'x', family 'y', point 2, draw 7".
+  std::string label(const CaseSpec& c) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// SHA-256 of `text` as 64 lowercase hex digits.
+std::string sha256_hex(const std::string& text);
+
+/// The format tag hashed with every case: a change to how cases are run or recorded changes it.
+inline constexpr const char* kCaseFormat = "feeddrive-study case format 1\n";
+
+}  // namespace feeddrive::study

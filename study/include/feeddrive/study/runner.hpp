@@ -1,0 +1,89 @@
+#pragma once
+// Running cases: one case in-process (run_case), its record in the output folder (the case file,
+// so a rerun skips it), and a pool of worker threads.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace feeddrive::study {
+
+/// What one case gave: its summary.json metrics (the numbers, in summary.json's order, without
+/// the wall-clock ones, which differ from run to run), or the error that stopped it.
+struct Outcome {
+  bool ok{false};
+  std::string error;
+  std::vector<std::pair<std::string, double>> metrics;
+  double wall_s{0.0};  ///< time of this case (not a result: kept out of results.csv)
+  bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
+};
+
+/// summary.json keys that measure the computer, not the drive: never in results.csv.
+bool is_timing_metric(const std::string& key);
+
+/// Loads the resolved scenario YAML, runs it in-process (sim::run, streamed into the online
+/// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
+/// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
+Outcome run_case(const std::string& yaml);
+
+/// The case file DIR/cases/<hash>.json: the outcome, keyed by the case's hash.
+std::string outcome_json(const std::string& hash, const Outcome& o);
+/// Parses a case file; nullopt if it is not a case file of this format for this hash (a stale,
+/// foreign or damaged file is run again, never trusted).
+std::optional<Outcome> parse_outcome(const std::string& text, const std::string& hash);
+
+/// A fixed set of worker threads running work(task) for pushed tasks; results come back through
+/// pop(). The work function must not throw (run_case does not).
+class Pool {
+ public:
+  Pool(int threads, std::function<Outcome(std::size_t)> work);
+  ~Pool();  ///< stops the threads after the tasks they are on
+  Pool(const Pool&) = delete;
+  Pool& operator=(const Pool&) = delete;
+
+  void push(std::size_t task);
+  /// Tasks pushed and not yet popped as results.
+  std::size_t in_flight() const;
+  /// Waits up to `wait` for a finished task.
+  std::optional<std::pair<std::size_t, Outcome>> pop(std::chrono::milliseconds wait);
+  int threads() const { return static_cast<int>(workers_.size()); }
+
+ private:
+  void loop();
+  std::function<Outcome(std::size_t)> work_;
+  mutable std::mutex mu_;
+  std::condition_variable task_cv_, done_cv_;
+  std::deque<std::size_t> tasks_;
+  std::deque<std::pair<std::size_t, Outcome>> done_;
+  std::size_t in_flight_{0};
+  bool stop_{false};
+  std::vector<std::thread> workers_;
+};
+
+/// Progress on stderr: a bar with the count, percentage and ETA, redrawn in place on a terminal;
+/// on anything else (a log file, CI) a plain line at most every 10 s and at the end.
+class Progress {
+ public:
+  Progress(std::size_t total, std::size_t already_done, bool enabled);
+  void step(bool failed);
+  void finish();
+
+ private:
+  void draw(bool final_line);
+  std::size_t total_, done_, ran_{0}, failed_{0};
+  bool enabled_, tty_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+/// "1h02m", "3m05s", "12s".
+std::string format_duration(double seconds);
+
+}  // namespace feeddrive::study

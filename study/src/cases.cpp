@@ -1,0 +1,288 @@
+#include "feeddrive/study/cases.hpp"
+
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "feeddrive/common/validate.hpp"
+
+namespace feeddrive::study {
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+std::vector<std::string> split_key(const std::string& key) {
+  std::vector<std::string> parts;
+  for (std::size_t b = 0;;) {
+    const std::size_t e = key.find('.', b);
+    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  return parts;
+}
+
+bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 0; }
+
+// plant.* keys change only the true plant under the nominal model rule, except the sensor the
+// controller is set up for (cases.hpp).
+bool plant_only(const std::string& key) { return starts_with(key, "plant.") && !starts_with(key, "plant.sensor."); }
+
+}  // namespace
+
+double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  std::uint64_t state = seed;
+  std::uint64_t h = splitmix64(state);
+  state = h ^ a;
+  h = splitmix64(state);
+  state = h ^ (b * 0xD1B54A32D192ED03ULL);
+  h = splitmix64(state);
+  state = h ^ (c * 0xAEF17502108EF2D9ULL);
+  h = splitmix64(state);
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+double draw_value(const DrawSpec& d, std::uint64_t seed, long draw, std::size_t param) {
+  const auto u = [&](std::uint64_t k) { return unit_uniform(seed, static_cast<std::uint64_t>(draw), param, k); };
+  if (d.distribution == Distribution::kUniform) return d.a + (d.b - d.a) * u(0);
+  // Box-Muller on two uniforms per attempt; an attempt outside [low, high] is redrawn with the
+  // next pair (Spec validation bounds the expected number of attempts by 1e4).
+  for (std::uint64_t attempt = 0;; ++attempt) {
+    const double u1 = 1.0 - u(2 * attempt);  // (0, 1]: log is finite
+    const double u2 = u(2 * attempt + 1);
+    const double n = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+    double v = d.a + d.b * n;
+    if (d.distribution == Distribution::kLognormal) v = std::exp(v);
+    if (v >= d.low && v <= d.high) return v;
+  }
+}
+
+std::vector<Variation> grid_point(const Family& f, long point) {
+  std::vector<Variation> out;
+  // Mixed radix, the last axis fastest.
+  std::vector<long> index(f.grid.size(), 0);
+  long rest = point;
+  for (std::size_t i = f.grid.size(); i-- > 0;) {
+    const long n = static_cast<long>(f.grid[i].values.size());
+    index[i] = rest % n;
+    rest /= n;
+  }
+  for (std::size_t i = 0; i < f.grid.size(); ++i) {
+    const GridAxis& a = f.grid[i];
+    const auto& vals = a.values[static_cast<std::size_t>(index[i])];
+    for (std::size_t k = 0; k < a.keys.size(); ++k) {
+      Variation v{a.keys[k], vals[k], a.scale, 1.0};
+      if (a.scale) v.factor = std::strtod(vals[k].c_str(), nullptr);  // checked finite by the spec
+      out.push_back(v);
+    }
+  }
+  return out;
+}
+
+std::vector<CaseSpec> expand(const Study& s) {
+  std::vector<CaseSpec> out;
+  out.reserve(static_cast<std::size_t>(s.total_cases()));
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) {
+    for (std::size_t f = 0; f < s.families.size(); ++f) {
+      const Family& fam = s.families[f];
+      long points = 1;
+      for (const GridAxis& a : fam.grid) points *= static_cast<long>(a.values.size());
+      const long draws = fam.monte_carlo.draws;
+      for (long p = 0; p < points; ++p) {
+        const std::vector<Variation> grid = grid_point(fam, p);
+        for (long d = draws > 0 ? 0 : -1; d < std::max(draws, 0L); ++d) {
+          CaseSpec cs{c, f, p, d, grid};
+          if (d >= 0) {
+            for (std::size_t i = 0; i < fam.monte_carlo.parameters.size(); ++i) {
+              const DrawSpec& ds = fam.monte_carlo.parameters[i];
+              const double x = draw_value(ds, fam.monte_carlo.seed, d, i);
+              for (const std::string& key : ds.keys)
+                cs.variations.push_back({key, validate::format_number(x), ds.scale, x});
+            }
+          }
+          out.push_back(std::move(cs));
+        }
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> varied_keys(const Study& s) {
+  std::vector<std::string> out;
+  const auto add = [&](const std::string& k) {
+    if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+  };
+  for (const Family& f : s.families) {
+    for (const GridAxis& a : f.grid)
+      for (const std::string& k : a.keys) add(k);
+    for (const DrawSpec& d : f.monte_carlo.parameters)
+      for (const std::string& k : d.keys) add(k);
+  }
+  return out;
+}
+
+void set_key(YAML::Node& root, const std::string& key, const std::string& value) {
+  const std::vector<std::string> parts = split_key(key);
+  YAML::Node cur = root;
+  std::string path;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    path += (path.empty() ? "" : ".") + parts[i];
+    YAML::Node next = cur[parts[i]];
+    if (!next.IsDefined() || next.IsNull()) {
+      cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      next = cur[parts[i]];
+    } else if (!next.IsMap()) {
+      throw StudyError(key + ": " + path + " is a single value in the scenario, not a map of keys");
+    }
+    cur.reset(next);
+  }
+  cur[parts.back()] = value;
+}
+
+std::string sha256_hex(const std::string& text) {
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  if (EVP_Digest(text.data(), text.size(), md, &n, EVP_sha256(), nullptr) != 1 || n != 32)
+    throw std::runtime_error("SHA-256 failed (libcrypto)");
+  std::string hex(64, '0');
+  static const char* kDigits = "0123456789abcdef";
+  for (unsigned i = 0; i < 32; ++i) {
+    hex[2 * i] = kDigits[md[i] >> 4];
+    hex[2 * i + 1] = kDigits[md[i] & 15];
+  }
+  return hex;
+}
+
+struct Resolver::Impl {
+  const Study& s;
+  YAML::Node base;
+  std::vector<YAML::Node> controller_blocks;
+  // Loads by document text: the same layers are shared by many cases.
+  std::map<std::string, sim::ResolvedKeys> loads;
+  std::vector<std::string> varied;  // every key a grid or draw of the study varies
+
+  explicit Impl(const Study& st) : s(st) {
+    varied = varied_keys(s);
+    try {
+      base = YAML::Load(s.base_yaml);
+    } catch (const YAML::Exception& e) {
+      throw StudyError(s.path + ": base: line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    }
+    if (!base.IsMap()) throw StudyError(s.path + ": base: the scenario must be a YAML map");
+    for (const ControllerEntry& c : s.controllers) controller_blocks.push_back(c.block.empty() ? YAML::Node() : YAML::Load(c.block));
+  }
+
+  sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin) const {
+    sim::ResolvedKeys keys;
+    try {
+      sim::parse_scenario(text, s.base_dir, origin, &keys);
+    } catch (const sim::ScenarioError& e) {
+      throw StudyError(e.what());
+    }
+    return keys;
+  }
+  static std::string text_of(const YAML::Node& doc) {
+    YAML::Emitter em;
+    em << doc;
+    return em.c_str();
+  }
+  const sim::ResolvedKeys& load(const YAML::Node& doc, const std::string& origin) {
+    std::string text = text_of(doc);
+    auto it = loads.find(text);
+    if (it != loads.end()) return it->second;
+    sim::ResolvedKeys keys = load_uncached(text, origin);
+    return loads.emplace(std::move(text), std::move(keys)).first->second;
+  }
+};
+
+Resolver::Resolver(const Study& s) : impl_(std::make_unique<Impl>(s)) {}
+Resolver::~Resolver() = default;
+
+std::string Resolver::label(const CaseSpec& c) const {
+  const Study& s = impl_->s;
+  std::string l = "controller '" + s.controllers[c.controller].name + "', family '" + s.families[c.family].name + "'";
+  if (!s.families[c.family].grid.empty()) l += ", point " + std::to_string(c.point);
+  if (c.draw >= 0) l += ", draw " + std::to_string(c.draw);
+  return l;
+}
+
+ResolvedCase Resolver::resolve(const CaseSpec& c) {
+  Impl& m = *impl_;
+  const Study& s = m.s;
+  const std::string origin = (s.path.empty() ? std::string("study") : s.path) + ": " + label(c);
+  const auto apply = [&](YAML::Node& doc, const std::string& key, const std::string& value, const std::string& where) {
+    try {
+      set_key(doc, key, value);
+    } catch (const StudyError& e) {
+      throw StudyError(origin + ": " + where + ": " + e.what());
+    }
+  };
+  // Layers without the variations: the nominal case of this controller and family.
+  YAML::Node doc = YAML::Clone(m.base);
+  for (const Setting& st : s.set) apply(doc, st.key, st.value, "set");
+  if (!s.controllers[c.controller].block.empty()) doc["controller"] = YAML::Clone(m.controller_blocks[c.controller]);
+  for (const Setting& st : s.controllers[c.controller].set) apply(doc, st.key, st.value, "controllers set");
+  for (const Setting& st : s.families[c.family].set) apply(doc, st.key, st.value, "family set");
+  const sim::ResolvedKeys nominal = m.load(doc, origin + " (without its variations)");
+
+  // The variations' values: scaled ones from the nominal values.
+  std::vector<std::pair<std::string, std::string>> values;
+  for (const Variation& v : c.variations) {
+    if (!v.scale) {
+      values.emplace_back(v.key, v.value);
+      continue;
+    }
+    const auto it = nominal.find(v.key);
+    if (it == nominal.end())
+      throw StudyError(origin + ": " + v.key + ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or reference type)");
+    if (it->second.is_string || it->second.text == "true" || it->second.text == "false")
+      throw StudyError(origin + ": " + v.key + " = '" + it->second.text + "': cannot scale a value that is not a number");
+    const double nominal_value = std::strtod(it->second.text.c_str(), nullptr);
+    values.emplace_back(v.key, validate::format_number(nominal_value * v.factor));
+  }
+
+  YAML::Node full = YAML::Clone(doc);
+  for (const auto& [k, v] : values) apply(full, k, v, "variation");
+  sim::ResolvedKeys keys = m.load_uncached(Impl::text_of(full), origin);  // one per case: not cached
+  if (s.model == ModelRule::kNominal) {
+    YAML::Node model_doc = YAML::Clone(doc);
+    bool differs = false;
+    for (const auto& [k, v] : values) {
+      if (plant_only(k)) {
+        differs = true;
+      } else {
+        apply(model_doc, k, v, "variation");
+      }
+    }
+    if (differs) {
+      const sim::ResolvedKeys& model = m.load(model_doc, origin + " (the controller's nominal model)");
+      for (auto& [k, v] : keys) {
+        if (!starts_with(k, "controller.model.")) continue;
+        const auto it = model.find(k);
+        if (it != model.end()) v = it->second;
+      }
+    }
+  }
+  ResolvedCase r;
+  r.yaml = sim::resolved_yaml(keys);
+  r.hash = sha256_hex(std::string(kCaseFormat) + r.yaml);
+  // Every varied key of the study, with its effective value in this case (its nominal value
+  // where this case does not vary it), so each row of results.csv places the case on every axis.
+  for (const std::string& k : m.varied) {
+    const auto it = keys.find(k);
+    if (it != keys.end()) r.parameters[k] = it->second.text;
+  }
+  for (const auto& [k, v] : values)
+    if (!r.parameters.count(k)) r.parameters[k] = v;
+  return r;
+}
+
+}  // namespace feeddrive::study

@@ -1,0 +1,209 @@
+#include "feeddrive/study/runner.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/simulation.hpp"
+#include "feeddrive/sim/summary.hpp"
+
+namespace feeddrive::study {
+
+bool is_timing_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }
+
+Outcome run_case(const std::string& yaml) {
+  Outcome o;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const sim::Scenario s = sim::parse_scenario(yaml, ".", "case");
+    // Streamed: the online summary keeps no records (memory independent of the run's length).
+    sim::SummaryBuilder builder(s);
+    const sim::RunStats st = sim::run(s, [&builder](const sim::Record& q) { builder.add(q); });
+    const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
+    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(sim::summary_json(sum, s));
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!it.value().is_number() || is_timing_metric(it.key())) continue;
+      o.metrics.emplace_back(it.key(), it.value().get<double>());
+    }
+    o.ok = true;
+  } catch (const interrupt::Interrupted& e) {
+    o.ok = false;
+    o.interrupted = true;
+    o.error = e.what();
+  } catch (const std::exception& e) {
+    o.ok = false;
+    o.error = e.what();
+    for (char& c : o.error)
+      if (c == '\n' || c == '\r') c = ' ';
+    o.metrics.clear();
+  }
+  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return o;
+}
+
+std::string outcome_json(const std::string& hash, const Outcome& o) {
+  nlohmann::ordered_json j;
+  j["format"] = 1;
+  j["hash"] = hash;
+  j["ok"] = o.ok;
+  j["error"] = o.error;
+  nlohmann::ordered_json m = nlohmann::ordered_json::object();
+  for (const auto& [k, v] : o.metrics) {
+    // JSON has no NaN or infinity: those are written as strings and read back.
+    if (std::isfinite(v)) {
+      m[k] = v;
+    } else {
+      m[k] = std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+    }
+  }
+  j["metrics"] = m;
+  j["wall_s"] = o.wall_s;
+  return j.dump(1) + "\n";
+}
+
+std::optional<Outcome> parse_outcome(const std::string& text, const std::string& hash) {
+  try {
+    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
+    if (!j.is_object() || j.value("format", 0) != 1 || j.value("hash", std::string()) != hash) return std::nullopt;
+    Outcome o;
+    o.ok = j.at("ok").get<bool>();
+    o.error = j.at("error").get<std::string>();
+    for (auto it = j.at("metrics").begin(); it != j.at("metrics").end(); ++it) {
+      double v = 0.0;
+      if (it.value().is_number()) {
+        v = it.value().get<double>();
+      } else {
+        const std::string s = it.value().get<std::string>();
+        v = s == "nan" ? NAN : s == "inf" ? INFINITY : s == "-inf" ? -INFINITY : throw std::runtime_error("bad metric");
+      }
+      o.metrics.emplace_back(it.key(), v);
+    }
+    o.wall_s = j.at("wall_s").get<double>();
+    if (o.ok == o.metrics.empty()) return std::nullopt;
+    return o;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+Pool::Pool(int threads, std::function<Outcome(std::size_t)> work) : work_(std::move(work)) {
+  for (int i = 0; i < std::max(1, threads); ++i) workers_.emplace_back([this] { loop(); });
+}
+
+Pool::~Pool() {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    stop_ = true;
+    tasks_.clear();
+  }
+  task_cv_.notify_all();
+  for (std::thread& t : workers_) t.join();
+}
+
+void Pool::push(std::size_t task) {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    tasks_.push_back(task);
+    ++in_flight_;
+  }
+  task_cv_.notify_one();
+}
+
+std::size_t Pool::in_flight() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return in_flight_;
+}
+
+std::optional<std::pair<std::size_t, Outcome>> Pool::pop(std::chrono::milliseconds wait) {
+  std::unique_lock<std::mutex> lock(mu_);
+  if (!done_cv_.wait_for(lock, wait, [this] { return !done_.empty(); })) return std::nullopt;
+  auto r = std::move(done_.front());
+  done_.pop_front();
+  --in_flight_;
+  return r;
+}
+
+void Pool::loop() {
+  for (;;) {
+    std::size_t task = 0;
+    {
+      std::unique_lock<std::mutex> lock(mu_);
+      task_cv_.wait(lock, [this] { return stop_ || !tasks_.empty(); });
+      if (stop_) return;
+      task = tasks_.front();
+      tasks_.pop_front();
+    }
+    Outcome o = work_(task);
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      done_.emplace_back(task, std::move(o));
+    }
+    done_cv_.notify_all();
+  }
+}
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  char buf[64];
+  if (s >= 3600) {
+    std::snprintf(buf, sizeof buf, "%ldh%02ldm", s / 3600, (s / 60) % 60);
+  } else if (s >= 60) {
+    std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%lds", s);
+  }
+  return buf;
+}
+
+Progress::Progress(std::size_t total, std::size_t already_done, bool enabled)
+    : total_(total), done_(already_done), enabled_(enabled), tty_(::isatty(2) == 1),
+      start_(std::chrono::steady_clock::now()), last_(start_) {
+  if (enabled_ && tty_) draw(false);
+}
+
+void Progress::step(bool failed) {
+  ++done_;
+  ++ran_;
+  failed_ += failed ? 1 : 0;
+  if (!enabled_) return;
+  const auto now = std::chrono::steady_clock::now();
+  const double since = std::chrono::duration<double>(now - last_).count();
+  if (tty_ ? since >= 0.1 : since >= 10.0) draw(false);
+}
+
+void Progress::finish() {
+  if (enabled_) draw(true);
+}
+
+void Progress::draw(bool final_line) {
+  last_ = std::chrono::steady_clock::now();
+  const double elapsed = std::chrono::duration<double>(last_ - start_).count();
+  const std::size_t left = total_ - done_;
+  // ETA from the rate of the cases run in this invocation (the cached ones cost nothing).
+  const double eta = ran_ > 0 ? elapsed / static_cast<double>(ran_) * static_cast<double>(left) : NAN;
+  const double frac = total_ > 0 ? static_cast<double>(done_) / static_cast<double>(total_) : 1.0;
+  char line[256];
+  const std::string eta_text = final_line ? "elapsed " + format_duration(elapsed) : "ETA " + format_duration(eta);
+  if (tty_) {
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(frac * kWidth);
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar += std::string(static_cast<std::size_t>(kWidth - filled), '.');
+    std::snprintf(line, sizeof line, "\r[%s] %zu/%zu %3.0f%%  %zu failed  %s   ", bar.c_str(), done_, total_, 100 * frac,
+                  failed_, eta_text.c_str());
+    std::fputs(line, stderr);
+    if (final_line) std::fputc('\n', stderr);
+  } else {
+    std::snprintf(line, sizeof line, "progress: %zu/%zu cases (%.0f%%), %zu failed, %s\n", done_, total_, 100 * frac,
+                  failed_, eta_text.c_str());
+    std::fputs(line, stderr);
+  }
+  std::fflush(stderr);
+}
+
+}  // namespace feeddrive::study

@@ -1,0 +1,175 @@
+// feeddrive-study end to end: parallel runs give the same bytes, reruns skip finished cases (and
+// only those whose scenario is unchanged), failed cases are reported while the others go on, bad
+// studies exit 2 with one line, and the output folder follows feeddrive::output's rules.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "study_util.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kStudy = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-study";
+
+fs::path scratch() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-study-cli-" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// Removes the scratch folder when the test program ends.
+struct ScratchCleanup : ::testing::Environment {
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(scratch(), ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path p = scratch() / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+struct ProcResult {
+  int code;
+  std::string err;
+};
+
+ProcResult study(const std::string& args) {
+  const fs::path err = scratch() / "stderr.txt";
+  const int status = std::system((kStudy + " " + args + " 2> " + err.string() + " > /dev/null").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+}
+
+// 2 controllers x (1 + 2 + 3 draws) cases of 20 ms; one family fails by design (a CVODE step
+// budget of one step).
+std::string small_study(const std::string& extra_value = "0.8") {
+  return feeddrive::study::test::study_text(
+      "controllers:\n"
+      "  - {name: smc, scenario: " + feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml}\n"
+      "  - {name: cascade, controller: {type: cascade, kv: 3000}}\n"
+      "families:\n"
+      "  - name: nominal\n"
+      "  - name: mass\n"
+      "    grid: [{key: plant.mass, scale: [" + extra_value + ", 1.2]}]\n"
+      "  - name: mc\n"
+      "    monte_carlo:\n"
+      "      draws: 3\n"
+      "      seed: 5\n"
+      "      parameters:\n"
+      "        - {keys: [plant.friction.static_force, plant.friction.coulomb_force], distribution: uniform, low: 0.7, high: 1.3, scale: true}\n"
+      "  - name: broken\n"
+      "    set: {plant.integrator.max_steps: 1}\n"
+      "report: {limit: 0.8}\n");
+}
+
+nlohmann::json timing(const fs::path& dir) { return nlohmann::json::parse(slurp(dir / "timing.json")); }
+
+TEST(StudyCli, SameBytesForAnyJobsAndRerunsSkipFinishedCases) {
+  const fs::path s = write_file("small.yaml", small_study());
+  const fs::path a = scratch() / "a", b = scratch() / "b";
+  ProcResult r = study(s.string() + " --out " + a.string() + " -j 1 --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = study(s.string() + " --out " + b.string() + " -j 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(a / "results.csv");
+  EXPECT_EQ(csv, slurp(b / "results.csv"));
+  // 1 header + 2 x 7 cases; the two broken ones failed with CVODE's error, the others went on.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 15);
+  EXPECT_EQ(timing(a)["cases_run"], 14);
+  std::istringstream lines(csv);
+  std::string line;
+  int failed = 0;
+  while (std::getline(lines, line))
+    if (line.find(",broken,") != std::string::npos) {
+      EXPECT_NE(line.find(",false,CVODE"), std::string::npos) << line;
+      ++failed;
+    }
+  EXPECT_EQ(failed, 2);
+  EXPECT_TRUE(fs::exists(b / "report.md"));
+  EXPECT_TRUE(fs::exists(b / "plots" / "box.png"));
+  EXPECT_NE(slurp(b / "report.md").find("| smc | 7 | 1 |"), std::string::npos);
+
+  // A rerun runs nothing and writes the same bytes.
+  r = study(s.string() + " --out " + a.string() + " --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(timing(a)["cases_run"], 0);
+  EXPECT_EQ(slurp(a / "results.csv"), csv);
+  // --retry-failed runs the two failed ones again.
+  r = study(s.string() + " --out " + a.string() + " --no-plots --retry-failed");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(timing(a)["cases_run"], 2);
+  // A changed study reruns exactly the cases whose scenario changed (mass x0.9 instead of x0.8,
+  // one case per controller), never a stale one.
+  const fs::path s2 = write_file("small2.yaml", small_study("0.9"));
+  r = study(s2.string() + " --out " + a.string() + " --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(timing(a)["cases_run"], 2);
+  const std::string csv2 = slurp(a / "results.csv");
+  EXPECT_NE(csv2, csv);
+  EXPECT_NE(csv2.find(",91.836"), std::string::npos);  // 102.04 x 0.9
+  EXPECT_EQ(csv2.find(",81.632"), std::string::npos);  // 102.04 x 0.8 is gone
+}
+
+TEST(StudyCli, BadStudiesAndFoldersExit2WithOneLine) {
+  const auto one_line = [](const ProcResult& r) {
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    return r.err;
+  };
+  const fs::path bad = write_file("bad.yaml", feeddrive::study::test::study_text(
+                                                   "families:\n  - {name: f, grid: [{key: plant.frction.static_force, values: [1]}]}\n"));
+  EXPECT_NE(one_line(study(bad.string() + " --out " + (scratch() / "x").string())).find("plant.frction: unknown key"), std::string::npos);
+  EXPECT_FALSE(fs::exists(scratch() / "x"));  // nothing written for a bad study
+  const fs::path mc = write_file("mc.yaml", feeddrive::study::test::study_text(
+                                                "families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, parameters: [{key: plant.mass, distribution: weibull}]}\n"));
+  EXPECT_NE(one_line(study(mc.string() + " --out " + (scratch() / "x").string())).find("distribution = 'weibull'"), std::string::npos);
+  EXPECT_NE(one_line(study((scratch() / "missing.yaml").string() + " --out " + (scratch() / "x").string())).find("cannot read the study file"),
+            std::string::npos);
+  // A folder feeddrive did not write is never touched.
+  const fs::path mine = scratch() / "mine";
+  fs::create_directories(mine);
+  std::ofstream(mine / "notes.txt") << "keep";
+  const fs::path ok = write_file("ok.yaml", feeddrive::study::test::study_text(""));
+  EXPECT_NE(one_line(study(ok.string() + " --out " + mine.string())).find("is not a feeddrive output"), std::string::npos);
+  EXPECT_EQ(slurp(mine / "notes.txt"), "keep");
+  // -j must be a count.
+  EXPECT_EQ(study(ok.string() + " --out " + (scratch() / "y").string() + " -j 0").code, 2);
+}
+
+TEST(StudyCli, ReplacesTheOutputOfAnotherFeeddriveTool) {
+  const fs::path dir = scratch() / "was_sim";
+  const std::string sim = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-sim";
+  ASSERT_EQ(std::system((sim + " " + feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml --out " + dir.string() +
+                         " --no-plots --quiet").c_str()),
+            0);
+  ASSERT_TRUE(fs::exists(dir / "timeseries.csv"));
+  const fs::path ok = write_file("ok2.yaml", feeddrive::study::test::study_text(""));
+  const ProcResult r = study(ok.string() + " --out " + dir.string() + " --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "timeseries.csv"));
+  EXPECT_TRUE(fs::exists(dir / "results.csv"));
+  EXPECT_NE(slurp(dir / ".feeddrive-output").find("tool: feeddrive-study"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,111 @@
+// Study files: strict loading with one-line errors naming the key and the value.
+#include <gtest/gtest.h>
+
+#include "feeddrive/study/spec.hpp"
+#include "study_util.hpp"
+
+namespace feeddrive::study {
+namespace {
+
+using test::study_error;
+using test::study_text;
+
+TEST(StudySpec, DefaultsOneControllerAndOneNominalCase) {
+  const Study s = parse_study(study_text(""), ".", "s.yaml");
+  ASSERT_EQ(s.controllers.size(), 1u);
+  EXPECT_EQ(s.controllers[0].name, "base");
+  ASSERT_EQ(s.families.size(), 1u);
+  EXPECT_EQ(s.families[0].name, "nominal");
+  EXPECT_EQ(s.total_cases(), 1);
+  EXPECT_EQ(s.model, ModelRule::kNominal);
+}
+
+TEST(StudySpec, ControllerFromScenarioTakesItsBlockAndControlPeriod) {
+  const Study s = parse_study(study_text("controllers:\n  - {name: sgn, scenario: " + test::scenarios() +
+                                         "/smc_jerk_limited.yaml, set: {plant.mass: 100}}\n"),
+                              ".", "s.yaml");
+  ASSERT_EQ(s.controllers.size(), 1u);
+  EXPECT_NE(s.controllers[0].block.find("sgn"), std::string::npos);
+  ASSERT_EQ(s.controllers[0].set.size(), 2u);
+  EXPECT_EQ(s.controllers[0].set[0].key, "control_period");
+  EXPECT_EQ(s.controllers[0].set[0].value, "2e-5");
+  EXPECT_EQ(s.controllers[0].set[1].key, "plant.mass");
+}
+
+TEST(StudySpec, CaseCountIsGridTimesDrawsTimesControllers) {
+  const Study s = parse_study(study_text(R"(
+controllers:
+  - {name: a, controller: {type: cascade}}
+  - {name: b, controller: {type: cascade, kv: 900}}
+  - {name: c, controller: {type: sliding_mode}}
+families:
+  - name: nominal
+  - name: g
+    grid:
+      - {key: plant.mass, values: [90, 100, 110]}
+      - {keys: [plant.friction.static_force, plant.friction.coulomb_force], scale: [0.7, 1.3]}
+    monte_carlo:
+      draws: 4
+      seed: 3
+      parameters:
+        - {key: plant.friction.viscous, distribution: lognormal, mu: 0, sigma: 0.2, scale: true}
+)"), ".", "s.yaml");
+  EXPECT_EQ(s.family_cases(0), 1);
+  EXPECT_EQ(s.family_cases(1), 3 * 2 * 4);
+  EXPECT_EQ(s.total_cases(), 3 * (1 + 24));
+}
+
+TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
+  const std::string fam = "families:\n  - name: f\n";
+  EXPECT_NE(study_error(study_text("familes: []\n")).find("familes: unknown key (did you mean 'families'?)"), std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid: []\n")).find("families[0].grid: empty grid"), std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: plant.mass, values: []}\n")).find("empty grid axis"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: plant.mass, values: [.nan]}\n"))
+                .find("families[0].grid[0].values[0] = '.nan': NaN is not allowed"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: plant.mass, scale: [x]}\n"))
+                .find("families[0].grid[0].scale[0] = 'x': not a number"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: 'plant..mass', values: [1]}\n")).find("not a dotted scenario key"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {keys: [a, b], values: [[1, 2, 3]]}\n"))
+                .find("expected one value per key (2)"),
+            std::string::npos);
+  const std::string mc = fam + "    monte_carlo:\n";
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: cauchy}\n"))
+                .find("distribution = 'cauchy': expected one of uniform, normal, lognormal"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: uniform, low: 2, high: 1}\n"))
+                .find("parameters[0].high = 1: must be > low (2)"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: normal, mean: 1}\n"))
+                .find("stddev: missing (required by distribution normal)"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: normal, mean: 0, stddev: 1, low: 50, high: 60}\n"))
+                .find("holds almost none of the distribution"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      parameters:\n        - {key: plant.mass, distribution: uniform, low: 1, high: 2}\n"))
+                .find("seed: missing"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 0\n      seed: 1\n      parameters: []\n")).find("draws = 0: must be >= 1"),
+            std::string::npos);
+  // Impossible case counts: each axis is fine, the product is not.
+  std::string axis = "[";
+  for (int i = 0; i < 100; ++i) axis += (i ? ",1" : "1");
+  axis += "]";
+  std::string huge = fam + "    grid:\n";
+  for (int i = 0; i < 4; ++i) huge += "      - {key: plant.k" + std::to_string(i) + ", values: " + axis + "}\n";
+  EXPECT_NE(study_error(study_text(huge)).find("more than 1000000 cases"), std::string::npos);
+  EXPECT_NE(study_error(study_text("controllers:\n  - {name: a, controller: {type: cascade}}\n  - {name: a, controller: {type: cascade}}\n"))
+                .find("controllers[1].name = 'a': used twice"),
+            std::string::npos);
+  EXPECT_NE(study_error(study_text("controllers:\n  - {name: a}\n")).find("give exactly one of controller:"), std::string::npos);
+  EXPECT_NE(study_error("name: t\n").find("base: missing"), std::string::npos);
+  EXPECT_NE(study_error("name: t\nbase: /nonexistent.yaml\n").find("base = '/nonexistent.yaml': cannot read the file"), std::string::npos);
+  EXPECT_NE(study_error("name: [t\n").find("YAML syntax error"), std::string::npos);
+  EXPECT_NE(study_error(study_text("report: {scale: .nan}\n")).find("report.scale = '.nan': NaN is not allowed"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace feeddrive::study
