@@ -69,6 +69,17 @@ completed_identical() {
   same_csv "$TMP/sim/timeseries.csv" "$TMP/$1/timeseries.csv"
 }
 
+# A key that group or others can read is refused before anything starts: exit 2, one line.
+cp "$KEY" "$TMP/open.key"
+chmod 644 "$TMP/open.key"
+rc=0
+feeddrive-launch "$scen" --out "$TMP/open" --no-plots -q --lcm-url "$URL" --key "$TMP/open.key" > "$TMP/open.log" 2>&1 || rc=$?
+[ "$rc" = 2 ] || { cat "$TMP/open.log" >&2; fail "a 0644 key: launch exited $rc, expected 2"; }
+[ "$(grep -c "" "$TMP/open.log")" = 1 ] && grep -q "error: --key .*open.key: mode 0644 lets group or others access it; run chmod 600" "$TMP/open.log" ||
+  { cat "$TMP/open.log" >&2; fail "a 0644 key: not the one-line error"; }
+[ -e "$TMP/open" ] && fail "a 0644 key: an output folder was made"
+pass "a 0644 key refused: $(cat "$TMP/open.log")"
+
 # 0. A clean run, recorded by the stock lcm-logger for the replay below.
 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/old.lcmlog" > /dev/null 2>&1 & lg=$!
 wait_on_bus $lg
