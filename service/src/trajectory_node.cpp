@@ -59,6 +59,7 @@ void TrajectoryNode::send_ahead(std::int64_t k) {
 
 void TrajectoryNode::run() {
   set_state("running");
+  wait_for_run();  // block 0 must carry the run's identity
   // Block 0 now; the look-ahead once the plant's first state shows that the run has started.
   send_block(0, false);
   next_block_ = 1;
