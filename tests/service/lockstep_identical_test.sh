@@ -16,3 +16,18 @@ for s in smc_jerk_limited smc_ramp_all_forces; do
   [ "$steps" = "$(json "$TMP/sim_$s/summary.json" .steps)" ] || fail "$s: $steps steps"
   pass "$s: $steps steps identical to feeddrive-sim; state->command p50 $(json "$TMP/mp_$s/summary.json" .lockstep.latency_us.state_to_command.p50) us"
 done
+# The recording options hold for the monitor too (one writer, sim::RunWriter): every 7th row, three
+# columns, the same bytes as feeddrive-sim, and the summary still of every step.
+scen=$TMP/options.yaml
+sed 's/^duration: .*/duration: 0.3/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+printf 'output: {every: 7, columns: [t, x, u]}\n' >> "$scen"
+sim_run "$scen" "$TMP/sim_options"
+timeout 300 feeddrive-launch "$scen" --out "$TMP/mp_options" --no-plots -q --lcm-url "$URL"
+same_csv "$TMP/sim_options/timeseries.csv" "$TMP/mp_options/timeseries.csv"
+[ "$(head -n 1 "$TMP/mp_options/timeseries.csv")" = "t,x,u" ] || fail "options: header $(head -n 1 "$TMP/mp_options/timeseries.csv")"
+rows=$(( $(wc -l < "$TMP/mp_options/timeseries.csv") - 1 ))
+[ "$rows" = $(( (3000 + 6) / 7 )) ] || fail "options: $rows rows"
+[ "$(json "$TMP/mp_options/summary.json" .steps)" = 3000 ] || fail "options: summary not of every step"
+[ "$(json "$TMP/mp_options/summary.json" .position_error_p95_abs_m)" = "$(json "$TMP/sim_options/summary.json" .position_error_p95_abs_m)" ] ||
+  fail "options: p95 differs"
+pass "output.every 7 and output.columns [t, x, u]: $rows rows identical to feeddrive-sim, summary of all 3000 steps"
