@@ -21,7 +21,7 @@ std::vector<double> record_values(const Record& r) {
 
 RunResult run(const Scenario& s, const std::function<void(long, long)>& progress) {
   const auto wall_start = std::chrono::steady_clock::now();
-  plant::Plant drive(s.plant, s.control_period);
+  plant::Plant drive(s.drive(), s.control_period);
   const auto reference = make_reference(s);
   const auto controller = make_controller(s);
   const long n = s.steps();
