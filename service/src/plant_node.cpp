@@ -16,7 +16,13 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
       drive_(s.drive(), s.control_period),
       states_(bus(), channels().state),
       previous_(no_applied()) {
+  if (!bus().run_known()) {
+    bus().set_run_id(draw_run_id());
+    spdlog::info("plant: run id {} (drawn: no --run-id given; the other processes join it from the plant's heartbeat)",
+                 bus().run_id());
+  }
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t) {
+    if (!admit(command_ledger_, channels().command, m.seq, m)) return;
     if (!command_ || m.seq > command_->seq) {
       command_ = m;
     } else {
@@ -29,7 +35,7 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
 }
 
 drive_state_t PlantNode::make_state(std::int64_t k) {
-  drive_state_t m;
+  drive_state_t m{};
   m.seq = k;
   m.t = s_.time_of(k);
   m.steps = steps_;

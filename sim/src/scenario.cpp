@@ -1,11 +1,15 @@
 #include "feeddrive/sim/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "feeddrive/common/validate.hpp"
+#include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
+#include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::sim {
@@ -13,6 +17,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using plant::PlantParams;
+
+// A name from the file as a message shows it: printable ASCII, at most 40 bytes.
+std::string output_shown(const std::string& s) {
+  std::string out;
+  for (char c : s.substr(0, 40)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  return s.size() > 40 ? out + "..." : out;
+}
 
 // --- plant ---------------------------------------------------------------------------------
 
@@ -215,7 +226,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model,
   p.quantization = model.sensor.quantization;
 }
 
-void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::string& base_dir) {
+void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_enum(r, "kind", p.kind, controller::open_loop_kind_from_string, controller::to_string(p.kind));
   r.number("amplitude", p.amplitude);
   r.number("frequency", p.frequency);
@@ -225,8 +236,9 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::stri
   r.number("start_time", p.start_time);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  r.string("file", p.file);
-  if (!p.file.empty() && fs::path(p.file).is_relative()) p.file = (fs::path(base_dir) / p.file).string();
+  r.string("file", file);
+  if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
+  if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
 // --- reference -----------------------------------------------------------------------------
@@ -298,7 +310,7 @@ void validate_reference(const ReferenceConfig& c) {
     case ReferenceType::kAccelLimited: c.accel_limited.validate("reference"); break;
     case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
     case ReferenceType::kRamp: c.ramp.validate("reference"); break;
-    case ReferenceType::kWaypoints: trajectory::read_waypoints_csv(c.waypoints_file); break;
+    case ReferenceType::kWaypoints: break;  // read and checked in parse_node
   }
 }
 
@@ -316,6 +328,10 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
   if (s.control_period > s.duration)
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
+  if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
+    throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " + root["control_period"].Scalar() +
+                        ": " + validate::format_number(n) + " steps; a run has at most " + validate::format_number(kMaxSteps) +
+                        " steps (docs/scenario.md, Limits)");
 
   {
     MapReader plant = top.child("plant");
@@ -343,7 +359,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
     s.controller.cascade.computation_delay = s.controller.computation_delay;
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
-    read_open_loop(c, s.controller.open_loop, base_dir);
+    read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
     s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
   } else {
     c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop");
@@ -351,14 +367,36 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   c.finish();
 
   read_reference(top.child("reference"), s.reference, base_dir);
+  {
+    MapReader o = top.child("output");
+    o.integer("every", s.output.every);
+    o.string_list("columns", s.output.columns);
+    o.finish();
+    if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
+    const auto& all = record_columns();
+    for (const std::string& c : s.output.columns) {
+      if (std::find(all.begin(), all.end(), c) == all.end()) {
+        std::string known;
+        for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
+        o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
+      }
+      if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
+        o.fail("columns", ": column '" + c + "' listed twice");
+    }
+    if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
+      o.fail("columns", ": empty list (leave the key out to record every column)");
+  }
   MapReader a = top.child("analysis");
   a.number("settled_after", s.analysis.settled_after);
   a.finish();
   top.finish();
   if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
 
-  // Component validation: each validate() names its key and value.
+  // Component validation: each validate() names its key and value; tables come from the files.
   try {
+    if (s.reference.type == ReferenceType::kWaypoints) s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
+    if (s.controller.type == ControllerType::kOpenLoop && s.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
+      read_open_loop_file(s.controller.open_loop_file, s.controller.open_loop);
     s.plant.validate("plant");
     switch (s.controller.type) {
       case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
@@ -369,11 +407,34 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(e.what());
   }
-  if (s.steps() < 1) throw ScenarioError("duration: shorter than one control period");
+  if (s.steps() < 1)
+    throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
+                        validate::format_number(s.control_period) + " s)");
   return s;
 }
 
 }  // namespace
+
+std::vector<trajectory::Waypoint> read_waypoints_file(const std::string& path) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"x"}}};
+  o.increasing = 0;
+  o.limits.min_rows = 2;  // a spline needs one interval
+  const csv::Table t = csv::read_file(path, o);
+  std::vector<trajectory::Waypoint> points(t.rows());
+  for (std::size_t i = 0; i < t.rows(); ++i) points[i] = {t.values[0][i], t.values[1][i]};
+  return points;
+}
+
+void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"force_N", "u"}}};  // force_N when the file has both
+  o.increasing = 0;
+  csv::Table t = csv::read_file(path, o);
+  p.table_t = std::move(t.values[0]);
+  p.table_value = std::move(t.values[1]);
+  p.table_is_force = t.used[1] == "force_N";
+}
 
 long Scenario::steps() const { return std::lround(duration / control_period); }
 
@@ -429,7 +490,7 @@ std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {
     case ReferenceType::kSCurve: return trajectory::make_scurve(c.scurve);
     case ReferenceType::kRamp: return trajectory::make_ramp(c.ramp);
     case ReferenceType::kWaypoints:
-      return trajectory::make_waypoints(trajectory::read_waypoints_csv(c.waypoints_file));
+      return trajectory::make_waypoints(c.waypoints);
   }
   return nullptr;
 }

@@ -9,11 +9,13 @@
 // the first state it sees, never asks for resends, and does not acknowledge (the plant's flow
 // control stays with the run's own monitor).
 
+#include <memory>
 #include <string>
 
 #include "feeddrive/monitor/recorder.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/node.hpp"
+#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::monitor {
@@ -27,6 +29,7 @@ struct MonitorOptions {
 
 class MonitorNode : public service::Node {
  public:
+  /// Opens the output (staged folder, timeseries.csv) at once: rows are written as they complete.
   MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt);
   /// Returns true if the run completed and its results were written; tries to write the
   /// results in every case.
@@ -42,13 +45,18 @@ class MonitorNode : public service::Node {
   sim::Scenario s_;
   MonitorOptions mopt_;
   Recorder rec_;
+  std::unique_ptr<sim::RunWriter> out_;
+  std::string open_error_;  // why out_ could not be opened
   std::int64_t start_us_{0};
   std::int64_t last_row_us_{0};
   std::int64_t last_request_us_{0};
   std::int64_t last_progress_us_{0};
   std::int64_t last_ack_sent_{-1};
   std::int64_t lost_{0};
-  run_summary_t summary_;
+  run_summary_t summary_{};
+  service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
+  service::StepLedger<reference_t> reference_ledger_;
+  service::StepLedger<control_command_t> command_ledger_;
 };
 
 }  // namespace feeddrive::monitor

@@ -34,6 +34,11 @@ struct NodeOptions {
   bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
   int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
   bool quiet{false};
+  /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
+  /// other process takes it from the plant's first fresh heartbeat.
+  std::int64_t run_id{0};
+  std::string key_file;              ///< --key: authenticate every message with this key; "": off
+  ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 
 /// Thrown when a run cannot go on: another role failed or stopped answering.
@@ -62,6 +67,17 @@ class Node {
 
   void request_resend(const std::string& channel, std::int64_t seq);
 
+  /// Checks the message `item` of step `seq` on `channel` against the one this node already has
+  /// for that step. True: new or identical (the caller goes on as before: an identical one is a
+  /// re-publication). A different one is a conflict: counted, logged naming channel, step and
+  /// fields, then RunFailure (--on-conflict fail, the default) or false (keep-first: drop it).
+  template <typename T>
+  bool admit(StepLedger<T>& ledger, const std::string& channel, std::int64_t seq, const T& item) {
+    std::string diff;
+    if (ledger.admit(seq, item, &diff) != StepLedger<T>::Seen::kConflict) return true;
+    return on_conflict(channel, seq, T::getTypeName(), diff);
+  }
+
   /// Throws RunFailure if another role announced a failure.
   void check_peers() const;
   /// The latest status of a role, if any was seen.
@@ -78,6 +94,7 @@ class Node {
   std::int64_t resends{0};
   std::int64_t duplicates{0};
   std::int64_t invalid_content{0};
+  std::int64_t conflicts{0};
   std::int64_t acked_seq{-1};  ///< monitor only: every step below is recorded
 
  protected:
@@ -85,6 +102,9 @@ class Node {
   std::function<void(const resend_request_t&)> on_resend_request;
 
  private:
+  bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);
+  process_status_t status_message(const std::string& state, const std::string& message) const;
+
   std::string role_;
   NodeOptions opt_;
   Bus bus_;
@@ -92,6 +112,7 @@ class Node {
   std::string state_{"starting"};
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
+  std::int64_t last_conflict_log_us_{-1};
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;
 };

@@ -46,6 +46,7 @@ class PlantNode : public Node {
   plant::Plant drive_;
   Outbox<drive_state_t> states_;
   std::optional<control_command_t> command_;  ///< the newest command received, any seq
+  StepLedger<control_command_t> command_ledger_;  ///< every command received, for conflicts
   applied_t previous_;
   std::int64_t rejected_{0};
   std::int64_t missed_{0};

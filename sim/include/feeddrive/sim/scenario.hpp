@@ -8,6 +8,7 @@
 //   controller: {type: sliding_mode | cascade | open_loop, ...}
 //   reference:  {type: sine | step | accel_limited | scurve | ramp | waypoints | none, ...}
 //   analysis:   {settled_after: 0.25}   (optional)
+//   output:     {every: 1, columns: [t, xd, x, ...]}   (optional)
 //
 // Loading is strict: an unknown or misspelt key, a missing value, a non-number, NaN or a value
 // that fails validate() throws ScenarioError with a one-line message naming the key and value.
@@ -15,6 +16,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/open_loop.hpp"
@@ -40,6 +42,7 @@ struct ReferenceConfig {
   trajectory::SCurveParams scurve;
   trajectory::RampParams ramp;
   std::string waypoints_file;  ///< resolved against the scenario file's folder
+  std::vector<trajectory::Waypoint> waypoints;  ///< read from waypoints_file when loaded
 };
 
 struct ControllerConfig {
@@ -49,13 +52,24 @@ struct ControllerConfig {
   double computation_delay{0.0};
   controller::SlidingModeParams sliding_mode;
   controller::CascadeParams cascade;
-  controller::OpenLoopParams open_loop;
+  controller::OpenLoopParams open_loop;  ///< kind csv: its table read from open_loop_file when loaded
+  std::string open_loop_file;            ///< controller.file, resolved against the scenario's folder
 };
 
 struct AnalysisConfig {
   /// Start [s] of the "settled" window over which the *_settled error metrics are computed.
   double settled_after{0.25};
 };
+
+/// What timeseries.csv records (the summary and the plots always cover every step).
+struct OutputConfig {
+  long every{1};                     ///< keep rows k with k % every == 0
+  std::vector<std::string> columns;  ///< the columns written, in this order; empty = all
+};
+
+/// Largest run: steps = round(duration / control_period) <= kMaxSteps (docs/scenario.md,
+/// "Limits"): 1e10 steps are about a day of wall time at the fastest measured 7 us per step.
+inline constexpr double kMaxSteps = 1e10;
 
 struct Scenario {
   std::string name;
@@ -66,6 +80,7 @@ struct Scenario {
   ControllerConfig controller;
   ReferenceConfig reference;
   AnalysisConfig analysis;
+  OutputConfig output;
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};
@@ -87,6 +102,13 @@ Scenario load_scenario(const std::string& path);
 /// source in messages.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
                         const std::string& origin = "scenario");
+
+/// The tables a scenario names (reference.file, controller.file), read with the one CSV reader
+/// (feeddrive/csv/reader.hpp). Throw csv::CsvError (std::invalid_argument), one line naming
+/// file:line:column and the value.
+std::vector<trajectory::Waypoint> read_waypoints_file(const std::string& path);
+/// Fills p.table_t, p.table_value and p.table_is_force from columns t and force_N (or u).
+void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p);
 
 std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s);
 std::unique_ptr<controller::Controller> make_controller(const Scenario& s);
