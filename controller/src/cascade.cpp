@@ -19,20 +19,49 @@ void CascadeParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".ki", ki);
   require_finite(prefix + ".velocity_feedforward", velocity_feedforward);
   require_finite(prefix + ".acceleration_feedforward", acceleration_feedforward);
+  require_non_negative(prefix + ".disturbance_observer_bandwidth", disturbance_observer_bandwidth);
+  require_non_negative(prefix + ".model.sensor.quantization", quantization);
+  require_non_negative(prefix + ".computation_delay", computation_delay);
   require_positive(prefix + ".model.mass", mass);
   require_positive(prefix + ".model.thrust_gain", thrust_gain);
+  if (friction_feedforward) friction.validate(prefix + ".model.friction");
   require_range(prefix, u_min, u_max);
   require_positive(prefix + ".period", period);
 }
 
-CascadeController::CascadeController(const CascadeParams& p) : p_(p) { p_.validate("controller"); }
+CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
+                            double scale) {
+  const double tau = computation_delay + 0.5 * period + (differenced_velocity ? 0.5 * period : 0.0);
+  const double pi = 3.14159265358979323846;
+  const double wv = scale * (pi / 4.0 - std::atan(0.25)) / tau;
+  const double kv = wv / std::sqrt(1.0 + 1.0 / 16.0);
+  return {wv / 4.0, kv, kv * wv / 4.0};
+}
 
-Command CascadeController::update(const trajectory::Sample& ref, const plant::Measurement& meas,
+CascadeController::CascadeController(const CascadeParams& p)
+    : p_((p.validate("controller"), p)),
+      friction_ff_(p.friction, p.period, 0.0),
+      observer_(p.disturbance_observer_bandwidth > 0.0 ? p.disturbance_observer_bandwidth : 1.0,
+                p.period, true, p.quantization),
+      delay_line_(p.compensate_delay ? p.computation_delay : 0.0, 1e-9 * p.period) {}
+
+Command CascadeController::update(const trajectory::Sample& ref_now, const plant::Measurement& meas,
                                   const Truth* /*truth*/) {
+  const bool delayed = p_.compensate_delay && p_.computation_delay > 0.0 && std::isfinite(meas.t);
+  // Feedback compares the measurement with the reference now; the feedforward forces are for
+  // when the command acts (t_k + d): "feedforward with preview".
+  const trajectory::Sample& ref = ref_now;
+  const trajectory::Sample ahead = delayed ? preview(ref_now, p_.computation_delay) : ref_now;
+  const bool dob = p_.disturbance_observer_bandwidth > 0.0;
+  if (dob) observer_.correct(meas.x, meas.v);
+  const double d_hat = dob && observer_.initialised() ? observer_.disturbance() : 0.0;
+  const double f_ff = p_.friction_feedforward ? friction_ff_.estimate(ahead.velocity) : 0.0;
+
   const double v_cmd = p_.velocity_feedforward * ref.velocity + p_.kp * (ref.position - meas.x);
   const double ev = v_cmd - meas.v;
   const double force =
-      p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ref.acceleration);
+      p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ahead.acceleration - d_hat) +
+      f_ff;
   Command cmd;
   cmd.u_unsaturated = force / p_.thrust_gain;
   cmd.u = saturate(cmd.u_unsaturated, p_.u_min, p_.u_max);
@@ -40,6 +69,26 @@ Command CascadeController::update(const trajectory::Sample& ref, const plant::Me
   const bool high = cmd.u_unsaturated > p_.u_max && ev > 0.0;
   const bool low = cmd.u_unsaturated < p_.u_min && ev < 0.0;
   if (!high && !low) integral_ += ev * p_.period;
+
+  if (p_.friction_feedforward) friction_ff_.advance(ahead.velocity, 0.0);
+  if (dob && observer_.initialised()) {
+    // Model: m^*x'' = Ka*Kf*u_acting - F^f_ff (held over the period); d^ takes up the rest.
+    if (delayed) {
+      delay_line_.push(meas.t, cmd.u);
+      double dv = 0.0, dx = 0.0;
+      const double t_end = meas.t + p_.period;
+      for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, t_end)) {
+        const double tau = piece.t1 - piece.t0;
+        const double a = (p_.thrust_gain * piece.u - f_ff) / p_.mass;
+        dv += a * tau;
+        dx += a * tau * (0.5 * tau + (t_end - piece.t1));
+      }
+      observer_.predict_increments(dv, dx);
+      delay_line_.forget_before(t_end);
+    } else {
+      observer_.predict((p_.thrust_gain * cmd.u - f_ff) / p_.mass);
+    }
+  }
   return cmd;
 }
 

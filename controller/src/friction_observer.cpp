@@ -11,7 +11,9 @@ FrictionObserver::FrictionObserver(const plant::FrictionParams& p, double period
 
 double FrictionObserver::estimate(double v) const { return plant::friction_force(p_, v, z_); }
 
-void FrictionObserver::advance(double v, double velocity_error) {
+void FrictionObserver::advance(double v, double velocity_error) { advance(v, velocity_error, period_); }
+
+void FrictionObserver::advance(double v, double velocity_error, double dt) {
   if (p_.model != plant::FrictionModel::kLuGre) return;
   // A non-finite velocity carries no information for this period: hold z^ rather than take a
   // NaN into the state for good. A non-finite correction is dropped likewise.
@@ -24,9 +26,9 @@ void FrictionObserver::advance(double v, double velocity_error) {
   const double b = v + (std::isfinite(correction) ? correction : 0.0);
   if (a > 0.0) {
     const double zs = b / a;
-    z_ = zs + (z_ - zs) * std::exp(-a * period_);
+    z_ = zs + (z_ - zs) * std::exp(-a * dt);
   } else {
-    z_ += b * period_;
+    z_ += b * dt;
   }
 }
 

@@ -45,4 +45,9 @@ void StateObserver::predict(double a) {
   v_ += total * period_;
 }
 
+void StateObserver::predict_increments(double dv, double dx) {
+  x_ += v_ * period_ + dx + 0.5 * d_ * period_ * period_;
+  v_ += dv + d_ * period_;
+}
+
 }  // namespace feeddrive::controller

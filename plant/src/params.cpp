@@ -155,6 +155,11 @@ void SensorParams::validate(const std::string& prefix) const {
   if (velocity != "auto" && velocity != "true" && velocity != "difference")
     throw std::invalid_argument(prefix + ".velocity = '" + velocity +
                                 "': expected one of auto, true, difference");
+  // An encoder measures position only: with quantization or noise the velocity a drive sees is
+  // formed from the counts, never the true velocity (issue 10: honest velocity estimation).
+  if (velocity == "true" && !ideal())
+    throw std::invalid_argument(prefix + ".velocity = 'true': an encoder with quantization or noise "
+                                "measures position only; use difference (or auto)");
 }
 
 void IntegratorParams::validate(const std::string& prefix) const {

@@ -13,7 +13,7 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
     : Node("plant", opt),
       s_(s),
       steps_(s.steps()),
-      drive_(s.plant, s.control_period),
+      drive_(s.drive(), s.control_period),
       states_(bus(), channels().state),
       previous_(no_applied()) {
   if (!bus().run_known()) {

@@ -144,8 +144,8 @@ void read_plant(MapReader r, PlantParams& p, bool with_effects) {
   if (with_effects) {
     read_effects(r.child("effects"), p.effects);
   } else if (r.has("effects")) {
-    r.fail("effects", ": a controller model has no effects (they are the plant's discrepancy from "
-                      "the model: plant.effects)");
+    r.fail("effects", ": only the sliding_mode controller's model takes effects (e.g. those "
+                      "feeddrive-fit found); the cascade uses the model's mass and friction only");
   }
   r.finish();
 }
@@ -182,22 +182,50 @@ void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
             controller::to_string(p.motion_state));
   r.number("motion_observer_bandwidth", p.motion_observer_bandwidth);
   r.boolean("motion_observer_disturbance", p.motion_observer_disturbance);
+  r.boolean("compensate_delay", p.compensate_delay);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), p.model, false);
+  read_plant(r.child("model"), p.model, true);
 }
 
-void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model) {
-  r.number("kp", p.kp);
-  r.number("kv", p.kv);
-  r.number("ki", p.ki);
+// tuning: manual (kp, kv, ki as given) or rule (controller/cascade.hpp cascade_tuning(): from the
+// control period, the computation delay and whether the velocity is differenced from an encoder,
+// times bandwidth_scale); with the rule, kp, kv and ki must not be given.
+void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model, double period,
+                  double computation_delay) {
+  std::string tuning = "manual";
+  r.string("tuning", tuning);
+  if (tuning != "manual" && tuning != "rule") r.fail("tuning", " = '" + tuning + "': expected one of manual, rule");
+  if (tuning == "rule") {
+    for (const char* key : {"kp", "kv", "ki"})
+      if (r.has(key)) r.fail(key, ": set by tuning: rule (remove it, or use tuning: manual)");
+    double scale = 1.0;
+    r.number("bandwidth_scale", scale);
+    if (!(scale > 0.0)) r.fail("bandwidth_scale", " = " + std::to_string(scale) + ": must be > 0");
+    const plant::SensorParams& sensor = model.sensor;
+    const bool differenced = sensor.velocity == "difference" || (sensor.velocity == "auto" && !sensor.ideal());
+    const controller::CascadeGains g = controller::cascade_tuning(period, computation_delay, differenced, scale);
+    p.kp = g.kp;
+    p.kv = g.kv;
+    p.ki = g.ki;
+  } else {
+    if (r.has("bandwidth_scale")) r.fail("bandwidth_scale", ": only with tuning: rule");
+    r.number("kp", p.kp);
+    r.number("kv", p.kv);
+    r.number("ki", p.ki);
+  }
   r.number("velocity_feedforward", p.velocity_feedforward);
   r.number("acceleration_feedforward", p.acceleration_feedforward);
+  r.boolean("friction_feedforward", p.friction_feedforward);
+  r.number("disturbance_observer_bandwidth", p.disturbance_observer_bandwidth);
+  r.boolean("compensate_delay", p.compensate_delay);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
   read_plant(r.child("model"), model, false);
   p.mass = model.mass;
   p.thrust_gain = model.thrust_gain();
+  p.friction = model.friction;
+  p.quantization = model.sensor.quantization;
 }
 
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
@@ -377,6 +405,9 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
 
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");
+  c.number("computation_delay", s.controller.computation_delay);
+  if (s.controller.computation_delay < 0.0)
+    c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
   if (type == "sliding_mode") {
     s.controller.type = ControllerType::kSlidingMode;
     s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself,
@@ -384,10 +415,12 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     // A model never carries the plant's sensor or initial state; they are not part of it.
     read_sliding_mode(c, s.controller.sliding_mode);
     s.controller.sliding_mode.period = s.control_period;
+    s.controller.sliding_mode.computation_delay = s.controller.computation_delay;
   } else if (type == "cascade") {
     s.controller.type = ControllerType::kCascade;
-    read_cascade(c, s.controller.cascade, s.plant);
+    read_cascade(c, s.controller.cascade, s.plant, s.control_period, s.controller.computation_delay);
     s.controller.cascade.period = s.control_period;
+    s.controller.cascade.computation_delay = s.controller.computation_delay;
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
     read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
@@ -469,6 +502,18 @@ void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p)
 }
 
 long Scenario::steps() const { return std::lround(duration / control_period); }
+
+PlantParams Scenario::drive() const {
+  PlantParams p = plant;
+  const double d = controller.computation_delay;
+  if (d > 0.0) {
+    plant::InputDelayEffect& delay = p.effects.input_delay;
+    if (!delay.enabled) delay.delay_s = 0.0;
+    delay.enabled = true;
+    delay.delay_s += d;
+  }
+  return p;
+}
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
                         ResolvedKeys* resolved) {

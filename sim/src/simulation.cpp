@@ -86,7 +86,7 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
 RunStats run(const Scenario& s, const RecordSink& sink) {
 
   const auto wall_start = std::chrono::steady_clock::now();
-  plant::Plant drive(s.plant, s.control_period);
+  plant::Plant drive(s.drive(), s.control_period);
   const auto reference = make_reference(s);
   const auto controller = make_controller(s);
   const long n = s.steps();

@@ -126,16 +126,28 @@ TEST(ScenarioEffects, ValidationNamesKeyAndValue) {
             "s.yaml: plant.effects.mass_error.mass_kg = 0: must be > 0");
 }
 
-TEST(ScenarioEffects, AControllerModelHasNoEffects) {
-  const std::string yaml = R"(
+// The sliding-mode controller's model takes effects (a fitted model, docs/fit.md): they are read
+// into the model, not the plant. The cascade's model does not (it uses mass and friction only).
+TEST(ScenarioEffects, OnlyTheSlidingModeModelTakesEffects) {
+  const Scenario s = parse_scenario(R"(
 duration: 0.01
 control_period: 1e-4
 controller: {type: sliding_mode, model: {effects: {constant_force: {force_N: 3}}}}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
+)",
+                                    ".", "s.yaml");
+  EXPECT_TRUE(s.controller.sliding_mode.model.effects.constant_force.enabled);
+  EXPECT_EQ(s.controller.sliding_mode.model.effects.constant_force.force_N, 3.0);
+  EXPECT_FALSE(s.plant.effects.any());
+  const std::string yaml = R"(
+duration: 0.01
+control_period: 1e-4
+controller: {type: cascade, model: {effects: {constant_force: {force_N: 3}}}}
+reference: {type: sine, amplitude: 0.1, frequency: 1.0}
 )";
   EXPECT_EQ(error_of(yaml),
-            "s.yaml: controller.model.effects: a controller model has no effects (they are the plant's "
-            "discrepancy from the model: plant.effects)");
+            "s.yaml: controller.model.effects: only the sliding_mode controller's model takes effects "
+            "(e.g. those feeddrive-fit found); the cascade uses the model's mass and friction only");
 }
 
 // A closed-loop run with effects of every kind (additive, folded, delayed) completes with finite

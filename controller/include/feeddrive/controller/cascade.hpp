@@ -1,15 +1,36 @@
 #pragma once
-// The usual CNC cascade: P position loop, PI velocity loop, velocity and acceleration feedforward.
+// The usual CNC cascade: P position loop, PI velocity loop, velocity and acceleration feedforward,
+// optional friction feedforward from the model and an optional disturbance observer.
 //
 //   v_cmd = kff_v*xd' + kp*(xd - x_m)
 //   e_v   = v_cmd - v_m
-//   F     = m^*( kv*e_v + ki*Integral(e_v) + kff_a*xd'' )
+//   F     = m^*( kv*e_v + ki*Integral(e_v) + kff_a*xd'' ) + F^f_ff - m^*d^
 //   u     = sat(F/(Ka*Kf)^, u_min, u_max)
 // The integrator is frozen while the output saturates in the direction of the error
 // (conditional-integration anti-windup). Gains are scaled by the model mass so they read as
 // bandwidths: kv [1/s], ki [1/s^2], kp [1/s].
+//
+// * Friction feedforward (friction_feedforward): F^f_ff = the model's LuGre friction along the
+//   reference, from a bristle observer (friction_observer.hpp) driven by xd' (not by the
+//   measurement: a feedforward term, free of sensor noise).
+// * Disturbance observer (disturbance_observer_bandwidth w_d > 0): the x,v,d observer of
+//   state_observer.hpp fed by the encoder (dead zone of one count q = quantization), predicting
+//   with the model m^*x'' = F - F^f_ff; its lumped disturbance d^ [m/s^2] is cancelled by -m^*d^.
+//   This is the extended-state form of the disturbance observer (Han 2009, "From PID to active
+//   disturbance rejection control"; Ohnishi's DOB with the model as the nominal plant).
+// * Delay (computation_delay d, compensate_delay): the feedforward forces (m^*kff_a*xd'' and
+//   F^f_ff) use the reference previewed to t_k + d (delay_line.hpp, preview()), when the command
+//   acts; the feedback compares the measurement with the reference at t_k; the disturbance
+//   observer predicts with the command that acts.
+//
+// The tuning rule (cascade_tuning()) sets kv, ki, kp from the sample period, the computation
+// delay and the sensor; see docs/controllers.md ("Cascade tuning rule").
 
 #include "feeddrive/controller/controller.hpp"
+#include "feeddrive/controller/delay_line.hpp"
+#include "feeddrive/controller/friction_observer.hpp"
+#include "feeddrive/controller/state_observer.hpp"
+#include "feeddrive/plant/params.hpp"
 
 namespace feeddrive::controller {
 
@@ -19,13 +40,31 @@ struct CascadeParams {
   double ki{40000.0};          ///< velocity integral gain [1/s^2]
   double velocity_feedforward{1.0};      ///< kff_v [-]
   double acceleration_feedforward{1.0};  ///< kff_a [-]
+  bool friction_feedforward{false};      ///< add the model friction along the reference
+  double disturbance_observer_bandwidth{0.0};  ///< w_d [rad/s]; 0 = no disturbance observer
+  double quantization{0.0};    ///< encoder count q [m] for the observer's dead zone
+  double computation_delay{0.0};  ///< d [s]: the command acts d after its sample
+  bool compensate_delay{false};   ///< preview the reference by d; observer predicts with the acting command
   double mass{102.04};         ///< m^ [kg]
   double thrust_gain{260.0};   ///< (Ka*Kf)^ [N/V]
+  plant::FrictionParams friction;  ///< the model's friction (friction feedforward)
   double u_min{-10.0};         ///< [V]
   double u_max{10.0};          ///< [V]
   double period{1e-4};         ///< T [s]
   void validate(const std::string& prefix = "controller") const;
 };
+
+/// The cascade tuning rule (docs/controllers.md, "Cascade tuning rule"): with the effective
+/// loop delay tau = d + T/2 (zero-order hold) + T/2 (velocity differenced from the encoder;
+/// 0 for a measured velocity), the velocity loop L(s) = (kv + ki/s)/s * exp(-s*tau) crosses over
+/// at w_v with phase margin 45 deg when the PI corner is w_v/4:
+///   w_v = (pi/4 - atan(1/4))/tau,  kv = w_v/sqrt(1 + 1/16),  ki = kv*w_v/4,  kp = w_v/4.
+/// `scale` multiplies w_v (1 = the rule). Returns {kp, kv, ki}.
+struct CascadeGains {
+  double kp, kv, ki;
+};
+CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
+                            double scale = 1.0);
 
 class CascadeController final : public Controller {
  public:
@@ -37,6 +76,9 @@ class CascadeController final : public Controller {
  private:
   CascadeParams p_;
   double integral_{0.0};
+  FrictionObserver friction_ff_;
+  StateObserver observer_;
+  DelayLine delay_line_;
 };
 
 }  // namespace feeddrive::controller

@@ -24,6 +24,8 @@ class FrictionObserver {
   double z() const { return z_; }
   /// Advances z^ over one period with v held; e_v is the velocity error for the correction.
   void advance(double v, double velocity_error);
+  /// The same over a duration dt [s] instead of one period (the delay predictor's pieces).
+  void advance(double v, double velocity_error, double dt);
 
  private:
   plant::FrictionParams p_;

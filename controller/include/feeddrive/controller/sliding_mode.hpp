@@ -22,6 +22,23 @@
 // grows to millimetres). The difference of the true z is the plant's own rate, whatever its
 // parameters, and is 0 in steady sliding. See docs/controllers.md ("Model mismatch").
 //
+// A model with effects (plant.effects keys under controller.model, e.g. the effects feeddrive-fit
+// found: docs/fit.md): the modifying ones (mass_error, presliding, grinding_force) are folded
+// into the model (plant::effective_params), the additive ones are compensated with the others:
+// with F_extra = e0(x, v) + e1(x)*F (e1 from reluctance_ripple),
+//   Ka*Kf*u*(1 - r(x) - e1) = m*(...) + F^f + F^g + Fcog(x) + e0.
+// input_delay in a model is ignored (the controller's delay is computation_delay).
+//
+// Delay compensation (compensate_delay, computation delay d > 0): the command u_k acts only
+// over [t_k + d, t_{k+1} + d). The controller keeps its issued commands (delay_line.hpp); the
+// x,v,d observer predicts each period with the command that acts in it (piecewise constant),
+// so its estimate at t_k is the drive's state now; the law then uses
+//   x_p, v_p = the model prediction from (x^, v^) over [t_k, t_k + d] through the commands
+//              already issued (model forces and d^ held at their t_k values),
+//   r_p      = the reference previewed to t_k + d (preview(), exact for polynomial segments),
+// i.e. a Smith-predictor structure (Smith 1957): with an exact model the loop is the delay-free
+// loop shifted by d; model errors enter through the observer's d^ and correction.
+//
 // Order within one period: (optionally) correct the x,v observer with the new sample; compute
 // u from the estimates at t_k; then advance the force observers and predict x,v over [t_k, t_k+T]
 // with u held (so nothing uses information from after t_k).
@@ -30,6 +47,7 @@
 #include <optional>
 
 #include "feeddrive/controller/controller.hpp"
+#include "feeddrive/controller/delay_line.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
 #include "feeddrive/controller/state_observer.hpp"
 #include "feeddrive/plant/params.hpp"
@@ -74,6 +92,13 @@ struct SlidingModeParams {
   /// Estimate a lumped disturbance acceleration d^ in the x,v observer and add m*d^ to the
   /// force (motion_state = observer only).
   bool motion_observer_disturbance{true};
+  /// Computation delay d [s] (scenario controller.computation_delay): the command computed from
+  /// the sample at t_k acts over [t_k + d, t_{k+1} + d); the plant applies it.
+  double computation_delay{0.0};
+  /// Compensate the known delay (needs motion_state = observer): the x,v observer predicts with
+  /// the command that actually acts (DelayLine), and the law acts on the state predicted to
+  /// t_k + d through the commands already issued, with the reference previewed to t_k + d.
+  bool compensate_delay{false};
   double u_min{-10.0};        ///< [V]
   double u_max{10.0};         ///< [V]
   plant::PlantParams model;   ///< the controller's model of the drive
@@ -90,10 +115,12 @@ class SlidingModeController final : public Controller {
   std::string name() const override { return "sliding_mode"; }
 
  private:
-  SlidingModeParams p_;
+  SlidingModeParams p_;  ///< with the model's modifying effects folded in
+  bool has_extra_;       ///< the model has additive effects (compensated with the others)
   FrictionObserver friction_observer_;
   GrindingObserver grinding_observer_;
   StateObserver motion_observer_;
+  DelayLine delay_line_;
   std::optional<double> last_true_z_;
 };
 

@@ -37,6 +37,11 @@ class StateObserver {
   void correct(double x_measured, double v0 = 0.0);
   /// Predicts one period ahead under model acceleration a [m/s^2] (d^ is added here).
   void predict(double acceleration);
+  /// Predicts one period ahead when the model acceleration is piecewise constant within it (a
+  /// delayed command switching inside the period): dv = sum a_i*tau_i and dx = the double
+  /// integral of the model acceleration over the period (sum a_i*tau_i*(tau_i/2 + time after
+  /// piece i)); d^ is added as in predict().
+  void predict_increments(double dv, double dx);
 
   double position() const { return x_; }
   double velocity() const { return v_; }

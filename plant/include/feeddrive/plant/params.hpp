@@ -189,7 +189,8 @@ struct SensorParams {
   std::uint64_t seed{1};       ///< seed of the noise generator (std::mt19937_64).
   /// How the measured velocity is formed:
   ///   "auto": the true velocity when the sensor is ideal, else "difference";
-  ///   "true": the true velocity (a tachometer-like ideal sensor);
+  ///   "true": the true velocity (a tachometer-like ideal sensor; only with an ideal sensor:
+  ///           validate() refuses it with quantization or noise, which measure position only);
   ///   "difference": (x_meas[k] - x_meas[k-1]) / T, what a drive computes from an encoder.
   std::string velocity{"auto"};
 

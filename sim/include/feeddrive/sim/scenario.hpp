@@ -48,6 +48,9 @@ struct ReferenceConfig {
 
 struct ControllerConfig {
   ControllerType type{ControllerType::kSlidingMode};
+  /// controller.computation_delay [s]: the command computed from the sample at t_k acts from
+  /// t_k + computation_delay (within or beyond the period). The drive applies it (drive()).
+  double computation_delay{0.0};
   controller::SlidingModeParams sliding_mode;
   controller::CascadeParams cascade;
   controller::OpenLoopParams open_loop;  ///< kind csv: its table read from open_loop_file when loaded
@@ -85,6 +88,11 @@ struct Scenario {
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};
+
+  /// The drive as it runs: `plant` with the controller's computation delay added to the input
+  /// delay (plant.effects.input_delay; the plant applies each command that long after its
+  /// sample, restarting CVODE at the switch times). Every Plant built from a scenario uses this.
+  plant::PlantParams drive() const;
 
   /// Number of control steps: round(duration / control_period).
   long steps() const;
