@@ -4,12 +4,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
-#include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/output/gnuplot.hpp"
+#include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/summary.hpp"
 
@@ -20,7 +23,16 @@ using service::us;
 
 MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
     : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched), s_(s), mopt_(mopt), rec_(mopt.attach) {
-  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) { rec_.on_state(m, t); });
+  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
+    rec_.on_state(m, t);
+    // First receive time of each state: the period-start lateness histogram (real time).
+    if (m.seq >= 0 && m.seq < s_.steps()) {
+      if (state_recv_us_.size() <= static_cast<std::size_t>(m.seq))
+        state_recv_us_.resize(static_cast<std::size_t>(m.seq) + 1, std::numeric_limits<double>::quiet_NaN());
+      double& r = state_recv_us_[static_cast<std::size_t>(m.seq)];
+      if (std::isnan(r)) r = static_cast<double>(t);
+    }
+  });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
     for (const reference_t& m : b.refs) rec_.on_reference(m, t);
   });
@@ -183,6 +195,24 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["reference_lead_us"] = {{"p50", lat(rec_.reference_lead(), 0.5)},
                             {"p1", lat(rec_.reference_lead(), 0.01)},
                             {"samples", rec_.reference_lead().size()}};
+  // Histograms: bins of T/20 up to 2T (5 us at 10 kHz); in real time a state_to_command beyond
+  // T - guard is a deadline miss, and period_start_lateness is how late each state went out
+  // relative to the earliest (timer wake-up and spin of the plant, as the monitor sees it).
+  const double period_us = s_.control_period * 1e6;
+  const double bin_us = period_us / 20.0;
+  std::vector<std::string> hist_names = {"state_to_command", "command_to_state"};
+  std::vector<Histogram> hists = {histogram(rec_.latency_state_to_command(), bin_us, 40),
+                                  histogram(rec_.latency_command_to_state(), bin_us, 40)};
+  if (options().realtime) {
+    hist_names.push_back("period_start_lateness");
+    hists.push_back(histogram(period_start_lateness(state_recv_us_, period_us), bin_us, 40));
+  }
+  {
+    auto& h = l["latency_histogram_us"];
+    h["bin_us"] = bin_us;
+    for (std::size_t i = 0; i < hists.size(); ++i)
+      h[hist_names[i]] = {{"counts", hists[i].counts}, {"overflow", hists[i].overflow}, {"samples", hists[i].samples}};
+  }
   for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
     for (const char* q : {"p50", "p99", "p1"})
       if (v->contains(q) && std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
@@ -190,8 +220,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   bool written = true;
   std::string why = failure;
   try {
-    sim::write_results(mopt_.out_dir, r, sum, s_, mopt_.plots && !r.records.empty(), j.dump(),
-                       mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
+    const bool plots = mopt_.plots && !r.records.empty();
+    sim::write_results(mopt_.out_dir, r, sum, s_, plots, j.dump(), mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor",
+                       [&](const std::string& dir) { write_histograms(dir, hist_names, hists, plots); });
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -211,6 +242,33 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",
                  output::shown(mopt_.out_dir));
   return written;
+}
+
+void MonitorNode::write_histograms(const std::string& dir, const std::vector<std::string>& names,
+                                   const std::vector<Histogram>& h, bool plot) const {
+  {
+    std::FILE* f = std::fopen((dir + "/latency_histogram.csv").c_str(), "w");
+    if (f == nullptr) throw std::runtime_error(dir + "/latency_histogram.csv: cannot open for writing");
+    const std::string csv = histograms_csv(names, h);
+    const bool ok = std::fwrite(csv.data(), 1, csv.size(), f) == csv.size();
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error(dir + "/latency_histogram.csv: write failed");
+  }
+  if (!plot) return;
+  const double period_us = s_.control_period * 1e6;
+  std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
+                   "set output 'latency_histogram.png'\nset grid\nset logscale y\nset yrange [0.5:*]\n"
+                   "set style fill transparent solid 0.4\nset boxwidth " + std::to_string(h.front().bin_us) + "\n"
+                   "set xlabel 'latency [us] (bins of T/20; the last bin of the csv is followed by the overflow)'\n"
+                   "set ylabel 'steps'\nset title " +
+                   output::gnuplot_string(s_.name + (options().realtime ? " (real time)" : " (lockstep)")) + "\n";
+  gp += "set arrow from " + std::to_string(period_us) + ",graph 0 to " + std::to_string(period_us) +
+        ",graph 1 nohead dt 2\nset label 'T' at " + std::to_string(period_us) + ",graph 0.95\n";
+  gp += "plot ";
+  for (std::size_t i = 0; i < names.size(); ++i)
+    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us / 2) +
+          "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
+  gp += "\n";
+  output::run_gnuplot(dir, gp, "latency_histogram.gp");
 }
 
 }  // namespace feeddrive::monitor

@@ -28,7 +28,8 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
                                 "--resend-interval", fmt_double(opt.resend_interval_s),
                                 "--monitor-window", std::to_string(opt.monitor_window),
                                 "--linger", fmt_double(opt.linger_s),
-                                "--max-bad-commands", std::to_string(opt.max_bad_commands)};
+                                "--max-bad-commands", std::to_string(opt.max_bad_commands),
+                                "--spin-us", std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
   return a;
 }

@@ -1,7 +1,14 @@
 #include "feeddrive/service/node.hpp"
 
+#include <sched.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <ctime>
 
 namespace feeddrive::service {
 namespace {
@@ -19,6 +26,28 @@ void install_signal_handlers() {
 }
 
 int interrupted_by() { return g_signal; }
+
+std::string enter_realtime(int priority) {
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+  const std::string lock = locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (::sched_setscheduler(0, SCHED_FIFO, &sp) == 0) return "SCHED_FIFO " + std::to_string(priority) + ", " + lock;
+  return std::string("normal scheduling (SCHED_FIFO not permitted: ") + std::strerror(errno) +
+         "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock;
+}
+
+void sleep_until(std::int64_t target_us, std::int64_t spin_us) {
+  const std::int64_t wake = target_us - spin_us;
+  if (mono_us() < wake) {
+    timespec ts{static_cast<time_t>(wake / 1000000), static_cast<long>((wake % 1000000) * 1000)};
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && g_signal == 0) {
+    }
+  }
+  while (mono_us() < target_us) {
+  }
+}
 
 std::string seconds_text(double s) {
   char buf[32];

@@ -68,6 +68,9 @@ void TrajectoryNode::run() {
     // A plant that still sends its heartbeat is waiting for another role (the controller, the
     // monitor) and will time out naming it; blaming the plant here would hide the real cause.
     // Never wait longer than three timeouts, though.
+    // Another role's failure first: it names the culprit (a stalled controller makes the plant
+    // fail, and then the plant's heartbeat stops too; our own timeout would blame the plant).
+    check_peers();
     const std::int64_t waited = mono_us() - last_progress_us_;
     const bool plant_waits = highest_state_ >= 0 && peer_alive("plant", 0.5) && waited <= 3 * us(limit);
     if (waited > us(limit) && !plant_waits)

@@ -66,7 +66,8 @@ void write_plots(const std::string& dir, const std::string& title) {
 }
 
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots, const std::string& extra_json, const std::string& tool) {
+                   bool plots, const std::string& extra_json, const std::string& tool,
+                   const std::function<void(const std::string&)>& extra_files) {
   output::StagedFolder out(out_dir, tool);
   const fs::path tmp = out.dir();
   write_timeseries_csv((tmp / "timeseries.csv").string(), r.records);
@@ -77,6 +78,7 @@ void write_results(const std::string& out_dir, const RunResult& r, const Summary
     if (!js) throw std::runtime_error((tmp / "summary.json").string() + ": write failed");
   }
   if (plots) write_plots(tmp.string(), s.name);
+  if (extra_files) extra_files(tmp.string());
   out.commit();
 }
 

@@ -10,7 +10,9 @@
 // control stays with the run's own monitor).
 
 #include <string>
+#include <vector>
 
+#include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/monitor/recorder.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/node.hpp"
@@ -38,6 +40,9 @@ class MonitorNode : public service::Node {
   void progress(bool force);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
+  /// latency_histogram.csv (and .png when `plot`) into the staged output folder `dir`.
+  void write_histograms(const std::string& dir, const std::vector<std::string>& names, const std::vector<Histogram>& h,
+                        bool plot) const;
 
   sim::Scenario s_;
   MonitorOptions mopt_;
@@ -49,6 +54,7 @@ class MonitorNode : public service::Node {
   std::int64_t last_ack_sent_{-1};
   std::int64_t lost_{0};
   run_summary_t summary_;
+  std::vector<double> state_recv_us_;  ///< first receive time of state k [us, monotonic]; NaN: none
 };
 
 }  // namespace feeddrive::monitor
