@@ -1,5 +1,5 @@
 // Xie & Liang Sec. 5 (sliding-mode control) against the paper's figures and the independent
-// check values of ../shared/notes/paper-analysis.md Sec. 3. Three controller families:
+// check values of docs/paper-analysis.md Sec. 3. Three controller families:
 //   smc_*       the paper's law with hard sgn at 20 us and the true z (Figs. 18-22);
 //   smc_bl_*    sat(S/phi) with a near-deadbeat boundary layer at 10 kHz, true z;
 //   beyond_*    the beyond-the-paper configuration: 10 kHz, bristle observer, 50 nm encoder,

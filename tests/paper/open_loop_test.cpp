@@ -1,5 +1,5 @@
 // Xie & Liang Sec. 4 (open-loop studies) against the paper and the independent check values of
-// ../shared/notes/paper-analysis.md ("[sim]": SciPy Radau, rtol 1e-8). Each tolerance is
+// docs/paper-analysis.md ("[sim]": SciPy Radau, rtol 1e-8). Each tolerance is
 // explained where it is used.
 #include <gtest/gtest.h>
 

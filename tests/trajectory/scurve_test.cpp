@@ -96,7 +96,7 @@ TEST(SCurve, PaperDefaultsGiveA1p10sPureSMove) {
 }
 
 TEST(SCurve, NotesTableOfPaperInterpretations) {
-  // ../shared/notes/paper-analysis.md Sec. 2.7: duration and peaks for the other readings.
+  // docs/paper-analysis.md Sec. 2.7: duration and peaks for the other readings.
   struct Row {
     double amax, jmax, t, v_peak, a_peak;
   };

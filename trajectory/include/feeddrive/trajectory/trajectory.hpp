@@ -65,7 +65,7 @@ std::unique_ptr<Trajectory> make_accel_limited(const AccelLimitedParams& p);
 /// Jerk-limited 7-segment double-S rest-to-rest move (Biagiotti & Melchiorri 2008, Sec. 3.4),
 /// time-optimal under |v| <= vmax, |a| <= amax, |j| <= jmax, in all four cases (vmax and amax
 /// each reached or not). Default: D = 0.1 m, vmax 0.2 m/s, amax 1.15 m/s^2, jmax 2.4 m/s^3
-/// (a 1.10 s move; see ../shared/notes/paper-analysis.md Sec. 2.7 on the garbled paper values).
+/// (a 1.10 s move; see docs/paper-analysis.md Sec. 2.7 on the garbled paper values).
 struct SCurveParams {
   double distance{0.1};           ///< [m]
   double max_velocity{0.2};       ///< [m/s]
