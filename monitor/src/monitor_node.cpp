@@ -14,6 +14,7 @@
 #include "feeddrive/output/gnuplot.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/sim/output.hpp"
+#include "feeddrive/service/translate.hpp"
 #include "feeddrive/sim/summary.hpp"
 
 namespace feeddrive::monitor {
@@ -37,6 +38,39 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     for (const reference_t& m : b.refs) rec_.on_reference(m, t);
   });
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) { rec_.on_command(m, t); });
+  if (!mopt_.lcm_log.empty()) {
+    if (!bus().batched())
+      throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
+                                  opt.lcm_url);
+    log_ = std::make_unique<LcmLogWriter>(mopt_.lcm_log);
+    const std::string run_channels = opt.prefix + "_";
+    bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
+      if (ch.compare(0, run_channels.size(), run_channels) != 0 || !log_error_.empty()) return;
+      try {
+        log_->write(ch, d, n, utime);
+      } catch (const std::exception& e) {
+        log_error_ = e.what();
+      }
+    });
+  }
+  // The run's self-description (run_info_t): the monitor is in every run (a hardware driver may
+  // take the plant's role, never the monitor's) and off the step's path. At the start, every
+  // second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
+  // monitor only listens.
+  if (!mopt_.attach) {
+    info_ = service::to_run_info(s_, opt.realtime, 0);
+    on_heartbeat = [this] {
+      if (heartbeats_++ % 10 == 0) publish_info();
+    };
+    on_resend_request = [this](const resend_request_t& r) {
+      if (r.channel == channels().info) publish_info();
+    };
+  }
+}
+
+void MonitorNode::publish_info() {
+  info_.utime = service::wall_utime();
+  bus().publish(channels().info, info_);
 }
 
 void MonitorNode::request_missing() {
@@ -98,6 +132,7 @@ bool MonitorNode::run() {
         if (due) last_ack_sent_ = acked_seq;
       }
       progress(false);
+      if (!log_error_.empty()) throw service::RunFailure(log_error_);
       if (rec_.complete()) break;
       request_missing();
       check_peers();
@@ -114,6 +149,19 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+  }
+  if (log_) {
+    // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
+    // closed before the run is announced done.
+    bus().poll(std::chrono::microseconds(0));
+    bus().set_tap({});
+    try {
+      log_->close();
+      if (!options().quiet) spdlog::info("monitor: {} LCM events -> {}", log_->events(), log_->path());
+    } catch (const std::exception& e) {
+      if (log_error_.empty()) log_error_ = e.what();
+    }
+    if (!log_error_.empty() && failure.empty()) failure = log_error_;
   }
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.

@@ -17,7 +17,8 @@ Channels::Channels(const std::string& prefix)
       reference(prefix + "_REF"),
       status(prefix + "_STATUS"),
       resend(prefix + "_RESEND"),
-      summary(prefix + "_SUMMARY") {}
+      summary(prefix + "_SUMMARY"),
+      info(prefix + "_INFO") {}
 
 std::int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(

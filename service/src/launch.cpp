@@ -101,6 +101,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
     if (role == "monitor") {
       args.insert(args.end(), {"--out", lo.out_dir});
       if (!lo.plots) args.push_back("--no-plots");
+      if (!lo.lcm_log.empty()) args.insert(args.end(), {"--lcm-log", lo.lcm_log});
     }
     const std::string exe = bin + "/feeddrive-" + role;
     if (::access(exe.c_str(), X_OK) != 0) throw std::runtime_error("cannot find " + exe);

@@ -82,6 +82,7 @@ void Node::heartbeat(bool force) {
   m.duplicates = duplicates;
   m.invalid = bus_.invalid() + invalid_content;
   bus_.publish(ch_.status, m);
+  if (on_heartbeat) on_heartbeat();
 }
 
 void Node::announce_failure(const std::string& message) {

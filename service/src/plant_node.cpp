@@ -149,10 +149,14 @@ void PlantNode::run_lockstep() {
         last_sent = now;
       }
       const double limit = k == 0 ? options().start_timeout_s : options().step_timeout_s;
-      if (now - start > us(limit))
+      // Another role's failure first: it names the culprit. A controller that still sends its
+      // heartbeat is waiting for someone else (the trajectory) and will name them; a stalled or
+      // dead one sends none. Never wait longer than three timeouts, though.
+      check_peers();
+      const bool controller_waits = k > 0 && peer_alive("controller", 0.5) && now - start <= 3 * us(limit);
+      if (now - start > us(limit) && !controller_waits)
         throw RunFailure("no command from the controller for step " + std::to_string(k) + " within " +
                          seconds_text(limit) + " s" + stale_note());
-      check_peers();
       heartbeat();
       bus().poll(std::chrono::microseconds(std::max<std::int64_t>(resend_us - (mono_us() - last_sent), 1)));
     }

@@ -58,9 +58,9 @@ void TrajectoryNode::send_ahead(std::int64_t k) {
 
 void TrajectoryNode::run() {
   set_state("running");
-  // Block 0 now; the look-ahead once the plant's first state shows that the run has started.
-  send_block(0, false);
-  next_block_ = 1;
+  // Everything, block 0 included, once the plant's first state shows that the run has started:
+  // the plant publishes it only when the monitor is up (its flow control), so the monitor (and
+  // its --lcm-log) sees the blocks in order from block 0, without asking for them again.
   last_progress_us_ = mono_us();
   while (!end_) {
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));

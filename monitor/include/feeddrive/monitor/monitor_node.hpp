@@ -9,11 +9,14 @@
 // the first state it sees, never asks for resends, and does not acknowledge (the plant's flow
 // control stays with the run's own monitor).
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/run_info_t.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/node.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -25,6 +28,10 @@ struct MonitorOptions {
   bool plots{true};
   bool attach{false};
   double progress_interval_s{0.5};
+  /// If set: every message of the run received on the bus (channels <prefix>_*, re-published
+  /// ones included) also goes to this file, in the standard LCM log format (lcm_log.hpp), with
+  /// the kernel's receive time: what lcm-logger writes, without another process on the group.
+  std::string lcm_log;
 };
 
 class MonitorNode : public service::Node {
@@ -37,6 +44,7 @@ class MonitorNode : public service::Node {
 
  private:
   void request_missing();
+  void publish_info();
   void progress(bool force);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
@@ -54,6 +62,10 @@ class MonitorNode : public service::Node {
   std::int64_t last_ack_sent_{-1};
   std::int64_t lost_{0};
   run_summary_t summary_;
+  run_info_t info_;
+  std::unique_ptr<LcmLogWriter> log_;
+  std::string log_error_;  ///< the first write error of the LCM log (ends the run)
+  std::int64_t heartbeats_{0};
   std::vector<double> state_recv_us_;  ///< first receive time of state k [us, monotonic]; NaN: none
 };
 

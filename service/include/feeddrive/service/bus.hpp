@@ -34,10 +34,10 @@ namespace feeddrive::service {
 /// under bursts).
 std::string default_lcm_url();
 
-/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY.
+/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY, _INFO.
 struct Channels {
   explicit Channels(const std::string& prefix);
-  std::string state, command, reference, status, resend, summary;
+  std::string state, command, reference, status, resend, summary, info;
 };
 
 /// Microseconds since the Unix epoch (process_status_t.utime) and a monotonic clock [us].

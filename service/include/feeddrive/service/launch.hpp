@@ -27,6 +27,8 @@ struct LaunchOptions {
   /// once, and on machines where waking a process on another core is slow (virtual machines)
   /// one core is fastest (bench/lockstep_bench.sh measures it).
   std::vector<int> cpus;
+  /// If set: the monitor also writes the run's messages to this LCM log (feeddrive-monitor --lcm-log).
+  std::string lcm_log;
 };
 
 /// Parses a CPU list "0" or "0,2" (each an index this process may run on). Throws

@@ -84,6 +84,8 @@ class Node {
  protected:
   /// Called for resend requests on `channel`; re-publish `seq` if this node owns the channel.
   std::function<void(const resend_request_t&)> on_resend_request;
+  /// Called each time the heartbeat goes out (every 100 ms and on changes of state).
+  std::function<void()> on_heartbeat;
 
  private:
   std::string role_;
