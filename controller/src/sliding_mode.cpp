@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "check.hpp"
@@ -115,8 +116,13 @@ Command SlidingModeController::update(const trajectory::Sample& ref, const plant
   double f_friction = 0.0;
   if (m.friction.model != plant::FrictionModel::kNone) {
     if (p_.friction_state == StateSource::kTrue && m.friction.model == plant::FrictionModel::kLuGre) {
-      f_friction = plant::friction_force(m.friction, v, truth != nullptr ? truth->z : 0.0);
-      cmd.z_estimate = truth != nullptr ? truth->z : 0.0;
+      // The bristle rate from the true z itself, not from the model's g(v) (sliding_mode.hpp).
+      const double z = truth != nullptr ? truth->z : 0.0;
+      const double zdot = last_true_z_ ? (z - *last_true_z_) / p_.period : plant::lugre_zdot(m.friction, v, z);
+      if (std::isfinite(z)) last_true_z_ = z;  // a NaN sample is not kept for the next rate
+      f_friction = m.friction.bristle_stiffness * z + plant::micro_damping(m.friction, v) * zdot +
+                   m.friction.viscous * v;
+      cmd.z_estimate = z;
     } else {
       f_friction = friction_observer_.estimate(v);
       cmd.z_estimate = friction_observer_.z();

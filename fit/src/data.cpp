@@ -162,12 +162,12 @@ MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
 
 MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
   monitor::LogConversion c;
+  std::vector<sim::Record> rows;
   try {
-    c = monitor::read_log(path, prefix);
+    c = monitor::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); });
   } catch (const std::exception& e) {
     throw DataError(e.what());
   }
-  const auto& rows = c.recorder.records();
   if (rows.empty())
     throw DataError(path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +
                     std::to_string(c.events) + " events read; wrong --prefix?)");

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
@@ -113,12 +114,6 @@ std::string findings_json(const FitResult& r) {
 
 namespace {
 
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream f(p);
-  f << text;
-  if (!f) throw std::runtime_error(p.string() + ": write failed");
-}
-
 std::string table(const std::vector<Bin>& bins) {
   std::ostringstream s;
   s << "| bin | points | force RMS [N] | share of residual | concentration | replay gap [um] |\n|---|---|---|---|---|---|\n";
@@ -146,22 +141,20 @@ std::string params_text(const Effect& e) {
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
                    const FitResult& r, bool plots) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
-  const fs::path tmp = out.dir();
   {
-    write_file(tmp / "findings.json", findings_json(r));
-    write_file(tmp / "model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
+    out.write_text("findings.json", findings_json(r));
+    out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
     const MeasuredData& d = *rec.data;
     // data behind the plots
     {
-      std::ofstream f(tmp / "replay.csv");
-      f << "t,x,x_sim_initial,x_sim_final,error_initial,error_final\n";
-      f.precision(12);
+      output::CsvWriter f(out.path("replay.csv"), {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
       for (std::size_t k = 0; k < d.size(); ++k)
-        f << d.t[k] << ',' << d.x[k] << ',' << r.replay_initial.x_sim[k] << ',' << r.replay_final.x_sim[k] << ','
-          << r.replay_initial.error[k] << ',' << r.replay_final.error[k] << '\n';
+        f.row({d.t[k], d.x[k], r.replay_initial.x_sim[k], r.replay_final.x_sim[k], r.replay_initial.error[k],
+               r.replay_final.error[k]});
+      f.close();
     }
     {
-      std::ofstream f(tmp / "gap.csv");
+      std::ofstream f(out.path("gap.csv"));
       f << "step,label,gap_m,force_rms_N\n";
       f << "0,initial," << r.replay_initial.gap << ',' << r.force_rms_initial << '\n';
       int k = 1;
@@ -173,14 +166,14 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       if (!st.accepted) continue;
       ++n_eff;
       const auto [label, xs] = effect_regressor(rec, st.effect);
-      std::ofstream f(tmp / ("effect" + std::to_string(n_eff) + ".csv"));
-      f << "regressor,residual_before,effect_force,residual_after\n";
+      output::CsvWriter f(out.path("effect" + std::to_string(n_eff) + ".csv"),
+                          {"regressor", "residual_before", "effect_force", "residual_after"});
       for (std::size_t i = 0; i < xs.size(); ++i) {
         const long li = static_cast<long>(i);
         // r = -filtered F_extra: the effect's own filtered force is -(r_after - r_before)
-        f << xs[i] << ',' << -st.residual_before[li] << ',' << -(st.residual_before[li] - st.residual_after[li])
-          << ',' << -st.residual_after[li] << '\n';
+        f.row({xs[i], -st.residual_before[li], -(st.residual_before[li] - st.residual_after[li]), -st.residual_after[li]});
       }
+      f.close();
     }
     // report.md
     std::ostringstream md;
@@ -255,12 +248,10 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
         md << "\n![residual against the regressor of " << st.effect.name << "](effect" << k << ".png)\n";
       }
     }
-    write_file(tmp / "report.md", md.str());
+    out.write_text("report.md", md.str());
     if (plots) {
       std::ostringstream gp;
       // Fixed data file names; every other text through output::gnuplot_string.
-      gp << "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\nset grid\n"
-         << "set key outside top center horizontal\n";
       gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
             "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
          << "plot 'replay.csv' every ::1 using 1:($2*1e3) with lines lw 2 title 'measured', '' every ::1 using "
@@ -283,7 +274,7 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
               "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
               "ps 0.3 title 'residual after'\n";
       }
-      output::run_gnuplot(tmp, gp.str());
+      out.plot(gp.str());
     }
   }
   out.commit();

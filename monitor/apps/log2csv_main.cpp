@@ -1,5 +1,5 @@
 // feeddrive-log2csv: turns an LCM log of a run (stock lcm-logger) into DIR/timeseries.csv and
-// DIR/summary.json, the same files feeddrive-monitor writes. Wiring only: read_log -> write_results.
+// DIR/summary.json, the same files feeddrive-monitor writes. Wiring only: read_log -> RunWriter.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -27,15 +27,14 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     const sim::Scenario s = sim::load_scenario(scenario_path);
     output::check_output_dir(out_dir);
-    const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix);
+    sim::check_run_size(s, out_dir);
+    sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
+    const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
     const monitor::Recorder& rec = c.recorder;
-    sim::RunResult r;
-    r.records = rec.records();
-    const sim::Summary sum = sim::summarize(r, s);
-    sim::write_results(out_dir, r, sum, s, plots && !r.records.empty(), "", "feeddrive-log2csv");
+    out.finish(out.summary().summary(0.0, {}), plots);
     const bool complete = rec.complete();
     spdlog::info("{}: {} events, {} rows{}, {} undecodable, {} on other channels -> {}", log_path, c.events,
-                 r.records.size(), complete ? " (complete run)" : "", c.undecodable, c.foreign_events, out_dir);
+                 rec.rows(), complete ? " (complete run)" : "", c.undecodable, c.foreign_events, out_dir);
     if (!complete) {
       std::string why = rec.end_seen() ? "" : "; the log has no end-of-run state";
       for (const auto& m : rec.missing()) why += "; no " + m.what + " " + std::to_string(m.seq) + " from the " + m.role;

@@ -3,6 +3,7 @@
 #include "feeddrive/monitor/monitor_node.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/service/cli.hpp"
+#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 int main(int argc, char** argv) {
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
     mopt.plots = !no_plots;
     const sim::Scenario s = sim::load_scenario(scenario_path);
     output::check_output_dir(mopt.out_dir);  // before the run
+    sim::check_run_size(s, mopt.out_dir);
     monitor::MonitorNode node(s, opt, mopt);
     return node.run() ? 0 : 1;
   });

@@ -81,7 +81,7 @@ void decode_into(const Event& ev, LogConversion& out, F&& f) {
 
 }  // namespace
 
-LogConversion read_log(const std::string& path, const std::string& prefix) {
+LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink) {
   LogParser log(path);
   const service::Channels ch(prefix);
   LogConversion out;
@@ -99,8 +99,9 @@ LogConversion read_log(const std::string& path, const std::string& prefix) {
     } else {
       ++out.foreign_events;
     }
+    if ((out.events & 4095) == 0) out.recorder.flush(sink);  // rows leave as they complete
   }
-  out.recorder.flush();
+  out.recorder.flush(sink);
   return out;
 }
 

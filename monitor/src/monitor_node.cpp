@@ -4,17 +4,16 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
-#include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 #include "feeddrive/reference_block_t.hpp"
-#include "feeddrive/sim/output.hpp"
 #include "feeddrive/service/translate.hpp"
+#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/summary.hpp"
 
 namespace feeddrive::monitor {
@@ -23,21 +22,25 @@ using service::mono_us;
 using service::us;
 
 MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
-    : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched), s_(s), mopt_(mopt), rec_(mopt.attach) {
+    : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched),
+      s_(s),
+      mopt_(mopt),
+      rec_(mopt.attach),
+      // Histograms: bins of T/20 up to 2T (5 us at 10 kHz).
+      hist_sc_(s.control_period * 1e6 / 20.0, 40),
+      hist_cs_(s.control_period * 1e6 / 20.0, 40),
+      lateness_(s.control_period * 1e6) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
     rec_.on_state(m, t);
-    // First receive time of each state: the period-start lateness histogram (real time).
-    if (m.seq >= 0 && m.seq < s_.steps()) {
-      if (state_recv_us_.size() <= static_cast<std::size_t>(m.seq))
-        state_recv_us_.resize(static_cast<std::size_t>(m.seq) + 1, std::numeric_limits<double>::quiet_NaN());
-      double& r = state_recv_us_[static_cast<std::size_t>(m.seq)];
-      if (std::isnan(r)) r = static_cast<double>(t);
-    }
+    on_state_timing(m, t);
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
     for (const reference_t& m : b.refs) rec_.on_reference(m, t);
   });
-  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) { rec_.on_command(m, t); });
+  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
+    rec_.on_command(m, t);
+    on_command_timing(m, t);
+  });
   if (!mopt_.lcm_log.empty()) {
     if (!bus().batched())
       throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
@@ -66,11 +69,40 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       if (r.channel == channels().info) publish_info();
     };
   }
+  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
 }
 
 void MonitorNode::publish_info() {
   info_.utime = service::wall_utime();
   bus().publish(channels().info, info_);
+}
+
+// Latency histograms from the first receive time of each message (one clock: the kernel's
+// receive stamps of this socket): state k -> command k, command k -> state k+1, and (real time)
+// how late state k went out. Only the steps in flight are kept.
+void MonitorNode::on_state_timing(const drive_state_t& m, std::int64_t t) {
+  if (m.end_of_run || m.seq <= timing_pruned_ || state_recv_.count(m.seq)) return;
+  state_recv_[m.seq] = t;
+  if (options().realtime) lateness_.add(m.seq, static_cast<double>(t));
+  if (const auto c = cmd_recv_.find(m.seq - 1); c != cmd_recv_.end() && t >= c->second)
+    hist_cs_.add(static_cast<double>(t - c->second));
+  prune_timing(m.seq);
+}
+
+void MonitorNode::on_command_timing(const control_command_t& m, std::int64_t t) {
+  if (m.seq <= timing_pruned_ || cmd_recv_.count(m.seq)) return;
+  cmd_recv_[m.seq] = t;
+  if (const auto s = state_recv_.find(m.seq); s != state_recv_.end() && t >= s->second)
+    hist_sc_.add(static_cast<double>(t - s->second));
+  prune_timing(m.seq);
+}
+
+void MonitorNode::prune_timing(std::int64_t seq) {
+  constexpr std::int64_t kKeep = 4096;  // steps in flight: far more than a step's messages are apart
+  if (seq - timing_pruned_ < 2 * kKeep) return;
+  timing_pruned_ = seq - kKeep;
+  state_recv_.erase(state_recv_.begin(), state_recv_.upper_bound(timing_pruned_));
+  cmd_recv_.erase(cmd_recv_.begin(), cmd_recv_.upper_bound(timing_pruned_));
 }
 
 void MonitorNode::request_missing() {
@@ -101,10 +133,10 @@ void MonitorNode::progress(bool force) {
   if (!force && now - last_progress_us_ < us(mopt_.progress_interval_s)) return;
   last_progress_us_ = now;
   if (options().quiet) return;
-  const auto& r = rec_.records();
   const double sim_t = static_cast<double>(rec_.next()) * s_.control_period;
   const double wall = static_cast<double>(now - start_us_) * 1e-6;
-  const double err = r.empty() ? 0.0 : (r.back().xd - (std::isnan(r.back().x) ? r.back().x_measured : r.back().x));
+  const sim::Record& last = out_->last();
+  const double err = out_->steps() == 0 ? 0.0 : (last.xd - (std::isnan(last.x) ? last.x_measured : last.x));
   std::fprintf(stderr, "\r[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um   ",
                static_cast<long long>(rec_.next()), static_cast<long long>(rec_.steps() < 0 ? s_.steps() : rec_.steps()),
                sim_t, wall > 0 ? sim_t / wall : 0.0, err * 1e6);
@@ -120,7 +152,7 @@ bool MonitorNode::run() {
       // Off the critical path: the bus takes the messages in batches (Receive::kBatched), one
       // wake-up per millisecond instead of one per message.
       bus().poll(std::chrono::microseconds(1000));
-      const std::size_t added = rec_.flush();
+      const std::size_t added = rec_.flush([this](const sim::Record& r) { out_->add(r); });
       const std::int64_t now = mono_us();
       if (added > 0) last_row_us_ = now;
       if (!mopt_.attach) {
@@ -149,6 +181,8 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+  } catch (const std::runtime_error& e) {  // writing a row failed (disk full, ...)
+    failure = e.what();
   }
   if (log_) {
     // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
@@ -169,10 +203,8 @@ bool MonitorNode::run() {
 }
 
 bool MonitorNode::finish(bool completed, const std::string& failure) {
-  sim::RunResult r;
-  r.records = rec_.records();
-  r.wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
-  const sim::Summary sum = sim::summarize(r, s_);
+  const double wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
+  const sim::Summary sum = out_->summary().summary(wall_time_s, {});
 
   std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(), invalid_total = bus().invalid();
   for (const char* role : {"plant", "controller", "trajectory"}) {
@@ -182,14 +214,14 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
       invalid_total += p->invalid;
     }
   }
-  const auto lat = [](const std::vector<double>& v, double q) { return quantile(v, q); };
+  const auto lat = [](const stats::StreamingQuantile& v, double q) { return v.quantile(q); };
   summary_.scenario = s_.name;
   summary_.completed = completed;
   summary_.failure = failure;
-  summary_.steps = static_cast<std::int64_t>(r.records.size());
+  summary_.steps = static_cast<std::int64_t>(sum.steps);
   summary_.stopped_at_seq = rec_.next();
   summary_.sim_time_s = sum.sim_time_s;
-  summary_.wall_time_s = r.wall_time_s;
+  summary_.wall_time_s = wall_time_s;
   summary_.position_error_max_abs_m = sum.position_error_max_abs_m;
   summary_.position_error_rms_m = sum.position_error_rms_m;
   summary_.velocity_error_max_abs_mps = sum.velocity_error_max_abs_mps;
@@ -235,31 +267,28 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
                           packet(channels().command, control_command_t().getEncodedSize());
   }
   l["safe_state"] = rec_.safe_state();
-  const auto hop = [&](const char* name, const std::vector<double>& v) {
-    l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.size()}};
+  const auto hop = [&](const char* name, const stats::StreamingQuantile& v) {
+    l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.count()}};
   };
   hop("state_to_command", rec_.latency_state_to_command());
   hop("command_to_state", rec_.latency_command_to_state());
   l["reference_lead_us"] = {{"p50", lat(rec_.reference_lead(), 0.5)},
                             {"p1", lat(rec_.reference_lead(), 0.01)},
-                            {"samples", rec_.reference_lead().size()}};
-  // Histograms: bins of T/20 up to 2T (5 us at 10 kHz); in real time a state_to_command beyond
-  // T - guard is a deadline miss, and period_start_lateness is how late each state went out
-  // relative to the earliest (timer wake-up and spin of the plant, as the monitor sees it).
-  const double period_us = s_.control_period * 1e6;
-  const double bin_us = period_us / 20.0;
+                            {"samples", rec_.reference_lead().count()}};
+  // In real time a state_to_command beyond T - guard is a deadline miss, and
+  // period_start_lateness is how late each state went out relative to the earliest (the plant's
+  // timer wake-up and spin, as the monitor sees it).
   std::vector<std::string> hist_names = {"state_to_command", "command_to_state"};
-  std::vector<Histogram> hists = {histogram(rec_.latency_state_to_command(), bin_us, 40),
-                                  histogram(rec_.latency_command_to_state(), bin_us, 40)};
+  std::vector<Histogram> hists = {hist_sc_, hist_cs_};
   if (options().realtime) {
     hist_names.push_back("period_start_lateness");
-    hists.push_back(histogram(period_start_lateness(state_recv_us_, period_us), bin_us, 40));
+    hists.push_back(lateness_.result(hist_sc_.bin_us(), static_cast<int>(hist_sc_.counts().size())));
   }
   {
     auto& h = l["latency_histogram_us"];
-    h["bin_us"] = bin_us;
+    h["bin_us"] = hist_sc_.bin_us();
     for (std::size_t i = 0; i < hists.size(); ++i)
-      h[hist_names[i]] = {{"counts", hists[i].counts}, {"overflow", hists[i].overflow}, {"samples", hists[i].samples}};
+      h[hist_names[i]] = {{"counts", hists[i].counts()}, {"overflow", hists[i].overflow()}, {"samples", hists[i].samples()}};
   }
   for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
     for (const char* q : {"p50", "p99", "p1"})
@@ -268,9 +297,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   bool written = true;
   std::string why = failure;
   try {
-    const bool plots = mopt_.plots && !r.records.empty();
-    sim::write_results(mopt_.out_dir, r, sum, s_, plots, j.dump(), mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor",
-                       [&](const std::string& dir) { write_histograms(dir, hist_names, hists, plots); });
+    const bool plots = mopt_.plots && out_->steps() > 0;
+    out_->finish(sum, mopt_.plots, j.dump(),
+                 [&](const output::StagedFolder& dir) { write_histograms(dir.dir().string(), hist_names, hists, plots); });
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -286,7 +315,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     announce_failure(why);
   }
   if (!options().quiet)
-    spdlog::info("monitor: {} steps recorded{} -> {}", r.records.size(),
+    spdlog::info("monitor: {} steps recorded{} -> {}", sum.steps,
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",
                  output::shown(mopt_.out_dir));
   return written;
@@ -303,17 +332,18 @@ void MonitorNode::write_histograms(const std::string& dir, const std::vector<std
   }
   if (!plot) return;
   const double period_us = s_.control_period * 1e6;
+  const std::string bin = std::to_string(h.front().bin_us());
   std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
                    "set output 'latency_histogram.png'\nset grid\nset logscale y\nset yrange [0.5:*]\n"
-                   "set style fill transparent solid 0.4\nset boxwidth " + std::to_string(h.front().bin_us) + "\n"
-                   "set xlabel 'latency [us] (bins of T/20; the last bin of the csv is followed by the overflow)'\n"
+                   "set style fill transparent solid 0.4\nset boxwidth " + bin + "\n"
+                   "set xlabel 'latency [us] (bins of T/20 up to 2T; later ones in summary.json as overflow)'\n"
                    "set ylabel 'steps'\nset title " +
                    output::gnuplot_string(s_.name + (options().realtime ? " (real time)" : " (lockstep)")) + "\n";
   gp += "set arrow from " + std::to_string(period_us) + ",graph 0 to " + std::to_string(period_us) +
         ",graph 1 nohead dt 2\nset label 'T' at " + std::to_string(period_us) + ",graph 0.95\n";
   gp += "plot ";
   for (std::size_t i = 0; i < names.size(); ++i)
-    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us / 2) +
+    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us() / 2) +
           "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
   gp += "\n";
   output::run_gnuplot(dir, gp, "latency_histogram.gp");

@@ -27,10 +27,10 @@ void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
     return;
   }
   states_[m.seq] = {m, recv_us};
-  if (const auto r = refs_.find(m.seq); r != refs_.end()) lead_.push_back(static_cast<double>(recv_us - r->second.recv_us));
+  if (const auto r = refs_.find(m.seq); r != refs_.end()) lead_.add(static_cast<double>(recv_us - r->second.recv_us));
   maybe_start();
   const auto c = cmds_.find(m.seq - 1);
-  if (c != cmds_.end() && recv_us >= c->second.recv_us) lat_cs_.push_back(static_cast<double>(recv_us - c->second.recv_us));
+  if (c != cmds_.end() && recv_us >= c->second.recv_us) lat_cs_.add(static_cast<double>(recv_us - c->second.recv_us));
 }
 
 void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
@@ -41,7 +41,7 @@ void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
   refs_[m.seq] = {m, recv_us};
   if (first_ref_seq_ < 0 || (whole_log_ && m.seq < first_ref_seq_)) first_ref_seq_ = m.seq;
   maybe_start();
-  if (const auto s = states_.find(m.seq); s != states_.end()) lead_.push_back(static_cast<double>(s->second.recv_us - recv_us));
+  if (const auto s = states_.find(m.seq); s != states_.end()) lead_.add(static_cast<double>(s->second.recv_us - recv_us));
 }
 
 void Recorder::on_command(const control_command_t& m, std::int64_t recv_us) {
@@ -51,7 +51,7 @@ void Recorder::on_command(const control_command_t& m, std::int64_t recv_us) {
   }
   cmds_[m.seq] = {m, recv_us};
   const auto s = states_.find(m.seq);
-  if (s != states_.end() && recv_us >= s->second.recv_us) lat_sc_.push_back(static_cast<double>(recv_us - s->second.recv_us));
+  if (s != states_.end() && recv_us >= s->second.recv_us) lat_sc_.add(static_cast<double>(recv_us - s->second.recv_us));
 }
 
 void Recorder::maybe_start() {
@@ -66,7 +66,7 @@ void Recorder::maybe_start() {
   cmds_.erase(cmds_.begin(), cmds_.lower_bound(next_));
 }
 
-std::size_t Recorder::flush() {
+std::size_t Recorder::flush(const sim::RecordSink& sink) {
   std::size_t added = 0;
   if (whole_log_) {  // the whole recording is in: start from its lowest steps
     whole_log_ = false;
@@ -88,16 +88,17 @@ std::size_t Recorder::flush() {
       none.seq = next_;
       none.t = s->second.msg.t;
       none.u = none.u_unsaturated = none.sliding = none.z_estimate = std::numeric_limits<double>::quiet_NaN();
-      records_.push_back(service::to_record(s->second.msg, r->second.msg, none, s1->second.msg.previous));
+      sink(service::to_record(s->second.msg, r->second.msg, none, s1->second.msg.previous));
       ++commandless_;
     } else {
-      records_.push_back(service::to_record(s->second.msg, r->second.msg, c->second.msg, s1->second.msg.previous));
+      sink(service::to_record(s->second.msg, r->second.msg, c->second.msg, s1->second.msg.previous));
       cmds_.erase(c);
     }
     states_.erase(s);
     refs_.erase(r);
     ++next_;
     ++added;
+    ++rows_;
   }
   return added;
 }
@@ -117,13 +118,6 @@ std::vector<Missing> Recorder::missing() const {
 double Recorder::steps_per_second() const {
   if (first_state_seq_ < 0 || highest_state_ <= first_state_seq_ || last_state_us_ <= first_state_us_) return 0.0;
   return static_cast<double>(highest_state_ - first_state_seq_) / (static_cast<double>(last_state_us_ - first_state_us_) * 1e-6);
-}
-
-double quantile(std::vector<double> v, double p) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const std::size_t k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
 }
 
 }  // namespace feeddrive::monitor

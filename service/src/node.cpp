@@ -6,26 +6,16 @@
 
 #include <cerrno>
 #include <csignal>
+
+#include "feeddrive/common/interrupt.hpp"
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 
 namespace feeddrive::service {
-namespace {
-volatile std::sig_atomic_t g_signal = 0;
-extern "C" void on_signal(int sig) { g_signal = sig; }
-}  // namespace
+void install_signal_handlers() { interrupt::install_handlers(); }
 
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: a blocking poll returns EINTR
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
-
-int interrupted_by() { return g_signal; }
+int interrupted_by() { return interrupt::signal_number(); }
 
 std::string enter_realtime(int priority) {
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
@@ -42,7 +32,7 @@ void sleep_until(std::int64_t target_us, std::int64_t spin_us) {
   const std::int64_t wake = target_us - spin_us;
   if (mono_us() < wake) {
     timespec ts{static_cast<time_t>(wake / 1000000), static_cast<long>((wake % 1000000) * 1000)};
-    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && g_signal == 0) {
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !interrupt::interrupted()) {
     }
   }
   while (mono_us() < target_us) {
@@ -111,7 +101,7 @@ void Node::request_resend(const std::string& channel, std::int64_t seq) {
 }
 
 void Node::check_peers() const {
-  if (g_signal != 0) throw RunFailure(std::string("interrupted by ") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM"));
+  if (const int sig = interrupt::signal_number(); sig != 0) throw RunFailure("interrupted by " + interrupt::signal_name(sig));
   for (const auto& [role, st] : peers_)
     if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
 }

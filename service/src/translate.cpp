@@ -70,29 +70,17 @@ applied_t no_applied() {
 sim::Record to_record(const drive_state_t& state, const reference_t& ref, const control_command_t& cmd,
                       const applied_t& applied) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  sim::Record r;
-  r.t = state.t;
-  r.xd = ref.position;
-  r.vd = ref.velocity;
-  r.ad = ref.acceleration;
-  r.jd = ref.jerk;
   const bool truth = state.truth.valid;
-  r.x = truth ? state.truth.x : nan;
-  r.v = truth ? state.truth.v : nan;
-  r.z = truth ? state.truth.z : nan;
-  r.fg = truth ? state.truth.fg : nan;
-  r.i = truth ? state.truth.i : nan;
-  r.x_measured = state.x_measured;
-  r.v_measured = state.v_measured;
-  r.u = applied.u;
-  r.u_unsaturated = cmd.u_unsaturated;
-  r.f_thrust = applied.forces_valid ? applied.f_thrust : nan;
-  r.f_friction = applied.forces_valid ? applied.f_friction : nan;
-  r.f_ripple = applied.forces_valid ? applied.f_ripple : nan;
-  r.f_grinding = applied.forces_valid ? applied.f_grinding : nan;
-  r.sliding = cmd.sliding;
-  r.z_estimate = cmd.z_estimate;
-  return r;
+  const plant::State st = truth ? plant::State{state.truth.x, state.truth.v, state.truth.z, state.truth.fg, state.truth.i}
+                                : plant::State{nan, nan, nan, nan, nan};
+  controller::Command c;
+  c.u = cmd.u;
+  c.u_unsaturated = cmd.u_unsaturated;
+  c.sliding = cmd.sliding;
+  c.z_estimate = cmd.z_estimate;
+  plant::Forces f{nan, nan, nan, nan, nan};
+  if (applied.forces_valid) f = {applied.f_thrust, applied.f_friction, applied.f_ripple, applied.f_grinding, 0.0};
+  return sim::make_record(state.t, to_sample(ref), st, to_measurement(state), c, applied.u, f);
 }
 
 run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_id) {

@@ -1,13 +1,16 @@
 // feeddrive-sim: runs one scenario in-process and writes DIR/{timeseries.csv, summary.json, *.png}.
 //
-//   scenario.yaml --> load_scenario --> run (reference -> controller -> CVODE plant) --> write_results
+//   scenario.yaml --> load_scenario --> run (reference -> controller -> CVODE plant) --> RunWriter
+//                                        each record streamed to timeseries.csv, summary, plots
 //
-// Exit codes: 0 ok, 2 bad input (scenario or arguments), 1 runtime failure.
+// Exit codes: 0 ok, 2 bad input (scenario, arguments, a run too large), 1 runtime failure,
+// 128 + signal after Ctrl-C / SIGTERM (the staged output folder is removed).
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -29,23 +32,29 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   spdlog::set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+  feeddrive::interrupt::install_handlers();
 
   feeddrive::sim::Scenario scenario;
   try {
     scenario = feeddrive::sim::load_scenario(scenario_path);
     feeddrive::output::check_output_dir(out_dir);  // before any work
+    feeddrive::sim::check_run_size(scenario, out_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
   }
   try {
     spdlog::info("{}: {} steps of {} s", scenario.name, scenario.steps(), scenario.control_period);
-    const auto result = feeddrive::sim::run(scenario);
-    const auto summary = feeddrive::sim::summarize(result, scenario);
-    feeddrive::sim::write_results(out_dir, result, summary, scenario, !no_plots);
+    feeddrive::sim::RunWriter out(out_dir, scenario, "feeddrive-sim");
+    const auto stats = feeddrive::sim::run(scenario, [&](const feeddrive::sim::Record& r) { out.add(r); });
+    const auto summary = out.summary().summary(stats.wall_time_s, stats.integrator);
+    out.finish(summary, !no_plots);
     spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",
                  summary.position_error_max_abs_m, summary.position_error_rms_m, summary.control_min,
                  summary.control_max, summary.wall_time_s, out_dir);
+  } catch (const feeddrive::interrupt::Interrupted& e) {
+    std::fprintf(stderr, "error: %s; nothing written to %s\n", e.what(), feeddrive::output::shown(out_dir).c_str());
+    return e.exit_code();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

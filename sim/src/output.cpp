@@ -1,85 +1,148 @@
 #include "feeddrive/sim/output.hpp"
 
-#include <cstdio>
+#include <sys/statvfs.h>
+
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-#include "feeddrive/output/folder.hpp"
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::sim {
 namespace fs = std::filesystem;
 
-void write_timeseries_csv(const std::string& path, const std::vector<Record>& records) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
-  const auto& cols = record_columns();
-  for (std::size_t c = 0; c < cols.size(); ++c) std::fprintf(f, c ? ",%s" : "%s", cols[c].c_str());
-  std::fputc('\n', f);
-  for (const Record& r : records) {
-    const std::vector<double> v = record_values(r);
-    for (std::size_t c = 0; c < v.size(); ++c) std::fprintf(f, c ? ",%.17g" : "%.17g", v[c]);
-    std::fputc('\n', f);
-  }
-  const bool ok = std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok) throw std::runtime_error(path + ": write failed");
+namespace {
+
+// The curves of the plots, computed from a record before the reduction (so the reduction keeps
+// the extremes of exactly what is drawn).
+enum Curve { kXd, kX, kE, kEv, kU, kFriction, kRipple, kGrinding, kCurves };
+const std::vector<std::string>& curve_names() {
+  static const std::vector<std::string> n = {"xd", "x", "e", "e_v", "u", "f_friction", "f_ripple", "f_grinding"};
+  return n;
+}
+void curve_values(const Record& r, double* y) {
+  y[kXd] = r.xd;
+  y[kX] = r.x;
+  y[kE] = r.xd - r.x;
+  y[kEv] = r.vd - r.v;
+  y[kU] = r.u;
+  y[kFriction] = r.f_friction;
+  y[kRipple] = r.f_ripple;
+  y[kGrinding] = r.f_grinding;
 }
 
-namespace {
-int column(const std::string& name) {
-  const auto& cols = record_columns();
-  for (std::size_t c = 0; c < cols.size(); ++c)
-    if (cols[c] == name) return static_cast<int>(c) + 1;
-  throw std::logic_error("no column " + name);
+std::vector<std::size_t> column_indices(const Scenario& s) {
+  const auto& all = record_columns();
+  std::vector<std::size_t> idx;
+  if (s.output.columns.empty()) {
+    for (std::size_t c = 0; c < all.size(); ++c) idx.push_back(c);
+    return idx;
+  }
+  for (const std::string& name : s.output.columns) {
+    const auto it = std::find(all.begin(), all.end(), name);
+    if (it == all.end()) throw std::invalid_argument("output.columns: unknown column '" + name + "'");
+    idx.push_back(static_cast<std::size_t>(it - all.begin()));
+  }
+  return idx;
 }
+
+// The plot's time axis: the whole run [0, steps*T] (at least one period).
+double plot_end(const Scenario& s) { return std::max(1.0, static_cast<double>(s.steps())) * s.control_period; }
+
 }  // namespace
 
-void write_plots(const std::string& dir, const std::string& title) {
+void check_run_size(const Scenario& s, const std::string& out_dir) {
+  const double rows = std::ceil(static_cast<double>(s.steps()) / static_cast<double>(s.output.every));
+  const double cols = static_cast<double>(s.output.columns.empty() ? kRecordColumns : s.output.columns.size());
+  const double least = rows * cols * 2.0;
+  fs::path up = fs::absolute(output::normalise(out_dir));
+  std::error_code ec;
+  while (!fs::exists(up, ec) && up.has_relative_path()) up = up.parent_path();
+  struct statvfs st {};
+  if (::statvfs(up.c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
+  const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
+  if (least > free_bytes) {
+    const auto gb = [](double b) { return validate::format_number(std::round(b / 1e7) / 100.0) + " GB"; };
+    throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv needs at least " +
+                                gb(least) + " (" + validate::format_number(rows) + " rows x " +
+                                validate::format_number(cols) + " columns x 2 bytes), only " + gb(free_bytes) +
+                                " free in " + up.string() + "; record fewer rows (output.every) or columns (output.columns)");
+  }
+}
+
+RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool)
+    : s_(s),
+      folder_(out_dir, tool),
+      columns_(column_indices(s)),
+      every_(s.output.every),
+      summary_(s),
+      plot_(0.0, plot_end(s), kPlotBuckets, kCurves) {
+  std::vector<std::string> header;
+  for (std::size_t c : columns_) header.push_back(record_columns()[c]);
+  csv_ = std::make_unique<output::CsvWriter>(folder_.path("timeseries.csv"), header);
+}
+
+RunWriter::~RunWriter() = default;
+
+void RunWriter::add(const Record& r) {
+  if (summary_.steps() % every_ == 0) {
+    double all[kRecordColumns], row[kRecordColumns];
+    record_values(r, all);
+    for (std::size_t c = 0; c < columns_.size(); ++c) row[c] = all[columns_[c]];
+    csv_->row(row, columns_.size());
+  }
+  double y[kCurves];
+  curve_values(r, y);
+  plot_.add(r.t, y);
+  summary_.add(r);
+}
+
+void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json,
+                       const std::function<void(const output::StagedFolder&)>& extra_files) {
+  csv_->close();
+  folder_.write_text("summary.json", summary_json(sum, s_, extra_json));
+  if (plots && summary_.steps() > 0) write_plots(folder_, plot_, s_.name);
+  if (extra_files) extra_files(folder_);
+  folder_.commit();
+}
+
+void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title) {
+  reduced.write_csv(dir.path("plot.csv"), curve_names());
+  // Curve c of plot.csv: time in column 2c+1, value in 2c+2 (MinMaxReducer::write_csv).
+  auto use = [](Curve c, const char* scale) {
+    std::ostringstream u;
+    u << "using " << 2 * c + 1 << ":($" << 2 * c + 2 << scale << ")";
+    return u.str();
+  };
   // Fixed data file name, the title through the one escaping rule (feeddrive/output/gnuplot.hpp).
   const std::string t = output::gnuplot_string(title);
   std::ostringstream gp;
-  auto c = [](const char* n) { return std::to_string(column(n)); };
-  gp << "set encoding utf8\nset datafile separator ','\n"
-     << "set terminal pngcairo size 1000,700 noenhanced\n"
-     << "set grid\nset key outside top center horizontal\n"
-     << "data = 'timeseries.csv'\n"
-     << "set xlabel 't [s]'\n";
+  gp << "data = 'plot.csv'\nset xlabel 't [s]'\n";
   gp << "set output 'position.png'\nset multiplot layout 2,1 title " << t << "\n"
      << "set ylabel 'position [mm]'\n"
-     << "plot data every ::1 using " << c("t") << ":($" << c("xd") << "*1e3) with lines lw 2 title 'x_d',"
-     << " '' every ::1 using " << c("t") << ":($" << c("x") << "*1e3) with lines title 'x'\n"
+     << "plot data every ::1 " << use(kXd, "*1e3") << " with lines lw 2 title 'x_d',"
+     << " '' every ::1 " << use(kX, "*1e3") << " with lines title 'x'\n"
      << "set ylabel 'error x_d - x [um]'\n"
-     << "plot data every ::1 using " << c("t") << ":(($" << c("xd") << "-$" << c("x")
-     << ")*1e6) with lines title 'e'\nunset multiplot\n";
+     << "plot data every ::1 " << use(kE, "*1e6") << " with lines title 'e'\nunset multiplot\n";
   gp << "set output 'velocity_error.png'\nset title " << t << "\nset ylabel 'velocity error v_d - v [um/s]'\n"
-     << "plot data every ::1 using " << c("t") << ":(($" << c("vd") << "-$" << c("v")
-     << ")*1e6) with lines title 'e_v'\n";
+     << "plot data every ::1 " << use(kEv, "*1e6") << " with lines title 'e_v'\n";
   gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n"
-     << "plot data every ::1 using " << c("t") << ":" << c("u") << " with lines title 'u'\n";
+     << "plot data every ::1 " << use(kU, "") << " with lines title 'u'\n";
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
-     << "plot data every ::1 using " << c("t") << ":" << c("f_friction") << " with lines title 'friction',"
-     << " '' every ::1 using " << c("t") << ":" << c("f_ripple") << " with lines title 'ripple',"
-     << " '' every ::1 using " << c("t") << ":" << c("f_grinding") << " with lines title 'grinding'\n";
-  output::run_gnuplot(dir, gp.str());
+     << "plot data every ::1 " << use(kFriction, "") << " with lines title 'friction',"
+     << " '' every ::1 " << use(kRipple, "") << " with lines title 'ripple',"
+     << " '' every ::1 " << use(kGrinding, "") << " with lines title 'grinding'\n";
+  dir.plot(gp.str());
 }
 
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots, const std::string& extra_json, const std::string& tool,
-                   const std::function<void(const std::string&)>& extra_files) {
-  output::StagedFolder out(out_dir, tool);
-  const fs::path tmp = out.dir();
-  write_timeseries_csv((tmp / "timeseries.csv").string(), r.records);
-  {
-    std::ofstream js(tmp / "summary.json");
-    js << summary_json(sum, s, extra_json);
-    js.close();
-    if (!js) throw std::runtime_error((tmp / "summary.json").string() + ": write failed");
-  }
-  if (plots) write_plots(tmp.string(), s.name);
-  if (extra_files) extra_files(tmp.string());
-  out.commit();
+                   bool plots, const std::string& extra_json, const std::string& tool) {
+  RunWriter w(out_dir, s, tool);
+  for (const Record& q : r.records) w.add(q);
+  w.finish(sum, plots, extra_json);
 }
 
 }  // namespace feeddrive::sim

@@ -1,11 +1,14 @@
 #include "feeddrive/sim/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/plant/effects.hpp"
+#include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::sim {
@@ -13,6 +16,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using plant::PlantParams;
+
+// A name from the file as a message shows it: printable ASCII, at most 40 bytes.
+std::string output_shown(const std::string& s) {
+  std::string out;
+  for (char c : s.substr(0, 40)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  return s.size() > 40 ? out + "..." : out;
+}
 
 // --- plant ---------------------------------------------------------------------------------
 
@@ -288,6 +298,10 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
   if (s.control_period > s.duration)
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
+  if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
+    throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " + root["control_period"].Scalar() +
+                        ": " + validate::format_number(n) + " steps; a run has at most " + validate::format_number(kMaxSteps) +
+                        " steps (docs/scenario.md, Limits)");
 
   {
     MapReader plant = top.child("plant");
@@ -318,6 +332,25 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   c.finish();
 
   read_reference(top.child("reference"), s.reference, base_dir);
+  {
+    MapReader o = top.child("output");
+    o.integer("every", s.output.every);
+    o.string_list("columns", s.output.columns);
+    o.finish();
+    if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
+    const auto& all = record_columns();
+    for (const std::string& c : s.output.columns) {
+      if (std::find(all.begin(), all.end(), c) == all.end()) {
+        std::string known;
+        for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
+        o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
+      }
+      if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
+        o.fail("columns", ": column '" + c + "' listed twice");
+    }
+    if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
+      o.fail("columns", ": empty list (leave the key out to record every column)");
+  }
   MapReader a = top.child("analysis");
   a.number("settled_after", s.analysis.settled_after);
   a.finish();
@@ -336,7 +369,9 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(e.what());
   }
-  if (s.steps() < 1) throw ScenarioError("duration: shorter than one control period");
+  if (s.steps() < 1)
+    throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
+                        validate::format_number(s.control_period) + " s)");
   return s;
 }
 

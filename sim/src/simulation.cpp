@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/plant/command.hpp"
 #include "feeddrive/plant/plant.hpp"
 
@@ -14,21 +15,54 @@ const std::vector<std::string>& record_columns() {
   return kColumns;
 }
 
-std::vector<double> record_values(const Record& r) {
-  return {r.t, r.xd, r.vd, r.ad, r.jd, r.x, r.x_measured, r.v, r.v_measured, r.z, r.fg, r.i, r.u,
-          r.u_unsaturated, r.f_thrust, r.f_friction, r.f_ripple, r.f_grinding, r.sliding, r.z_estimate};
+void record_values(const Record& r, double* out) {
+  const double v[kRecordColumns] = {r.t, r.xd, r.vd, r.ad, r.jd, r.x, r.x_measured, r.v, r.v_measured, r.z,
+                                    r.fg, r.i, r.u, r.u_unsaturated, r.f_thrust, r.f_friction, r.f_ripple,
+                                    r.f_grinding, r.sliding, r.z_estimate};
+  for (std::size_t c = 0; c < kRecordColumns; ++c) out[c] = v[c];
 }
 
-RunResult run(const Scenario& s, const std::function<void(long, long)>& progress) {
+std::vector<double> record_values(const Record& r) {
+  std::vector<double> v(kRecordColumns);
+  record_values(r, v.data());
+  return v;
+}
+
+Record make_record(double t, const trajectory::Sample& ref, const plant::State& st, const plant::Measurement& meas,
+                   const controller::Command& cmd, double u_applied, const plant::Forces& f) {
+  Record r;
+  r.t = t;
+  r.xd = ref.position;
+  r.vd = ref.velocity;
+  r.ad = ref.acceleration;
+  r.jd = ref.jerk;
+  r.x = st.x;
+  r.v = st.v;
+  r.z = st.z;
+  r.fg = st.fg;
+  r.i = st.i;
+  r.x_measured = meas.x;
+  r.v_measured = meas.v;
+  r.u = u_applied;  // what the drive applied (plant/command.hpp)
+  r.u_unsaturated = cmd.u_unsaturated;
+  r.f_thrust = f.thrust;
+  r.f_friction = f.friction;
+  r.f_ripple = f.ripple;
+  r.f_grinding = f.grinding;
+  r.sliding = cmd.sliding;
+  r.z_estimate = cmd.z_estimate;
+  return r;
+}
+
+RunStats run(const Scenario& s, const RecordSink& sink) {
   const auto wall_start = std::chrono::steady_clock::now();
   plant::Plant drive(s.plant, s.control_period);
   const auto reference = make_reference(s);
   const auto controller = make_controller(s);
   const long n = s.steps();
 
-  RunResult result;
-  result.records.reserve(static_cast<std::size_t>(n));
   for (long k = 0; k < n; ++k) {
+    if ((k & 1023) == 0) interrupt::check();
     const double t = s.time_of(k);
     const trajectory::Sample ref = reference->sample(t);
     const plant::Measurement meas = drive.measure();
@@ -36,37 +70,22 @@ RunResult run(const Scenario& s, const std::function<void(long, long)>& progress
     const controller::Truth truth{st.z, st.fg};
     const controller::Command cmd = controller->update(ref, meas, &truth);
     const double u = plant::admit_command(cmd.u, s.plant.input_limit).u;
-    const plant::Forces f = drive.forces(u);
-
-    Record r;
-    r.t = t;
-    r.xd = ref.position;
-    r.vd = ref.velocity;
-    r.ad = ref.acceleration;
-    r.jd = ref.jerk;
-    r.x = st.x;
-    r.v = st.v;
-    r.z = st.z;
-    r.fg = st.fg;
-    r.i = st.i;
-    r.x_measured = meas.x;
-    r.v_measured = meas.v;
-    r.u = u;  // what the drive applied (plant/command.hpp)
-    r.u_unsaturated = cmd.u_unsaturated;
-    r.f_thrust = f.thrust;
-    r.f_friction = f.friction;
-    r.f_ripple = f.ripple;
-    r.f_grinding = f.grinding;
-    r.sliding = cmd.sliding;
-    r.z_estimate = cmd.z_estimate;
-    result.records.push_back(r);
-
+    sink(make_record(t, ref, st, meas, cmd, u, drive.forces(u)));
     drive.advance(u, s.time_of(k + 1));
-    if (progress && (k % 5000 == 0 || k + 1 == n)) progress(k + 1, n);
   }
-  result.integrator = drive.integrator_stats();
-  result.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  RunStats stats;
+  stats.steps = n;
+  stats.integrator = drive.integrator_stats();
+  stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return stats;
+}
+
+RunResult run(const Scenario& s) {
+  RunResult result;
+  result.records.reserve(static_cast<std::size_t>(s.steps()));
+  const RunStats st = run(s, [&](const Record& r) { result.records.push_back(r); });
+  result.wall_time_s = st.wall_time_s;
+  result.integrator = st.integrator;
   return result;
 }
 

@@ -6,61 +6,71 @@
 
 namespace feeddrive::sim {
 
-Summary summarize(const RunResult& r, const Scenario& s) {
-  Summary m;
-  const auto& rec = r.records;
-  m.steps = static_cast<long>(rec.size());
-  m.sim_time_s = static_cast<double>(rec.size()) * s.control_period;
-  m.wall_time_s = r.wall_time_s;
-  m.settled_after_s = s.analysis.settled_after;
-  m.integrator_steps = r.integrator.steps;
-  m.integrator_rhs_evals = r.integrator.rhs_evals;
-  m.integrator_jac_evals = r.integrator.jac_evals;
-  m.integrator_error_test_fails = r.integrator.error_test_fails;
-  if (rec.empty()) return m;
+SummaryBuilder::SummaryBuilder(const Scenario& s)
+    : settled_after_(s.analysis.settled_after), control_period_(s.control_period) {
+  m_.settled_after_s = settled_after_;
+}
 
-  double se = 0.0, sev = 0.0, se_settled = 0.0;
-  long n_settled = 0;
-  std::vector<double> abs_e;
-  abs_e.reserve(rec.size());
-  m.control_min = m.control_max = rec.front().u;
-  m.max_position_m = m.min_position_m = rec.front().x;
-  for (std::size_t k = 0; k < rec.size(); ++k) {
-    const Record& q = rec[k];
-    const double e = q.xd - q.x;
-    const double ev = q.vd - q.v;
-    abs_e.push_back(std::abs(e));
-    m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
-    m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
-    if (k > 0) m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
-    se += e * e;
-    sev += ev * ev;
-    if (q.t >= s.analysis.settled_after) {
-      m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
-      m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
-      se_settled += e * e;
-      ++n_settled;
-    }
-    m.control_min = std::min(m.control_min, q.u);
-    m.control_max = std::max(m.control_max, q.u);
-    if (k > 0) m.control_total_variation += std::abs(q.u - rec[k - 1].u);
-    if (q.u != q.u_unsaturated) ++m.control_saturated_steps;
-    m.max_position_m = std::max(m.max_position_m, q.x);
-    m.min_position_m = std::min(m.min_position_m, q.x);
+void SummaryBuilder::add(const Record& q) {
+  const double e = q.xd - q.x;
+  const double ev = q.vd - q.v;
+  Summary& m = m_;
+  if (n_ == 0) {
+    m.control_min = m.control_max = q.u;
+    m.max_position_m = m.min_position_m = q.x;
   }
-  const double n = static_cast<double>(rec.size());
-  m.position_error_rms_m = std::sqrt(se / n);
-  m.velocity_error_rms_mps = std::sqrt(sev / n);
-  if (n_settled > 0) m.position_error_rms_settled_m = std::sqrt(se_settled / static_cast<double>(n_settled));
-  const std::size_t i95 = std::min(abs_e.size() - 1, static_cast<std::size_t>(0.95 * n));
-  std::nth_element(abs_e.begin(), abs_e.begin() + static_cast<long>(i95), abs_e.end());
-  m.position_error_p95_abs_m = abs_e[i95];
-  const Record& last = rec.back();
-  m.final_position_m = last.x;
-  m.final_velocity_mps = last.v;
-  m.final_bristle_m = last.z;
-  m.final_friction_N = last.f_friction;
+  abs_e_.add(std::abs(e));
+  m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
+  m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
+  if (n_ > 0) m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
+  se_ += e * e;
+  sev_ += ev * ev;
+  if (q.t >= settled_after_) {
+    m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
+    m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
+    se_settled_ += e * e;
+    ++n_settled_;
+  }
+  m.control_min = std::min(m.control_min, q.u);
+  m.control_max = std::max(m.control_max, q.u);
+  if (n_ > 0) m.control_total_variation += std::abs(q.u - last_.u);
+  if (q.u != q.u_unsaturated) ++m.control_saturated_steps;
+  m.max_position_m = std::max(m.max_position_m, q.x);
+  m.min_position_m = std::min(m.min_position_m, q.x);
+  last_ = q;
+  ++n_;
+}
+
+Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) const {
+  Summary m = m_;
+  m.steps = n_;
+  m.sim_time_s = static_cast<double>(n_) * control_period_;
+  m.wall_time_s = wall_time_s;
+  m.integrator_steps = integrator.steps;
+  m.integrator_rhs_evals = integrator.rhs_evals;
+  m.integrator_jac_evals = integrator.jac_evals;
+  m.integrator_error_test_fails = integrator.error_test_fails;
+  if (n_ == 0) return m;
+  const double n = static_cast<double>(n_);
+  m.position_error_rms_m = std::sqrt(se_ / n);
+  m.velocity_error_rms_mps = std::sqrt(sev_ / n);
+  if (n_settled_ > 0) m.position_error_rms_settled_m = std::sqrt(se_settled_ / static_cast<double>(n_settled_));
+  // rank floor(0.95 n) of the n values |e| (the NaN of a run without truth are not ranked)
+  if (abs_e_.count() > 0) {
+    const auto k = std::min<std::uint64_t>(abs_e_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_e_.count())));
+    m.position_error_p95_abs_m = abs_e_.value_at_rank(k);
+  }
+  m.final_position_m = last_.x;
+  m.final_velocity_mps = last_.v;
+  m.final_bristle_m = last_.z;
+  m.final_friction_N = last_.f_friction;
   return m;
+}
+
+Summary summarize(const RunResult& r, const Scenario& s) {
+  SummaryBuilder b(s);
+  for (const Record& q : r.records) b.add(q);
+  return b.summary(r.wall_time_s, r.integrator);
 }
 
 std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {

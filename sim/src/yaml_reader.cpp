@@ -137,6 +137,24 @@ void MapReader::string(const std::string& key, std::string& out) {
   if (n.IsDefined()) out = n.Scalar();
 }
 
+void MapReader::string_list(const std::string& key, std::vector<std::string>& out) {
+  read_.insert(key);
+  if (!node_.IsMap()) return;
+  const YAML::Node n = node_[key];
+  if (!n.IsDefined()) return;
+  if (n.IsNull()) fail(key, ": missing value");
+  if (n.IsScalar()) {
+    out = {n.Scalar()};
+    return;
+  }
+  if (!n.IsSequence()) fail(key, " = " + describe(n) + ": expected a list of names");
+  out.clear();
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key, "[" + std::to_string(i) + "] = " + describe(n[i]) + ": expected a name");
+    out.push_back(n[i].Scalar());
+  }
+}
+
 std::string MapReader::required_string(const std::string& key) {
   const YAML::Node n = scalar(key);
   if (!n.IsDefined()) fail(key, ": missing (required)");

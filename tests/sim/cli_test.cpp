@@ -2,6 +2,7 @@
 // before the run and never replacing a folder feeddrive did not write, names never run as code.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -282,3 +283,121 @@ TEST(Cli, NamesAreNeverRunAsCommands) {
 }
 
 }  // namespace
+
+// --- Long runs (issue 11): recording options, impossible runs, Ctrl-C, stale staging folders ---
+
+std::vector<std::string> csv_lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+TEST(Cli, OutputEveryAndColumnsKeepTheSummaryOfEveryStep) {
+  const fs::path all_out = scratch() / "cli_all", some_out = scratch() / "cli_some";
+  fs::remove_all(all_out);
+  fs::remove_all(some_out);
+  ASSERT_EQ(run_sim(write_file("all.yaml", kGood).string() + " --out " + all_out.string() + " --no-plots").code, 0);
+  const ProcResult r = run_sim(write_file("some.yaml", std::string(kGood) + "output: {every: 7, columns: [t, x, u]}\n").string() +
+                               " --out " + some_out.string() + " --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto all = csv_lines(all_out / "timeseries.csv"), some = csv_lines(some_out / "timeseries.csv");
+  ASSERT_EQ(some.front(), "t,x,u");
+  ASSERT_EQ(some.size(), 1u + (500 + 6) / 7);  // rows k = 0, 7, ..., 497
+  // each kept row is the full row's t, x and u, byte for byte
+  const auto field = [](const std::string& line, int c) {
+    std::stringstream ss(line);
+    std::string f;
+    for (int i = 0; i <= c; ++i) std::getline(ss, f, ',');
+    return f;
+  };
+  for (std::size_t i = 1; i < some.size(); ++i) {
+    const std::string& full = all[1 + 7 * (i - 1)];
+    EXPECT_EQ(some[i], field(full, 0) + "," + field(full, 5) + "," + field(full, 12)) << i;
+  }
+  // the summary still covers every step: identical to the run that kept every row
+  std::ifstream a(all_out / "summary.json"), b(some_out / "summary.json");
+  auto ja = nlohmann::json::parse(a), jb = nlohmann::json::parse(b);
+  for (auto* j : {&ja, &jb})
+    for (const char* k : {"wall_time_s", "realtime_factor", "scenario", "scenario_path"}) j->erase(k);
+  EXPECT_EQ(ja, jb);
+}
+
+TEST(Cli, BadOutputOptionsAndImpossibleRunsExitTwoBeforeAnyWork) {
+  expect_bad_input(std::string(kGood) + "output: {columns: [t, speed]}\n", "output.columns: unknown column 'speed'");
+  expect_bad_input(std::string(kGood) + "output: {every: 0}\n", "output.every = 0: must be an integer >= 1");
+  expect_bad_input(std::string(kGood) + "output: {evry: 2}\n", "output.evry: unknown key (did you mean 'every'?)");
+  std::string s = kGood;
+  // 1e16 steps: was std::bad_alloc with exit 1
+  expect_bad_input(std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1e12"),
+                   "duration = 1e12, control_period = 1e-4: 1e+16 steps; a run has at most 1e+10 steps");
+  // was "shorter than one control period" (the step count overflowed)
+  expect_bad_input(std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1e300"),
+                   "duration = 1e300, control_period = 1e-4: 1.0000000000000001e+304 steps; a run has at most 1e+10 steps");
+}
+
+TEST(Cli, TimeseriesThatCannotFitTheDiskIsRefusedBeforeAnyWork) {
+  // 1e10 steps (within the step limit) need at least 400 GB of CSV: more than a test machine has.
+  std::string s = kGood;
+  std::string text = std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1e6");
+  const fs::path out = scratch() / "cli_huge";
+  const ProcResult r = run_sim(write_file("huge.yaml", text).string() + " --out " + out.string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("duration, control_period, output.every, output.columns: timeseries.csv needs at least 400 GB"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+bool has_staging(const std::string& name) {
+  for (const auto& e : fs::directory_iterator(scratch()))
+    if (e.path().filename().string().rfind("." + name + ".partial-", 0) == 0) return true;
+  return false;
+}
+
+TEST(Cli, InterruptLeavesNoOutputAndNoStagingFolder) {
+  std::string s = kGood;
+  const fs::path scen = write_file("long.yaml", std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1000"));
+  for (int sig : {SIGINT, SIGTERM}) {
+    const fs::path out = scratch() / "cli_interrupted";
+    fs::remove_all(out);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::execl(kSim.c_str(), kSim.c_str(), scen.c_str(), "--out", out.c_str(), "-q", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    // wait until the run has started writing (its staging folder exists), then interrupt it
+    for (int i = 0; i < 200 && !has_staging("cli_interrupted"); ++i) ::usleep(20000);
+    ASSERT_TRUE(has_staging("cli_interrupted"));
+    ::usleep(300000);
+    ::kill(pid, sig);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(has_staging("cli_interrupted")) << "the staged folder is removed on " << sig;
+  }
+}
+
+TEST(Cli, AStagingFolderLeftByAKilledRunIsRemovedByTheNextRun) {
+  const fs::path out = scratch() / "cli_stale";
+  fs::remove_all(out);
+  // a staging folder of a feeddrive process that no longer runs (kill -9): marked, PID dead
+  const pid_t dead = ::fork();
+  if (dead == 0) ::_exit(0);
+  ::waitpid(dead, nullptr, 0);
+  const fs::path stale = scratch() / (".cli_stale.partial-" + std::to_string(dead) + "-0");
+  fs::create_directories(stale);
+  std::ofstream(stale / ".feeddrive-output") << "feeddrive-output\nformat: 1\ntool: feeddrive-sim\n";
+  std::ofstream(stale / "timeseries.csv") << "t\n0\n";
+  // one that is not marked is not ours: left alone
+  const fs::path foreign = scratch() / (".cli_stale.partial-" + std::to_string(dead) + "-1");
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "notes.txt") << "mine";
+  ASSERT_EQ(run_sim(write_file("stale.yaml", kGood).string() + " --out " + out.string() + " --no-plots").code, 0);
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(foreign / "notes.txt"));
+  fs::remove_all(foreign);
+}

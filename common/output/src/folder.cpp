@@ -1,5 +1,7 @@
 #include "feeddrive/output/folder.hpp"
 
+#include <signal.h>
+
 #include <fcntl.h>
 #include <stdio.h>  // renameat2, RENAME_EXCHANGE (_GNU_SOURCE)
 #include <sys/stat.h>
@@ -13,6 +15,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+
+#include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::output {
 namespace fs = std::filesystem;
@@ -154,6 +158,32 @@ bool remove_output(const fs::path& dir) noexcept {
   }
 }
 
+int remove_stale_staging(const fs::path& target) noexcept {
+  int removed = 0;
+  try {
+    const std::string prefix = "." + target.filename().string() + ".partial-";
+    std::error_code ec;
+    for (fs::directory_iterator it(target.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (name.rfind(prefix, 0) != 0) continue;
+      // ".NAME.partial-PID-N": PID and N decimal
+      const std::string rest = name.substr(prefix.size());
+      const auto dash = rest.find('-');
+      if (dash == std::string::npos || dash == 0 || dash > 9 || dash + 1 >= rest.size()) continue;
+      const std::string pid_text = rest.substr(0, dash), n_text = rest.substr(dash + 1);
+      if (pid_text.find_first_not_of("0123456789") != std::string::npos ||
+          n_text.find_first_not_of("0123456789") != std::string::npos)
+        continue;
+      const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+      if (pid <= 0 || pid == ::getpid()) continue;
+      if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // running (or not ours to ask): keep
+      if (remove_output(it->path())) ++removed;
+    }
+  } catch (...) {
+  }
+  return removed;
+}
+
 StagedFolder::StagedFolder(const std::string& out, const std::string& tool, const std::string& option)
     : value_(out), option_(option) {
   target_ = fs::absolute(check_output_dir(out, option));
@@ -162,6 +192,7 @@ StagedFolder::StagedFolder(const std::string& out, const std::string& tool, cons
   if (ec)
     throw std::runtime_error(option_ + " " + shown(value_) + ": cannot create " + target_.parent_path().string() + ": " +
                              ec.message());
+  remove_stale_staging(target_);
   for (;;) {
     staging_ = unused_sibling(target_, "partial");
     if (::mkdir(staging_.c_str(), 0777) == 0) break;
@@ -178,6 +209,21 @@ StagedFolder::StagedFolder(const std::string& out, const std::string& tool, cons
     done_ = true;
     throw std::runtime_error(option_ + " " + shown(value_) + ": cannot write in " + staging_.string());
   }
+}
+
+void StagedFolder::write_text(const std::string& name, const std::string& text) const {
+  const fs::path p = staging_ / name;
+  std::ofstream f(p, std::ios::binary);
+  f << text;
+  f.close();
+  if (!f) throw std::runtime_error(p.string() + ": write failed");
+}
+
+void StagedFolder::plot(const std::string& script) const {
+  run_gnuplot(staging_,
+              "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\n"
+              "set grid\nset key outside top center horizontal\n" +
+                  script);
 }
 
 StagedFolder::~StagedFolder() {

@@ -1,6 +1,7 @@
 #include "feeddrive/output/gnuplot.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+
+#include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::output {
 namespace fs = std::filesystem;
@@ -123,6 +126,12 @@ void run_gnuplot(const fs::path& dir, const std::string& script, const std::stri
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
+    if (interrupt::interrupted()) {  // Ctrl-C or SIGTERM: stop gnuplot at once, then unwind
+      ::kill(pid, SIGKILL);
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      interrupt::check();
+    }
   }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   if (code == 127) throw std::runtime_error("cannot run gnuplot (not installed? use --no-plots to skip the plots)");

@@ -11,11 +11,23 @@
 // The reluctance ripple depends on the commanded force itself, F^r = Fcog(x) + Ka*Kf*u*r(x),
 // so the law is solved for u exactly:  Ka*Kf*u*(1 - r(x)) = m*(...) + F^f + F^g + Fcog(x).
 //
+// Friction estimate with the plant's true z (friction_state = true, the paper's "all states
+// available"): F^f = sigma0*z + sigma1(v)*zdot^ + sigma2*v with the model's sigma0, sigma1,
+// sigma2 and the bristle *rate* taken from the true z as well,
+//   zdot^_k = (z_k - z_{k-1})/T            (the model rate v - sigma0|v|z/g(v) at the first sample)
+// not from the model law zdot = v - sigma0*|v|*z/g(v). The model law mixes the plant's z with the
+// model's g(v): with the plant's Fs, Fc 30 % off, z settles at g_plant/sigma0 and the model rate
+// reads zdot = v*(1 - g_plant/g_model) = -+0.3 v in steady sliding, i.e. sigma1*zdot ~ 1,200 N at
+// 0.2 m/s (more than the switching authority m*eta = 510 N, so S leaves the layer and the error
+// grows to millimetres). The difference of the true z is the plant's own rate, whatever its
+// parameters, and is 0 in steady sliding. See docs/controllers.md ("Model mismatch").
+//
 // Order within one period: (optionally) correct the x,v observer with the new sample; compute
 // u from the estimates at t_k; then advance the force observers and predict x,v over [t_k, t_k+T]
 // with u held (so nothing uses information from after t_k).
 
 #include <memory>
+#include <optional>
 
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
@@ -82,6 +94,7 @@ class SlidingModeController final : public Controller {
   FrictionObserver friction_observer_;
   GrindingObserver grinding_observer_;
   StateObserver motion_observer_;
+  std::optional<double> last_true_z_;
 };
 
 }  // namespace feeddrive::controller

@@ -15,8 +15,9 @@ struct LogConversion {
   long undecodable{0};            ///< events on our channels that are not our type
 };
 
-/// Converts the events on <prefix>_STATE/_REF/_CMD of log `path`. Throws std::invalid_argument
-/// naming the file when it cannot be opened or is corrupt (with the event number and offset).
-LogConversion read_log(const std::string& path, const std::string& prefix);
+/// Converts the events on <prefix>_STATE/_REF/_CMD of log `path`, handing each row to `sink` in
+/// step order as soon as it is complete. Throws std::invalid_argument naming the file when it
+/// cannot be opened or is corrupt (with the event number and offset).
+LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink);
 
 }  // namespace feeddrive::monitor

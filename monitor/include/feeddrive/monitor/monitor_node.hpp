@@ -11,14 +11,18 @@
 
 #include <memory>
 #include <string>
+#include <map>
 #include <vector>
 
 #include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/control_command_t.hpp"
+#include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/run_info_t.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/node.hpp"
+#include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::monitor {
@@ -36,6 +40,7 @@ struct MonitorOptions {
 
 class MonitorNode : public service::Node {
  public:
+  /// Opens the output (staged folder, timeseries.csv) at once: rows are written as they complete.
   MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt);
   /// Returns true if the run completed and its results were written; tries to write the
   /// results in every case.
@@ -45,6 +50,9 @@ class MonitorNode : public service::Node {
  private:
   void request_missing();
   void publish_info();
+  void on_state_timing(const drive_state_t& m, std::int64_t t);
+  void on_command_timing(const control_command_t& m, std::int64_t t);
+  void prune_timing(std::int64_t seq);
   void progress(bool force);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
@@ -55,6 +63,8 @@ class MonitorNode : public service::Node {
   sim::Scenario s_;
   MonitorOptions mopt_;
   Recorder rec_;
+  std::unique_ptr<sim::RunWriter> out_;
+  std::string open_error_;  // why out_ could not be opened
   std::int64_t start_us_{0};
   std::int64_t last_row_us_{0};
   std::int64_t last_request_us_{0};
@@ -66,7 +76,10 @@ class MonitorNode : public service::Node {
   std::unique_ptr<LcmLogWriter> log_;
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)
   std::int64_t heartbeats_{0};
-  std::vector<double> state_recv_us_;  ///< first receive time of state k [us, monotonic]; NaN: none
+  Histogram hist_sc_, hist_cs_;
+  LatenessHistogram lateness_;
+  std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight
+  std::int64_t timing_pruned_{-1};                              ///< steps <= this are no longer timed
 };
 
 }  // namespace feeddrive::monitor

@@ -5,13 +5,17 @@
 // In real-time runs (drive_state_t.realtime) a step may have no command of its own (it came too
 // late, the plant applied the previous one): the row is then written once state k+2 (or the end)
 // is there, with the command's diagnostic fields NaN; the applied u always comes from the plant.
-// Pure logic, no I/O: used by the live monitor and by the log converter alike.
+// Pure logic, no I/O: used by the live monitor and by the log converter alike. Complete rows are
+// handed to a sink and not kept, and the latency statistics are bounded histograms
+// (feeddrive/common/quantile.hpp): memory holds only the steps in flight, whatever the length
+// of the run.
 
 #include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/quantile.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_t.hpp"
@@ -40,8 +44,8 @@ class Recorder {
   void on_reference(const reference_t& m, std::int64_t recv_us);
   void on_command(const control_command_t& m, std::int64_t recv_us);
 
-  /// Moves every complete row, in order, to records(); returns how many were added.
-  std::size_t flush();
+  /// Hands every complete row, in order, to `sink`; returns how many.
+  std::size_t flush(const sim::RecordSink& sink);
 
   std::int64_t next() const { return next_; }             ///< first step not recorded
   std::int64_t steps() const { return steps_; }           ///< steps of the run (-1 until known)
@@ -51,7 +55,7 @@ class Recorder {
   /// What row next() is waiting for.
   std::vector<Missing> missing() const;
 
-  const std::vector<sim::Record>& records() const { return records_; }
+  std::int64_t rows() const { return rows_; }  ///< rows handed out so far
   std::int64_t duplicates() const { return duplicates_; }
   /// Steps per second of the run between the first and the newest state received (0 if < 2).
   double steps_per_second() const;
@@ -62,11 +66,11 @@ class Recorder {
   bool safe_state() const { return safe_state_; }
 
   /// Per-hop latencies from receive times [us]: state k -> command k, command k -> state k+1.
-  const std::vector<double>& latency_state_to_command() const { return lat_sc_; }
-  const std::vector<double>& latency_command_to_state() const { return lat_cs_; }
+  const stats::StreamingQuantile& latency_state_to_command() const { return lat_sc_; }
+  const stats::StreamingQuantile& latency_command_to_state() const { return lat_cs_; }
   /// How long before state k its reference k arrived [us]: the trajectory's lead. Negative:
   /// the reference came after the state, and the step waited for it.
-  const std::vector<double>& reference_lead() const { return lead_; }
+  const stats::StreamingQuantile& reference_lead() const { return lead_; }
 
  private:
   template <typename Msg>
@@ -84,7 +88,7 @@ class Recorder {
   std::map<std::int64_t, Seen<drive_state_t>> states_;
   std::map<std::int64_t, Seen<reference_t>> refs_;
   std::map<std::int64_t, Seen<control_command_t>> cmds_;
-  std::vector<sim::Record> records_;
+  std::int64_t rows_{0};
   std::int64_t duplicates_{0};
   std::int64_t commandless_{0};
   std::int64_t first_state_seq_{-1}, first_state_us_{0}, last_state_us_{0};
@@ -93,10 +97,7 @@ class Recorder {
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
   bool safe_state_{false};
-  std::vector<double> lat_sc_, lat_cs_, lead_;
+  stats::StreamingQuantile lat_sc_, lat_cs_, lead_;
 };
-
-/// p-quantile (0..1) of a sample, NaN when empty.
-double quantile(std::vector<double> v, double p);
 
 }  // namespace feeddrive::monitor

@@ -1,32 +1,75 @@
 #pragma once
-// Writing a run's results: DIR/timeseries.csv, DIR/summary.json and PNG plots (gnuplot).
-// The folder is checked, staged and swapped into place by feeddrive::output (output/folder.hpp):
-// DIR is never half-written, and only an earlier feeddrive output (or an empty folder) is
-// replaced. Check --out before the run with feeddrive::output::check_output_dir.
+// Writing a run's results as the run goes: DIR/timeseries.csv (streamed), DIR/summary.json and
+// PNG plots (gnuplot). The folder is checked, staged and swapped into place by
+// feeddrive::output::StagedFolder (output/folder.hpp): DIR is never half-written, and only an
+// earlier feeddrive output (or an empty folder) is replaced. Check --out before the run with
+// feeddrive::output::check_output_dir, and the run's size with check_run_size.
+//
+// Memory does not grow with the run: each record goes to the CSV (every output.every-th row,
+// the output.columns), to the online summary (SummaryBuilder) and to the plot reduction
+// (output::MinMaxReducer, kPlotBuckets min/max pairs per curve), and is dropped. feeddrive-sim
+// and feeddrive-monitor both write through RunWriter, so the same records give the same bytes.
 
 #include <functional>
+#include <memory>
 #include <string>
 
+#include "feeddrive/output/csv.hpp"
+#include "feeddrive/output/folder.hpp"
+#include "feeddrive/output/plot_reduce.hpp"
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/summary.hpp"
 
 namespace feeddrive::sim {
 
-/// timeseries.csv: header of record_columns(), one row per record, %.17g (round-trips exactly).
-void write_timeseries_csv(const std::string& path, const std::vector<Record>& records);
+/// Buckets of the plot reduction: two per pixel column of the 1000-pixel-wide plots.
+inline constexpr std::size_t kPlotBuckets = 2000;
 
-/// Plots position+error, velocity error, control and forces with gnuplot into dir
-/// (position.png, velocity_error.png, control.png, forces.png, plots.gp), from dir/timeseries.csv.
+/// Throws std::invalid_argument (one line naming the keys and the figure; the tools exit 2) if
+/// timeseries.csv cannot fit: rows x columns x 2 bytes (the least a value takes, a digit and a
+/// separator) above the free space of the file system that will hold out_dir. Call after
+/// output::check_output_dir, before any work.
+void check_run_size(const Scenario& s, const std::string& out_dir);
+
+class RunWriter {
+ public:
+  /// Creates the staged folder (marked as written by `tool`) and starts timeseries.csv.
+  /// Throws std::invalid_argument if out_dir must not be replaced, std::runtime_error if it
+  /// cannot be written.
+  RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool);
+  ~RunWriter();
+
+  /// One record, in step order.
+  void add(const Record& r);
+  long steps() const { return summary_.steps(); }
+  const SummaryBuilder& summary() const { return summary_; }
+  /// The most recent record (undefined before the first add).
+  const Record& last() const { return summary_.last(); }
+
+  /// Closes timeseries.csv, writes summary.json (`sum` plus the keys of the JSON object
+  /// extra_json) and the plots (when asked and there is at least one record), and swaps the
+  /// folder into place. On failure the previous output is kept and the staged folder removed.
+  /// `extra_files` (if given) writes the caller's own files into the staged folder first.
+  void finish(const Summary& sum, bool plots, const std::string& extra_json = "",
+              const std::function<void(const output::StagedFolder&)>& extra_files = {});
+
+ private:
+  const Scenario& s_;
+  output::StagedFolder folder_;
+  std::unique_ptr<output::CsvWriter> csv_;
+  std::vector<std::size_t> columns_;  // indices into record_columns()
+  long every_;
+  SummaryBuilder summary_;
+  output::MinMaxReducer plot_;
+};
+
+/// Plots position+error, velocity error, control and forces into the staged folder (position.png,
+/// velocity_error.png, control.png, forces.png, plots.gp) from its reduced plot data plot.csv.
 /// `title` is any text (it goes through output::gnuplot_string). Throws on failure.
-void write_plots(const std::string& dir, const std::string& title);
+void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title);
 
-/// Writes timeseries.csv, summary.json (with the keys of extra_json appended) and the plots into
-/// out_dir atomically (output::StagedFolder, marked as written by `tool`). Throws
-/// std::invalid_argument if out_dir must not be replaced, std::runtime_error if writing fails;
-/// a previous output is kept in both cases. `extra_files` (if given) writes the caller's own
-/// files into the staged folder (its path) before it is swapped into place.
+/// All records at once (RunWriter over r.records); log2csv and tests.
 void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots = true, const std::string& extra_json = "", const std::string& tool = "feeddrive-sim",
-                   const std::function<void(const std::string&)>& extra_files = {});
+                   bool plots = true, const std::string& extra_json = "", const std::string& tool = "feeddrive-sim");
 
 }  // namespace feeddrive::sim

@@ -8,6 +8,7 @@
 //   controller: {type: sliding_mode | cascade | open_loop, ...}
 //   reference:  {type: sine | step | accel_limited | scurve | ramp | waypoints | none, ...}
 //   analysis:   {settled_after: 0.25}   (optional)
+//   output:     {every: 1, columns: [t, xd, x, ...]}   (optional)
 //
 // Loading is strict: an unknown or misspelt key, a missing value, a non-number, NaN or a value
 // that fails validate() throws ScenarioError with a one-line message naming the key and value.
@@ -15,6 +16,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/open_loop.hpp"
@@ -54,6 +56,16 @@ struct AnalysisConfig {
   double settled_after{0.25};
 };
 
+/// What timeseries.csv records (the summary and the plots always cover every step).
+struct OutputConfig {
+  long every{1};                     ///< keep rows k with k % every == 0
+  std::vector<std::string> columns;  ///< the columns written, in this order; empty = all
+};
+
+/// Largest run: steps = round(duration / control_period) <= kMaxSteps (docs/scenario.md,
+/// "Limits"): 1e10 steps are about a day of wall time at the fastest measured 7 us per step.
+inline constexpr double kMaxSteps = 1e10;
+
 struct Scenario {
   std::string name;
   std::string path;  ///< file it was loaded from ("" if parsed from a string)
@@ -63,6 +75,7 @@ struct Scenario {
   ControllerConfig controller;
   ReferenceConfig reference;
   AnalysisConfig analysis;
+  OutputConfig output;
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};

@@ -6,13 +6,20 @@
 //     record(t_k, r_k, state_k, m_k, c_k, forces(state_k, u_k));  plant.advance(u_k, t_{k+1})
 //
 // The multi-process service runs the same components in the same order, so both produce the
-// same records bit for bit.
+// same records bit for bit; both assemble a row with make_record.
+//
+// Streaming: run(s, sink) hands each record to `sink` as it is made and keeps none, so its
+// memory does not depend on the number of steps.
 
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "feeddrive/controller/controller.hpp"
 #include "feeddrive/plant/cvode_integrator.hpp"
+#include "feeddrive/plant/dynamics.hpp"
+#include "feeddrive/plant/sensor.hpp"
+#include "feeddrive/trajectory/trajectory.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::sim {
@@ -30,16 +37,37 @@ struct Record {
 
 /// Column names of timeseries.csv, in order.
 const std::vector<std::string>& record_columns();
-/// The values of a record in the order of record_columns().
+/// Number of columns.
+inline constexpr std::size_t kRecordColumns = 20;
+/// The values of a record in the order of record_columns() (out[kRecordColumns]).
+void record_values(const Record& r, double* out);
 std::vector<double> record_values(const Record& r);
 
+/// The one assembly of a row (the in-process loop and the monitor's translator): step time t,
+/// reference, true state at t, measurement, the controller's command, the u the drive applied
+/// and the forces under it.
+Record make_record(double t, const trajectory::Sample& ref, const plant::State& state, const plant::Measurement& meas,
+                   const controller::Command& cmd, double u_applied, const plant::Forces& forces);
+
+using RecordSink = std::function<void(const Record&)>;
+
+struct RunStats {
+  long steps{0};
+  double wall_time_s{0.0};
+  plant::CvodeIntegrator::Stats integrator;
+};
+
+/// Runs a scenario in-process, handing every record to `sink` in step order. Polls the
+/// interrupt flag (feeddrive/common/interrupt.hpp) every 1024 steps and throws
+/// interrupt::Interrupted after Ctrl-C or SIGTERM.
+RunStats run(const Scenario& s, const RecordSink& sink);
+
+/// All records in memory (tests, short runs).
 struct RunResult {
   std::vector<Record> records;
   double wall_time_s{0.0};
   plant::CvodeIntegrator::Stats integrator;
 };
-
-/// Runs a scenario in-process. progress(k, N) is called every few thousand steps if given.
-RunResult run(const Scenario& s, const std::function<void(long, long)>& progress = {});
+RunResult run(const Scenario& s);
 
 }  // namespace feeddrive::sim

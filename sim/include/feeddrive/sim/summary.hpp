@@ -1,10 +1,16 @@
 #pragma once
 // Run metrics (summary.json). Errors are true-state errors: e = xd - x, e_v = vd - v.
 // "settled" metrics are over t >= analysis.settled_after.
+//
+// Computed online (SummaryBuilder::add, one record at a time, memory independent of the number
+// of steps): maxima, minima, sums of squares (RMS), the total variation and the end state are
+// exact; position_error_p95_abs_m is the rank-floor(0.95 n) order statistic of |e| from a
+// bounded histogram (feeddrive/common/quantile.hpp), within 2^-11 (0.05 %) of the exact value.
 
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/quantile.hpp"
 #include "feeddrive/sim/simulation.hpp"
 
 namespace feeddrive::sim {
@@ -39,6 +45,26 @@ struct Summary {
   long integrator_error_test_fails{0};
 };
 
+/// The metrics of a stream of records.
+class SummaryBuilder {
+ public:
+  explicit SummaryBuilder(const Scenario& s);
+  void add(const Record& q);
+  long steps() const { return n_; }
+  const Record& last() const { return last_; }
+  /// The summary of every record added so far.
+  Summary summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) const;
+
+ private:
+  double settled_after_, control_period_;
+  Summary m_;
+  long n_{0}, n_settled_{0};
+  double se_{0.0}, sev_{0.0}, se_settled_{0.0};
+  Record last_;
+  stats::StreamingQuantile abs_e_;
+};
+
+/// All records in memory at once (SummaryBuilder over r.records).
 Summary summarize(const RunResult& r, const Scenario& s);
 /// The summary as a JSON document (also carries the scenario name and path). `extra`, if not
 /// empty, is a JSON object whose keys are appended (the monitor's lockstep statistics).

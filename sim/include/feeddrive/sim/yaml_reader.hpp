@@ -25,6 +25,9 @@ class MapReader {
   void unsigned_integer(const std::string& key, std::uint64_t& out);
   void boolean(const std::string& key, bool& out);
   void string(const std::string& key, std::string& out);
+  /// A list of strings ([a, b] or a block list) if the key is present; a single string is a
+  /// list of one.
+  void string_list(const std::string& key, std::vector<std::string>& out);
   /// A required string key.
   std::string required_string(const std::string& key);
   /// A nested map (absent = empty).

@@ -8,9 +8,14 @@
 //                          DIR names no folder of its own ("", "/", ".", ".."), is too long,
 //                          lies under a file, cannot be written, or exists and is neither empty
 //                          nor a feeddrive output.
-//   StagedFolder           the writer: a new sibling folder ".NAME.partial-PID-N" (marked from
-//                          the start) that commit() swaps into place. A failure before or during
-//                          commit never deletes the previous output or anything else.
+//   StagedFolder           the one writer of every tool's results: a new sibling folder
+//                          ".NAME.partial-PID-N" (marked from the start) that the tool fills
+//                          (write_text, CsvWriter on path(), plot) and commit() swaps into place.
+//                          A failure before or during commit never deletes the previous output or
+//                          anything else; an exception, Ctrl-C or SIGTERM (the tools poll
+//                          feeddrive/common/interrupt.hpp and unwind) removes the staging folder,
+//                          and a staging folder left by a process that was killed (-9, power) is
+//                          removed by the next run that writes the same DIR.
 //
 // A folder is a feeddrive output only if it holds the marker file `.feeddrive-output` that a
 // StagedFolder wrote (first line "feeddrive-output", then "format: 1" and "tool: NAME"). Outputs
@@ -56,6 +61,13 @@ class StagedFolder {
 
   /// Where to write the files (absolute).
   const std::filesystem::path& dir() const { return staging_; }
+  /// dir() / name.
+  std::filesystem::path path(const std::string& name) const { return staging_ / name; }
+  /// Writes dir()/name; throws std::runtime_error naming the file.
+  void write_text(const std::string& name, const std::string& text) const;
+  /// Runs a gnuplot script in dir() (run_gnuplot) after the preamble every feeddrive plot shares:
+  /// UTF-8, comma-separated data, 1000x700 PNG (cairo, no enhanced text), grid, key on top.
+  void plot(const std::string& script) const;
   /// The final folder (absolute, normalised).
   const std::filesystem::path& target() const { return target_; }
 
@@ -74,6 +86,11 @@ class StagedFolder {
   std::filesystem::path staging_;
   bool done_{false};
 };
+
+/// Removes the staging folders ".NAME.partial-PID-N" next to `target` that a feeddrive process
+/// left when it was killed: only marked ones (is_feeddrive_output) whose PID is not running.
+/// Returns how many were removed. StagedFolder's constructor calls it.
+int remove_stale_staging(const std::filesystem::path& target) noexcept;
 
 /// Removes `dir` with everything in it only if it is a feeddrive output or an empty folder;
 /// returns false (and removes nothing) otherwise or on failure.

@@ -1,0 +1,60 @@
+#pragma once
+// The one interrupt flag of every feeddrive process: SIGINT and SIGTERM set it, long loops poll
+// it (interrupted()) and unwind, so destructors run: a staged output folder is removed
+// (output::StagedFolder), a child gnuplot is stopped (output::run_gnuplot).
+//
+// The handler only stores the signal number (async-signal-safe). It is installed without
+// SA_RESTART, so a blocking system call (poll, nanosleep, waitpid) returns EINTR at once and the
+// caller sees the flag.
+
+#include <signal.h>
+
+#include <csignal>
+#include <stdexcept>
+#include <string>
+
+namespace feeddrive::interrupt {
+
+namespace detail {
+inline volatile std::sig_atomic_t g_signal = 0;
+extern "C" inline void on_signal(int sig) { g_signal = sig; }
+}  // namespace detail
+
+/// Installs the SIGINT/SIGTERM handlers (idempotent).
+inline void install_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = detail::on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking call returns EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+/// The signal that interrupted the process, or 0.
+inline int signal_number() { return detail::g_signal; }
+inline bool interrupted() { return detail::g_signal != 0; }
+
+/// "SIGINT", "SIGTERM" or "signal N".
+inline std::string signal_name(int sig) {
+  if (sig == SIGINT) return "SIGINT";
+  if (sig == SIGTERM) return "SIGTERM";
+  return "signal " + std::to_string(sig);
+}
+
+/// Thrown by a loop that saw the flag; the tools exit 128 + signal.
+class Interrupted : public std::runtime_error {
+ public:
+  explicit Interrupted(int sig) : std::runtime_error("interrupted by " + signal_name(sig)), sig_(sig) {}
+  int signal() const { return sig_; }
+  int exit_code() const { return 128 + sig_; }
+
+ private:
+  int sig_;
+};
+
+/// Throws Interrupted if a signal came.
+inline void check() {
+  if (const int s = detail::g_signal; s != 0) throw Interrupted(s);
+}
+
+}  // namespace feeddrive::interrupt
