@@ -66,7 +66,11 @@ void ControllerNode::try_answer() {
 void ControllerNode::run() {
   // Above the plant (80): on a shared core the controller's answer preempts the plant's final
   // spin before a period start.
-  if (options().realtime) spdlog::info("controller: real time: {}", enter_realtime(81));
+  if (options().realtime) {
+    const std::string rt = enter_realtime(81);
+    if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("controller: real time: {}", rt);
+    else spdlog::warn("controller: real time: {}", rt);
+  }
   set_state("running");
   last_progress_us_ = mono_us();
   const std::int64_t resend_us = us(options().resend_interval_s);

@@ -209,7 +209,9 @@ bool PlantNode::take_commands(std::int64_t k, double t_end) {
 }
 
 void PlantNode::run_realtime() {
-  spdlog::info("plant: real time: {}", enter_realtime(80));
+  const std::string rt = enter_realtime(80);
+  if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("plant: real time: {}", rt);
+  else spdlog::warn("plant: real time: {}", rt);
   command_.reset();
   // Start handshake: state 0 waits for its command as in lockstep, so the clock starts only
   // when the controller, the trajectory and the monitor are all up.
