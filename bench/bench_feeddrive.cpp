@@ -10,8 +10,11 @@
 #include <benchmark/benchmark.h>
 
 #include <optional>
+#include <vector>
 
+#include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/plant/plant.hpp"
+#include "feeddrive/service/integrity.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
 
@@ -91,5 +94,32 @@ void BM_JerkLimitedRun_Beyond10kHz(benchmark::State& state) { jerk_limited_run(s
 BENCHMARK(BM_JerkLimitedRun_Beyond10kHz)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
+
+// Authentication of the bus (--key, docs/security.md): one HMAC-SHA256 to sign a drive_state_t
+// (the largest message of a step) and one to verify it, as Bus::publish and subscribe do.
+static std::vector<std::uint8_t> encoded_state() {
+  drive_state_t m{};
+  const int n = m.getEncodedSize();
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(n) + feeddrive::service::MessageAuth::kMacSize);
+  m.encode(buf.data(), 0, n);
+  return buf;
+}
+static void BM_SignDriveState(benchmark::State& state) {
+  const feeddrive::service::MessageAuth auth("0123456789abcdef0123456789abcdef");
+  std::vector<std::uint8_t> buf = encoded_state();
+  for (auto _ : state) {
+    auth.sign("FD_STATE", buf.data(), buf.size());
+    benchmark::DoNotOptimize(buf.data());
+  }
+  state.counters["bytes"] = static_cast<double>(buf.size());
+}
+BENCHMARK(BM_SignDriveState)->MinTime(1.0);
+static void BM_VerifyDriveState(benchmark::State& state) {
+  const feeddrive::service::MessageAuth auth("0123456789abcdef0123456789abcdef");
+  std::vector<std::uint8_t> buf = encoded_state();
+  auth.sign("FD_STATE", buf.data(), buf.size());
+  for (auto _ : state) benchmark::DoNotOptimize(auth.verify("FD_STATE", buf.data(), buf.size()));
+}
+BENCHMARK(BM_VerifyDriveState)->MinTime(1.0);
 
 BENCHMARK_MAIN();

@@ -15,6 +15,9 @@
 # (feeddrive-launch --lcm-log), alternating; medians of steps/s.
 # Last, what other processes on the multicast group cost a ping-pong round trip (why the
 # monitor and the trajectory read in batches; docs/lcm-contract.md, "Receiving").
+# Then the cost of authentication (--key, HMAC-SHA256 on every message; docs/security.md): the
+# same lockstep run without and with a key, alternating, medians, ratio and cost per step.
+# A third argument "auth" runs only that part: bench/lockstep_bench.sh BUILD ROUNDS auth
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -51,6 +54,29 @@ bench() {
   echo "$placement: medians: raw liblcm ping-pong $mr, Bus ping-pong $mb round trips/s; lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
   echo "$placement: Bus ping-pong / raw: $(ratio "$mb" "$mr") (target >= 0.95); lockstep / raw: $(ratio "$ml" "$mr") (target >= 0.8)"
 }
+auth() {
+  local plain=() keyed=() key="$TMP/bench.key"
+  head -c 32 /dev/urandom > "$key"
+  chmod 600 "$key"
+  for r in $(seq "$ROUNDS"); do
+    for mode in plain keyed; do
+      local k=(); [ "$mode" = keyed ] && k=(--key "$key")
+      "$BUILD/bin/feeddrive-launch" scenarios/paper/smc_bl_jerk_limited.yaml --out "$TMP/auth$mode$r" --no-plots -q \
+          --lcm-url "$URL" --prefix "AU$mode$r" --cpus 0 "${k[@]}"
+      local rate
+      rate=$(jq -r .lockstep.steps_per_second "$TMP/auth$mode$r/summary.json")
+      [ "$mode" = plain ] && plain+=("$rate") || keyed+=("$rate")
+    done
+    echo "auth round $r: without a key ${plain[-1]} steps/s, with --key ${keyed[-1]} steps/s"
+  done
+  local mp mk
+  mp=$(median "${plain[@]}"); mk=$(median "${keyed[@]}")
+  awk -v p="$mp" -v k="$mk" 'BEGIN { printf "auth (one core): median %s steps/s without a key, %s with --key: ratio %.3f, cost %.2f us per step (HMAC-SHA256 of every message sent and received)\n", p, k, k / p, 1e6 / k - 1e6 / p }'
+}
+if [ "${3:-all}" = auth ]; then
+  auth
+  exit 0
+fi
 bench free
 bench one-core
 
@@ -103,4 +129,5 @@ group() {
 }
 group free
 group one-core
+auth
 echo "bytes per step on the wire: $(jq -r .lockstep.bytes_per_step "$TMP/runfree1/summary.json") (target < 1024)"

@@ -15,7 +15,8 @@ PACKAGES=(
   libbenchmark-dev libceres-dev
   gnuplot-nox jq python3 python3-yaml
   iproute2 nftables util-linux procps
-  lua5.2 liblcm-lua
+  lua5.2 liblcm-lua lua-luaossl
+  libssl-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -5,7 +5,8 @@
 // velocity, and observers for the bristle and grinding states (no "truth").
 //   sliding-mode-controller [LCM_URL [PREFIX]]     (after feeddrive-launch SCENARIO --out DIR --external controller)
 // Protocol: answer state k once when reference k is known; repeat the same command for a
-// repeated state or a resend request; ask for a missing reference or run_info_t; heartbeat
+// repeated state or a resend request; ask for a missing reference; wait for run_info_t (every
+// second) and stamp its run_id on everything published; heartbeat
 // every 100 ms; stop at the end-of-run state, linger until the monitor is done; fail (exit 1,
 // one line, status "failed") when another role fails or nothing comes for 5 s (30 s at the start).
 #include <lcm/lcm-cpp.hpp>
@@ -87,14 +88,13 @@ class Node {
     while (!ended_) {
       handle(1);
       const double t = now_s();
-      if (!controller_ && t - last_request > 0.1) request(p_ + "_INFO", 0), last_request = t;
       if (controller_ && pending_ && t - last_request > 0.002) request(p_ + "_REF", pending_->seq), last_request = t;
       if (!failure_.empty()) return fail(failure_);
       const double limit = next_seq_ == 0 ? 30.0 : 5.0;
       if (t - last_progress_ > limit)
         return fail("no state from the plant for step " + std::to_string(next_seq_) + " within " +
                     std::to_string(static_cast<int>(limit)) + " s");
-      if (t - last_beat >= 0.1) status("running"), last_beat = t;
+      if (controller_ && t - last_beat >= 0.1) status("running"), last_beat = t;
     }
     status("done");
     for (const double end = now_s(); !monitor_done_ && now_s() - end < 10.0;) {
@@ -133,6 +133,7 @@ class Node {
     fd::run_info_t info;
     if (controller_ || !decode(rb, info)) return;
     controller_ = std::make_unique<fd::controller::SlidingModeController>(params_from(info));
+    run_id_ = info.run_id;  // stamped on everything published: messages of another run are ignored
     std::fprintf(stderr, "sliding-mode-controller: run %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V\n",
                  info.scenario.c_str(), info.mode.c_str(), info.control_period, static_cast<long long>(info.steps),
                  info.mass, info.thrust_gain);
@@ -183,6 +184,7 @@ class Node {
     const fd::trajectory::Sample ref{r->second.position, r->second.velocity, r->second.acceleration, r->second.jerk};
     const fd::controller::Command u = controller_->update(ref, meas, nullptr);  // once per step
     fd::control_command_t c{};
+    c.run_id = run_id_;
     c.seq = st.seq;
     c.t = st.t;
     c.u = std::isfinite(u.u) ? u.u : 0.0;
@@ -199,6 +201,7 @@ class Node {
 
   void status(const std::string& state, const std::string& message = "") {
     fd::process_status_t m{};
+    m.run_id = run_id_;
     m.utime = wall_us();
     m.role = "controller";
     m.state = state;
@@ -210,6 +213,7 @@ class Node {
   }
   void request(const std::string& channel, std::int64_t seq) {
     fd::resend_request_t r{};
+    r.run_id = run_id_;
     r.requester = "controller";
     r.channel = channel;
     r.seq = seq;
@@ -228,7 +232,7 @@ class Node {
   std::optional<fd::drive_state_t> pending_;
   std::map<std::int64_t, fd::reference_t> refs_;
   std::map<std::int64_t, fd::control_command_t> sent_;
-  std::int64_t next_seq_{0}, invalid_{0};
+  std::int64_t next_seq_{0}, invalid_{0}, run_id_{0};
   double last_progress_{0};
   bool ended_{false}, monitor_done_{false};
   std::string failure_;

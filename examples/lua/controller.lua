@@ -34,6 +34,15 @@ Protocol:
   * A process_status_t of another role with state "failed", or no progress for --start-timeout
     (30 s, before step 0) / --step-timeout (5 s, after): announce "failed" (3 times, with the
     reason), print one line naming the role and the step, exit 1.
+  * Run identity (docs/security.md): every message carries run_id. With --run-id 0 (default)
+    the controller joins the run of the first plant heartbeat whose utime is within 5 s of its
+    own clock (a replayed log is older), then ignores and counts (status "foreign") every message
+    of another run, and stamps its own messages with the run's id.
+  * --key FILE (docs/security.md): every message is signed, and every message received must be:
+    mac_size = 32 and mac = HMAC-SHA256(key, channel .. "\0" .. E), E = the encoding up to
+    mac_size. A message without a valid mac is counted (status "unauthenticated") and dropped.
+    Needs luaossl (Debian lua-luaossl). This script does not check the key file's mode (plain
+    Lua has no stat): keep it 0600, as the C++ processes require.
   * A message that does not decode as the channel's type is counted (status "invalid") and
     dropped. Handler errors never unwind through LCM's C dispatch: they are kept and re-raised
     after lc:handle_timeout() returns.
@@ -95,6 +104,8 @@ local defaults = {
   {'step-timeout', 5.0, 'seconds without progress before failing'},
   {'resend-interval', 0.002, 'ask for a missing reference after this long [s]'},
   {'linger', 10.0, 'after the end: seconds to keep answering until the monitor is done'},
+  {'run-id', 0, 'identity of the run (0: join the plant\'s, from its heartbeat)'},
+  {'key', '', 'key file: sign and verify every message with HMAC-SHA256 (docs/security.md)'},
 }
 
 local function usage(out)
@@ -149,6 +160,10 @@ do
       io.stderr:write('lua-controller: error: --' .. name .. ' = ' .. opt[name] .. ': must be > 0\n'); os.exit(2)
     end
   end
+  if opt['run-id'] < 0 or opt['run-id'] > 2^53 - 1 or opt['run-id'] % 1 ~= 0 then
+    io.stderr:write('lua-controller: error: --run-id = ' .. opt['run-id'] .. ': must be an integer in 0..2^53-1\n')
+    os.exit(2)
+  end
   for _, name in ipairs({'eta', 'k', 'ki', 'coulomb', 'linger'}) do
     if opt[name] < 0 then
       io.stderr:write('lua-controller: error: --' .. name .. ' = ' .. opt[name] .. ': must be >= 0\n'); os.exit(2)
@@ -200,7 +215,47 @@ local last_seq = -1             -- last answered step
 local ended = false
 local run_info = nil            -- the run's run_info_t, once received: no command goes out before it
 local state = 'starting'
-local counters = {resends = 0, duplicates = 0, invalid = 0, send_errors = 0}
+local counters = {resends = 0, duplicates = 0, invalid = 0, send_errors = 0, foreign = 0, unauthenticated = 0}
+local run_id = opt['run-id'] ~= 0 and opt['run-id'] or nil   -- nil: not joined yet
+
+-- Authentication (docs/security.md, "Signing in another language"). luaossl only with --key.
+local key = nil
+local hmac = nil
+if opt.key ~= '' then
+  local ok, mod = pcall(require, 'openssl.hmac')
+  if not ok then
+    io.stderr:write('lua-controller: error: --key needs luaossl (Debian package lua-luaossl)\n'); os.exit(2)
+  end
+  hmac = mod
+  local f = io.open(opt.key, 'rb')
+  if not f then io.stderr:write('lua-controller: error: --key ' .. opt.key .. ': cannot open it\n'); os.exit(2) end
+  key = f:read('*a')
+  f:close()
+  if #key < 16 or #key > 4096 then
+    io.stderr:write('lua-controller: error: --key ' .. opt.key .. ': ' .. #key .. ' bytes; a key has 16..4096\n')
+    os.exit(2)
+  end
+end
+local function mac(channel, body) return hmac.new(key, 'sha256'):final(channel .. '\0' .. body) end
+
+-- The bytes to publish: the message stamped with the run's id, signed with --key. The trailer
+-- of an unsigned encoding is mac_size = 0 (two zero bytes); a signed one is 0x00 0x20 and the mac.
+local function seal(channel, m)
+  m.run_id = run_id or 0
+  m.mac_size = 0
+  m.mac = {}
+  local e = m:encode()
+  if not key then return e end
+  local body = e:sub(1, #e - 2)
+  return body .. '\0\32' .. mac(channel, body)
+end
+
+-- True if a received message carries a valid mac (always, without --key).
+local function authentic(channel, data)
+  if not key then return true end
+  if #data < 42 or data:sub(-34, -33) ~= '\0\32' then return false end
+  return mac(channel, data:sub(1, -35)) == data:sub(-32)
+end
 local last_heartbeat = -math.huge
 local last_invalid_log = -math.huge
 local handler_error = nil       -- first error raised inside an LCM handler
@@ -235,14 +290,17 @@ local function send_status(st, message)
   m.resends = counters.resends
   m.duplicates = counters.duplicates
   m.invalid = counters.invalid
-  publish(ch.status, m:encode())
+  m.foreign = counters.foreign
+  m.conflicts = 0               -- this example leaves conflict detection to the plant and the monitor
+  m.unauthenticated = counters.unauthenticated
+  publish(ch.status, seal(ch.status, m))
 end
 
 local function heartbeat(force)
   local t = now()
   if not force and t - last_heartbeat < 0.1 then return end
   last_heartbeat = t
-  send_status(state)
+  if run_id then send_status(state) end   -- nothing to say before joining a run
 end
 
 local function set_state(s) state = s; heartbeat(true) end
@@ -319,7 +377,7 @@ local function try_answer()
   m.u_unsaturated = u_unsat
   m.sliding = s
   m.z_estimate = 0 / 0          -- NaN: this law estimates no bristle state
-  local encoded = m:encode()
+  local encoded = seal(ch.command, m)    -- signed once; repeats are these bytes
   commands[st.seq] = encoded
   commands[st.seq - KEEP] = nil
   publish(ch.command, encoded)
@@ -334,15 +392,31 @@ local function request_resend(channel, seq)
   r.requester = ROLE
   r.channel = channel
   r.seq = seq
-  publish(ch.resend, r:encode())
+  publish(ch.resend, seal(ch.resend, r))
 end
 local function request_reference(seq) request_resend(ch.reference, seq) end
 
 -- Subscriptions -----------------------------------------------------------------------------------
 
-local function subscribe(channel, msgtype, handler)
+local last_drop_log = {}
+local function dropped(kind, fmt, ...)
+  counters[kind] = counters[kind] + 1
+  local t = now()
+  if t - (last_drop_log[kind] or -math.huge) > 1 then
+    last_drop_log[kind] = t
+    warn(fmt, ...)
+  end
+end
+
+-- any_run: the handler gets messages of every run (the heartbeats, to join one).
+local function subscribe(channel, msgtype, handler, any_run)
   lc:subscribe(channel, function(_, data)
     if handler_error ~= nil then return end
+    if not authentic(channel, data) then
+      dropped('unauthenticated', 'rejected a message on %s without a valid mac (%d so far)', channel,
+              counters.unauthenticated + 1)
+      return
+    end
     local ok, msg = pcall(msgtype.decode, data)
     if not ok and is_interrupt(msg) then handler_error = msg; return end
     if not ok then
@@ -353,6 +427,13 @@ local function subscribe(channel, msgtype, handler)
         warn('ignored a message on %s that is not a %s (%d bytes)', channel, msgtype.name, #data)
       end
       return
+    end
+    if not any_run then
+      if not run_id then return end     -- not joined yet: the plant repeats what matters
+      if msg.run_id ~= run_id then
+        dropped('foreign', 'ignored a message of another run (run id %.0f) on %s', msg.run_id, channel)
+        return
+      end
     end
     local ok2, err = pcall(handler, msg)
     if not ok2 then handler_error = err end
@@ -410,8 +491,18 @@ subscribe(ch.info, feeddrive.run_info_t, function(m)
 end)
 
 subscribe(ch.status, feeddrive.process_status_t, function(m)
+  if not run_id then
+    -- Join the first plant whose heartbeat is fresh (a replayed log carries old times).
+    if m.role ~= 'plant' or math.abs(m.utime - wall_utime()) > 5e6 then return end
+    run_id = m.run_id
+    info('joined run %.0f (from the plant\'s heartbeat)', run_id)
+  end
+  if m.run_id ~= run_id then
+    dropped('foreign', 'ignored a message of another run (run id %.0f) on %s', m.run_id, ch.status)
+    return
+  end
   if m.role ~= ROLE then peers[m.role] = m end
-end)
+end, true)
 
 subscribe(ch.resend, feeddrive.resend_request_t, function(r)
   if r.channel == ch.command then

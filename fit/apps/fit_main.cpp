@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstdio>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/workflow.hpp"
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
   }
   spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
+  interrupt::install_handlers();
   try {
     // Bad input (scenario, data, too short a record, an --out that must not be replaced) is a
     // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.
@@ -101,6 +103,8 @@ int main(int argc, char** argv) {
                     st.force_rms_after);
     std::printf("%s\nresults: %s/{findings.json,model.fitted.yaml,report.md}\n", r.conclusion.c_str(), out_dir.c_str());
     return 0;
+  } catch (const interrupt::Interrupted& e) {  // Ctrl-C in any phase: nothing written
+    return interrupt::report(e);
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

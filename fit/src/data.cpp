@@ -9,31 +9,10 @@
 #include <map>
 #include <sstream>
 
+#include "feeddrive/csv/reader.hpp"
 #include "feeddrive/monitor/log_reader.hpp"
 
 namespace feeddrive::fit {
-namespace {
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream ss(line);
-  while (std::getline(ss, cell, ',')) out.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-std::string short_value(const std::string& s) { return s.size() > 40 ? s.substr(0, 40) + "..." : s; }
-
-}  // namespace
-
 double MeasuredData::median_period() const {
   if (t.size() < 2) return 0.0;
   std::vector<double> d(t.size() - 1);
@@ -66,98 +45,49 @@ void validate(const MeasuredData& d) {
   }
 }
 
-MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt) {
-  MeasuredData d;
-  d.source = origin;
-  std::istringstream in(text);
-  std::string line;
-  long line_no = 0;
-  std::vector<std::string> header;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
-    if (!trim(line).empty()) {
-      header = split(line);
-      break;
-    }
-  }
-  if (header.empty()) throw DataError(origin + ": empty file (expected a CSV header with t, x and u or force_N)");
-  std::map<std::string, std::size_t> col;
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    if (header[c].empty()) throw DataError(origin + ": line " + std::to_string(line_no) + ": empty column name " +
-                                           std::to_string(c + 1));
-    if (!col.emplace(header[c], c).second)
-      throw DataError(origin + ": line " + std::to_string(line_no) + ": column '" + header[c] + "' appears twice");
-  }
-  const std::string hint = (header.size() == 1 && (line.find(';') != std::string::npos || line.find('\t') != std::string::npos))
-                               ? "; columns must be separated by commas"
-                               : "";
-  const auto require = [&](const std::string& name) {
-    const auto it = col.find(name);
-    if (it == col.end())
-      throw DataError(origin + ": missing column '" + name + "' (header: " + short_value(line) + hint + ")");
-    return it->second;
-  };
-  const std::size_t ct = require(opt.time_column);
-  const std::size_t cx = require(opt.position_column);
-  std::size_t cu;
-  if (col.count(opt.command_column)) {
-    cu = col[opt.command_column];
-    d.input_kind = InputKind::kCommand;
-  } else if (col.count(opt.force_column)) {
-    cu = col[opt.force_column];
-    d.input_kind = InputKind::kForce;
-  } else {
-    throw DataError(origin + ": missing column '" + opt.command_column + "' or '" + opt.force_column +
-                    "' (the input; header: " + short_value(line) + hint + ")");
-  }
-  const long cxd = col.count(opt.reference_column) ? static_cast<long>(col[opt.reference_column]) : -1;
-  const long cv = col.count("v") ? static_cast<long>(col["v"]) : -1;
+namespace {
 
-  std::string previous_t;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (trim(line).empty()) continue;
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() != header.size())
-      throw DataError(origin + ": line " + std::to_string(line_no) + ": " + std::to_string(cells.size()) +
-                      " columns, the header has " + std::to_string(header.size()) + " (truncated row?)");
-    const auto number = [&](std::size_t c) {
-      const std::string& s = cells[c];
-      const char* b = s.c_str();
-      char* end = nullptr;
-      errno = 0;
-      const double v = std::strtod(b, &end);
-      if (s.empty() || end != b + s.size() || errno == ERANGE || !std::isfinite(v))
-        throw DataError(origin + ": line " + std::to_string(line_no) + ", column " + header[c] + ": '" +
-                        short_value(s) + "' is not a finite number");
-      return v;
-    };
-    const double t = number(ct);
-    if (!d.t.empty() && !(t > d.t.back()))
-      throw DataError(origin + ": line " + std::to_string(line_no) + ", column " + header[ct] + ": " + cells[ct] +
-                      (t == d.t.back() ? " repeats the previous time" : " is before the previous time " + previous_t) +
-                      " (times must increase)");
-    previous_t = cells[ct];
-    d.t.push_back(t);
-    d.x.push_back(number(cx));
-    d.input.push_back(number(cu));
-    if (cxd >= 0) d.xd.push_back(number(static_cast<std::size_t>(cxd)));
-    if (cv >= 0) d.v.push_back(number(static_cast<std::size_t>(cv)));
-  }
+// The columns of the roles, for the one CSV reader (feeddrive/csv/reader.hpp).
+csv::Options csv_options(const CsvOptions& opt) {
+  csv::Options o;
+  o.columns = {{{opt.time_column}},
+               {{opt.position_column}},
+               {{opt.command_column, opt.force_column}},
+               {{opt.reference_column}, false},
+               {{"v"}, false}};
+  o.increasing = 0;
+  return o;
+}
+
+MeasuredData from_table(csv::Table t, const CsvOptions& opt) {
+  MeasuredData d;
+  d.source = t.source;
+  d.t = std::move(t.values[0]);
+  d.x = std::move(t.values[1]);
+  d.input = std::move(t.values[2]);
+  d.input_kind = t.used[2] == opt.command_column ? InputKind::kCommand : InputKind::kForce;
+  d.xd = std::move(t.values[3]);
+  d.v = std::move(t.values[4]);
   validate(d);
   return d;
 }
 
+}  // namespace
+
+MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt) {
+  try {
+    return from_table(csv::parse(text, origin, csv_options(opt)), opt);
+  } catch (const csv::CsvError& e) {
+    throw DataError(e.what());
+  }
+}
+
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw DataError(path + ": is a folder, not a data file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw DataError(path + ": cannot open the data file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  if (f.bad()) throw DataError(path + ": read error");
-  return parse_csv(ss.str(), path, opt);
+  try {
+    return from_table(csv::read_file(path, csv_options(opt)), opt);
+  } catch (const csv::CsvError& e) {
+    throw DataError(e.what());
+  }
 }
 
 MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {

@@ -9,6 +9,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/plant/effects.hpp"
 
 namespace feeddrive::fit {
@@ -376,8 +377,16 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
   opt.logging_type = ceres::SILENT;
   opt.minimizer_progress_to_stdout = false;
   opt.num_threads = 1;
+  // Ctrl-C ends the fit within an iteration (interrupt.hpp).
+  struct StopOnInterrupt : ceres::IterationCallback {
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+      return interrupt::interrupted() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    }
+  } stop;
+  opt.callbacks.push_back(&stop);
   ceres::Solver::Summary sum;
   ceres::Solve(opt, &problem, &sum);
+  interrupt::check();
   Solved out;
   out.theta = theta;
   out.rss = 2.0 * sum.final_cost;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <functional>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/plant/plant.hpp"
 
 namespace feeddrive::fit {
@@ -30,6 +31,7 @@ Replay replay(const Record& rec, const plant::PlantParams& model, double window)
   long count = 0;
   long s = 0;
   while (s + 1 < n) {
+    interrupt::check();
     long e = s;
     while (e + 1 < n && d.t[e + 1] - d.t[s] <= W + 1e-12) ++e;
     if (e == s) e = s + 1;

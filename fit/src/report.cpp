@@ -109,7 +109,9 @@ std::string findings_json(const FitResult& r) {
                                        {"position", bins_json(st.localisation.position)}}}});
   }
   j["steps"] = steps;
-  return j.dump(2) + "\n";
+  // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
+  // exception after the run.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 namespace {

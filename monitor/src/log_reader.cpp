@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
@@ -87,7 +88,7 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
   LogConversion out;
   Event ev;
   while (log.next(ev, out.events)) {
-    ++out.events;
+    if (++out.events % 1024 == 0) interrupt::check();
     if (ev.channel == ch.state) {
       decode_into<drive_state_t>(ev, out, [&](const drive_state_t& m, std::int64_t t) { out.recorder.on_state(m, t); });
     } else if (ev.channel == ch.reference) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -30,14 +31,20 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       hist_sc_(s.control_period * 1e6 / 20.0, 40),
       hist_cs_(s.control_period * 1e6 / 20.0, 40),
       lateness_(s.control_period * 1e6) {
+  if (mopt.attach) bus().join_first_seen();
+  // Every message passes the conflict check first: a second, different message for a step is
+  // never recorded (service::Node::admit).
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
+    if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     rec_.on_state(m, t);
     on_state_timing(m, t);
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
-    for (const reference_t& m : b.refs) rec_.on_reference(m, t);
+    for (const reference_t& m : b.refs)
+      if (admit(reference_ledger_, channels().reference, m.seq, m)) rec_.on_reference(m, t);
   });
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
+    if (!admit(command_ledger_, channels().command, m.seq, m)) return;
     rec_.on_command(m, t);
     on_command_timing(m, t);
   });
@@ -61,7 +68,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   // second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
   // monitor only listens.
   if (!mopt_.attach) {
-    info_ = service::to_run_info(s_, opt.realtime, 0);
+    info_ = service::to_run_info(s_, opt.realtime, 0);  // run_id: stamped by the bus
     on_heartbeat = [this] {
       if (heartbeats_++ % 10 == 0) publish_info();
     };
@@ -181,6 +188,14 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+  } catch (const interrupt::Interrupted& e) {
+    // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
+    // Ctrl-C stops that too; then the process exits as interrupted (128 + signal).
+    progress(true);
+    interrupt::clear();
+    mopt_.plots = false;
+    finish(false, e.what());
+    throw interrupt::Interrupted(e.signal());
   } catch (const std::runtime_error& e) {  // writing a row failed (disk full, ...)
     failure = e.what();
   }
@@ -207,11 +222,17 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   const sim::Summary sum = out_->summary().summary(wall_time_s, {});
 
   std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(), invalid_total = bus().invalid();
+  // Foreign, conflicting and unauthenticated messages: the most any one process saw (each
+  // process hears the same bus; the monitor hears every channel, the others fewer).
+  std::int64_t foreign = bus().foreign(), conflicts_seen = conflicts, unauthenticated = bus().unauthenticated();
   for (const char* role : {"plant", "controller", "trajectory"}) {
     if (const process_status_t* p = peer(role)) {
       resends_total += p->resends;
       duplicates_total += p->duplicates;
       invalid_total += p->invalid;
+      foreign = std::max(foreign, p->foreign);
+      conflicts_seen = std::max(conflicts_seen, p->conflicts);
+      unauthenticated = std::max(unauthenticated, p->unauthenticated);
     }
   }
   const auto lat = [](const stats::StreamingQuantile& v, double q) { return v.quantile(q); };
@@ -234,6 +255,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   summary_.invalid = invalid_total;
   summary_.rejected_commands = rec_.rejected_commands();
   summary_.deadline_misses = rec_.missed_deadlines();
+  summary_.foreign = foreign;
+  summary_.conflicts = conflicts_seen;
+  summary_.unauthenticated = unauthenticated;
   summary_.latency_state_to_command_p50_us = lat(rec_.latency_state_to_command(), 0.5);
   summary_.latency_state_to_command_p99_us = lat(rec_.latency_state_to_command(), 0.99);
   summary_.latency_command_to_state_p50_us = lat(rec_.latency_command_to_state(), 0.5);
@@ -254,16 +278,26 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["invalid_messages"] = invalid_total;
   l["rejected_commands"] = rec_.rejected_commands();
   l["deadline_misses"] = rec_.missed_deadlines();
+  l["run_id"] = bus().run_id();
+  l["authenticated"] = bus().authenticated();
+  l["foreign_messages"] = foreign;
+  l["conflicts"] = conflicts_seen;
+  l["unauthenticated_messages"] = unauthenticated;
   l["steps_without_command"] = rec_.commandless_rows();
   l["steps_per_second"] = rec_.steps_per_second();
   {
-    // One step on the wire: state + command + 1/16 of a reference block, each an LCM datagram of
-    // an 8-byte header, the channel name and its NUL, and the encoded message.
-    const auto packet = [](const std::string& channel, int payload) {
-      return 8 + static_cast<int>(channel.size()) + 1 + payload;
+    // One step on the wire: state + command + 1/16 of a block of 16 references, each an LCM
+    // datagram of an 8-byte header, the channel name and its NUL, and the encoded message (with
+    // its 32-byte mac when the run is authenticated).
+    const int mac = bus().authenticated() ? static_cast<int>(service::MessageAuth::kMacSize) : 0;
+    const auto packet = [mac](const std::string& channel, int payload) {
+      return 8 + static_cast<int>(channel.size()) + 1 + payload + mac;
     };
+    reference_block_t block{};
+    block.count = 16;
+    block.refs.resize(16);
     l["bytes_per_step"] = packet(channels().state, drive_state_t().getEncodedSize()) +
-                          (packet(channels().reference, 12) + 16 * reference_t().getEncodedSize()) / 16 +
+                          packet(channels().reference, block.getEncodedSize()) / 16 +
                           packet(channels().command, control_command_t().getEncodedSize());
   }
   l["safe_state"] = rec_.safe_state();

@@ -43,6 +43,21 @@ Bus::Bus(const std::string& url, Receive receive) : url_(url), lcm_(url), receiv
   if (!reader_) receive_ = Receive::kEvent;
 }
 
+bool Bus::log_due(std::int64_t& last) {
+  const std::int64_t now = mono_us();
+  if (last >= 0 && now - last < 1000000) return false;
+  last = now;
+  return true;
+}
+
+void Bus::count_foreign(const std::string& channel, std::int64_t run_id) {
+  ++foreign_;
+  if (log_due(last_foreign_log_us_))
+    std::fprintf(stderr, "feeddrive: ignored a message of another run (run id %lld, this run %lld) on %s: %lld so far "
+                 "(a second run on this group, or a replayed log)\n", static_cast<long long>(run_id),
+                 static_cast<long long>(run_id_), channel.c_str(), static_cast<long long>(foreign_));
+}
+
 void Bus::subscribe_raw(const std::string& channel,
                         std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f) {
   raws_.push_back(std::make_unique<Raw>(Raw{std::move(f)}));

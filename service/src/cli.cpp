@@ -4,7 +4,9 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <limits>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
@@ -33,6 +35,18 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
   app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
+  app.add_option("--run-id", opt.run_id,
+                 "identity of the run (nonzero; docs/security.md); default: the plant draws one, the others join "
+                 "the plant's")
+      ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+  app.add_option("--key", opt.key_file,
+                 "authenticate every message with HMAC-SHA256 and this key file (mode 0600; docs/security.md)")
+      ->type_name("FILE");
+  app.add_option_function<std::string>(
+         "--on-conflict", [&opt](const std::string& v) { opt.on_conflict = parse_conflict_policy(v); },
+         "a second, different message for a step: fail (default) or keep-first (count and log it)")
+      ->check(CLI::IsMember({"fail", "keep-first"}))
+      ->type_name("fail|keep-first");
 }
 
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body) {
@@ -49,6 +63,8 @@ int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, co
   install_signal_handlers();
   try {
     return body();
+  } catch (const interrupt::Interrupted& e) {
+    return interrupt::report(e);
   } catch (const sim::ScenarioError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

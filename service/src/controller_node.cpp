@@ -9,6 +9,7 @@ namespace feeddrive::service {
 ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt)
     : Node("controller", opt), controller_(std::move(c)), commands_(bus(), channels().command) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
+    if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {
       end_ = true;
       return;
@@ -31,6 +32,7 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t) {
     for (const reference_t& m : b.refs) {
+      if (!admit(reference_ledger_, channels().reference, m.seq, m)) continue;
       if (m.seq < next_seq_ || refs_.count(m.seq)) {
         ++duplicates;
         continue;

@@ -10,7 +10,15 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <optional>
+
+#include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/process_status_t.hpp"
+#include "feeddrive/service/bus.hpp"
+#include "feeddrive/service/integrity.hpp"
 #include <stdexcept>
+
+#include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::service {
 namespace {
@@ -31,6 +39,9 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
                                 "--max-bad-commands", std::to_string(opt.max_bad_commands),
                                 "--spin-us", std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
+  if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
+  if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
+  if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
   return a;
 }
 
@@ -49,6 +60,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
       for (int c : cpus) CPU_SET(c, &set);
       if (::sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "warning: sched_setaffinity failed\n");
     }
+    ::setenv(interrupt::kQuietEnv, "1", 1);  // an interrupt is reported once, by the launcher
     ::execv(exe.c_str(), argv.data());
     std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
     ::_exit(127);
@@ -81,17 +93,58 @@ std::vector<int> parse_cpu_list(const std::string& text) {
   return out;
 }
 
-LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
+void check_group_free(const NodeOptions& opt, double listen_s) {
+  Bus probe(opt.lcm_url);
+  const Channels ch(opt.prefix);
+  std::string holder;
+  // Any run's messages: the probe has not joined one (and has no key: any run counts).
+  probe.subscribe<process_status_t>(
+      ch.status,
+      [&](const process_status_t& m, std::int64_t) {
+        if (holder.empty() && m.role == "plant")
+          holder = "run id " + std::to_string(m.run_id) + ", its plant " + m.state + " at step " + std::to_string(m.seq);
+      },
+      Admit::kAnyRun);
+  probe.subscribe<drive_state_t>(
+      ch.state,
+      [&](const drive_state_t& m, std::int64_t) {
+        if (holder.empty()) holder = "run id " + std::to_string(m.run_id) + ", its plant at step " + std::to_string(m.seq);
+      },
+      Admit::kAnyRun);
+  const std::int64_t end = mono_us() + us(listen_s);
+  while (holder.empty() && mono_us() < end) probe.poll(std::chrono::microseconds(std::max<std::int64_t>(end - mono_us(), 1)));
+  if (holder.empty()) return;
+  const std::optional<UdpmAddress> a = parse_udpm_url(opt.lcm_url);
+  const std::string other_port = a ? "udpm://" + a->group + ":" + std::to_string(a->port + 1) + "?ttl=0" : "another URL";
+  throw std::invalid_argument("another run holds " + opt.prefix + "_* on " + opt.lcm_url + " (" + holder +
+                              "): give this one another --prefix (e.g. --prefix " + opt.prefix +
+                              "2) or --lcm-url (e.g. '" + other_port + "'), and the same to its external processes");
+}
+
+LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   const std::vector<std::string> roles = {"monitor", "plant", "trajectory", "controller"};
   for (const auto& r : lo.external)
     if (r != "controller" && r != "plant" && r != "trajectory")
       throw std::invalid_argument("--external " + r + ": expected one of controller, plant, trajectory");
   const std::string bin = lo.bin_dir.empty() ? executable_dir() : lo.bin_dir;
+  if (!given.key_file.empty()) read_key_file(given.key_file);  // a bad key fails here, before any process
+  NodeOptions opt = given;
+  if (!lo.external.count("plant")) {
+    // The group must be free: another run's plant on it means a second run (point of
+    // docs/security.md, "Concurrent runs"). An external plant is expected there, so no check.
+    if (lo.busy_check_s > 0) check_group_free(opt, lo.busy_check_s);
+    if (opt.run_id == 0) opt.run_id = draw_run_id();
+    spdlog::info("run id {}{}", opt.run_id, opt.key_file.empty() ? "" : " (messages authenticated with " + opt.key_file + ")");
+  } else if (opt.run_id == 0) {
+    spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
+  }
 
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}", role, opt.lcm_url, opt.prefix);
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}", role, opt.lcm_url, opt.prefix,
+                   opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
+                   opt.key_file.empty() ? "" : " --key " + opt.key_file);
       continue;
     }
     std::vector<std::string> args = {lo.scenario};
@@ -144,6 +197,8 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt) {
     }
     ::usleep(20000);
   }
+  // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
+  interrupt::check();
   result.exit_code = result.failed.empty() ? 0 : 1;
   return result;
 }

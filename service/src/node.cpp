@@ -1,16 +1,18 @@
 #include "feeddrive/service/node.hpp"
 
 #include <sched.h>
+#include <spdlog/spdlog.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
 
 #include <cerrno>
 #include <csignal>
+#include <cstring>
+#include <ctime>
 
 #include "feeddrive/common/interrupt.hpp"
 #include <cstdio>
-#include <cstring>
-#include <ctime>
+#include <cstdlib>
 
 namespace feeddrive::service {
 void install_signal_handlers() { interrupt::install_handlers(); }
@@ -47,45 +49,61 @@ std::string seconds_text(double s) {
 
 Node::Node(std::string role, const NodeOptions& opt, Receive receive)
     : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive), ch_(opt.prefix) {
-  bus_.subscribe<process_status_t>(ch_.status, [this](const process_status_t& m, std::int64_t recv_us) {
-    if (m.role == role_) return;
-    peers_[m.role] = m;
-    peer_seen_us_[m.role] = recv_us;
-  });
+  if (!opt.key_file.empty()) bus_.set_auth(read_key_file(opt.key_file));
+  if (opt.run_id != 0) bus_.set_run_id(opt.run_id);
+  bus_.subscribe<process_status_t>(
+      ch_.status,
+      [this](const process_status_t& m, std::int64_t recv_us) {
+        if (!bus_.run_known()) {
+          // Join the run of the first plant whose heartbeat is fresh (its wall clock within 5 s
+          // of ours): a log replayed by lcm-logplayer carries the old times and is not joined.
+          if (m.role != "plant" || std::llabs(m.utime - wall_utime()) > 5000000) return;
+          bus_.set_run_id(m.run_id);
+          spdlog::info("{}: joined run {} (taken from the plant's heartbeat)", role_, m.run_id);
+        }
+        if (m.run_id != bus_.run_id()) {
+          bus_.count_foreign(ch_.status, m.run_id);
+          return;
+        }
+        if (m.role == role_) return;
+        peers_[m.role] = m;
+        peer_seen_us_[m.role] = recv_us;
+      },
+      Admit::kAnyRun);
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
     if (on_resend_request) on_resend_request(m);
   });
 }
 
-void Node::heartbeat(bool force) {
-  const std::int64_t now = mono_us();
-  if (!force && last_heartbeat_us_ >= 0 && now - last_heartbeat_us_ < 100000) return;
-  last_heartbeat_us_ = now;
-  process_status_t m;
+process_status_t Node::status_message(const std::string& state, const std::string& message) const {
+  process_status_t m{};
   m.utime = wall_utime();
   m.role = role_;
-  m.state = state_;
-  m.seq = seq_;
-  m.acked_seq = acked_seq;
-  m.message = "";
-  m.resends = resends;
-  m.duplicates = duplicates;
-  m.invalid = bus_.invalid() + invalid_content;
-  bus_.publish(ch_.status, m);
-  if (on_heartbeat) on_heartbeat();
-}
-
-void Node::announce_failure(const std::string& message) {
-  state_ = "failed";
-  process_status_t m;
-  m.role = role_;
-  m.state = "failed";
+  m.state = state;
   m.seq = seq_;
   m.acked_seq = acked_seq;
   m.message = message;
   m.resends = resends;
   m.duplicates = duplicates;
   m.invalid = bus_.invalid() + invalid_content;
+  m.foreign = bus_.foreign();
+  m.conflicts = conflicts;
+  m.unauthenticated = bus_.unauthenticated();
+  return m;
+}
+
+void Node::heartbeat(bool force) {
+  const std::int64_t now = mono_us();
+  if (!force && last_heartbeat_us_ >= 0 && now - last_heartbeat_us_ < 100000) return;
+  last_heartbeat_us_ = now;
+  if (!bus_.run_known()) return;  // nothing to say before joining a run
+  bus_.publish(ch_.status, status_message(state_, ""));
+  if (on_heartbeat) on_heartbeat();
+}
+
+void Node::announce_failure(const std::string& message) {
+  state_ = "failed";
+  process_status_t m = status_message("failed", message);
   for (int i = 0; i < 3; ++i) {
     m.utime = wall_utime();
     bus_.publish(ch_.status, m);
@@ -93,15 +111,30 @@ void Node::announce_failure(const std::string& message) {
 }
 
 void Node::request_resend(const std::string& channel, std::int64_t seq) {
-  resend_request_t m;
+  resend_request_t m{};
   m.requester = role_;
   m.channel = channel;
   m.seq = seq;
   bus_.publish(ch_.resend, m);
 }
 
+bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff) {
+  ++conflicts;
+  const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +
+                           " for one step (" + diff + " differ); another publisher on the bus, or a stale step number (an answer to "
+                           "state k carrying seq < k)? (docs/security.md)";
+  if (opt_.on_conflict == ConflictPolicy::kFail) throw RunFailure(what);
+  // keep-first: every conflict is counted; the log names the first ten, then one a second.
+  const std::int64_t now = mono_us();
+  if (conflicts <= 10 || now - last_conflict_log_us_ > 1000000) {
+    last_conflict_log_us_ = now;
+    spdlog::error("{}: {}; kept the first ({} conflicts so far)", role_, what, conflicts);
+  }
+  return false;
+}
+
 void Node::check_peers() const {
-  if (const int sig = interrupt::signal_number(); sig != 0) throw RunFailure("interrupted by " + interrupt::signal_name(sig));
+  interrupt::check();
   for (const auto& [role, st] : peers_)
     if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
 }

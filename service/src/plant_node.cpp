@@ -24,15 +24,20 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
       drive_(s.plant, s.control_period),
       states_(bus(), channels().state),
       previous_(no_applied()) {
+  if (!bus().run_known()) {
+    bus().set_run_id(draw_run_id());
+    spdlog::info("plant: run id {} (drawn: no --run-id given; the other processes join it from the plant's heartbeat)",
+                 bus().run_id());
+  }
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t recv_us) {
+    if (!admit(command_ledger_, channels().command, m.seq, m)) return;
     if (options().realtime) arrived_.emplace_back(m, recv_us);
+    // A command for a step already answered that differs from the first one (a stale step
+    // number, or another publisher) is a conflict (admit): counted and named.
     if (!command_ || m.seq > command_->seq) {
       command_ = m;
-      received_u_[m.seq % kRecentCommands] = {m.seq, m.u};
-    } else if (options().realtime || is_repeat(m)) {
-      ++duplicates;  // a repeat (real time: a late command, counted as a missed deadline)
     } else {
-      on_stale_command(m);
+      ++duplicates;  // a repeat (real time: also a late command, counted as a missed deadline)
     }
   });
   on_resend_request = [this](const resend_request_t& r) {
@@ -40,37 +45,8 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
   };
 }
 
-bool PlantNode::is_repeat(const control_command_t& m) const {
-  const auto& [seq, u] = received_u_[static_cast<std::size_t>(m.seq >= 0 ? m.seq % kRecentCommands : 0)];
-  // The same bits (NaN included): a controller repeats its answer byte for byte.
-  return m.seq >= 0 && seq == m.seq && std::memcmp(&u, &m.u, sizeof u) == 0;
-}
-
-void PlantNode::on_stale_command(const control_command_t& m) {
-  // Lockstep: a command for a step already applied that is not a repeat of the one applied is
-  // an answer with a stale step number (the controller did not copy seq from the state, or
-  // answered an old state). Counted as invalid, logged at most once a second, and named in
-  // the timeout that follows if the right command never comes.
-  ++invalid_content;
-  ++stale_;
-  last_stale_seq_ = m.seq;
-  const std::int64_t now = mono_us();
-  if (last_stale_log_us_ < 0 || now - last_stale_log_us_ > 1000000) {
-    last_stale_log_us_ = now;
-    spdlog::error("plant: a command for step {} (u = {}) while the plant waits for step {}: a stale step number, "
-                  "not a repeat of the command applied for step {}; ignored ({} so far)",
-                  m.seq, m.u, command_ ? command_->seq + 1 : 0, m.seq, stale_);
-  }
-}
-
-std::string PlantNode::stale_note() const {
-  if (stale_ == 0) return "";
-  return " (" + std::to_string(stale_) + " command(s) with a stale step number came instead, the last for step " +
-         std::to_string(last_stale_seq_) + ": does the controller copy seq from the state?)";
-}
-
 drive_state_t PlantNode::make_state(std::int64_t k) {
-  drive_state_t m;
+  drive_state_t m{};
   m.seq = k;
   m.t = s_.time_of(k);
   m.steps = steps_;
@@ -156,7 +132,7 @@ void PlantNode::run_lockstep() {
       const bool controller_waits = k > 0 && peer_alive("controller", 0.5) && now - start <= 3 * us(limit);
       if (now - start > us(limit) && !controller_waits)
         throw RunFailure("no command from the controller for step " + std::to_string(k) + " within " +
-                         seconds_text(limit) + " s" + stale_note());
+                         seconds_text(limit) + " s");
       heartbeat();
       bus().poll(std::chrono::microseconds(std::max<std::int64_t>(resend_us - (mono_us() - last_sent), 1)));
     }

@@ -7,6 +7,7 @@ namespace feeddrive::service {
 TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
     : Node("trajectory", opt, Receive::kBatched), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
+    if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {
       end_ = true;
       return;
@@ -42,7 +43,7 @@ void TrajectoryNode::send_block(std::int64_t b, bool resend) {
     if (resend && blocks_.republish(b, us(options().resend_interval_s))) ++resends;
     return;
   }
-  reference_block_t m;
+  reference_block_t m{};
   m.first_seq = first;
   m.count = static_cast<std::int32_t>(std::min<std::int64_t>(kBlock, s_.steps() - first));
   for (std::int64_t k = first; k < first + m.count; ++k) {

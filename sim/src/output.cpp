@@ -3,6 +3,7 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -104,7 +105,11 @@ void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_
                        const std::function<void(const output::StagedFolder&)>& extra_files) {
   csv_->close();
   folder_.write_text("summary.json", summary_json(sum, s_, extra_json));
-  if (plots && summary_.steps() > 0) write_plots(folder_, plot_, s_.name);
+  if (plots && summary_.steps() > 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    write_plots(folder_, plot_, s_.name);
+    plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   if (extra_files) extra_files(folder_);
   folder_.commit();
 }

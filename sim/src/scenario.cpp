@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "feeddrive/common/text.hpp"
 #include "feeddrive/common/validate.hpp"
+#include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -197,7 +200,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model)
   p.thrust_gain = model.thrust_gain();
 }
 
-void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::string& base_dir) {
+void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_enum(r, "kind", p.kind, controller::open_loop_kind_from_string, controller::to_string(p.kind));
   r.number("amplitude", p.amplitude);
   r.number("frequency", p.frequency);
@@ -207,8 +210,9 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, const std::stri
   r.number("start_time", p.start_time);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  r.string("file", p.file);
-  if (!p.file.empty() && fs::path(p.file).is_relative()) p.file = (fs::path(base_dir) / p.file).string();
+  r.string("file", file);
+  if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
+  if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
 // --- reference -----------------------------------------------------------------------------
@@ -280,7 +284,22 @@ void validate_reference(const ReferenceConfig& c) {
     case ReferenceType::kAccelLimited: c.accel_limited.validate("reference"); break;
     case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
     case ReferenceType::kRamp: c.ramp.validate("reference"); break;
-    case ReferenceType::kWaypoints: trajectory::read_waypoints_csv(c.waypoints_file); break;
+    case ReferenceType::kWaypoints: break;  // read and checked in parse_node
+  }
+}
+
+// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length
+// (a 50 MB name once made the plots take 4.8 GB).
+void check_name(const std::string& name, const std::string& what) {
+  if (name.size() > kMaxNameBytes)
+    throw ScenarioError(what + ": " + std::to_string(name.size()) + " bytes: too long (at most " +
+                        std::to_string(kMaxNameBytes) + ")");
+  const std::size_t bad = text::first_unprintable(name);
+  if (bad < name.size()) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(name[bad])));
+    throw ScenarioError(what + ": byte " + std::to_string(bad + 1) + " (" + hex +
+                        ") is not printable UTF-8 (control character or malformed sequence)");
   }
 }
 
@@ -289,6 +308,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   MapReader top(root, "");
   Scenario s;
   top.string("name", s.name);
+  check_name(s.name, "name");
   if (!top.has("duration")) top.fail("duration", ": missing (required)");
   if (!top.has("control_period")) top.fail("control_period", ": missing (required)");
   top.number("duration", s.duration);
@@ -324,7 +344,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
     s.controller.cascade.period = s.control_period;
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
-    read_open_loop(c, s.controller.open_loop, base_dir);
+    read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
     s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
   } else {
     c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop");
@@ -357,8 +377,11 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   top.finish();
   if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
 
-  // Component validation: each validate() names its key and value.
+  // Component validation: each validate() names its key and value; tables come from the files.
   try {
+    if (s.reference.type == ReferenceType::kWaypoints) s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
+    if (s.controller.type == ControllerType::kOpenLoop && s.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
+      read_open_loop_file(s.controller.open_loop_file, s.controller.open_loop);
     s.plant.validate("plant");
     switch (s.controller.type) {
       case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
@@ -377,16 +400,32 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
 
 }  // namespace
 
+std::vector<trajectory::Waypoint> read_waypoints_file(const std::string& path) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"x"}}};
+  o.increasing = 0;
+  o.limits.min_rows = 2;  // a spline needs one interval
+  const csv::Table t = csv::read_file(path, o);
+  std::vector<trajectory::Waypoint> points(t.rows());
+  for (std::size_t i = 0; i < t.rows(); ++i) points[i] = {t.values[0][i], t.values[1][i]};
+  return points;
+}
+
+void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p) {
+  csv::Options o;
+  o.columns = {{{"t"}}, {{"force_N", "u"}}};  // force_N when the file has both
+  o.increasing = 0;
+  csv::Table t = csv::read_file(path, o);
+  p.table_t = std::move(t.values[0]);
+  p.table_value = std::move(t.values[1]);
+  p.table_is_force = t.used[1] == "force_N";
+}
+
 long Scenario::steps() const { return std::lround(duration / control_period); }
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
   try {
-    YAML::Node root;
-    try {
-      root = YAML::Load(yaml_text);
-    } catch (const YAML::Exception& e) {
-      throw ScenarioError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-    }
+    const YAML::Node root = load_yaml_strict(yaml_text);
     Scenario s = parse_node(root, base_dir);
     return s;
   } catch (const ScenarioError& e) {
@@ -405,7 +444,10 @@ Scenario load_scenario(const std::string& path) {
   const fs::path p(path);
   Scenario s = parse_scenario(buf.str(), p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;
-  if (s.name.empty()) s.name = p.stem().string();
+  if (s.name.empty()) {
+    s.name = p.stem().string();
+    check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
+  }
   return s;
 }
 
@@ -419,7 +461,7 @@ std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {
     case ReferenceType::kSCurve: return trajectory::make_scurve(c.scurve);
     case ReferenceType::kRamp: return trajectory::make_ramp(c.ramp);
     case ReferenceType::kWaypoints:
-      return trajectory::make_waypoints(trajectory::read_waypoints_csv(c.waypoints_file));
+      return trajectory::make_waypoints(c.waypoints);
   }
   return nullptr;
 }

@@ -46,6 +46,7 @@ Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator
   m.steps = n_;
   m.sim_time_s = static_cast<double>(n_) * control_period_;
   m.wall_time_s = wall_time_s;
+  m.settled_steps = n_settled_;
   m.integrator_steps = integrator.steps;
   m.integrator_rhs_evals = integrator.rhs_evals;
   m.integrator_jac_evals = integrator.jac_evals;
@@ -75,6 +76,9 @@ Summary summarize(const RunResult& r, const Scenario& s) {
 
 std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
   nlohmann::ordered_json j;
+  // Metrics over an empty window are null (summary.hpp), never 0.
+  const auto val = [&](double v) { return m.steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  const auto settled = [&](double v) { return m.settled_steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
   j["scenario"] = s.name;
   j["scenario_path"] = s.path;
   j["control_period_s"] = s.control_period;
@@ -82,26 +86,26 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["sim_time_s"] = m.sim_time_s;
   j["wall_time_s"] = m.wall_time_s;
   j["realtime_factor"] = m.wall_time_s > 0.0 ? m.sim_time_s / m.wall_time_s : 0.0;
-  j["position_error_max_abs_m"] = m.position_error_max_abs_m;
-  j["position_error_rms_m"] = m.position_error_rms_m;
-  j["position_error_p95_abs_m"] = m.position_error_p95_abs_m;
-  j["velocity_error_max_abs_mps"] = m.velocity_error_max_abs_mps;
-  j["velocity_error_max_abs_after_first_mps"] = m.velocity_error_max_abs_after_first_mps;
-  j["velocity_error_rms_mps"] = m.velocity_error_rms_mps;
+  j["position_error_max_abs_m"] = val(m.position_error_max_abs_m);
+  j["position_error_rms_m"] = val(m.position_error_rms_m);
+  j["position_error_p95_abs_m"] = val(m.position_error_p95_abs_m);
+  j["velocity_error_max_abs_mps"] = val(m.velocity_error_max_abs_mps);
+  j["velocity_error_max_abs_after_first_mps"] = m.steps > 1 ? nlohmann::ordered_json(m.velocity_error_max_abs_after_first_mps) : nlohmann::ordered_json();
+  j["velocity_error_rms_mps"] = val(m.velocity_error_rms_mps);
   j["settled_after_s"] = m.settled_after_s;
-  j["position_error_max_abs_settled_m"] = m.position_error_max_abs_settled_m;
-  j["position_error_rms_settled_m"] = m.position_error_rms_settled_m;
-  j["velocity_error_max_abs_settled_mps"] = m.velocity_error_max_abs_settled_mps;
-  j["control_min"] = m.control_min;
-  j["control_max"] = m.control_max;
-  j["control_total_variation"] = m.control_total_variation;
+  j["position_error_max_abs_settled_m"] = settled(m.position_error_max_abs_settled_m);
+  j["position_error_rms_settled_m"] = settled(m.position_error_rms_settled_m);
+  j["velocity_error_max_abs_settled_mps"] = settled(m.velocity_error_max_abs_settled_mps);
+  j["control_min"] = val(m.control_min);
+  j["control_max"] = val(m.control_max);
+  j["control_total_variation"] = val(m.control_total_variation);
   j["control_saturated_steps"] = m.control_saturated_steps;
-  j["final_position_m"] = m.final_position_m;
-  j["final_velocity_mps"] = m.final_velocity_mps;
-  j["final_bristle_m"] = m.final_bristle_m;
-  j["final_friction_N"] = m.final_friction_N;
-  j["max_position_m"] = m.max_position_m;
-  j["min_position_m"] = m.min_position_m;
+  j["final_position_m"] = val(m.final_position_m);
+  j["final_velocity_mps"] = val(m.final_velocity_mps);
+  j["final_bristle_m"] = val(m.final_bristle_m);
+  j["final_friction_N"] = val(m.final_friction_N);
+  j["max_position_m"] = val(m.max_position_m);
+  j["min_position_m"] = val(m.min_position_m);
   j["integrator_steps"] = m.integrator_steps;
   j["integrator_rhs_evals"] = m.integrator_rhs_evals;
   j["integrator_jac_evals"] = m.integrator_jac_evals;
@@ -110,7 +114,9 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
     const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
     for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();
   }
-  return j.dump(2) + "\n";
+  // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
+  // exception after the run.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace feeddrive::sim

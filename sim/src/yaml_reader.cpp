@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
+#include <string_view>
 
 #include "feeddrive/sim/scenario.hpp"
 
@@ -41,7 +43,122 @@ bool parse_double(const std::string& text, double& out) {
   return end == text.c_str() + text.size();
 }
 
+// The line (1-based) where a quoted scalar opens and is not closed on the same line, or 0.
+// Plain scalars may contain quotes (it's); a quote opens a quoted scalar only where a value
+// starts: at the start of the line's content, or after ": ", "- ", "? ", "[", "{" or ",".
+// Comments and block scalars (| and >) are skipped.
+struct OpenQuote {
+  long line{0};
+  long closed_on{0};  ///< 0: never closed
+};
+
+OpenQuote find_multiline_quote(const std::string& text) {
+  std::size_t i = 0;
+  long line = 1;
+  long block_indent = -1;  // inside a block scalar: lines indented deeper than this are its text
+  while (i < text.size()) {
+    const std::size_t eol = std::min(text.find('\n', i), text.size());
+    const std::string_view l(text.data() + i, eol - i);
+    const std::size_t first = l.find_first_not_of(" \t\r");
+    const long indent = first == std::string_view::npos ? -1 : static_cast<long>(first);
+    if (block_indent >= 0 && (indent < 0 || indent > block_indent)) {
+      i = eol + 1;
+      ++line;
+      continue;
+    }
+    block_indent = -1;
+    char prev_token = '\n';  // last non-space character before the current position
+    for (std::size_t k = first == std::string_view::npos ? l.size() : first; k < l.size(); ++k) {
+      const char c = l[k];
+      if (c == '#' && (k == 0 || l[k - 1] == ' ' || l[k - 1] == '\t')) break;
+      const bool after_space = k > 0 && (l[k - 1] == ' ' || l[k - 1] == '\t');
+      const bool value_start = k == first || (after_space && std::string_view(":-?,[{").find(prev_token) != std::string_view::npos) ||
+                               std::string_view("[{,").find(prev_token) != std::string_view::npos;
+      if ((c == '"' || c == '\'') && value_start) {
+        // Scan to the closing quote, possibly over lines.
+        const long open_line = line;
+        std::size_t j = i + k + 1;
+        long cur = line;
+        for (;;) {
+          if (j >= text.size()) return {open_line, 0};
+          const char q = text[j];
+          if (q == '\n') ++cur;
+          if (c == '"' && q == '\\') {
+            if (j + 1 < text.size() && text[j + 1] == '\n') ++cur;
+            j += 2;
+            continue;
+          }
+          if (q == c) {
+            if (c == '\'' && j + 1 < text.size() && text[j + 1] == '\'') {
+              j += 2;
+              continue;
+            }
+            break;
+          }
+          ++j;
+        }
+        if (cur != open_line) return {open_line, cur};
+        k = j - i;  // the closing quote
+        prev_token = c;
+        continue;
+      }
+      if (c != ' ' && c != '\t' && c != '\r') prev_token = c;
+    }
+    // A block scalar indicator ends the line's content: "key: |", "key: >-", "- |2".
+    {
+      std::string_view content = l.substr(0, l.find(" #"));
+      while (!content.empty() && (content.back() == ' ' || content.back() == '\t' || content.back() == '\r'))
+        content.remove_suffix(1);
+      std::size_t e = content.size();
+      while (e > 0 && std::string_view("+-0123456789").find(content[e - 1]) != std::string_view::npos) --e;
+      if (e > 0 && (content[e - 1] == '|' || content[e - 1] == '>') &&
+          (e == 1 || content[e - 2] == ' ' || content[e - 2] == '\t'))
+        block_indent = std::max<long>(indent, 0);
+    }
+    i = eol + 1;
+    ++line;
+  }
+  return {};
+}
+
+void check_duplicate_keys(const YAML::Node& n, const std::string& path, long& budget) {
+  if (--budget < 0) throw ScenarioError("more than 100000 YAML nodes (aliases that expand too far?)");
+  if (n.IsMap()) {
+    std::map<std::string, long> seen;
+    for (const auto& kv : n) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "(a " + std::string(kv.first.IsMap() ? "map" : "list") + ")";
+      const std::string key_path = path.empty() ? key : path + "." + key;
+      const long line = kv.first.Mark().line + 1;
+      const auto [it, fresh] = seen.emplace(key, line);
+      if (!fresh)
+        throw ScenarioError("line " + std::to_string(line) + ": " + key_path + ": duplicate key on lines " +
+                            std::to_string(it->second) + " and " + std::to_string(line));
+      check_duplicate_keys(kv.second, key_path, budget);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t k = 0; k < n.size(); ++k) check_duplicate_keys(n[k], path + "[" + std::to_string(k) + "]", budget);
+  }
+}
+
 }  // namespace
+
+YAML::Node load_yaml_strict(const std::string& text) {
+  const OpenQuote q = find_multiline_quote(text);
+  if (q.line > 0 && q.closed_on == 0)
+    throw ScenarioError("line " + std::to_string(q.line) + ": YAML syntax error: a quote opened here is never closed");
+  if (q.line > 0)
+    throw ScenarioError("line " + std::to_string(q.line) + ": YAML syntax error: a quote opened here closes only on line " +
+                        std::to_string(q.closed_on) + " (a quoted value must end on the line where it starts)");
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ScenarioError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  long budget = 100000;
+  check_duplicate_keys(root, "", budget);
+  return root;
+}
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);

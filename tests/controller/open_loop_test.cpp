@@ -1,5 +1,5 @@
 // Open-loop force sources (Xie & Liang Sec. 4): analytic step/sine/ramp forces, u = F/(Ka*Kf),
-// and the CSV source with its zero-order hold and FILE:LINE error messages.
+// and the table source (kind csv) with its zero-order hold and row-naming errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -88,33 +88,21 @@ TEST(OpenLoop, CommandIsForceOverThrustGain) {
   EXPECT_FALSE(s.needs_truth());
 }
 
-std::string write_file(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "feeddrive_open_loop_" + name;
-  std::ofstream out(path);
-  out << text;
-  return path;
-}
-
-OpenLoopParams csv_params(const std::string& path) {
+OpenLoopParams table_params(std::vector<double> t, std::vector<double> value, bool is_force) {
   OpenLoopParams p;
   p.kind = OpenLoopKind::kCsv;
-  p.file = path;
+  p.table_t = std::move(t);
+  p.table_value = std::move(value);
+  p.table_is_force = is_force;
   p.thrust_gain = 200.0;
   return p;
 }
 
 // Zero-order hold: the value of the last row with t_row <= t; 0 before the first row; the last
-// value after the last row. Comments (#) and blank lines are skipped, CRLF is accepted, and
-// other columns are ignored.
-TEST(OpenLoopCsv, ForceColumnZeroOrderHold) {
-  const std::string path = write_file("force.csv",
-                                      "# applied force\n"
-                                      "t,note,force_N\r\n"
-                                      "0.1,a,10\r\n"
-                                      "\n"
-                                      "0.2,b,-4.5\n"
-                                      "0.35,c,130\n");
-  OpenLoopSource s(csv_params(path));
+// value after the last row. (The table's CSV file is read by the scenario layer with
+// feeddrive::csv: tests/output/csv_reader_test.cpp and tests/sim/scenario_test.cpp.)
+TEST(OpenLoopTable, ForceZeroOrderHold) {
+  OpenLoopSource s(table_params({0.1, 0.2, 0.35}, {10, -4.5, 130}, true));
   EXPECT_EQ(s.force(0.0), 0.0);
   EXPECT_EQ(s.force(0.0999), 0.0);
   EXPECT_EQ(s.force(0.1), 10.0);
@@ -129,48 +117,29 @@ TEST(OpenLoopCsv, ForceColumnZeroOrderHold) {
   EXPECT_EQ(s.update({}, {0.05, 0.0, 0.0}, nullptr).u, 0.0);
 }
 
-// A `u` column gives the command in volts directly; force() reports Ka*Kf*u.
-TEST(OpenLoopCsv, VoltageColumn) {
-  const std::string path = write_file("u.csv", "t,u\n0,0.5\n1.0,-0.25\n");
-  OpenLoopSource s(csv_params(path));
+// A `u` table gives the command in volts directly; force() reports Ka*Kf*u.
+TEST(OpenLoopTable, VoltageColumn) {
+  OpenLoopSource s(table_params({0, 1.0}, {0.5, -0.25}, false));
   EXPECT_DOUBLE_EQ(s.update({}, {0.5, 0.0, 0.0}, nullptr).u, 0.5);
   EXPECT_DOUBLE_EQ(s.update({}, {1.5, 0.0, 0.0}, nullptr).u, -0.25);
   EXPECT_DOUBLE_EQ(s.force(0.5), 100.0);
 }
 
-// Bad files: std::invalid_argument with "FILE:LINE: ..." naming the bad value.
-void expect_csv_error(const std::string& name, const std::string& text, const std::string& where_what) {
-  const std::string path = write_file(name, text);
-  try {
-    OpenLoopSource s(csv_params(path));
-    ADD_FAILURE() << name << ": accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()), path + ":" + where_what) << name;
-  }
-}
-
-TEST(OpenLoopCsv, MalformedFilesNameFileLineAndValue) {
-  expect_csv_error("no_value_col.csv", "t,force\n0,1\n", "1: header 't,force' has no column 'force_N' or 'u'");
-  expect_csv_error("no_t_col.csv", "time,force_N\n0,1\n", "1: header 'time,force_N' has no column 't'");
-  expect_csv_error("short_row.csv", "t,force_N\n0,1\n0.5\n", "3: row '0.5' has 1 columns, the header names 2");
-  expect_csv_error("empty_cell.csv", "t,force_N\n0,1\n0.5,\n", "3: force_N = '': not a finite number");
-  expect_csv_error("abc.csv", "t,force_N\n0,1\n0.5,abc\n", "3: force_N = 'abc': not a finite number");
-  expect_csv_error("nan.csv", "t,u\n0,nan\n", "2: u = 'nan': not a finite number");
-  expect_csv_error("inf_t.csv", "t,u\n0,1\ninf,1\n", "3: t = 'inf': not a finite number");
-  expect_csv_error("trailing.csv", "t,force_N\n0,1\n0.5,2x\n", "3: force_N = '2x': not a finite number");
-  // Line numbers count comments and blank lines.
-  expect_csv_error("decreasing.csv", "# c\nt,force_N\n0,1\n\n0.5,2\n0.4,3\n", "6: t = 0.4: times must increase strictly");
-  expect_csv_error("repeated.csv", "t,force_N\n0,1\n0,2\n", "3: t = 0: times must increase strictly");
-  expect_csv_error("no_rows.csv", "t,force_N\n# nothing\n", "2: no data rows");
-
-  // A missing file has no line; the message names the key and the path.
-  const std::string missing = ::testing::TempDir() + "feeddrive_open_loop_does_not_exist.csv";
-  try {
-    OpenLoopSource s(csv_params(missing));
-    ADD_FAILURE() << "missing file accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()), "controller.file = '" + missing + "': cannot open the file");
-  }
+// A bad table: one line naming the row and the value.
+TEST(OpenLoopTable, BadTablesNameTheRow) {
+  const auto message = [](const OpenLoopParams& p) {
+    try {
+      OpenLoopSource s(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message(table_params({}, {}, true)), "controller.file: kind = csv needs a table of at least one row");
+  EXPECT_EQ(message(table_params({0, 1}, {1}, true)), "controller.file: the table has 2 times and 1 values");
+  EXPECT_EQ(message(table_params({0, 0.5, 0.4}, {1, 2, 3}, true)),
+            "controller.file[2].t = 0.4: must be greater than the previous t = 0.5");
+  EXPECT_EQ(message(table_params({0, 1}, {1, std::nan("")}, false)), "controller.file[1].u = nan: must be a finite number");
 }
 
 TEST(OpenLoop, ValidateAndNames) {
@@ -202,7 +171,7 @@ TEST(OpenLoop, ValidateAndNames) {
   expect_invalid(p, "controller.u_max = -1: must be > u_min");
   p = {};
   p.kind = OpenLoopKind::kCsv;
-  expect_invalid(p, "controller.file = '': kind = csv needs a file");
+  expect_invalid(p, "controller.file: kind = csv needs a table of at least one row");
 
   for (OpenLoopKind k : {OpenLoopKind::kStep, OpenLoopKind::kSine, OpenLoopKind::kRamp, OpenLoopKind::kCsv})
     EXPECT_EQ(open_loop_kind_from_string(to_string(k)), k);

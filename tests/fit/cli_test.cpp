@@ -130,22 +130,22 @@ TEST(FitCli, MissingInputColumn) {
 TEST(FitCli, NaNNamesLineAndColumn) {
   auto rows = good_rows(100);
   rows[41] = "0.041,nan,0.1";  // file line 43: the header is line 1, rows[0] is line 2
-  expect_data_error("nan.csv", csv("t,x,u", rows), {"nan.csv", "line 43", "column x", "'nan'"});
+  expect_data_error("nan.csv", csv("t,x,u", rows), {"nan.csv:43:7:", "column 'x'", "'nan'"});
   rows = good_rows(100);
   rows[9] = "0.009,0.0,";  // an empty cell: line 11, column u
-  expect_data_error("empty_cell.csv", csv("t,x,u", rows), {"empty_cell.csv", "line 11", "column u"});
+  expect_data_error("empty_cell.csv", csv("t,x,u", rows), {"empty_cell.csv:11:11:", "column 'u': missing value"});
 }
 
 TEST(FitCli, RepeatedTime) {
   auto rows = good_rows(100);
   rows[20] = "0.019,0.0,0.1";  // same t as rows[19]: line 22
-  expect_data_error("repeat.csv", csv("t,x,u", rows), {"repeat.csv", "line 22", "column t", "repeats"});
+  expect_data_error("repeat.csv", csv("t,x,u", rows), {"repeat.csv:22:1:", "column 't'", "0.019 is not greater than the previous t = 0.019 (line 21)"});
 }
 
 TEST(FitCli, TimeGoingBackwards) {
   auto rows = good_rows(100);
   rows[30] = "0.025,0.0,0.1";  // before rows[29] (0.029): line 32
-  expect_data_error("backwards.csv", csv("t,x,u", rows), {"backwards.csv", "line 32", "column t", "before"});
+  expect_data_error("backwards.csv", csv("t,x,u", rows), {"backwards.csv:32:1:", "column 't'", "0.025 is not greater than the previous t = 0.029 (line 31)"});
 }
 
 TEST(FitCli, TooFewSamples) {
@@ -167,7 +167,7 @@ TEST(FitCli, UnreadableDataFile) {
   EXPECT_EQ(std::count(l.err.begin(), l.err.end(), '\n'), 1) << l.err;
   EXPECT_NE(l.err.find("does_not_exist.lcmlog: cannot open"), std::string::npos) << l.err;
   // An empty CSV file.
-  expect_data_error("empty.csv", "", {"empty.csv", "empty file"});
+  expect_data_error("empty.csv", "", {"empty.csv", "no header line"});
 }
 
 TEST(FitCli, FolderSeparatorAndByteOrderMark) {

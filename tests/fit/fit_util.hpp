@@ -65,6 +65,7 @@ inline sim::Scenario recording_scenario(const plant::PlantParams& truth, const R
   s.controller.cascade.thrust_gain = truth.thrust_gain();
   s.reference.type = sim::ReferenceType::kWaypoints;
   s.reference.waypoints_file = waypoints_csv;
+  s.reference.waypoints = sim::read_waypoints_file(waypoints_csv);
   return s;
 }
 

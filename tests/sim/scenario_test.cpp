@@ -1,5 +1,6 @@
 // Strict scenario loading: every bad input is one line naming the key and the value.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -133,6 +134,52 @@ TEST(Scenario, EveryShippedScenarioLoads) {
       EXPECT_GE(n, 20);
     }
   }
+}
+
+// The scenario layer reads the tables a scenario names with the one CSV reader, when the
+// scenario is loaded: the controller and trajectory libraries get data, and a bad file is a
+// ScenarioError (exit 2) naming file:line:column and the value.
+std::string temp_csv(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "feeddrive_scen_" + std::to_string(::getpid()) + "_" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+TEST(Scenario, TablesAreReadWhenTheScenarioIsLoaded) {
+  const std::string force = temp_csv("force.csv", "\xEF\xBB\xBF# force\nt,note,force_N\r\n0.1,a,10\n0.2,b,-4.5\n");
+  const Scenario ol = parse_scenario(with("controller: {type: sliding_mode}",
+                                          "controller: {type: open_loop, kind: csv, file: '" + force + "'}"));
+  EXPECT_EQ(ol.controller.open_loop.table_t, (std::vector<double>{0.1, 0.2}));
+  EXPECT_EQ(ol.controller.open_loop.table_value, (std::vector<double>{10.0, -4.5}));
+  EXPECT_TRUE(ol.controller.open_loop.table_is_force);
+  EXPECT_DOUBLE_EQ(make_controller(ol)->update({}, {0.15, 0, 0}, nullptr).u_unsaturated, 10.0 / ol.plant.thrust_gain());
+
+  const std::string wp = temp_csv("wp.csv", "t,x\n0,0\n0.5,0.01\n1,0.02\n");
+  const Scenario w = parse_scenario(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
+                                         "reference: {type: waypoints, file: '" + wp + "'}"));
+  ASSERT_EQ(w.reference.waypoints.size(), 3u);
+  EXPECT_DOUBLE_EQ(make_reference(w)->sample(0.5).position, 0.01);
+}
+
+TEST(Scenario, BadTablesAreOneLineScenarioErrors) {
+  const std::string bad = temp_csv("bad.csv", "t,u\n0,1\n0.5,2x\n");
+  EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv, file: '" + bad + "'}")),
+            "s.yaml: " + bad + ":3:5: column 'u': not a number: '2x'");
+  EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv}")),
+            "s.yaml: controller.file = '': kind = csv needs a file");
+  EXPECT_EQ(error_of(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}", "reference: {type: waypoints, file: /dev/zero}")),
+            "s.yaml: /dev/zero:1:1: not a text file: byte 0x00 in \"\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00"
+            "\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00...\"");
+}
+
+TEST(Scenario, OutputOptions) {
+  const Scenario s = parse_scenario(std::string(kMinimal) + "output: {every: 10, columns: [t, x, u]}\n");
+  EXPECT_EQ(s.output.every, 10);
+  EXPECT_EQ(s.output.columns, (std::vector<std::string>{"t", "x", "u"}));
+  EXPECT_EQ(error_of(std::string(kMinimal) + "output: {columns: [t, t]}\n"), "s.yaml: output.columns: column 't' listed twice");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "output: {columns: []}\n"),
+            "s.yaml: output.columns: empty list (leave the key out to record every column)");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "output: {every: 1.5}\n"), "s.yaml: output.every = '1.5': not an integer");
 }
 
 }  // namespace

@@ -245,6 +245,8 @@ TEST(UdpmReader, BatchedBusDecodesAndCountsWrongTypes) {
   ASSERT_TRUE(batched.batched());
   Bus event(url);
   EXPECT_FALSE(event.batched());
+  batched.set_run_id(1);  // one run: the bus passes only its messages
+  event.set_run_id(1);
   std::vector<std::int64_t> seqs;
   batched.subscribe<drive_state_t>("T_STATE", [&](const drive_state_t& m, std::int64_t) { seqs.push_back(m.seq); });
   drive_state_t s{};
@@ -265,6 +267,7 @@ TEST(UdpmReader, BatchedBusDecodesAndCountsWrongTypes) {
 TEST(UdpmReader, OtherTransportsFallBackToLiblcm) {
   Bus bus("memq://", Receive::kBatched);
   EXPECT_FALSE(bus.batched());
+  bus.set_run_id(1);
   int n = 0;
   bus.subscribe<control_command_t>("T_CMD", [&](const control_command_t&, std::int64_t) { ++n; });
   bus.publish("T_CMD", control_command_t{});

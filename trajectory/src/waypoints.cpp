@@ -1,4 +1,5 @@
-// Waypoint references: a natural cubic spline through (t_i, x_i), and the CSV reader.
+// Waypoint references: a natural cubic spline through (t_i, x_i). The points come from the
+// scenario layer (sim/scenario.cpp reads the CSV with feeddrive::csv).
 //
 // Spline: e.g. Burden & Faires, "Numerical Analysis", 9th ed., Sec. 3.5 "Cubic Spline
 // Interpolation"; de Boor, "A Practical Guide to Splines", Ch. IV. Knots t_0 < ... < t_n, h_i =
@@ -13,15 +14,11 @@
 // Outside [t_0, t_n] the sample is the end value with zero derivatives.
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -32,7 +29,6 @@ namespace feeddrive::trajectory {
 namespace {
 
 constexpr std::size_t kMinPoints = 2;             // a spline needs at least one interval
-constexpr const char* kUtf8Bom = "\xEF\xBB\xBF";  // skipped at the start of a CSV file
 
 class Waypoints final : public Trajectory {
  public:
@@ -88,53 +84,6 @@ class Waypoints final : public Trajectory {
   std::vector<double> d_;  // x'''/6 on interval i [m/s^3]
 };
 
-// ------------------------------------------------------------------------------------------
-// CSV reading.
-
-// Strips spaces, tabs and a trailing '\r' (files written on Windows).
-std::string trim(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return s.substr(first, last - first + 1);
-}
-
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> fields;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma - start)));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return fields;
-}
-
-// Header names may be double-quoted ("t").
-std::string unquote(const std::string& s) {
-  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') return s.substr(1, s.size() - 2);
-  return s;
-}
-
-enum class Parse { kOk, kNotANumber, kOutOfRange };
-
-// Locale-independent parse of a whole field; accepts a leading '+', "nan" and "inf".
-Parse parse_double(const std::string& text, double* out) {
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (first != last && *first == '+') ++first;
-  if (first == last) return Parse::kNotANumber;
-  const auto res = std::from_chars(first, last, *out);
-  if (res.ptr != last) return Parse::kNotANumber;
-  if (res.ec == std::errc::result_out_of_range) return Parse::kOutOfRange;  // 1e999, 1e-999
-  return res.ec == std::errc() ? Parse::kOk : Parse::kNotANumber;
-}
-
-[[noreturn]] void csv_fail(const std::string& path, std::size_t line, const std::string& what) {
-  throw std::invalid_argument(path + ":" + std::to_string(line) + ": " + what);
-}
-
 }  // namespace
 
 std::unique_ptr<Trajectory> make_waypoints(const std::vector<Waypoint>& points) {
@@ -151,83 +100,6 @@ std::unique_ptr<Trajectory> make_waypoints(const std::vector<Waypoint>& points) 
           "must be greater than the previous t = " + detail::format_number(points[i - 1].t));
   }
   return std::make_unique<Waypoints>(points);
-}
-
-std::vector<Waypoint> read_waypoints_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot open file for reading");
-
-  std::vector<Waypoint> points;
-  std::size_t t_col = 0;
-  std::size_t x_col = 0;
-  bool have_header = false;
-  std::string prev_t_text;  // the previous t as written in the file
-  std::size_t prev_t_line = 0;
-  std::string raw;
-  std::size_t line_no = 0;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    if (line_no == 1 && raw.rfind(kUtf8Bom, 0) == 0) raw.erase(0, 3);
-    const std::string line = trim(raw);
-    if (line.empty() || line.front() == '#') continue;
-    const std::vector<std::string> fields = split_fields(line);
-
-    if (!have_header) {
-      std::optional<std::size_t> t_index;
-      std::optional<std::size_t> x_index;
-      for (std::size_t c = 0; c < fields.size(); ++c) {
-        const std::string name = unquote(fields[c]);
-        std::optional<std::size_t>* slot = name == "t"   ? &t_index
-                                           : name == "x" ? &x_index
-                                                         : nullptr;
-        if (slot == nullptr) continue;  // another column: ignored
-        if (slot->has_value())
-          csv_fail(path, line_no, "duplicate column '" + name + "' in the header");
-        *slot = c;
-      }
-      if (!t_index) csv_fail(path, line_no, "missing column 't' in the header '" + line + "'");
-      if (!x_index) csv_fail(path, line_no, "missing column 'x' in the header '" + line + "'");
-      t_col = *t_index;
-      x_col = *x_index;
-      have_header = true;
-      continue;
-    }
-
-    // The value of column `name` (index `col`) of this row, or a one-line error.
-    const auto field = [&](const char* name, std::size_t col) {
-      const std::string where = std::string("column '") + name + "': ";
-      if (col >= fields.size() || fields[col].empty())
-        csv_fail(path, line_no, where + "missing value");
-      double value = 0.0;
-      switch (parse_double(fields[col], &value)) {
-        case Parse::kOk:
-          break;
-        case Parse::kNotANumber:
-          csv_fail(path, line_no, where + "not a number: '" + fields[col] + "'");
-        case Parse::kOutOfRange:
-          csv_fail(path, line_no, where + "out of the range of a double: '" + fields[col] + "'");
-      }
-      if (!std::isfinite(value))
-        csv_fail(path, line_no, where + "not a finite number: '" + fields[col] + "'");
-      return value;
-    };
-    const Waypoint w{field("t", t_col), field("x", x_col)};
-    if (!points.empty() && !(w.t > points.back().t))
-      csv_fail(path, line_no,
-               "column 't': t=" + fields[t_col] + " is not greater than the previous t=" +
-                   prev_t_text + " (line " + std::to_string(prev_t_line) + ")");
-    prev_t_text = fields[t_col];
-    prev_t_line = line_no;
-    points.push_back(w);
-  }
-  if (in.bad()) throw std::invalid_argument(path + ": read error");
-  if (!have_header)
-    throw std::invalid_argument(path + ": no header line (expected columns 't' and 'x')");
-  if (points.size() < kMinPoints)
-    throw std::invalid_argument(path + ":" + std::to_string(line_no) +
-                                ": need at least 2 data rows, found " +
-                                std::to_string(points.size()) + " (end of file)");
-  return points;
 }
 
 }  // namespace feeddrive::trajectory

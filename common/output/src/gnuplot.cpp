@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/text.hpp"
 
 namespace feeddrive::output {
 namespace fs = std::filesystem;
@@ -23,34 +24,6 @@ bool safe_ascii(unsigned char c) {
   if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9')) return true;
   static constexpr std::string_view kPunctuation = " _-.,:;+/()[]=#%*!?<>|~^&";
   return kPunctuation.find(static_cast<char>(c)) != std::string_view::npos;
-}
-
-// Length of the well-formed UTF-8 sequence at s[i] encoding a character from U+00A0 up
-// (no overlong forms, no surrogates, at most U+10FFFF), or 0.
-std::size_t utf8_char(std::string_view s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
-  const unsigned char c = b(0);
-  std::size_t n = 0;
-  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-    if (c == 0xC2) lo = 0xA0;  // U+0080..U+009F are C1 control characters
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0) lo = 0xA0;  // overlong
-    if (c == 0xED) hi = 0x9F;  // surrogates
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0) lo = 0x90;  // overlong
-    if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
-  } else {
-    return 0;
-  }
-  if (i + n > s.size()) return 0;
-  if (b(1) < lo || b(1) > hi) return 0;
-  for (std::size_t k = 2; k < n; ++k)
-    if (b(k) < 0x80 || b(k) > 0xBF) return 0;
-  return n;
 }
 
 std::string slurp(const fs::path& p) {
@@ -86,7 +59,7 @@ std::string gnuplot_string(std::string_view text, std::size_t max_bytes) {
     std::string_view piece = "?";
     if (safe_ascii(c)) {
       piece = text.substr(i, 1);
-    } else if (const std::size_t u = utf8_char(text, i); u > 0) {
+    } else if (const std::size_t u = text::utf8_char(text, i); u > 0) {
       n = u;
       piece = text.substr(i, u);
     }

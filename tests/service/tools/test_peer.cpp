@@ -6,6 +6,12 @@
 //                   a new command carrying the stale step number k - 1
 //   junk            publishes, every 1 ms for --seconds, a reference_block_t on <prefix>_CMD, a
 //                   control_command_t on <prefix>_STATE and 7 random bytes on <prefix>_REF
+//   forge-controller an attacker on the bus (issue 13): answers every new state k at once with its
+//                   own control_command_t for step k, u = --u V, in the run's identity read off
+//                   the states (no key: with --key on the run, its messages are unauthenticated)
+//   forge-reference an attacker ahead of the trajectory: on every state k, a reference_block_t
+//                   of position --u m for the aligned block 512 steps ahead (before the real one)
+// Every peer joins the run of the first message it hears (or --run-id).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -26,7 +32,13 @@ int main(int argc, char** argv) {
   std::string mode, url = default_lcm_url(), prefix = "FD";
   long steps = 100;
   double seconds = 1.0;
-  app.add_option("mode", mode)->required()->check(CLI::IsMember({"nan-controller", "stall-controller", "stale-controller", "junk"}));
+  double forged_u = 3.0;
+  std::int64_t run_id = 0;
+  app.add_option("mode", mode)
+      ->required()
+      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller", "forge-reference"}));
+  app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
+  app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
   app.add_option("--prefix", prefix);
   app.add_option("--steps", steps);
@@ -34,6 +46,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   Bus bus(url);
+  if (run_id != 0) {
+    bus.set_run_id(run_id);
+  } else {
+    bus.join_first_seen();
+  }
   const Channels ch(prefix);
   if (mode == "junk") {
     lcm::LCM raw(url);
@@ -54,6 +71,42 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     std::printf("junk: %ld rounds\n", n);
+    return 0;
+  }
+  if (mode == "forge-controller" || mode == "forge-reference") {
+    std::int64_t highest = -1, forged = 0;
+    bool end = false;
+    std::int64_t last_us = mono_us();
+    bus.subscribe<drive_state_t>(ch.state, [&](const drive_state_t& m, std::int64_t now) {
+      if (m.end_of_run) end = true;
+      last_us = now;
+      if (m.end_of_run || m.seq <= highest) return;
+      highest = m.seq;
+      if (mode == "forge-controller") {
+        control_command_t c{};
+        c.seq = m.seq;
+        c.t = m.t;
+        c.u = c.u_unsaturated = forged_u;
+        c.sliding = c.z_estimate = std::nan("");
+        bus.publish(ch.command, c);
+        ++forged;
+      } else if (m.seq % 16 == 0 && m.seq + 512 < m.steps) {
+        reference_block_t b{};
+        b.first_seq = m.seq + 512;
+        b.count = 16;
+        for (std::int64_t k = b.first_seq; k < b.first_seq + 16; ++k) {
+          reference_t r{};
+          r.seq = k;
+          r.t = m.t + static_cast<double>(k - m.seq) * (m.seq > 0 ? m.t / static_cast<double>(m.seq) : 0.0);
+          r.position = forged_u;
+          b.refs.push_back(r);
+        }
+        bus.publish(ch.reference, b);
+        ++forged;
+      }
+    });
+    while (!end && mono_us() - last_us < 10'000'000) bus.poll(std::chrono::milliseconds(10));
+    std::printf("%s: %lld forged messages\n", mode.c_str(), static_cast<long long>(forged));
     return 0;
   }
   std::map<std::int64_t, control_command_t> answered;

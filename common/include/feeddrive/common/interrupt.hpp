@@ -10,6 +10,8 @@
 #include <signal.h>
 
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -55,6 +57,23 @@ class Interrupted : public std::runtime_error {
 /// Throws Interrupted if a signal came.
 inline void check() {
   if (const int s = detail::g_signal; s != 0) throw Interrupted(s);
+}
+
+/// Forgets the signal: for a tool that, once interrupted, still finishes a short job it must not
+/// lose (the monitor writing the steps it recorded); a second signal then stops that too.
+inline void clear() { detail::g_signal = 0; }
+
+/// Set (to "1") by feeddrive-launch for the processes it starts: the launcher reports the
+/// interrupt once, its children stay silent about it.
+inline constexpr const char* kQuietEnv = "FEEDDRIVE_INTERRUPT_QUIET";
+
+/// The end of an interrupted tool (docs/scenario.md, "Exit codes and Ctrl-C"): prints the one
+/// line "error: interrupted by SIGINT<detail>" (unless started by feeddrive-launch) and returns
+/// the exit code 128 + signal. Usage: `catch (const Interrupted& e) { return report(e); }`.
+inline int report(const Interrupted& e, const std::string& detail = "") {
+  const char* quiet = std::getenv(kQuietEnv);
+  if (quiet == nullptr || std::string(quiet) != "1") std::fprintf(stderr, "error: %s%s\n", e.what(), detail.c_str());
+  return e.exit_code();
 }
 
 }  // namespace feeddrive::interrupt

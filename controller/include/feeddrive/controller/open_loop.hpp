@@ -4,7 +4,9 @@
 //   step:  F = offset + amplitude           for t >= start_time, else offset
 //   sine:  F = offset + amplitude*sin(2*pi*f*(t - start_time) + phase)   for t >= start_time
 //   ramp:  F = offset + rate*(t - start_time)  for t >= start_time (capped at |amplitude| if > 0)
-//   csv:   F from a file with columns t and force_N (or u), zero-order hold between rows
+//   csv:   F from a table of rows (t_i, F_i) (or (t_i, u_i)), zero-order hold between rows, 0
+//          before the first. The table is data: the scenario layer reads it from the CSV file
+//          (feeddrive::csv, columns t and force_N or u); this library reads no files.
 
 #include <string>
 #include <vector>
@@ -25,7 +27,9 @@ struct OpenLoopParams {
   double offset{0.0};       ///< [N]
   double rate{100.0};       ///< [N/s] (ramp)
   double start_time{0.0};   ///< [s]
-  std::string file;         ///< CSV path (csv)
+  std::vector<double> table_t;      ///< csv: row times [s], strictly increasing
+  std::vector<double> table_value;  ///< csv: force [N] (table_is_force) or u [V] of each row
+  bool table_is_force{true};
   double thrust_gain{260.0};  ///< Ka*Kf [N/V] used to turn force into u
   double u_min{-1e9};       ///< [V]
   double u_max{1e9};        ///< [V]
@@ -43,7 +47,7 @@ class OpenLoopSource final : public Controller {
 
  private:
   OpenLoopParams p_;
-  std::vector<double> csv_t_, csv_u_;  // csv rows: time and u
+  std::vector<double> csv_u_;  // csv rows: u [V]
 };
 
 }  // namespace feeddrive::controller

@@ -71,7 +71,10 @@ class MonitorNode : public service::Node {
   std::int64_t last_progress_us_{0};
   std::int64_t last_ack_sent_{-1};
   std::int64_t lost_{0};
-  run_summary_t summary_;
+  run_summary_t summary_{};
+  service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
+  service::StepLedger<reference_t> reference_ledger_;
+  service::StepLedger<control_command_t> command_ledger_;
   run_info_t info_;
   std::unique_ptr<LcmLogWriter> log_;
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)

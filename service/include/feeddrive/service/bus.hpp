@@ -15,16 +15,19 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdint>
 #include <deque>
 #include <exception>
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/udpm_reader.hpp"
 
 namespace feeddrive::service {
@@ -44,6 +47,12 @@ struct Channels {
 std::int64_t wall_utime();
 std::int64_t mono_us();
 
+/// Which runs' messages a subscription gets (see Bus::set_run_id).
+enum class Admit {
+  kRun,     ///< only the bus's run: others are counted as foreign and dropped (all message flow)
+  kAnyRun,  ///< every run's (the heartbeat, from which a process joins a run); the handler checks
+};
+
 enum class Receive {
   kDirect,   ///< our socket, woken by each datagram: lowest latency (udpm:// URLs; else kEvent)
   kBatched,  ///< drained every batch interval, no wake-up per message (udpm:// URLs; else kEvent)
@@ -60,15 +69,37 @@ class Bus {
   Bus(const Bus&) = delete;
   Bus& operator=(const Bus&) = delete;
 
-  /// Subscribes to `channel`, decoding every message as Msg. Messages that fail to decode
-  /// (another type, another fingerprint, truncated) are counted in invalid() and dropped.
+  /// Subscribes to `channel`, decoding every message as Msg. With a key (set_auth), a message
+  /// without a valid mac is counted in unauthenticated() and dropped before it is decoded.
+  /// Messages that fail to decode (another type, another fingerprint, truncated) are counted in
+  /// invalid() and dropped. Admit::kRun: a message of another run is counted in foreign() and
+  /// dropped, and before the run is known (run_known()) every message is dropped uncounted.
   /// recv_us is the monotonic time [us] at which LCM received the datagram.
   template <typename Msg>
-  void subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t recv_us)> handler);
+  void subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t recv_us)> handler,
+                 Admit admit = Admit::kRun);
 
-  /// Publishes a message. Returns false (and counts) when LCM reports a send error.
+  /// Publishes a message stamped with the run's identity (run_id), signed when a key is set.
+  /// Returns false (and counts) when LCM reports a send error.
   template <typename Msg>
   bool publish(const std::string& channel, const Msg& msg);
+
+  /// The run this bus belongs to. Until it is set, Admit::kRun subscriptions get nothing.
+  void set_run_id(std::int64_t id) {
+    run_id_ = id;
+    run_known_ = true;
+  }
+  bool run_known() const { return run_known_; }
+  /// Until the run is known, join the run of the first message that arrives on an Admit::kRun
+  /// subscription (an attached recorder: whatever is on the bus, a replayed log too).
+  void join_first_seen() { join_first_ = true; }
+  std::int64_t run_id() const { return run_id_; }
+  /// Authenticates every message with this key from now on (integrity.hpp).
+  void set_auth(const std::string& key) { auth_ = std::make_unique<MessageAuth>(key); }
+  bool authenticated() const { return auth_ != nullptr; }
+  /// Counts (and logs, at most once a second) a message of another run seen by an
+  /// Admit::kAnyRun handler.
+  void count_foreign(const std::string& channel, std::int64_t run_id);
 
   /// Dispatches the messages that arrive within `timeout` (at least one wait). Returns true if
   /// at least one message was handled. Rethrows the first exception a handler threw.
@@ -86,6 +117,10 @@ class Bus {
   /// not LCM's framing.
   std::int64_t invalid() const { return invalid_ + (reader_ ? reader_->malformed() : 0); }
   std::int64_t send_errors() const { return send_errors_; }
+  /// Messages of another run (Admit::kRun subscriptions, and count_foreign()).
+  std::int64_t foreign() const { return foreign_; }
+  /// With a key: messages without a valid mac.
+  std::int64_t unauthenticated() const { return unauthenticated_; }
   const std::string& url() const { return url_; }
 
  private:
@@ -111,7 +146,18 @@ class Bus {
   std::int64_t invalid_{0};
   std::int64_t send_errors_{0};
   std::int64_t last_invalid_log_us_{-1};
+  std::int64_t foreign_{0};
+  std::int64_t last_foreign_log_us_{-1};
+  std::int64_t unauthenticated_{0};
+  std::int64_t last_unauthenticated_log_us_{-1};
+  std::int64_t run_id_{0};
+  bool run_known_{false};
+  bool join_first_{false};
+  std::unique_ptr<MessageAuth> auth_;
+  std::vector<std::uint8_t> out_;  ///< publish(): the encoded message
   std::exception_ptr error_;
+  /// Logs at most once a second per kind: `last` is that kind's last log time.
+  static bool log_due(std::int64_t& last);
 };
 
 /// Remembers the last `capacity` messages published on one channel, by step number, and
@@ -166,18 +212,36 @@ class Outbox {
 // --- template definitions -------------------------------------------------------------------
 
 template <typename Msg>
-void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t)> handler) {
-  subscribe_raw(channel, [this, handler](const lcm::ReceiveBuffer* rbuf, const std::string& ch) {
+void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, std::int64_t)> handler, Admit admit) {
+  subscribe_raw(channel, [this, handler, admit](const lcm::ReceiveBuffer* rbuf, const std::string& ch) {
+    const auto* bytes = static_cast<const std::uint8_t*>(rbuf->data);
+    if (auth_ && !auth_->verify(ch, bytes, rbuf->data_size)) {
+      ++unauthenticated_;
+      if (log_due(last_unauthenticated_log_us_))
+        std::fprintf(stderr, "feeddrive: rejected a message on %s without a valid mac (%lld so far; forged, or a "
+                     "publisher without the key)\n", ch.c_str(), static_cast<long long>(unauthenticated_));
+      return;
+    }
     Msg msg;
     const std::int64_t now = mono_us();
     if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) {
       ++invalid_;
-      if (last_invalid_log_us_ < 0 || now - last_invalid_log_us_ > 1000000) {
-        last_invalid_log_us_ = now;
+      if (log_due(last_invalid_log_us_))
         std::fprintf(stderr, "feeddrive: ignored a message on %s that is not a %s (%u bytes)\n",
                      ch.c_str(), Msg::getTypeName(), rbuf->data_size);
-      }
       return;
+    }
+    if (admit == Admit::kRun) {
+      if (!run_known_ && join_first_) {
+        set_run_id(msg.run_id);
+        std::fprintf(stderr, "feeddrive: joined run %lld (the first message on %s)\n",
+                     static_cast<long long>(msg.run_id), ch.c_str());
+      }
+      if (!run_known_) return;  // not joined yet: its own run re-sends what matters
+      if (msg.run_id != run_id_) {
+        count_foreign(ch, msg.run_id);
+        return;
+      }
     }
     // The receive time is when LCM read the datagram off the socket (recv_utime: the kernel's
     // SO_TIMESTAMP where available, else LCM's clock on reading), not when handle() dispatches
@@ -199,8 +263,19 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
 }
 
 template <typename Msg>
-bool Bus::publish(const std::string& channel, const Msg& msg) {
-  if (lcm_.publish(channel, &msg) != 0) {
+bool Bus::publish(const std::string& channel, const Msg& m) {
+  // Stamped and, with a key, signed in a copy: the caller keeps its message (an Outbox
+  // re-publishes it); the copy's mac is empty, so the copy costs no allocation.
+  Msg msg = m;
+  msg.run_id = run_id_;
+  msg.mac_size = 0;
+  msg.mac.clear();
+  const int n = msg.getEncodedSize();
+  const std::size_t size = static_cast<std::size_t>(n) + (auth_ ? MessageAuth::kMacSize : 0);
+  if (out_.size() < size) out_.resize(size);
+  if (msg.encode(out_.data(), 0, n) != n) throw std::logic_error(std::string("cannot encode a ") + Msg::getTypeName());
+  if (auth_) auth_->sign(channel, out_.data(), size);  // mac_size 0 -> 32, then the mac
+  if (lcm_.publish(channel, out_.data(), static_cast<unsigned int>(size)) != 0) {
     ++send_errors_;
     return false;
   }

@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/service/node.hpp"
 
 namespace feeddrive::service {
@@ -16,7 +17,8 @@ namespace feeddrive::service {
 void add_node_options(CLI::App& app, NodeOptions& opt);
 
 /// Parses the arguments and runs body(). body returns the exit code; std::invalid_argument
-/// (bad input) gives 2, RunFailure and other exceptions 1, each as one line on stderr.
+/// (bad input) gives 2, RunFailure and other exceptions 1, interrupt::Interrupted 130 (SIGINT) or
+/// 143 (SIGTERM), each as one line on stderr.
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body);
 
 /// Runs node.run() and returns 0; a RunFailure is first announced on <prefix>_STATUS (so the
@@ -26,6 +28,9 @@ int run_node(NodeType& node) {
   try {
     node.run();
   } catch (const RunFailure& e) {
+    node.announce_failure(e.what());
+    throw;
+  } catch (const interrupt::Interrupted& e) {
     node.announce_failure(e.what());
     throw;
   }

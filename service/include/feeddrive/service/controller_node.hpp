@@ -31,6 +31,8 @@ class ControllerNode : public Node {
   std::int64_t pending_since_us_{0};
   std::int64_t last_ref_request_us_{0};
   std::map<std::int64_t, reference_t> refs_;
+  StepLedger<drive_state_t> state_ledger_;      ///< every state received, for conflicts
+  StepLedger<reference_t> reference_ledger_;    ///< every reference received, for conflicts
   std::int64_t next_seq_{0};       ///< first step not answered yet
   std::int64_t last_progress_us_{0};
   bool end_{false};

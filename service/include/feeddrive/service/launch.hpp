@@ -27,6 +27,10 @@ struct LaunchOptions {
   /// once, and on machines where waking a process on another core is slow (virtual machines)
   /// one core is fastest (bench/lockstep_bench.sh measures it).
   std::vector<int> cpus;
+  /// Before starting, listen this long for another run's plant on the group and prefix (its
+  /// heartbeat comes every 100 ms); if one is there, refuse in one line (docs/security.md).
+  /// 0: no check.
+  double busy_check_s{0.3};
   /// If set: the monitor also writes the run's messages to this LCM log (feeddrive-monitor --lcm-log).
   std::string lcm_log;
 };
@@ -40,7 +44,12 @@ struct LaunchResult {
   std::vector<std::string> failed;  ///< "role (exit n)" of each process that did not exit 0
 };
 
-/// Validates roles (std::invalid_argument naming a bad one), starts, waits, reports.
+/// Throws std::invalid_argument (one line: who holds it, how to choose another) if another
+/// run's plant publishes on opt's URL and prefix within `listen_s` seconds.
+void check_group_free(const NodeOptions& opt, double listen_s);
+
+/// Validates roles (std::invalid_argument naming a bad one), starts, waits, reports. Draws the
+/// run id (unless given, or the plant is external) and passes it to every process it starts.
 LaunchResult launch(const LaunchOptions& lo, const NodeOptions& opt);
 
 /// The directory of the running executable.

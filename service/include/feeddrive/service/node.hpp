@@ -35,6 +35,11 @@ struct NodeOptions {
   int max_bad_commands{10};
   std::int64_t realtime_spin_us{10};  ///< real time: busy-wait this long before a period start (after clock_nanosleep)          ///< real time: consecutive missed/invalid commands before the safe state
   bool quiet{false};
+  /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
+  /// other process takes it from the plant's first fresh heartbeat.
+  std::int64_t run_id{0};
+  std::string key_file;              ///< --key: authenticate every message with this key; "": off
+  ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 
 /// Thrown when a run cannot go on: another role failed or stopped answering.
@@ -63,6 +68,17 @@ class Node {
 
   void request_resend(const std::string& channel, std::int64_t seq);
 
+  /// Checks the message `item` of step `seq` on `channel` against the one this node already has
+  /// for that step. True: new or identical (the caller goes on as before: an identical one is a
+  /// re-publication). A different one is a conflict: counted, logged naming channel, step and
+  /// fields, then RunFailure (--on-conflict fail, the default) or false (keep-first: drop it).
+  template <typename T>
+  bool admit(StepLedger<T>& ledger, const std::string& channel, std::int64_t seq, const T& item) {
+    std::string diff;
+    if (ledger.admit(seq, item, &diff) != StepLedger<T>::Seen::kConflict) return true;
+    return on_conflict(channel, seq, T::getTypeName(), diff);
+  }
+
   /// Throws RunFailure if another role announced a failure.
   void check_peers() const;
   /// The latest status of a role, if any was seen.
@@ -79,6 +95,7 @@ class Node {
   std::int64_t resends{0};
   std::int64_t duplicates{0};
   std::int64_t invalid_content{0};
+  std::int64_t conflicts{0};
   std::int64_t acked_seq{-1};  ///< monitor only: every step below is recorded
 
  protected:
@@ -88,6 +105,9 @@ class Node {
   std::function<void()> on_heartbeat;
 
  private:
+  bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);
+  process_status_t status_message(const std::string& state, const std::string& message) const;
+
   std::string role_;
   NodeOptions opt_;
   Bus bus_;
@@ -95,6 +115,7 @@ class Node {
   std::string state_{"starting"};
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
+  std::int64_t last_conflict_log_us_{-1};
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;
 };

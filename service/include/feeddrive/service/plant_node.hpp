@@ -42,7 +42,6 @@ class PlantNode : public Node {
 
   std::int64_t rejected_commands() const { return rejected_; }
   std::int64_t missed_deadlines() const { return missed_; }
-  std::int64_t stale_commands() const { return stale_; }
 
  private:
   void run_lockstep();
@@ -52,11 +51,6 @@ class PlantNode : public Node {
   /// Applies u over step k and advances the drive.
   void apply(std::int64_t k, double u);
   void wait_for_monitor(std::int64_t k);
-  /// Lockstep: true if m repeats the command received for its step (same u, bit for bit).
-  bool is_repeat(const control_command_t& m) const;
-  void on_stale_command(const control_command_t& m);
-  /// "" or the note on stale commands appended to a timeout message.
-  std::string stale_note() const;
   /// Real time: takes the commands received so far; each newer one switches the input at its
   /// arrival (simulated time clamped to [now, t_end]). Returns true if command k was among them.
   bool take_commands(std::int64_t k, double t_end);
@@ -68,16 +62,12 @@ class PlantNode : public Node {
   plant::Plant drive_;
   Outbox<drive_state_t> states_;
   std::optional<control_command_t> command_;  ///< the newest command received, any seq
+  StepLedger<control_command_t> command_ledger_;  ///< every command received, for conflicts
   std::vector<std::pair<control_command_t, std::int64_t>> arrived_;  ///< real time: (command, recv_us) not yet taken
   std::int64_t newest_seq_{-1};  ///< real time: the newest command seq taken
   std::int64_t t0_us_{0};        ///< real time: the wall (monotonic) time of t = 0 [us]
   double u_now_{0.0};            ///< real time: the input the drive holds now [V]
   applied_t previous_;
-  static constexpr std::size_t kRecentCommands = 4096;  ///< commands kept to tell a repeat from a stale one
-  std::array<std::pair<std::int64_t, double>, kRecentCommands> received_u_{};  ///< (seq, u) by seq % kRecentCommands
-  std::int64_t stale_{0};
-  std::int64_t last_stale_seq_{-1};
-  std::int64_t last_stale_log_us_{-1};
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
   int bad_in_a_row_{0};

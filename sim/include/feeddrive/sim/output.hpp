@@ -52,6 +52,8 @@ class RunWriter {
   /// `extra_files` (if given) writes the caller's own files into the staged folder first.
   void finish(const Summary& sum, bool plots, const std::string& extra_json = "",
               const std::function<void(const output::StagedFolder&)>& extra_files = {});
+  /// Wall time finish() spent on the plots [s] (0 without plots).
+  double plot_seconds() const { return plot_seconds_; }
 
  private:
   const Scenario& s_;
@@ -61,6 +63,7 @@ class RunWriter {
   long every_;
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
+  double plot_seconds_{0.0};
 };
 
 /// Plots position+error, velocity error, control and forces into the staged folder (position.png,

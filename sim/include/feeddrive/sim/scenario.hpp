@@ -42,13 +42,15 @@ struct ReferenceConfig {
   trajectory::SCurveParams scurve;
   trajectory::RampParams ramp;
   std::string waypoints_file;  ///< resolved against the scenario file's folder
+  std::vector<trajectory::Waypoint> waypoints;  ///< read from waypoints_file when loaded
 };
 
 struct ControllerConfig {
   ControllerType type{ControllerType::kSlidingMode};
   controller::SlidingModeParams sliding_mode;
   controller::CascadeParams cascade;
-  controller::OpenLoopParams open_loop;
+  controller::OpenLoopParams open_loop;  ///< kind csv: its table read from open_loop_file when loaded
+  std::string open_loop_file;            ///< controller.file, resolved against the scenario's folder
 };
 
 struct AnalysisConfig {
@@ -66,8 +68,11 @@ struct OutputConfig {
 /// "Limits"): 1e10 steps are about a day of wall time at the fastest measured 7 us per step.
 inline constexpr double kMaxSteps = 1e10;
 
+/// Longest scenario name accepted [bytes].
+inline constexpr std::size_t kMaxNameBytes = 256;
+
 struct Scenario {
-  std::string name;
+  std::string name;  ///< printable UTF-8, at most kMaxNameBytes
   std::string path;  ///< file it was loaded from ("" if parsed from a string)
   double duration{1.0};        ///< [s]
   double control_period{1e-4}; ///< [s]
@@ -92,6 +97,13 @@ Scenario load_scenario(const std::string& path);
 /// source in messages.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
                         const std::string& origin = "scenario");
+
+/// The tables a scenario names (reference.file, controller.file), read with the one CSV reader
+/// (feeddrive/csv/reader.hpp). Throw csv::CsvError (std::invalid_argument), one line naming
+/// file:line:column and the value.
+std::vector<trajectory::Waypoint> read_waypoints_file(const std::string& path);
+/// Fills p.table_t, p.table_value and p.table_is_force from columns t and force_N (or u).
+void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p);
 
 std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s);
 std::unique_ptr<controller::Controller> make_controller(const Scenario& s);

@@ -1,6 +1,9 @@
 #pragma once
 // Run metrics (summary.json). Errors are true-state errors: e = xd - x, e_v = vd - v.
-// "settled" metrics are over t >= analysis.settled_after.
+// "settled" metrics are over t >= analysis.settled_after. A metric over an empty window has no
+// value: summary_json writes null, never 0, for the settled metrics when no step reaches
+// settled_after (settled_steps == 0), for the after-first metric with fewer than two steps, and
+// for every error, control and position metric of a run without steps.
 //
 // Computed online (SummaryBuilder::add, one record at a time, memory independent of the number
 // of steps): maxima, minima, sums of squares (RMS), the total variation and the end state are
@@ -26,6 +29,7 @@ struct Summary {
   double velocity_error_max_abs_after_first_mps{0.0};  ///< excludes the first sample
   double velocity_error_rms_mps{0.0};
   double settled_after_s{0.0};
+  long settled_steps{0};  ///< steps with t >= settled_after (0: the settled metrics have no value)
   double position_error_max_abs_settled_m{0.0};
   double position_error_rms_settled_m{0.0};
   double velocity_error_max_abs_settled_mps{0.0};

@@ -11,6 +11,15 @@
 
 namespace feeddrive::sim {
 
+/// Parses YAML text strictly; every error is a ScenarioError "line N: ...":
+///   * a syntax error (yaml-cpp's message, with its line);
+///   * a quoted value that is not closed on the line where it opens (yaml-cpp would silently
+///     swallow the rest of the file into it: "name: \"abc" then reported "duration: missing");
+///   * a key that appears twice in one map ("duration: duplicate key on lines 2 and 7"; yaml-cpp
+///     keeps the first silently);
+///   * more than 100000 nodes (aliases that expand exponentially).
+YAML::Node load_yaml_strict(const std::string& text);
+
 class MapReader {
  public:
   /// node must be a map (or null/absent, treated as empty); path is its dotted key ("plant").

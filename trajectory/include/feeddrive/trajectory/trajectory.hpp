@@ -105,9 +105,7 @@ struct Waypoint {
   double t{0.0};
   double x{0.0};
 };
+/// (The scenario layer reads them from a CSV file with feeddrive::csv; this library reads no files.)
 std::unique_ptr<Trajectory> make_waypoints(const std::vector<Waypoint>& points);
-/// Reads a CSV file with a header containing columns `t` and `x` (other columns ignored).
-/// Throws std::invalid_argument naming the file, line and value on bad input.
-std::vector<Waypoint> read_waypoints_csv(const std::string& path);
 
 }  // namespace feeddrive::trajectory
