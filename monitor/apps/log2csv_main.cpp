@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
     const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
     const monitor::Recorder& rec = c.recorder;
-    out.finish(out.summary().summary(0.0, {}), plots);
+    const sim::Summary sum = out.summary(0.0, {});
+    out.finish(sum, plots);
     const bool complete = rec.complete();
     spdlog::info("{}: {} events, {} rows{}, {} undecodable, {} on other channels -> {}", log_path, c.events,
                  rec.rows(), complete ? " (complete run)" : "", c.undecodable, c.foreign_events, out_dir);

@@ -100,7 +100,10 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
     } else {
       ++out.foreign_events;
     }
-    if ((out.events & 4095) == 0) out.recorder.flush(sink);  // rows leave as they complete
+    if ((out.events & 4095) == 0) {
+      out.recorder.flush(sink);  // rows leave as they complete
+      interrupt::check();        // Ctrl-C: unwind (a staged output folder is removed)
+    }
   }
   out.recorder.flush(sink);
   return out;

@@ -219,7 +219,13 @@ bool MonitorNode::run() {
 
 bool MonitorNode::finish(bool completed, const std::string& failure) {
   const double wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
-  const sim::Summary sum = out_->summary().summary(wall_time_s, {});
+  sim::Summary sum;
+  std::string write_error;  // the writer thread could not write (disk full, ...)
+  try {
+    sum = out_->summary(wall_time_s, {});
+  } catch (const std::exception& e) {
+    write_error = e.what();
+  }
 
   std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(), invalid_total = bus().invalid();
   // Foreign, conflicting and unauthenticated messages: the most any one process saw (each
@@ -331,6 +337,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   bool written = true;
   std::string why = failure;
   try {
+    if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
     out_->finish(sum, mopt_.plots, j.dump(),
                  [&](const output::StagedFolder& dir) { write_histograms(dir.dir().string(), hist_names, hists, plots); });

@@ -118,6 +118,17 @@ void Node::request_resend(const std::string& channel, std::int64_t seq) {
   bus_.publish(ch_.resend, m);
 }
 
+void Node::wait_for_run() {
+  const std::int64_t start = mono_us();
+  while (!bus_.run_known()) {
+    check_peers();
+    if (mono_us() - start > us(opt_.start_timeout_s))
+      throw RunFailure("no heartbeat from the plant within " + seconds_text(opt_.start_timeout_s) +
+                       " s to join its run (start the plant, or give every process the same --run-id)");
+    bus_.poll(std::chrono::microseconds(us(opt_.resend_interval_s)));
+  }
+}
+
 bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff) {
   ++conflicts;
   const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +

@@ -59,6 +59,7 @@ void TrajectoryNode::send_ahead(std::int64_t k) {
 
 void TrajectoryNode::run() {
   set_state("running");
+  wait_for_run();  // every block must carry the run's identity
   // Everything, block 0 included, once the plant's first state shows that the run has started:
   // the plant publishes it only when the monitor is up (its flow control), so the monitor (and
   // its --lcm-log) sees the blocks in order from block 0, without asking for them again.

@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     spdlog::info("{}: {} steps of {} s", scenario.name, scenario.steps(), scenario.control_period);
     feeddrive::sim::RunWriter out(out_dir, scenario, "feeddrive-sim");
     const auto stats = feeddrive::sim::run(scenario, [&](const feeddrive::sim::Record& r) { out.add(r); });
-    const auto summary = out.summary().summary(stats.wall_time_s, stats.integrator);
+    const auto summary = out.summary(stats.wall_time_s, stats.integrator);
     out.finish(summary, !no_plots);
     if (!no_plots) spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
     spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",

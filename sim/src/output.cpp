@@ -84,12 +84,82 @@ RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::s
   std::vector<std::string> header;
   for (std::size_t c : columns_) header.push_back(record_columns()[c]);
   csv_ = std::make_unique<output::CsvWriter>(folder_.path("timeseries.csv"), header);
+  block_.reserve(kBlockRows);
+  worker_ = std::thread([this] { work(); });
 }
 
-RunWriter::~RunWriter() = default;
+RunWriter::~RunWriter() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
 
 void RunWriter::add(const Record& r) {
-  if (summary_.steps() % every_ == 0) {
+  block_.push_back(r);
+  last_ = r;
+  ++added_;
+  if (block_.size() == kBlockRows) submit();
+}
+
+void RunWriter::submit() {
+  if (block_.empty()) return;
+  std::unique_lock<std::mutex> lock(m_);
+  cv_.wait(lock, [this] { return queue_.size() < kQueuedBlocks || error_; });
+  if (error_) std::rethrow_exception(error_);
+  queue_.push_back(std::move(block_));
+  if (!spare_.empty()) {
+    block_ = std::move(spare_.back());
+    spare_.pop_back();
+  } else {
+    block_ = {};
+    block_.reserve(kBlockRows);
+  }
+  lock.unlock();
+  cv_.notify_all();
+}
+
+void RunWriter::drain() {
+  submit();
+  std::unique_lock<std::mutex> lock(m_);
+  cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || error_; });
+  if (error_) std::rethrow_exception(error_);
+}
+
+void RunWriter::work() {
+  std::unique_lock<std::mutex> lock(m_);
+  for (;;) {
+    cv_.wait(lock, [this] { return !queue_.empty() || stop_; });
+    if (queue_.empty()) return;  // stop_
+    std::vector<Record> rows = std::move(queue_.front());
+    queue_.pop_front();
+    busy_ = true;
+    lock.unlock();
+    cv_.notify_all();  // room in the queue
+    std::exception_ptr err;
+    try {
+      for (const Record& r : rows) write(r);
+    } catch (...) {
+      err = std::current_exception();
+    }
+    rows.clear();
+    lock.lock();
+    busy_ = false;
+    if (err && !error_) error_ = err;
+    if (spare_.size() < kQueuedBlocks) spare_.push_back(std::move(rows));
+    cv_.notify_all();
+    if (error_) {
+      queue_.clear();
+      cv_.wait(lock, [this] { return stop_; });
+      return;
+    }
+  }
+}
+
+void RunWriter::write(const Record& r) {
+  if (written_ % every_ == 0) {
     double all[kRecordColumns], row[kRecordColumns];
     record_values(r, all);
     for (std::size_t c = 0; c < columns_.size(); ++c) row[c] = all[columns_[c]];
@@ -99,13 +169,26 @@ void RunWriter::add(const Record& r) {
   curve_values(r, y);
   plot_.add(r.t, y);
   summary_.add(r);
+  ++written_;
+}
+
+Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) {
+  drain();
+  return summary_.summary(wall_time_s, integrator);
 }
 
 void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json,
                        const std::function<void(const output::StagedFolder&)>& extra_files) {
+  drain();
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  worker_.join();
   csv_->close();
   folder_.write_text("summary.json", summary_json(sum, s_, extra_json));
-  if (plots && summary_.steps() > 0) {
+  if (plots && written_ > 0) {
     const auto t0 = std::chrono::steady_clock::now();
     write_plots(folder_, plot_, s_.name);
     plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

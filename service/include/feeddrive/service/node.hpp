@@ -67,6 +67,10 @@ class Node {
   void set_seq(std::int64_t seq) { seq_ = seq; }
 
   void request_resend(const std::string& channel, std::int64_t seq);
+  /// Returns once this process knows its run (--run-id, or the plant's heartbeat); throws
+  /// RunFailure after --start-timeout. A process that publishes before any message of the run
+  /// reaches it (the trajectory's first block) calls this first.
+  void wait_for_run();
 
   /// Checks the message `item` of step `seq` on `channel` against the one this node already has
   /// for that step. True: new or identical (the caller goes on as before: an identical one is a

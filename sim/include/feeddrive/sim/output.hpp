@@ -9,10 +9,21 @@
 // the output.columns), to the online summary (SummaryBuilder) and to the plot reduction
 // (output::MinMaxReducer, kPlotBuckets min/max pairs per curve), and is dropped. feeddrive-sim
 // and feeddrive-monitor both write through RunWriter, so the same records give the same bytes.
+//
+// Off the critical path: add() only copies the record into a block of kBlockRows; full blocks
+// go, in order, to one writer thread that formats and writes them (at most kQueuedBlocks
+// waiting, so memory stays bounded and a slow disk slows the run instead of filling memory).
+// On a machine with a free core the output costs the simulation nothing but the copy.
 
+#include <condition_variable>
+#include <deque>
+#include <exception>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -39,12 +50,16 @@ class RunWriter {
   RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool);
   ~RunWriter();
 
-  /// One record, in step order.
+  static constexpr std::size_t kBlockRows = 4096;
+  static constexpr std::size_t kQueuedBlocks = 4;
+
+  /// One record, in step order. Rethrows a write error of the writer thread.
   void add(const Record& r);
-  long steps() const { return summary_.steps(); }
-  const SummaryBuilder& summary() const { return summary_; }
+  long steps() const { return added_; }
   /// The most recent record (undefined before the first add).
-  const Record& last() const { return summary_.last(); }
+  const Record& last() const { return last_; }
+  /// The summary of every record added so far (waits until the writer thread has them all).
+  Summary summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator);
 
   /// Closes timeseries.csv, writes summary.json (`sum` plus the keys of the JSON object
   /// extra_json) and the plots (when asked and there is at least one record), and swaps the
@@ -64,6 +79,25 @@ class RunWriter {
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
   double plot_seconds_{0.0};
+
+  // the caller's side
+  std::vector<Record> block_;
+  long added_{0};
+  Record last_;
+  void submit();  // hands block_ to the writer thread
+  void drain();   // submits block_ and waits until the writer thread has written everything
+
+  // the writer thread: write() runs there, in order
+  void work();
+  void write(const Record& r);
+  long written_{0};
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<std::vector<Record>> queue_;
+  std::vector<std::vector<Record>> spare_;  // emptied blocks, reused
+  bool busy_{false}, stop_{false};
+  std::exception_ptr error_;
+  std::thread worker_;
 };
 
 /// Plots position+error, velocity error, control and forces into the staged folder (position.png,
