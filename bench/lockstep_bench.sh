@@ -1,45 +1,58 @@
 #!/usr/bin/env bash
 # Lockstep speed against its ceiling, measured in the same run (run inside a private network
 # namespace: scripts/netns-run.sh bench/lockstep_bench.sh [BUILD_DIR] [ROUNDS]):
-#   1. a raw LCM ping-pong between two processes (bench/lcm_pingpong.cpp): one round trip per step;
-#   2. the four-process lockstep run (plant + controller + trajectory + monitor) of the paper's
+#   1. the ceiling: a raw liblcm ping-pong between two processes (bench/lcm_pingpong_raw.c: only
+#      lcm_publish and lcm_handle), one round trip per step;
+#   2. the same ping-pong through the project's Bus (bench/lcm_pingpong.cpp: decoding, polling,
+#      the direct socket the plant and the controller use);
+#   3. the four-process lockstep run (plant + controller + trajectory + monitor) of the paper's
 #      boundary-layer jerk-limited move, 15,000 steps; steps/s from the monitor (first to last step).
-# Each is run ROUNDS times (default 3), alternating; medians and their ratio are printed, for
-# two placements: free (the scheduler's) and one core (all processes of both pinned to CPU 0).
-# Target: lockstep >= 0.8 x ping-pong. Message sizes are printed too (target < 1 KB per step).
-# Then, what other processes on the multicast group cost a ping-pong round trip (the reason the
-# monitor and the trajectory read in batches; docs/lcm-contract.md, "Receiving in batches").
-# Last, the cost of authentication (--key, HMAC-SHA256 on every message; docs/security.md): the
+# Each is run ROUNDS times (default 5), alternating; medians and their ratios are printed, for
+# two placements: free (the scheduler's) and one core (all processes pinned to CPU 0).
+# Targets: lockstep >= 0.8 x raw; Bus ping-pong >= 0.95 x raw.
+# Then recording: the same lockstep run alone, with the stock lcm-logger next to it (real-time
+# priority where permitted, as docs/lcm-contract.md recommends) and with the monitor's own log
+# (feeddrive-launch --lcm-log), alternating; medians of steps/s.
+# Last, what other processes on the multicast group cost a ping-pong round trip (why the
+# monitor and the trajectory read in batches; docs/lcm-contract.md, "Receiving").
+# Then the cost of authentication (--key, HMAC-SHA256 on every message; docs/security.md): the
 # same lockstep run without and with a key, alternating, medians, ratio and cost per step.
 # A third argument "auth" runs only that part: bench/lockstep_bench.sh BUILD ROUNDS auth
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
-ROUNDS=${2:-3}
+ROUNDS=${2:-5}
 URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'
+SCEN=scenarios/paper/smc_bl_jerk_limited.yaml
 TMP=$(mktemp -d)
-trap 'jobs -p | xargs -r kill 2>/dev/null || true; rm -rf "$TMP"' EXIT
+LOGDIR=$TMP
+if [ -d /dev/shm ] && [ -w /dev/shm ]; then LOGDIR=$(mktemp -d /dev/shm/feeddrive-bench.XXXXXX); fi
+trap 'jobs -p | xargs -r kill 2>/dev/null || true; rm -rf "$TMP" "$LOGDIR"' EXIT
 median() { printf '%s\n' "$@" | sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
-# bench PLACEMENT: "free" (the scheduler places the processes) or "one-core" (every process of
-# both benchmarks pinned to CPU 0: taskset for the ping-pong, feeddrive-launch --cpus 0).
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a / b }'; }
+steps_per_s() { jq -r .lockstep.steps_per_second "$1/summary.json"; }
+# bench PLACEMENT: "free" (the scheduler places the processes) or "one-core" (every process
+# pinned to CPU 0: taskset for the ping-pongs, feeddrive-launch --cpus 0).
 bench() {
-  local placement=$1 pin=() cpus=() pp=() ls_rates=()
+  local placement=$1 pin=() cpus=() raw=() bus=() ls=() rate
   if [ "$placement" = one-core ]; then pin=(taskset -c 0); cpus=(--cpus 0); fi
   for r in $(seq "$ROUNDS"); do
-    "${pin[@]}" "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PP$placement$r" & srv=$!
-    rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PP$placement$r" |
+    "${pin[@]}" "$BUILD/bin/lcm-pingpong-raw" server "$URL" "RAW$placement$r" & srv=$!
+    rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong-raw" client "$URL" "RAW$placement$r" 15000 | awk '/pingpong_rate/ { print $2 }')
+    wait $srv; raw+=("$rate")
+    "${pin[@]}" "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "BUS$placement$r" & srv=$!
+    rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "BUS$placement$r" |
            awk '/pingpong_rate/ { print $2 }')
-    wait $srv
-    pp+=("$rate")
-    "$BUILD/bin/feeddrive-launch" scenarios/paper/smc_bl_jerk_limited.yaml --out "$TMP/run$placement$r" --no-plots -q \
+    wait $srv; bus+=("$rate")
+    "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/run$placement$r" --no-plots -q \
         --lcm-url "$URL" --prefix "LS$placement$r" "${cpus[@]}"
-    ls_rates+=("$(jq -r .lockstep.steps_per_second "$TMP/run$placement$r/summary.json")")
-    echo "$placement round $r: ping-pong ${pp[-1]} round trips/s, lockstep ${ls_rates[-1]} steps/s"
+    ls+=("$(steps_per_s "$TMP/run$placement$r")")
+    echo "$placement round $r: raw liblcm ping-pong ${raw[-1]}, Bus ping-pong ${bus[-1]} round trips/s; lockstep ${ls[-1]} steps/s"
   done
-  local mp ml
-  mp=$(median "${pp[@]}"); ml=$(median "${ls_rates[@]}")
-  echo "$placement: median ping-pong $mp round trips/s, median lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
-  awk -v l="$ml" -v p="$mp" -v w="$placement" 'BEGIN { printf "%s: ratio lockstep / ping-pong: %.3f (target >= 0.8)\n", w, l / p }'
+  local mr mb ml
+  mr=$(median "${raw[@]}"); mb=$(median "${bus[@]}"); ml=$(median "${ls[@]}")
+  echo "$placement: medians: raw liblcm ping-pong $mr, Bus ping-pong $mb round trips/s; lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
+  echo "$placement: Bus ping-pong / raw: $(ratio "$mb" "$mr") (target >= 0.95); lockstep / raw: $(ratio "$ml" "$mr") (target >= 0.8)"
 }
 auth() {
   local plain=() keyed=() key="$TMP/bench.key"
@@ -66,6 +79,30 @@ if [ "${3:-all}" = auth ]; then
 fi
 bench free
 bench one-core
+
+# Recording: alone, with the stock lcm-logger, with the monitor's --lcm-log.
+prio=(chrt -f 20)
+"${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority for lcm-logger here; it runs at normal priority"; prio=(); }
+alone=(); stock=(); own=()
+for r in $(seq "$ROUNDS"); do
+  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/alone$r" --no-plots -q --lcm-url "$URL" --prefix "LA$r"
+  alone+=("$(steps_per_s "$TMP/alone$r")")
+  "${prio[@]}" lcm-logger --lcm-url="$URL" --channel="LL${r}_.*" --force "$LOGDIR/stock$r.lcmlog" > /dev/null 2>&1 & lg=$!
+  sleep 0.5   # the logger joins the group
+  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/stock$r" --no-plots -q --lcm-url "$URL" --prefix "LL$r"
+  kill -INT $lg; wait $lg || true
+  stock+=("$(steps_per_s "$TMP/stock$r")")
+  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/own$r" --no-plots -q --lcm-url "$URL" --prefix "LO$r" \
+      --lcm-log "$LOGDIR/own$r.lcmlog"
+  own+=("$(steps_per_s "$TMP/own$r")")
+  complete=$("$BUILD/bin/feeddrive-log2csv" "$LOGDIR/stock$r.lcmlog" --prefix "LL$r" --scenario "$SCEN" --out "$TMP/conv$r" -q 2>&1 &&
+             echo complete || echo INCOMPLETE)
+  echo "recording round $r: alone ${alone[-1]}, stock lcm-logger ${stock[-1]} (its log $complete), monitor --lcm-log ${own[-1]} steps/s"
+  rm -f "$LOGDIR/stock$r.lcmlog" "$LOGDIR/own$r.lcmlog"
+done
+ma=$(median "${alone[@]}"); ms=$(median "${stock[@]}"); mo=$(median "${own[@]}")
+echo "recording: medians [steps/s]: alone $ma, stock lcm-logger $ms ($(ratio "$ms" "$ma") of alone), monitor --lcm-log $mo ($(ratio "$mo" "$ma") of alone)"
+
 # What other processes on the multicast group cost a round trip, for both placements: none, two
 # liblcm subscribers to a channel nobody publishes, two batched readers (the monitor's and the
 # trajectory's way of receiving, service/udpm_reader.hpp). A lockstep run has two such processes.
@@ -80,15 +117,14 @@ group() {
         for i in 1 2; do "${pin[@]}" "$BUILD/bin/lcm-pingpong" listen "${flag[@]}" --seconds 60 --lcm-url "$URL" --prefix "G$i" & listeners+=($!); done
         sleep 0.2
       fi
-      "${pin[@]}" "$BUILD/bin/lcm-pingpong" server --lcm-url "$URL" --prefix "PG$placement$extra$r" & srv=$!
-      rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "PG$placement$extra$r" |
-             awk '/pingpong_rate/ { print $2 }')
+      "${pin[@]}" "$BUILD/bin/lcm-pingpong-raw" server "$URL" "PG$placement$extra$r" & srv=$!
+      rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong-raw" client "$URL" "PG$placement$extra$r" 15000 | awk '/pingpong_rate/ { print $2 }')
       wait $srv
       [ ${#listeners[@]} -gt 0 ] && { kill "${listeners[@]}"; wait "${listeners[@]}" 2>/dev/null || true; }
       case $extra in none) bare+=("$rate") ;; lcm) lcm+=("$rate") ;; batched) batched+=("$rate") ;; esac
     done
   done
-  echo "$placement: ping-pong with other processes on the group, medians [round trips/s]:" \
+  echo "$placement: raw ping-pong with other processes on the group, medians [round trips/s]:" \
        "none $(median "${bare[@]}"), two liblcm subscribers $(median "${lcm[@]}"), two batched readers $(median "${batched[@]}")"
 }
 group free

@@ -90,16 +90,16 @@ end
 local defaults = {
   {'lcm-url', 'udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304', 'LCM URL'},
   {'prefix', 'FD', 'channel prefix: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND'},
-  {'mass', 102.04, 'moving mass m [kg]'},
-  {'thrust-gain', 260.0, 'Ka*Kf [N/V]'},
+  {'mass', 102.04, 'moving mass m [kg]; default: the run_info_t of the run'},
+  {'thrust-gain', 260.0, 'Ka*Kf [N/V]; default: the run_info_t of the run'},
   {'lambda', 50.0, 'sliding surface S = e\' + lambda*e [1/s]'},
   {'eta', 5.0, 'switching gain [m/s^2]'},
   {'k', 10.0, 'proportional gain on S [1/s]'},
   {'phi', 0.5e-3, 'boundary layer of sat(S/phi) [m/s]'},
   {'ki', 1e6, 'integral gain on S [1/s^2] (0: off)'},
-  {'coulomb', 80.0, 'Coulomb friction feed-forward Fc [N] (0: off)'},
+  {'coulomb', 80.0, 'Coulomb friction feed-forward Fc [N] (0: off); default: the run_info_t of the run'},
   {'coulomb-velocity', 1e-3, 'feed-forward Fc*tanh(v_d / this) [m/s]'},
-  {'u-limit', 10.0, 'the controller saturates u to [-u_limit, u_limit] [V]'},
+  {'u-limit', 10.0, 'the controller saturates u to [-u_limit, u_limit] [V]; default: the run_info_t of the run'},
   {'start-timeout', 30.0, 'seconds to wait for step 0'},
   {'step-timeout', 5.0, 'seconds without progress before failing'},
   {'resend-interval', 0.002, 'ask for a missing reference after this long [s]'},
@@ -119,6 +119,7 @@ end
 
 local opt = {quiet = false}
 for _, d in ipairs(defaults) do opt[d[1]] = d[2] end
+local given = {}                -- options set on the command line (run_info_t does not override them)
 
 do
   local i = 1
@@ -149,6 +150,7 @@ do
       else
         opt[name] = value
       end
+      given[name] = true
     end
     i = i + 1
   end
@@ -195,7 +197,7 @@ local function wall_utime() return math.floor((wall0 + (now() - mono0)) * 1e6) e
 
 local P = opt.prefix
 local ch = {state = P .. '_STATE', command = P .. '_CMD', reference = P .. '_REF',
-            status = P .. '_STATUS', resend = P .. '_RESEND'}
+            status = P .. '_STATUS', resend = P .. '_RESEND', info = P .. '_INFO'}
 local ROLE = 'controller'
 local RESEND_MS = math.max(1, math.floor(opt['resend-interval'] * 1000 + 0.5))
 local KEEP = 65536              -- commands remembered for repeats and resend requests
@@ -211,6 +213,7 @@ local last_request_age_ms = 0
 local next_seq = 0              -- first step not answered yet
 local last_seq = -1             -- last answered step
 local ended = false
+local run_info = nil            -- the run's run_info_t, once received: no command goes out before it
 local state = 'starting'
 local counters = {resends = 0, duplicates = 0, invalid = 0, send_errors = 0, foreign = 0, unauthenticated = 0}
 local run_id = opt['run-id'] ~= 0 and opt['run-id'] or nil   -- nil: not joined yet
@@ -361,7 +364,7 @@ local function control(ref, st)
 end
 
 local function try_answer()
-  if not pending then return end
+  if not pending or not run_info then return end
   local ref = refs[pending.seq]
   if not ref then return end
   local st = pending
@@ -384,13 +387,14 @@ local function try_answer()
   for k in pairs(refs) do if k <= st.seq then refs[k] = nil end end
 end
 
-local function request_reference(seq)
+local function request_resend(channel, seq)
   local r = feeddrive.resend_request_t:new()
   r.requester = ROLE
-  r.channel = ch.reference
+  r.channel = channel
   r.seq = seq
   publish(ch.resend, seal(ch.resend, r))
 end
+local function request_reference(seq) request_resend(ch.reference, seq) end
 
 -- Subscriptions -----------------------------------------------------------------------------------
 
@@ -467,6 +471,25 @@ subscribe(ch.reference, feeddrive.reference_block_t, function(b)
   try_answer()
 end)
 
+-- The run describes itself (run_info_t, re-published every second and on request): take the
+-- drive's nominal mass, thrust gain, Coulomb friction, the command limit and the period from it,
+-- unless given on the command line.
+subscribe(ch.info, feeddrive.run_info_t, function(m)
+  if run_info then return end
+  run_info = m
+  local from = {mass = m.mass, ['thrust-gain'] = m.thrust_gain,
+                coulomb = m.friction_model == 'none' and 0.0 or m.coulomb_force,
+                ['u-limit'] = math.min(-m.u_min, m.u_max, m.input_limit)}
+  for name, value in pairs(from) do
+    if not given[name] and finite(value) and value >= 0 then opt[name] = value end
+  end
+  info('run %s (%s): T = %g s, %d steps; m %g kg, Ka*Kf %g N/V, Fc %g N, |u| <= %g V (from run_info_t)',
+       m.scenario, m.mode, m.control_period, m.steps, opt.mass, opt['thrust-gain'], opt.coulomb, opt['u-limit'])
+  ctl.period = nil
+  check_period({seq = 1, t = m.control_period})
+  try_answer()
+end)
+
 subscribe(ch.status, feeddrive.process_status_t, function(m)
   if not run_id then
     -- Join the first plant whose heartbeat is fresh (a replayed log carries old times).
@@ -521,6 +544,10 @@ local function run()
   ctl.last_progress = now()
   while not ended do
     local got = poll()
+    if not run_info and now() - (ctl.last_info_request or -1) >= 0.1 then  -- joined late: ask for it
+      request_resend(ch.info, 0)
+      ctl.last_info_request = now()
+    end
     if not got and pending then pending_age_ms = pending_age_ms + 1 end
     if pending and pending_age_ms - last_request_age_ms >= RESEND_MS then
       request_reference(pending.seq)
@@ -529,6 +556,9 @@ local function run()
     local t = now()
     local limit = next_seq == 0 and opt['start-timeout'] or opt['step-timeout']
     if t - ctl.last_progress > limit then
+      if not run_info then
+        fail(string.format('no run_info_t on %s from the monitor within %g s', ch.info, limit))
+      end
       if pending then
         fail(string.format('no reference from the trajectory for step %d within %g s', pending.seq, limit))
       end

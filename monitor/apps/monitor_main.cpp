@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   app.add_flag("--attach", mopt.attach,
                "join a running system or an lcm-logplayer playback: record from the first state seen, "
                "never ask for resends or acknowledge");
+  app.add_option("--lcm-log", mopt.lcm_log,
+                 "also write every message of the run to FILE in the standard LCM log format (as lcm-logger, "
+                 "without its cost; lcm-logplayer, lcm-spy and feeddrive-log2csv read it)");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     mopt.plots = !no_plots;

@@ -7,16 +7,14 @@
 #include <vector>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
 
 namespace feeddrive::monitor {
 namespace {
 
-// One event of an LCM log file (the format of lcm/eventlog.c, LCM 1.3): a big-endian header
-//   uint32 sync = 0xEDA1DA01, int64 event number, int64 timestamp [us], int32 channel length,
-//   int32 data length,
-// then the channel name and the payload. We parse it ourselves rather than with lcm::LogFile
+// One event of an LCM log file (the format: lcm_log.hpp). We parse it ourselves rather than with lcm::LogFile
 // because liblcm prints its own diagnostics to stderr on a corrupt event, and a bad log must get
 // exactly one line that names the event and the byte offset.
 struct Event {
@@ -25,15 +23,8 @@ struct Event {
   std::vector<std::uint8_t> data;
 };
 
-constexpr std::uint32_t kSync = 0xEDA1DA01u;
 constexpr std::int32_t kMaxChannel = 4096;        // far above LCM's 63-character channel limit
 constexpr std::int32_t kMaxData = 64 * 1024 * 1024;  // our messages are < 1 KB
-
-std::uint64_t big_endian(const std::uint8_t* p, int n) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
-  return v;
-}
 
 class LogParser {
  public:
@@ -47,13 +38,14 @@ class LogParser {
   // Reads the next event into `ev`; false at the clean end of the file. Throws on corruption.
   bool next(Event& ev, long events_so_far) {
     if (offset_ == size_) return false;
-    std::uint8_t h[28];
+    std::uint8_t h[kLcmLogHeaderSize];
     if (size_ - offset_ < static_cast<std::int64_t>(sizeof h)) corrupt(events_so_far, "truncated event header");
     in_.read(reinterpret_cast<char*>(h), sizeof h);
-    if (static_cast<std::uint32_t>(big_endian(h, 4)) != kSync) corrupt(events_so_far, "bad sync word");
-    ev.timestamp = static_cast<std::int64_t>(big_endian(h + 12, 8));
-    const auto channel_len = static_cast<std::int32_t>(big_endian(h + 20, 4));
-    const auto data_len = static_cast<std::int32_t>(big_endian(h + 24, 4));
+    const LcmLogHeader header = decode_lcm_log_header(h);
+    if (header.sync != kLcmLogSync) corrupt(events_so_far, "bad sync word");
+    ev.timestamp = header.timestamp;
+    const std::int32_t channel_len = header.channel_length;
+    const std::int32_t data_len = header.data_length;
     if (channel_len <= 0 || channel_len > kMaxChannel) corrupt(events_so_far, "bad channel length");
     if (data_len < 0 || data_len > kMaxData) corrupt(events_so_far, "bad data length");
     if (size_ - offset_ - static_cast<std::int64_t>(sizeof h) < std::int64_t{channel_len} + data_len)

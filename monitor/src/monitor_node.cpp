@@ -5,12 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
-#include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/output/gnuplot.hpp"
+#include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/service/translate.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/summary.hpp"
 
@@ -20,21 +23,93 @@ using service::mono_us;
 using service::us;
 
 MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
-    : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched), s_(s), mopt_(mopt), rec_(mopt.attach) {
+    : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched),
+      s_(s),
+      mopt_(mopt),
+      rec_(mopt.attach),
+      // Histograms: bins of T/20 up to 2T (5 us at 10 kHz).
+      hist_sc_(s.control_period * 1e6 / 20.0, 40),
+      hist_cs_(s.control_period * 1e6 / 20.0, 40),
+      lateness_(s.control_period * 1e6) {
   if (mopt.attach) bus().join_first_seen();
   // Every message passes the conflict check first: a second, different message for a step is
   // never recorded (service::Node::admit).
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
-    if (admit(state_ledger_, channels().state, m.seq, m)) rec_.on_state(m, t);
+    if (!admit(state_ledger_, channels().state, m.seq, m)) return;
+    rec_.on_state(m, t);
+    on_state_timing(m, t);
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
     for (const reference_t& m : b.refs)
       if (admit(reference_ledger_, channels().reference, m.seq, m)) rec_.on_reference(m, t);
   });
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
-    if (admit(command_ledger_, channels().command, m.seq, m)) rec_.on_command(m, t);
+    if (!admit(command_ledger_, channels().command, m.seq, m)) return;
+    rec_.on_command(m, t);
+    on_command_timing(m, t);
   });
+  if (!mopt_.lcm_log.empty()) {
+    if (!bus().batched())
+      throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
+                                  opt.lcm_url);
+    log_ = std::make_unique<LcmLogWriter>(mopt_.lcm_log);
+    const std::string run_channels = opt.prefix + "_";
+    bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
+      if (ch.compare(0, run_channels.size(), run_channels) != 0 || !log_error_.empty()) return;
+      try {
+        log_->write(ch, d, n, utime);
+      } catch (const std::exception& e) {
+        log_error_ = e.what();
+      }
+    });
+  }
+  // The run's self-description (run_info_t): the monitor is in every run (a hardware driver may
+  // take the plant's role, never the monitor's) and off the step's path. At the start, every
+  // second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
+  // monitor only listens.
+  if (!mopt_.attach) {
+    info_ = service::to_run_info(s_, opt.realtime, 0);  // run_id: stamped by the bus
+    on_heartbeat = [this] {
+      if (heartbeats_++ % 10 == 0) publish_info();
+    };
+    on_resend_request = [this](const resend_request_t& r) {
+      if (r.channel == channels().info) publish_info();
+    };
+  }
   out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
+}
+
+void MonitorNode::publish_info() {
+  info_.utime = service::wall_utime();
+  bus().publish(channels().info, info_);
+}
+
+// Latency histograms from the first receive time of each message (one clock: the kernel's
+// receive stamps of this socket): state k -> command k, command k -> state k+1, and (real time)
+// how late state k went out. Only the steps in flight are kept.
+void MonitorNode::on_state_timing(const drive_state_t& m, std::int64_t t) {
+  if (m.end_of_run || m.seq <= timing_pruned_ || state_recv_.count(m.seq)) return;
+  state_recv_[m.seq] = t;
+  if (options().realtime) lateness_.add(m.seq, static_cast<double>(t));
+  if (const auto c = cmd_recv_.find(m.seq - 1); c != cmd_recv_.end() && t >= c->second)
+    hist_cs_.add(static_cast<double>(t - c->second));
+  prune_timing(m.seq);
+}
+
+void MonitorNode::on_command_timing(const control_command_t& m, std::int64_t t) {
+  if (m.seq <= timing_pruned_ || cmd_recv_.count(m.seq)) return;
+  cmd_recv_[m.seq] = t;
+  if (const auto s = state_recv_.find(m.seq); s != state_recv_.end() && t >= s->second)
+    hist_sc_.add(static_cast<double>(t - s->second));
+  prune_timing(m.seq);
+}
+
+void MonitorNode::prune_timing(std::int64_t seq) {
+  constexpr std::int64_t kKeep = 4096;  // steps in flight: far more than a step's messages are apart
+  if (seq - timing_pruned_ < 2 * kKeep) return;
+  timing_pruned_ = seq - kKeep;
+  state_recv_.erase(state_recv_.begin(), state_recv_.upper_bound(timing_pruned_));
+  cmd_recv_.erase(cmd_recv_.begin(), cmd_recv_.upper_bound(timing_pruned_));
 }
 
 void MonitorNode::request_missing() {
@@ -96,6 +171,7 @@ bool MonitorNode::run() {
         if (due) last_ack_sent_ = acked_seq;
       }
       progress(false);
+      if (!log_error_.empty()) throw service::RunFailure(log_error_);
       if (rec_.complete()) break;
       request_missing();
       check_peers();
@@ -122,6 +198,19 @@ bool MonitorNode::run() {
     throw interrupt::Interrupted(e.signal());
   } catch (const std::runtime_error& e) {  // writing a row failed (disk full, ...)
     failure = e.what();
+  }
+  if (log_) {
+    // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
+    // closed before the run is announced done.
+    bus().poll(std::chrono::microseconds(0));
+    bus().set_tap({});
+    try {
+      log_->close();
+      if (!options().quiet) spdlog::info("monitor: {} LCM events -> {}", log_->events(), log_->path());
+    } catch (const std::exception& e) {
+      if (log_error_.empty()) log_error_ = e.what();
+    }
+    if (!log_error_.empty() && failure.empty()) failure = log_error_;
   }
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.
@@ -226,6 +315,21 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["reference_lead_us"] = {{"p50", lat(rec_.reference_lead(), 0.5)},
                             {"p1", lat(rec_.reference_lead(), 0.01)},
                             {"samples", rec_.reference_lead().count()}};
+  // In real time a state_to_command beyond T - guard is a deadline miss, and
+  // period_start_lateness is how late each state went out relative to the earliest (the plant's
+  // timer wake-up and spin, as the monitor sees it).
+  std::vector<std::string> hist_names = {"state_to_command", "command_to_state"};
+  std::vector<Histogram> hists = {hist_sc_, hist_cs_};
+  if (options().realtime) {
+    hist_names.push_back("period_start_lateness");
+    hists.push_back(lateness_.result(hist_sc_.bin_us(), static_cast<int>(hist_sc_.counts().size())));
+  }
+  {
+    auto& h = l["latency_histogram_us"];
+    h["bin_us"] = hist_sc_.bin_us();
+    for (std::size_t i = 0; i < hists.size(); ++i)
+      h[hist_names[i]] = {{"counts", hists[i].counts()}, {"overflow", hists[i].overflow()}, {"samples", hists[i].samples()}};
+  }
   for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
     for (const char* q : {"p50", "p99", "p1"})
       if (v->contains(q) && std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
@@ -234,7 +338,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   std::string why = failure;
   try {
     if (!write_error.empty()) throw std::runtime_error(write_error);
-    out_->finish(sum, mopt_.plots, j.dump());
+    const bool plots = mopt_.plots && out_->steps() > 0;
+    out_->finish(sum, mopt_.plots, j.dump(),
+                 [&](const output::StagedFolder& dir) { write_histograms(dir.dir().string(), hist_names, hists, plots); });
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -254,6 +360,34 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",
                  output::shown(mopt_.out_dir));
   return written;
+}
+
+void MonitorNode::write_histograms(const std::string& dir, const std::vector<std::string>& names,
+                                   const std::vector<Histogram>& h, bool plot) const {
+  {
+    std::FILE* f = std::fopen((dir + "/latency_histogram.csv").c_str(), "w");
+    if (f == nullptr) throw std::runtime_error(dir + "/latency_histogram.csv: cannot open for writing");
+    const std::string csv = histograms_csv(names, h);
+    const bool ok = std::fwrite(csv.data(), 1, csv.size(), f) == csv.size();
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error(dir + "/latency_histogram.csv: write failed");
+  }
+  if (!plot) return;
+  const double period_us = s_.control_period * 1e6;
+  const std::string bin = std::to_string(h.front().bin_us());
+  std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
+                   "set output 'latency_histogram.png'\nset grid\nset logscale y\nset yrange [0.5:*]\n"
+                   "set style fill transparent solid 0.4\nset boxwidth " + bin + "\n"
+                   "set xlabel 'latency [us] (bins of T/20 up to 2T; later ones in summary.json as overflow)'\n"
+                   "set ylabel 'steps'\nset title " +
+                   output::gnuplot_string(s_.name + (options().realtime ? " (real time)" : " (lockstep)")) + "\n";
+  gp += "set arrow from " + std::to_string(period_us) + ",graph 0 to " + std::to_string(period_us) +
+        ",graph 1 nohead dt 2\nset label 'T' at " + std::to_string(period_us) + ",graph 0.95\n";
+  gp += "plot ";
+  for (std::size_t i = 0; i < names.size(); ++i)
+    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us() / 2) +
+          "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
+  gp += "\n";
+  output::run_gnuplot(dir, gp, "latency_histogram.gp");
 }
 
 }  // namespace feeddrive::monitor

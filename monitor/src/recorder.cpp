@@ -42,7 +42,7 @@ void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
     return;
   }
   refs_[m.seq] = {m, recv_us};
-  if (first_ref_seq_ < 0) first_ref_seq_ = m.seq;
+  if (first_ref_seq_ < 0 || (whole_log_ && m.seq < first_ref_seq_)) first_ref_seq_ = m.seq;
   maybe_start();
   if (const auto s = states_.find(m.seq); s != states_.end()) lead_.add(static_cast<double>(s->second.recv_us - recv_us));
 }
@@ -61,7 +61,7 @@ void Recorder::maybe_start() {
   // Attach mode: references arrive in blocks ahead of the states, so the first row is the first
   // step for which both the state and the reference can have been seen: max(first state, first
   // reference). What came before it is dropped.
-  if (!attach_ || started_ || first_state_seq_ < 0 || first_ref_seq_ < 0) return;
+  if (!attach_ || started_ || whole_log_ || first_state_seq_ < 0 || first_ref_seq_ < 0) return;
   next_ = std::max(first_state_seq_, first_ref_seq_);
   started_ = true;
   states_.erase(states_.begin(), states_.lower_bound(next_));
@@ -71,6 +71,10 @@ void Recorder::maybe_start() {
 
 std::size_t Recorder::flush(const sim::RecordSink& sink) {
   std::size_t added = 0;
+  if (whole_log_) {  // the whole recording is in: start from its lowest steps
+    whole_log_ = false;
+    maybe_start();
+  }
   if (attach_ && !started_) return 0;
   for (;;) {
     if (steps_ >= 0 && next_ >= steps_) break;

@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   app.add_option("--external", external, "leave ROLE (controller, plant or trajectory) to a process you start")
       ->type_name("ROLE");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  app.add_option("--lcm-log", lo.lcm_log,
+                 "the monitor also writes every message of the run to FILE in the standard LCM log format "
+                 "(instead of the stock lcm-logger, which halves a lockstep run's speed)");
   std::string cpus;
   app.add_option("--cpus", cpus, "pin every process to these CPUs, e.g. 0 or 0,1 (a lockstep chain runs fastest on one core where cross-core wake-ups are slow)")
       ->type_name("LIST");

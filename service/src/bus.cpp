@@ -17,7 +17,8 @@ Channels::Channels(const std::string& prefix)
       reference(prefix + "_REF"),
       status(prefix + "_STATUS"),
       resend(prefix + "_RESEND"),
-      summary(prefix + "_SUMMARY") {}
+      summary(prefix + "_SUMMARY"),
+      info(prefix + "_INFO") {}
 
 std::int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
@@ -31,14 +32,15 @@ std::int64_t mono_us() {
       .count();
 }
 
-Bus::Bus(const std::string& url, Receive receive) : url_(url), lcm_(url) {
+Bus::Bus(const std::string& url, Receive receive) : url_(url), lcm_(url), receive_(receive) {
   if (!lcm_.good())
     throw std::runtime_error("cannot open LCM at '" + url +
                              "' (is there a multicast route? see docs/lcm-contract.md)");
-  // Batched: liblcm only publishes (it opens its receive socket and thread on the first
-  // subscribe or handle, which then never come); our reader takes the group's datagrams.
-  if (receive == Receive::kBatched)
+  // Direct and batched: liblcm only publishes (it opens its receive socket and thread on the
+  // first subscribe or handle, which then never come); our reader takes the group's datagrams.
+  if (receive != Receive::kEvent)
     if (const std::optional<UdpmAddress> a = parse_udpm_url(url)) reader_ = std::make_unique<UdpmReader>(*a);
+  if (!reader_) receive_ = Receive::kEvent;
 }
 
 bool Bus::log_due(std::int64_t& last) {
@@ -76,16 +78,18 @@ void Bus::rethrow_handler_error() {
 }
 
 bool Bus::poll(std::chrono::microseconds timeout) {
-  return reader_ ? poll_batched(timeout) : poll_event(timeout);
+  switch (receive_) {
+    case Receive::kDirect: return poll_direct(timeout);
+    case Receive::kBatched: return poll_batched(timeout);
+    case Receive::kEvent: break;
+  }
+  return poll_event(timeout);
 }
 
-bool Bus::poll_batched(std::chrono::microseconds timeout) {
-  // Sleep first, never on the socket: datagrams queue meanwhile without waking anyone.
-  const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, kBatchInterval).count(), 0);
-  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
-  ::nanosleep(&ts, nullptr);  // EINTR (a signal): drain what is there and return
+std::size_t Bus::drain() {
   std::string channel;
   const std::size_t n = reader_->drain([&](std::string_view ch, const std::uint8_t* d, std::size_t size, std::int64_t utime) {
+    if (tap_) tap_(ch, d, size, utime);
     channel.assign(ch);
     const auto it = batched_subs_.find(channel);
     if (it == batched_subs_.end()) return;
@@ -93,7 +97,25 @@ bool Bus::poll_batched(std::chrono::microseconds timeout) {
     for (Raw* r : it->second) r->handle(&rbuf, channel);
   });
   rethrow_handler_error();
-  return n > 0;
+  return n;
+}
+
+bool Bus::poll_batched(std::chrono::microseconds timeout) {
+  // Sleep first, never on the socket: datagrams queue meanwhile without waking anyone.
+  const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, kBatchInterval).count(), 0);
+  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+  ::nanosleep(&ts, nullptr);  // EINTR (a signal): drain what is there and return
+  return drain() > 0;
+}
+
+bool Bus::poll_direct(std::chrono::microseconds timeout) {
+  // One wait on the socket (returns at once when something is queued), then take everything.
+  const std::int64_t wait_us = std::max<std::int64_t>(timeout.count(), 0);
+  struct pollfd p{reader_->fd(), POLLIN, 0};
+  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+  const int r = ::ppoll(&p, 1, &ts, nullptr);
+  if (r < 0 && errno != EINTR) throw std::runtime_error("poll on the LCM socket failed");
+  return r > 0 && drain() > 0;
 }
 
 bool Bus::poll_event(std::chrono::microseconds timeout) {

@@ -31,6 +31,10 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
   app.add_option("--max-bad-commands", opt.max_bad_commands,
                  "real time: missed or invalid commands in a row before the plant goes to zero thrust")
       ->capture_default_str();
+  app.add_option("--spin-us", opt.realtime_spin_us,
+                 "real time: busy-wait this many us before each period start (timer wake-up latency)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
   app.add_option("--run-id", opt.run_id,
                  "identity of the run (nonzero; docs/security.md); default: the plant draws one, the others join "

@@ -66,6 +66,13 @@ void ControllerNode::try_answer() {
 }
 
 void ControllerNode::run() {
+  // Above the plant (80): on a shared core the controller's answer preempts the plant's final
+  // spin before a period start.
+  if (options().realtime) {
+    const std::string rt = enter_realtime(81);
+    if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("controller: real time: {}", rt);
+    else spdlog::warn("controller: real time: {}", rt);
+  }
   set_state("running");
   last_progress_us_ = mono_us();
   const std::int64_t resend_us = us(options().resend_interval_s);
@@ -76,6 +83,9 @@ void ControllerNode::run() {
       request_resend(channels().reference, pending_->seq);
       last_ref_request_us_ = now;
     }
+    // Another role's failure first: it names the culprit (after this process was stopped, the
+    // plant has failed naming it, and our own timeout would blame the plant).
+    check_peers();
     const double limit = next_seq_ == 0 ? options().start_timeout_s : options().step_timeout_s;
     // As in the trajectory: a plant that still sends its heartbeat waits for another role and
     // will name it; never wait longer than three timeouts, though.

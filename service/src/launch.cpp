@@ -36,7 +36,8 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
                                 "--resend-interval", fmt_double(opt.resend_interval_s),
                                 "--monitor-window", std::to_string(opt.monitor_window),
                                 "--linger", fmt_double(opt.linger_s),
-                                "--max-bad-commands", std::to_string(opt.max_bad_commands)};
+                                "--max-bad-commands", std::to_string(opt.max_bad_commands),
+                                "--spin-us", std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
@@ -153,6 +154,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     if (role == "monitor") {
       args.insert(args.end(), {"--out", lo.out_dir});
       if (!lo.plots) args.push_back("--no-plots");
+      if (!lo.lcm_log.empty()) args.insert(args.end(), {"--lcm-log", lo.lcm_log});
     }
     const std::string exe = bin + "/feeddrive-" + role;
     if (::access(exe.c_str(), X_OK) != 0) throw std::runtime_error("cannot find " + exe);

@@ -1,8 +1,14 @@
 #include "feeddrive/service/node.hpp"
 
+#include <sched.h>
 #include <spdlog/spdlog.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
+#include <ctime>
 
 #include "feeddrive/common/interrupt.hpp"
 #include <cstdio>
@@ -12,6 +18,28 @@ namespace feeddrive::service {
 void install_signal_handlers() { interrupt::install_handlers(); }
 
 int interrupted_by() { return interrupt::signal_number(); }
+
+std::string enter_realtime(int priority) {
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+  const std::string lock = locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (::sched_setscheduler(0, SCHED_FIFO, &sp) == 0) return "SCHED_FIFO " + std::to_string(priority) + ", " + lock;
+  return std::string("normal scheduling (SCHED_FIFO not permitted: ") + std::strerror(errno) +
+         "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock;
+}
+
+void sleep_until(std::int64_t target_us, std::int64_t spin_us) {
+  const std::int64_t wake = target_us - spin_us;
+  if (mono_us() < wake) {
+    timespec ts{static_cast<time_t>(wake / 1000000), static_cast<long>((wake % 1000000) * 1000)};
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !interrupt::interrupted()) {
+    }
+  }
+  while (mono_us() < target_us) {
+  }
+}
 
 std::string seconds_text(double s) {
   char buf[32];
@@ -70,6 +98,7 @@ void Node::heartbeat(bool force) {
   last_heartbeat_us_ = now;
   if (!bus_.run_known()) return;  // nothing to say before joining a run
   bus_.publish(ch_.status, status_message(state_, ""));
+  if (on_heartbeat) on_heartbeat();
 }
 
 void Node::announce_failure(const std::string& message) {
@@ -103,7 +132,8 @@ void Node::wait_for_run() {
 bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff) {
   ++conflicts;
   const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +
-                           " for one step (" + diff + " differ); another publisher on the bus? (docs/security.md)";
+                           " for one step (" + diff + " differ); another publisher on the bus, or a stale step number (an answer to "
+                           "state k carrying seq < k)? (docs/security.md)";
   if (opt_.on_conflict == ConflictPolicy::kFail) throw RunFailure(what);
   // keep-first: every conflict is counted; the log names the first ten, then one a second.
   const std::int64_t now = mono_us();

@@ -2,12 +2,20 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstring>
 #include <thread>
 
 #include "feeddrive/plant/command.hpp"
 #include "feeddrive/service/translate.hpp"
 
 namespace feeddrive::service {
+namespace {
+// Real time: command k must arrive this long before w_{k+1}, so that the plant can integrate
+// the rest of the period and prepare state k+1 before w_{k+1}: a fifth of the period, at most
+// 25 us (the plant's integrate + prepare takes 10-20 us on the development VM, measured as the
+// monitor's command_to_state hop in lockstep, which includes a wake-up).
+std::int64_t realtime_guard_us(std::int64_t period_us) { return std::min<std::int64_t>(period_us / 5, 25); }
+}  // namespace
 
 PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
     : Node("plant", opt),
@@ -21,12 +29,15 @@ PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
     spdlog::info("plant: run id {} (drawn: no --run-id given; the other processes join it from the plant's heartbeat)",
                  bus().run_id());
   }
-  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t) {
+  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t recv_us) {
     if (!admit(command_ledger_, channels().command, m.seq, m)) return;
+    if (options().realtime) arrived_.emplace_back(m, recv_us);
+    // A command for a step already answered that differs from the first one (a stale step
+    // number, or another publisher) is a conflict (admit): counted and named.
     if (!command_ || m.seq > command_->seq) {
       command_ = m;
     } else {
-      ++duplicates;
+      ++duplicates;  // a repeat (real time: also a late command, counted as a missed deadline)
     }
   });
   on_resend_request = [this](const resend_request_t& r) {
@@ -114,10 +125,14 @@ void PlantNode::run_lockstep() {
         last_sent = now;
       }
       const double limit = k == 0 ? options().start_timeout_s : options().step_timeout_s;
-      if (now - start > us(limit))
+      // Another role's failure first: it names the culprit. A controller that still sends its
+      // heartbeat is waiting for someone else (the trajectory) and will name them; a stalled or
+      // dead one sends none. Never wait longer than three timeouts, though.
+      check_peers();
+      const bool controller_waits = k > 0 && peer_alive("controller", 0.5) && now - start <= 3 * us(limit);
+      if (now - start > us(limit) && !controller_waits)
         throw RunFailure("no command from the controller for step " + std::to_string(k) + " within " +
                          seconds_text(limit) + " s");
-      check_peers();
       heartbeat();
       bus().poll(std::chrono::microseconds(std::max<std::int64_t>(resend_us - (mono_us() - last_sent), 1)));
     }
@@ -135,7 +150,45 @@ void PlantNode::run_lockstep() {
   publish_state(steps_);
 }
 
+double PlantNode::sim_time_of(std::int64_t mono) const { return static_cast<double>(mono - t0_us_) * 1e-6; }
+
+bool PlantNode::take_commands(std::int64_t k, double t_end) {
+  bool got_k = false;  // command k arrived (valid or not)
+  for (const auto& [c, recv_us] : arrived_) {
+    if (c.seq <= newest_seq_) continue;  // a repeat (counted by the handler), or older than one acting
+    newest_seq_ = c.seq;
+    if (c.seq > k) throw RunFailure("the controller answered step " + std::to_string(c.seq) +
+                                    " while the plant is at step " + std::to_string(k));
+    const bool on_time = c.seq == k;
+    const plant::AdmittedCommand a = plant::admit_command(c.u, s_.plant.input_limit, last_good_u_);
+    if (a.status != plant::CommandStatus::kApplied) ++rejected_;
+    const bool good = a.status != plant::CommandStatus::kRejected;
+    if (on_time) {
+      got_k = true;
+      bad_in_a_row_ = good ? 0 : bad_in_a_row_ + 1;
+      if (good && safe_state_) {
+        spdlog::info("plant: valid commands again at step {}, leaving the safe state", k);
+        safe_state_ = false;
+      }
+    }
+    if (!good || safe_state_) continue;  // in the safe state only a command on time acts
+    // Zero-order hold from the arrival: [now, t_a] with the old input, then the new one.
+    // Arrivals within 1 ns of the current time or of the period's end are taken as there: the
+    // clock has 1 us resolution, so only rounding makes them differ, and CVODE refuses an
+    // interval of a few ulps (CV_TOO_CLOSE).
+    const double ta = std::min(sim_time_of(recv_us), t_end);
+    if (ta > drive_.time() + 1e-9 && ta < t_end - 1e-9) drive_.advance(u_now_, ta);
+    u_now_ = last_good_u_ = a.u;
+  }
+  arrived_.clear();
+  return got_k;
+}
+
 void PlantNode::run_realtime() {
+  const std::string rt = enter_realtime(80);
+  if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("plant: real time: {}", rt);
+  else spdlog::warn("plant: real time: {}", rt);
+  command_.reset();
   // Start handshake: state 0 waits for its command as in lockstep, so the clock starts only
   // when the controller, the trajectory and the monitor are all up.
   wait_for_monitor(0);
@@ -155,42 +208,45 @@ void PlantNode::run_realtime() {
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));
   }
   const std::int64_t period_us = us(s_.control_period);
-  const std::int64_t t0 = mono_us();
+  const std::int64_t guard_us = realtime_guard_us(period_us);
+  t0_us_ = mono_us();
+  for (auto& [c, recv_us] : arrived_) recv_us = t0_us_;  // command 0 came before the clock started
   for (std::int64_t k = 0; k < steps_; ++k) {
-    if (k > 0) publish_state(k);
-    const std::int64_t deadline = t0 + (k + 1) * period_us;
-    while (mono_us() < deadline) {
-      bus().poll(std::chrono::microseconds(std::max<std::int64_t>(deadline - mono_us(), 1)));
+    // State k went out at w_k. Wait for command k until the deadline; every command that comes
+    // switches the input at its arrival.
+    const double t_next = s_.time_of(k + 1);
+    const std::int64_t deadline = t0_us_ + (k + 1) * period_us - guard_us;
+    bool got_k = take_commands(k, t_next);
+    for (std::int64_t now = mono_us(); !got_k && now < deadline; now = mono_us()) {
+      bus().poll(std::chrono::microseconds(deadline - now));
+      got_k = take_commands(k, t_next);
+    }
+    if (!got_k) {
+      ++missed_;
+      ++bad_in_a_row_;
+    }
+    {
+      if (bad_in_a_row_ >= options().max_bad_commands && !safe_state_) {
+        safe_state_ = true;
+        u_now_ = 0.0;
+        spdlog::error("plant: {} missed or invalid commands in a row at step {}: safe state, zero thrust",
+                      bad_in_a_row_, k);
+      }
+    }
+    if (safe_state_) u_now_ = 0.0;
+    // The rest of the period with the input held now; state k+1 is ready before w_{k+1}.
+    previous_ = to_applied(k, u_now_, drive_.forces(u_now_));
+    drive_.advance(u_now_, t_next);
+    if (k + 1 < steps_) {
+      const drive_state_t next = make_state(k + 1);
+      sleep_until(t0_us_ + (k + 1) * period_us, options().realtime_spin_us);
+      states_.publish(k + 1, next);  // first thing in the period
+      set_seq(k + 1);
     }
     check_peers();
     heartbeat();
-    double u = last_good_u_;
-    bool good = false;
-    if (command_ && command_->seq == k) {
-      const plant::AdmittedCommand a = plant::admit_command(command_->u, s_.plant.input_limit, last_good_u_);
-      if (a.status != plant::CommandStatus::kApplied) ++rejected_;
-      if (a.status != plant::CommandStatus::kRejected) {
-        u = a.u;
-        good = true;
-      }
-    } else {
-      ++missed_;
-    }
-    bad_in_a_row_ = good ? 0 : bad_in_a_row_ + 1;
-    if (good) {
-      last_good_u_ = u;
-      if (safe_state_) spdlog::info("plant: valid commands again at step {}, leaving the safe state", k);
-      safe_state_ = false;
-    } else if (bad_in_a_row_ >= options().max_bad_commands && !safe_state_) {
-      safe_state_ = true;
-      spdlog::error("plant: {} missed or invalid commands in a row at step {}: safe state, zero thrust",
-                    bad_in_a_row_, k);
-    }
-    if (safe_state_) u = 0.0;
-    apply(k, u);
   }
   publish_state(steps_);
 }
-
 
 }  // namespace feeddrive::service

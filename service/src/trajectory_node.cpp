@@ -59,10 +59,10 @@ void TrajectoryNode::send_ahead(std::int64_t k) {
 
 void TrajectoryNode::run() {
   set_state("running");
-  wait_for_run();  // block 0 must carry the run's identity
-  // Block 0 now; the look-ahead once the plant's first state shows that the run has started.
-  send_block(0, false);
-  next_block_ = 1;
+  wait_for_run();  // every block must carry the run's identity
+  // Everything, block 0 included, once the plant's first state shows that the run has started:
+  // the plant publishes it only when the monitor is up (its flow control), so the monitor (and
+  // its --lcm-log) sees the blocks in order from block 0, without asking for them again.
   last_progress_us_ = mono_us();
   while (!end_) {
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));
@@ -70,6 +70,9 @@ void TrajectoryNode::run() {
     // A plant that still sends its heartbeat is waiting for another role (the controller, the
     // monitor) and will time out naming it; blaming the plant here would hide the real cause.
     // Never wait longer than three timeouts, though.
+    // Another role's failure first: it names the culprit (a stalled controller makes the plant
+    // fail, and then the plant's heartbeat stops too; our own timeout would blame the plant).
+    check_peers();
     const std::int64_t waited = mono_us() - last_progress_us_;
     const bool plant_waits = highest_state_ >= 0 && peer_alive("plant", 0.5) && waited <= 3 * us(limit);
     if (waited > us(limit) && !plant_waits)

@@ -83,4 +83,44 @@ sim::Record to_record(const drive_state_t& state, const reference_t& ref, const 
   return sim::make_record(state.t, to_sample(ref), st, to_measurement(state), c, applied.u, f);
 }
 
+run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_id) {
+  run_info_t m;
+  m.run_id = run_id;
+  m.utime = 0;
+  m.scenario = s.name;
+  m.mode = realtime ? "realtime" : "lockstep";
+  m.control_period = s.control_period;
+  m.steps = s.steps();
+  const plant::PlantParams& p = s.plant;
+  m.mass = p.mass;
+  m.thrust_gain = p.thrust_gain();
+  m.friction_model = plant::to_string(p.friction.model);
+  m.static_force = p.friction.static_force;
+  m.coulomb_force = p.friction.coulomb_force;
+  m.stribeck_velocity = p.friction.stribeck_velocity;
+  m.bristle_stiffness = p.friction.bristle_stiffness;
+  m.bristle_damping = p.friction.bristle_damping;
+  m.viscous = p.friction.viscous;
+  m.ripple = p.ripple.enabled;
+  m.ripple_pitch = p.ripple.pitch;
+  m.cogging_amplitude = p.ripple.cogging_amplitude;
+  m.reluctance_amplitude = p.ripple.reluctance_amplitude;
+  m.input_limit = p.input_limit;
+  switch (s.controller.type) {
+    case sim::ControllerType::kSlidingMode:
+      m.u_min = s.controller.sliding_mode.u_min;
+      m.u_max = s.controller.sliding_mode.u_max;
+      break;
+    case sim::ControllerType::kCascade:
+      m.u_min = s.controller.cascade.u_min;
+      m.u_max = s.controller.cascade.u_max;
+      break;
+    case sim::ControllerType::kOpenLoop:
+      m.u_min = s.controller.open_loop.u_min;
+      m.u_max = s.controller.open_loop.u_max;
+      break;
+  }
+  return m;
+}
+
 }  // namespace feeddrive::service

@@ -177,7 +177,8 @@ Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Sta
   return summary_.summary(wall_time_s, integrator);
 }
 
-void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json) {
+void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json,
+                       const std::function<void(const output::StagedFolder&)>& extra_files) {
   drain();
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -192,6 +193,7 @@ void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_
     write_plots(folder_, plot_, s_.name);
     plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  if (extra_files) extra_files(folder_);
   folder_.commit();
 }
 

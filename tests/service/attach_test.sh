@@ -4,9 +4,10 @@
 # identical to the same step's row of the run's own monitor (it never asks for resends, so the
 # run's monitor is what guarantees delivery; on loopback nothing is lost).
 source "$(dirname "$0")/lib.sh" "$@"
-# 5 s of the jerk-limited move (50,000 steps, several seconds of lockstep): long enough to join.
+# 10 s of the jerk-limited move (100,000 steps, about 3 s of lockstep at 33,000 steps/s): long
+# enough to join after 1 s.
 scen=$TMP/long.yaml
-sed 's/^duration: .*/duration: 5.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
 timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --lcm-url "$URL" & l=$!
 sleep 1.0
 timeout 120 feeddrive-monitor "$scen" --attach --out "$TMP/attached" --no-plots --lcm-url "$URL" --step-timeout 5 2> "$TMP/attached.err" & m=$!
@@ -14,7 +15,7 @@ wait $l || fail "the run failed"
 wait $m || { tail -5 "$TMP/attached.err" >&2; fail "the attached monitor failed"; }
 total=$(( $(wc -l < "$TMP/run/timeseries.csv") - 1 ))
 rows=$(( $(wc -l < "$TMP/attached/timeseries.csv") - 1 ))
-[ "$total" = 50000 ] || fail "the run recorded $total rows, expected 50000"
+[ "$total" = 100000 ] || fail "the run recorded $total rows, expected 100000"
 [ "$rows" -gt 0 ] && [ "$rows" -lt "$total" ] || fail "the attached monitor recorded $rows rows (joined mid-way: 0 < rows < $total)"
 # The attached rows are the last $rows rows of the run, byte for byte (same header too).
 same_csv <(head -n 1 "$TMP/run/timeseries.csv"; tail -n "$rows" "$TMP/run/timeseries.csv") "$TMP/attached/timeseries.csv"

@@ -68,8 +68,17 @@ javac -nowarn -cp "$JAR:$LCM_JAR" -d "$TMP/java" "$TMP/java/SpyDecode.java" 2> "
   { cat "$TMP/javac.err" >&2; fail "javac failed on the decoder"; }
 out=$(timeout 120 java -cp "$TMP/java:$JAR:$LCM_JAR" SpyDecode "$JAR" "$LOGDIR/run.lcmlog") ||
   { echo "$out" >&2; fail "the jar does not decode every message of the run"; }
-for ch in SPY_STATE SPY_CMD SPY_REF SPY_STATUS SPY_SUMMARY; do
+for ch in SPY_STATE SPY_CMD SPY_REF SPY_STATUS SPY_SUMMARY SPY_INFO; do
   printf '%s\n' "$out" | grep -q "$ch " || fail "no decoded message on $ch: $out"
 done
 pass "every logged message decodes with $JAR, as lcm-spy would: $out"
+# The monitor's own log (feeddrive-launch --lcm-log) reads with LCM's Java log reader too (what
+# lcm-logplayer-gui and lcm-spy's tools use).
+timeout 120 feeddrive-launch "$scen" --out "$TMP/mp2" --no-plots -q --prefix SPY --lcm-url "$URL" --lcm-log "$LOGDIR/mon.lcmlog"
+out=$(timeout 120 java -cp "$TMP/java:$JAR:$LCM_JAR" SpyDecode "$JAR" "$LOGDIR/mon.lcmlog") ||
+  { echo "$out" >&2; fail "the jar does not decode every message of the monitor's log"; }
+for ch in SPY_STATE SPY_CMD SPY_REF SPY_STATUS SPY_INFO; do
+  printf '%s\n' "$out" | grep -q "$ch " || fail "no decoded message on $ch in the monitor's log: $out"
+done
+pass "the monitor's --lcm-log decodes with LCM's Java log reader: $out"
 pass "start the spy with: CLASSPATH=$JAR lcm-spy --lcm-url='$URL'"

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Lost packets for real: an nftables rule in this test's namespace drops 3 % of the multicast
 # packets at random (every role's messages: states, commands, references, status, resend
-# requests). The run must still complete and be byte-identical to feeddrive-sim.
+# requests). The run must still complete and be byte-identical to feeddrive-sim, and the
+# monitor's LCM log (--lcm-log) must hold every step: what the monitor recovered by asking again
+# is logged too, so feeddrive-log2csv gives the same file.
 source "$(dirname "$0")/lib.sh" "$@"
 # The rule must only ever drop packets in this test's own namespace, never on the host.
 [ "${FEEDDRIVE_NETNS:-}" = private ] ||
@@ -14,10 +16,13 @@ nft add chain inet fdloss out '{ type filter hook output priority 0; }'
 nft add rule inet fdloss out ip daddr 239.0.0.0/8 numgen random mod 100 '<' 3 counter drop
 scen=$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml
 sim_run "$scen" "$TMP/sim"
-timeout 600 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --lcm-url "$URL"
+timeout 600 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --lcm-url "$URL" --lcm-log "$LOGDIR/mon.lcmlog"
 dropped=$(nft list chain inet fdloss out | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
 [ "${dropped:-0}" -gt 100 ] || fail "the rule dropped only ${dropped:-0} packets"
 same_csv "$TMP/sim/timeseries.csv" "$TMP/mp/timeseries.csv"
 resends=$(json "$TMP/mp/summary.json" .lockstep.resends)
 [ "$resends" -gt 0 ] || fail "no resends recorded although $dropped packets were dropped"
 pass "$dropped packets dropped; $resends resends, $(json "$TMP/mp/summary.json" .lockstep.lost) recovered by the monitor, $(json "$TMP/mp/summary.json" .lockstep.duplicates) duplicates ignored; identical"
+timeout 120 feeddrive-log2csv "$LOGDIR/mon.lcmlog" --scenario "$scen" --out "$TMP/conv" -q
+same_csv "$TMP/mp/timeseries.csv" "$TMP/conv/timeseries.csv"
+pass "the monitor's --lcm-log under loss converts to the same timeseries.csv"

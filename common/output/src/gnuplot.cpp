@@ -74,8 +74,8 @@ std::string gnuplot_string(std::string_view text, std::size_t max_bytes) {
   return out + "\"";
 }
 
-void run_gnuplot(const fs::path& dir, const std::string& script) {
-  const fs::path script_path = dir / "plots.gp", log_path = dir / "gnuplot.log";
+void run_gnuplot(const fs::path& dir, const std::string& script, const std::string& script_name) {
+  const fs::path script_path = dir / script_name, log_path = dir / "gnuplot.log";
   {
     std::ofstream gp(script_path, std::ios::binary);
     gp << script;
@@ -83,8 +83,9 @@ void run_gnuplot(const fs::path& dir, const std::string& script) {
   }
   // Everything the child needs, prepared before fork: it only makes system calls.
   const std::string cwd = dir.string();
-  char arg0[] = "gnuplot", arg1[] = "plots.gp";
-  char* const argv[] = {arg0, arg1, nullptr};
+  char arg0[] = "gnuplot";
+  std::string arg1 = script_name;
+  char* const argv[] = {arg0, arg1.data(), nullptr};
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(std::string("gnuplot: fork failed: ") + std::strerror(errno));
   if (pid == 0) {

@@ -2,6 +2,8 @@
 //   nan-controller  answers like a controller but sends NaN at steps k % 7 == 3 and 1e9 V at
 //                   k % 7 == 5 (a plant must reject/clip and count them), 0.5 V otherwise
 //   stall-controller answers with 0.5 V for the first --steps states, then goes silent
+//   stale-controller answers with 0.5 V for the first --steps states, then answers state k with
+//                   a new command carrying the stale step number k - 1
 //   junk            publishes, every 1 ms for --seconds, a reference_block_t on <prefix>_CMD, a
 //                   control_command_t on <prefix>_STATE and 7 random bytes on <prefix>_REF
 //   forge-controller an attacker on the bus (issue 13): answers every new state k at once with its
@@ -34,7 +36,7 @@ int main(int argc, char** argv) {
   std::int64_t run_id = 0;
   app.add_option("mode", mode)
       ->required()
-      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "forge-controller", "forge-reference"}));
+      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller", "forge-reference"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -117,6 +119,15 @@ int main(int argc, char** argv) {
     }
     last_us = now;
     if (mode == "stall-controller" && m.seq >= steps) return;
+    if (mode == "stale-controller" && m.seq >= steps) {
+      control_command_t c{};
+      c.seq = m.seq - 1;
+      c.t = m.t;
+      c.u = c.u_unsaturated = 0.5 + 1e-3 * static_cast<double>(m.seq);  // not the command applied for k - 1
+      c.sliding = c.z_estimate = std::nan("");
+      bus.publish(ch.command, c);
+      return;
+    }
     auto it = answered.find(m.seq);
     if (it == answered.end()) {
       control_command_t c{};

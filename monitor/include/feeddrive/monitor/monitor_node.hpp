@@ -11,8 +11,15 @@
 
 #include <memory>
 #include <string>
+#include <map>
+#include <vector>
 
+#include "feeddrive/monitor/lcm_log.hpp"
+#include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/control_command_t.hpp"
+#include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/run_info_t.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/node.hpp"
 #include "feeddrive/sim/output.hpp"
@@ -25,6 +32,10 @@ struct MonitorOptions {
   bool plots{true};
   bool attach{false};
   double progress_interval_s{0.5};
+  /// If set: every message of the run received on the bus (channels <prefix>_*, re-published
+  /// ones included) also goes to this file, in the standard LCM log format (lcm_log.hpp), with
+  /// the kernel's receive time: what lcm-logger writes, without another process on the group.
+  std::string lcm_log;
 };
 
 class MonitorNode : public service::Node {
@@ -38,9 +49,16 @@ class MonitorNode : public service::Node {
 
  private:
   void request_missing();
+  void publish_info();
+  void on_state_timing(const drive_state_t& m, std::int64_t t);
+  void on_command_timing(const control_command_t& m, std::int64_t t);
+  void prune_timing(std::int64_t seq);
   void progress(bool force);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
+  /// latency_histogram.csv (and .png when `plot`) into the staged output folder `dir`.
+  void write_histograms(const std::string& dir, const std::vector<std::string>& names, const std::vector<Histogram>& h,
+                        bool plot) const;
 
   sim::Scenario s_;
   MonitorOptions mopt_;
@@ -57,6 +75,14 @@ class MonitorNode : public service::Node {
   service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
   service::StepLedger<reference_t> reference_ledger_;
   service::StepLedger<control_command_t> command_ledger_;
+  run_info_t info_;
+  std::unique_ptr<LcmLogWriter> log_;
+  std::string log_error_;  ///< the first write error of the LCM log (ends the run)
+  std::int64_t heartbeats_{0};
+  Histogram hist_sc_, hist_cs_;
+  LatenessHistogram lateness_;
+  std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight
+  std::int64_t timing_pruned_{-1};                              ///< steps <= this are no longer timed
 };
 
 }  // namespace feeddrive::monitor

@@ -47,7 +47,10 @@ class Recorder {
   /// attach = false: rows start at step 0 and a gap is never skipped. attach = true: rows start
   /// at the first step whose state and reference can both have been seen, max(first state,
   /// first reference) (joining a running system or a log mid-way).
-  explicit Recorder(bool attach = false) : attach_(attach) {}
+  /// whole_log (attach only): the messages are a whole recording read at once (a log file, in
+  /// the order its recorder received them, re-published ones late): the first row is chosen at
+  /// the first flush() from the lowest state and reference steps seen, not from the first ones.
+  explicit Recorder(bool attach = false, bool whole_log = false) : attach_(attach), whole_log_(attach && whole_log) {}
 
   void on_state(const drive_state_t& m, std::int64_t recv_us);
   void on_reference(const reference_t& m, std::int64_t recv_us);
@@ -101,6 +104,7 @@ class Recorder {
     std::int64_t recv_us;
   };
   bool attach_;
+  bool whole_log_;
   std::int64_t next_{0};
   bool started_{false};
   std::int64_t steps_{-1};

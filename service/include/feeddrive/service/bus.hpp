@@ -3,10 +3,12 @@
 // and drop undecodable messages (wrong type or fingerprint) instead of crashing, and publishers
 // that keep their recent messages so a lost one can be re-published on request.
 //
-// Two ways to receive: kEvent (liblcm's: woken by each message, for the step's critical path,
-// the plant and the controller) and kBatched (udpm_reader.hpp: sleep for a batch interval,
-// then take everything queued, for the monitor and the trajectory). Both publish with liblcm,
-// and both see the same messages: the choice changes when a process wakes, not what it gets.
+// Three ways to receive: kDirect (udpm_reader.hpp's socket, waited on directly: woken once by
+// each datagram, for the step's critical path, the plant and the controller), kBatched (the same
+// socket, but sleep for a batch interval, then take everything queued, for the monitor and the
+// trajectory) and kEvent (liblcm's receive thread and its notification pipe: two wake-ups per
+// message; the fallback for URLs other than udpm://, e.g. memq://). All publish with liblcm,
+// and all see the same messages: the choice changes when a process wakes, not what it gets.
 //
 // Nothing here knows about drives: the nodes (plant_node.hpp, ...) hold the protocol logic.
 
@@ -35,10 +37,10 @@ namespace feeddrive::service {
 /// under bursts).
 std::string default_lcm_url();
 
-/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY.
+/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY, _INFO.
 struct Channels {
   explicit Channels(const std::string& prefix);
-  std::string state, command, reference, status, resend, summary;
+  std::string state, command, reference, status, resend, summary, info;
 };
 
 /// Microseconds since the Unix epoch (process_status_t.utime) and a monotonic clock [us].
@@ -52,15 +54,16 @@ enum class Admit {
 };
 
 enum class Receive {
-  kEvent,    ///< liblcm's receive thread: a wake-up per message, lowest latency
-  kBatched,  ///< drained every batch interval, no wake-up per message (udpm:// URLs only)
+  kDirect,   ///< our socket, woken by each datagram: lowest latency (udpm:// URLs; else kEvent)
+  kBatched,  ///< drained every batch interval, no wake-up per message (udpm:// URLs; else kEvent)
+  kEvent,    ///< liblcm's receive thread: two wake-ups per message (receive thread, then pipe)
 };
 
 class Bus {
  public:
-  /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kBatched falls
-  /// back to kEvent for URLs other than udpm:// (memq://, file://).
-  explicit Bus(const std::string& url, Receive receive = Receive::kEvent);
+  /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kDirect and
+  /// kBatched fall back to kEvent for URLs other than udpm:// (memq://, file://).
+  explicit Bus(const std::string& url, Receive receive = Receive::kDirect);
   /// kBatched: how long poll() sleeps before it takes what is queued.
   static constexpr std::chrono::microseconds kBatchInterval{1000};
   Bus(const Bus&) = delete;
@@ -101,8 +104,14 @@ class Bus {
   /// Dispatches the messages that arrive within `timeout` (at least one wait). Returns true if
   /// at least one message was handled. Rethrows the first exception a handler threw.
   /// kBatched: sleeps min(timeout, batch interval), then dispatches everything queued.
+  /// kDirect: waits on the socket until a datagram comes (or the timeout), then dispatches
+  /// everything queued.
   bool poll(std::chrono::microseconds timeout);
-  bool batched() const { return reader_ != nullptr; }
+  bool batched() const { return reader_ != nullptr && receive_ == Receive::kBatched; }
+
+  /// Called with every complete LCM message this bus receives (kDirect and kBatched), before
+  /// it is dispatched, whatever its channel: a recorder's tap (the monitor's --lcm-log).
+  void set_tap(MessageSink tap) { tap_ = std::move(tap); }
 
   /// Messages that did not decode as their channel's type, and (kBatched) datagrams that are
   /// not LCM's framing.
@@ -123,12 +132,16 @@ class Bus {
                      std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f);
   bool poll_event(std::chrono::microseconds timeout);
   bool poll_batched(std::chrono::microseconds timeout);
+  bool poll_direct(std::chrono::microseconds timeout);
+  std::size_t drain();
   void rethrow_handler_error();
 
   std::string url_;
   lcm::LCM lcm_;
   std::vector<std::unique_ptr<Raw>> raws_;
-  std::unique_ptr<UdpmReader> reader_;  ///< kBatched only
+  Receive receive_;
+  std::unique_ptr<UdpmReader> reader_;  ///< kDirect and kBatched on udpm:// URLs
+  MessageSink tap_;
   std::unordered_map<std::string, std::vector<Raw*>> batched_subs_;
   std::int64_t invalid_{0};
   std::int64_t send_errors_{0};

@@ -31,6 +31,8 @@ struct LaunchOptions {
   /// heartbeat comes every 100 ms); if one is there, refuse in one line (docs/security.md).
   /// 0: no check.
   double busy_check_s{0.3};
+  /// If set: the monitor also writes the run's messages to this LCM log (feeddrive-monitor --lcm-log).
+  std::string lcm_log;
 };
 
 /// Parses a CPU list "0" or "0,2" (each an index this process may run on). Throws

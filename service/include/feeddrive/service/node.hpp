@@ -32,7 +32,8 @@ struct NodeOptions {
   long monitor_window{4096};         ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
   double linger_s{10.0};             ///< after the end: keep answering resend requests until the monitor is done
   bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
-  int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
+  int max_bad_commands{10};
+  std::int64_t realtime_spin_us{10};  ///< real time: busy-wait this long before a period start (after clock_nanosleep)          ///< real time: consecutive missed/invalid commands before the safe state
   bool quiet{false};
   /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
   /// other process takes it from the plant's first fresh heartbeat.
@@ -48,9 +49,9 @@ struct RunFailure : std::runtime_error {
 
 class Node {
  public:
-  /// `receive`: kEvent for the roles on a step's critical path (plant, controller), kBatched
+  /// `receive`: kDirect for the roles on a step's critical path (plant, controller), kBatched
   /// for the others (monitor, trajectory): see bus.hpp.
-  Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kEvent);
+  Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kDirect);
   virtual ~Node() = default;
 
   const std::string& role() const { return role_; }
@@ -104,6 +105,8 @@ class Node {
  protected:
   /// Called for resend requests on `channel`; re-publish `seq` if this node owns the channel.
   std::function<void(const resend_request_t&)> on_resend_request;
+  /// Called each time the heartbeat goes out (every 100 ms and on changes of state).
+  std::function<void()> on_heartbeat;
 
  private:
   bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);
@@ -125,6 +128,18 @@ class Node {
 void install_signal_handlers();
 /// The signal that interrupted the process, or 0.
 int interrupted_by();
+
+/// Real-time setup of a process on a real-time run's critical path (plant, controller), as
+/// real-time Linux practice has it: mlockall(MCL_CURRENT | MCL_FUTURE) (no page fault in a
+/// period), SCHED_FIFO at `priority` where permitted, and a 1 ns timer slack (the default 50 us
+/// would delay every timed wake-up). Returns one line saying what was granted, e.g.
+/// "SCHED_FIFO 80, memory locked" or "normal scheduling (SCHED_FIFO not permitted: needs root,
+/// CAP_SYS_NICE or an rtprio limit), memory locked"; the caller logs it.
+std::string enter_realtime(int priority);
+
+/// Sleeps until monotonic time `target_us` [us]: an absolute clock_nanosleep to spin_us before
+/// it, then a busy wait (the wake-up latency of a timer is tens of us on a virtual machine).
+void sleep_until(std::int64_t target_us, std::int64_t spin_us);
 
 /// "2", "0.5", "30": a duration in seconds for messages (shortest exact form, %g).
 std::string seconds_text(double s);

@@ -11,6 +11,8 @@
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_t.hpp"
+#include "feeddrive/run_info_t.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
 
@@ -32,5 +34,9 @@ applied_t no_applied();
 /// command, and what the plant applied during it (carried by the state of step k+1).
 sim::Record to_record(const drive_state_t& state, const reference_t& ref, const control_command_t& cmd,
                       const applied_t& applied);
+
+/// The run's self-description (run_info_t) from its scenario: name, mode, period, steps, the
+/// drive's nominal parameters and the command limits (utime and run_id are the sender's).
+run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_id);
 
 }  // namespace feeddrive::service

@@ -84,6 +84,8 @@ class UdpmReader {
   std::size_t drain(const MessageSink& sink);
 
   std::int64_t malformed() const { return reassembler_.malformed(); }
+  /// The socket, for waiting on it (poll/ppoll).
+  int fd() const { return fd_; }
   /// The receive buffer the kernel granted [bytes].
   int recv_buf_size() const { return granted_; }
 

@@ -18,6 +18,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,7 +64,9 @@ class RunWriter {
   /// Closes timeseries.csv, writes summary.json (`sum` plus the keys of the JSON object
   /// extra_json) and the plots (when asked and there is at least one record), and swaps the
   /// folder into place. On failure the previous output is kept and the staged folder removed.
-  void finish(const Summary& sum, bool plots, const std::string& extra_json = "");
+  /// `extra_files` (if given) writes the caller's own files into the staged folder first.
+  void finish(const Summary& sum, bool plots, const std::string& extra_json = "",
+              const std::function<void(const output::StagedFolder&)>& extra_files = {});
   /// Wall time finish() spent on the plots [s] (0 without plots).
   double plot_seconds() const { return plot_seconds_; }
 

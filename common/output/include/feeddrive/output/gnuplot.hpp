@@ -25,9 +25,10 @@ namespace feeddrive::output {
 /// At most max_bytes of text are kept (cut at a character boundary, then "...").
 std::string gnuplot_string(std::string_view text, std::size_t max_bytes = 200);
 
-/// Writes `script` to dir/plots.gp and runs `gnuplot plots.gp` in `dir` (fork and exec, no
-/// shell; output to dir/gnuplot.log, removed on success). Throws std::runtime_error with
-/// gnuplot's last message on failure.
-void run_gnuplot(const std::filesystem::path& dir, const std::string& script);
+/// Writes `script` to dir/script_name and runs `gnuplot script_name` in `dir` (fork and exec, no
+/// shell; output to dir/gnuplot.log, removed on success). script_name is a fixed name chosen by
+/// the caller, never the user's. Throws std::runtime_error with gnuplot's last message on failure.
+void run_gnuplot(const std::filesystem::path& dir, const std::string& script,
+                 const std::string& script_name = "plots.gp");
 
 }  // namespace feeddrive::output

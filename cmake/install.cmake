@@ -1,0 +1,31 @@
+# The SDK for external controllers (docs/external-controllers.md, "C++: the SDK"):
+# `cmake --install build --prefix P` installs the drive model, the plant (with CVODE), the
+# controllers and the trajectories as libraries (static, or shared with -DBUILD_SHARED_LIBS=ON),
+# their headers, the generated message headers and a CMake package, so that
+#   find_package(feeddrive REQUIRED)   # with -DCMAKE_PREFIX_PATH=P
+#   target_link_libraries(my_controller PRIVATE feeddrive::controller feeddrive::lcmtypes)
+# works. feeddrive::controller needs feeddrive::model and feeddrive::trajectory only, not CVODE.
+include(CMakePackageConfigHelpers)
+set(FEEDDRIVE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/feeddrive)
+install(TARGETS feeddrive_common feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory feeddrive_lcmtypes
+  EXPORT feeddriveTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY
+  ${PROJECT_SOURCE_DIR}/common/include/feeddrive
+  ${PROJECT_SOURCE_DIR}/plant/include/feeddrive
+  ${PROJECT_SOURCE_DIR}/controller/include/feeddrive
+  ${PROJECT_SOURCE_DIR}/trajectory/include/feeddrive
+  ${PROJECT_BINARY_DIR}/lcmtypes/include/feeddrive
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/lcmtypes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/feeddrive/lcmtypes
+  FILES_MATCHING PATTERN "*.lcm")
+install(EXPORT feeddriveTargets NAMESPACE feeddrive:: DESTINATION ${FEEDDRIVE_CMAKE_DIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/feeddriveConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/feeddriveConfig.cmake INSTALL_DESTINATION ${FEEDDRIVE_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/feeddriveConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/feeddriveConfig.cmake ${PROJECT_BINARY_DIR}/feeddriveConfigVersion.cmake
+  DESTINATION ${FEEDDRIVE_CMAKE_DIR})

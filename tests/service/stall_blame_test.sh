@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Errors name the right culprit.
+# 1. The controller stalls (SIGSTOP) past the step timeout, then resumes (SIGCONT): the plant
+#    names the controller, and so must every other process (trajectory, monitor, and the
+#    controller itself, which finds the plant's failure when it wakes), never "no state from the
+#    plant" (the race the trajectory's and the controller's own timeouts used to win).
+# 2. A controller that answers with a stale step number (state k answered as k - 1, with a new
+#    u) gets a counted error naming the stale step at once, not a silent drop and a timeout: a
+#    second, different command for a step already answered is a conflict (service::Node::admit),
+#    which names the channel and the step and says it may be a stale step number.
+source "$(dirname "$0")/lib.sh" "$@"
+scen=$TMP/long.yaml
+sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+grep -q '^duration: 10.0' "$scen" || fail "could not lengthen the scenario"
+opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
+timeout 60 feeddrive-launch "$scen" --out "$TMP/stall" --no-plots --external controller "${opts[@]}" 2> "$TMP/launch.err" & l=$!
+feeddrive-controller "$scen" "${opts[@]}" 2> "$TMP/controller.err" & c=$!
+sleep 1.5
+kill -STOP $c; echo "controller stopped"
+sleep 3.5      # past the 2 s step timeout: the plant has failed meanwhile
+kill -CONT $c; echo "controller resumed"
+set +e; wait $l; rl=$?; wait $c; rc=$?; set -e
+[ $rl -ne 0 ] && [ $rl -ne 124 ] || fail "launch exit $rl"
+[ $rc -ne 0 ] || fail "the controller exited 0 after the plant failed"
+# Each process's error line (the monitor's is its closing line: "N steps recorded (stopped at
+# step k: why)").
+cat "$TMP/launch.err" "$TMP/controller.err" | grep -E "\[error\]|stopped at step" > "$TMP/errors" || true
+for role in plant trajectory monitor controller; do
+  grep "feeddrive-$role\]" "$TMP/errors" > "$TMP/$role.lines" || fail "no error line from the $role: $(cat "$TMP/errors")"
+  grep -v "still running" "$TMP/$role.lines" | grep -qv "controller" && { cat "$TMP/$role.lines" >&2; fail "the $role blames someone else"; }
+  echo "$role: $(head -n 1 "$TMP/$role.lines")"
+done
+grep -q "no state from the plant" "$TMP/errors" && fail "a process blamed the plant"
+json "$TMP/stall/summary.json" .lockstep.failure | grep -q "controller" || fail "summary failure does not name the controller"
+pass "stalled controller: every process names it"
+
+timeout 60 feeddrive-launch "$scen" --out "$TMP/stale" --no-plots --external controller "${opts[@]}" 2> "$TMP/stale.err" & l=$!
+timeout 60 "$BUILD/tests/fd-test-peer" stale-controller --steps 100 --lcm-url "$URL" > /dev/null & p=$!
+set +e; wait $l; rl=$?; wait $p; set -e
+[ $rl -ne 0 ] || fail "launch exited 0 with a stale controller"
+grep -q "\[feeddrive-plant\] \[error\] conflict on FD_CMD step 99: two different control_command_t .*stale step number" "$TMP/stale.err" ||
+  { cat "$TMP/stale.err" >&2; fail "no error naming the stale step"; }
+failure=$(json "$TMP/stale/summary.json" .lockstep.failure)
+printf "%s" "$failure" | grep -q "step 99.*stale step number" || fail "the failure does not name the stale step: $failure"
+[ "$(json "$TMP/stale/summary.json" .lockstep.stopped_at_step)" -le 101 ] || fail "not stopped at once"
+pass "stale step number: named at once: $failure"
