@@ -129,6 +129,10 @@ void Recorder::add_row(const Seen<drive_state_t>& s, const reference_t* r, const
 
 std::size_t Recorder::flush_final(const sim::RecordSink& sink, bool need_reference) {
   std::size_t added = 0;
+  if (whole_log_) {  // a short recording never flushed before: start from its lowest steps
+    whole_log_ = false;
+    maybe_start();
+  }
   if (attach_ && !started_) return added;
   // The step count: the value most states carry.
   std::int64_t steps = -1;

@@ -42,7 +42,7 @@ Msg encode(const std::string& channel, const T& m) {
 
 // The messages of a run in lockstep order: reference blocks of 16 ahead, then per step the
 // state (carrying what was applied in the step before) and the command; the end-of-run state.
-std::vector<Msg> run_messages() {
+std::vector<Msg> run_messages(long kSteps = kSteps) {
   std::vector<Msg> out;
   const auto u_of = [](long k) { return 0.1 * std::sin(0.01 * static_cast<double>(k)); };
   for (long k = 0; k <= kSteps; ++k) {
@@ -128,6 +128,14 @@ TEST(LogGaps, CompleteLogHasEveryStepAndNoGap) {
   EXPECT_EQ(rows.size(), static_cast<std::size_t>(kSteps));
   EXPECT_TRUE(c.recorder.gaps().empty());
   EXPECT_EQ(c.recorder.commandless_rows(), 0);
+}
+
+TEST(LogGaps, ShortLogReadBeforeAnyPeriodicFlushHasEveryStep) {
+  // read_log flushes rows every 4096 events; a run of 1,000 steps (about 2,060 events) is only
+  // flushed at the end, and must still start at its lowest logged step.
+  const auto [c, rows] = read_all(write_log("short", run_messages(1000)));
+  EXPECT_EQ(rows.size(), 1000u);
+  EXPECT_TRUE(c.recorder.gaps().empty());
 }
 
 TEST(LogGaps, DroppedCommandCostsNoStep) {

@@ -47,7 +47,7 @@ ranks=$(jq -r .ranks "$TMP/mpi/timing.json")
 [ "$ranks" = 3 ] || fail "timing.json says $ranks ranks, expected 3"
 rows=$(($(wc -l < "$TMP/local/results.csv") - 1))
 [ "$rows" = 20 ] || fail "expected 20 cases, results.csv has $rows"
-grep -q ",broken,.*,false,CVODE" "$TMP/mpi/results.csv" || fail "the failed case is not reported under MPI"
+grep -q ",broken,.*,false,\"CVODE" "$TMP/mpi/results.csv" || fail "the failed case is not reported under MPI"
 cmp "$TMP/local/results.csv" "$TMP/mpi/results.csv" || fail "results.csv differs between the local run and mpirun -np 3"
 echo "PASS: mpirun -np 3 gives the local results.csv byte for byte ($rows cases)"
 

@@ -47,9 +47,10 @@ class Recorder {
   /// attach = false: rows start at step 0 and a gap is never skipped. attach = true: rows start
   /// at the first step whose state and reference can both have been seen, max(first state,
   /// first reference) (joining a running system or a log mid-way).
-  /// whole_log (attach only): the messages are a whole recording read at once (a log file, in
-  /// the order its recorder received them, re-published ones late): the first row is chosen at
-  /// the first flush() from the lowest state and reference steps seen, not from the first ones.
+  /// whole_log (attach only): the messages come from a recording (a log file, in the order its
+  /// recorder received them, re-published ones late): the first row is chosen at the first
+  /// flush() or flush_final() from the lowest state and reference steps seen so far, not from
+  /// the first ones (read_log flushes every 4096 events).
   explicit Recorder(bool attach = false, bool whole_log = false) : attach_(attach), whole_log_(attach && whole_log) {}
 
   void on_state(const drive_state_t& m, std::int64_t recv_us);
