@@ -17,47 +17,23 @@
 #include <vector>
 
 #include "feeddrive/sim/scenario.hpp"
+#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::slurp;
 
 const std::string kFit = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-fit";
 const std::string kSim = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-sim";
 const fs::path kScenarios = fs::path(FEEDDRIVE_SOURCE_DIR) / "scenarios" / "fit";
 
-// A scratch folder of this test process: ctest runs every test in its own process, in parallel,
-// so the folder is named by the pid.
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-fit-cli-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("fit-cli");
   return dir;
 }
 
-// Removes the scratch folder when the test program ends.
-class ScratchCleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(scratch(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
+  return feeddrive::test_support::write_text(scratch() / name, text);
 }
 
 struct ProcResult {
@@ -204,6 +180,20 @@ TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
   EXPECT_NE(r.err.find("mine"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("not_there.csv"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(scratch() / "mine" / "keep.txt"), "mine\n");
+}
+
+TEST(FitCli, WindowsThatHoldTooFewSamplesAreRefused) {
+  // At 1 kHz a replay window of 5 ms holds 6 samples: the start-state correction (offset and
+  // slope) then fits away any gap (the "gap 0 -> 0" at --replay-window 1e-9); a filter
+  // half-width below 2 periods averages nothing. Both are refused with the record's period.
+  const std::string data = csv("t,x,u", good_rows(2000));
+  expect_data_error("short_window.csv", data,
+                    {"short_window.csv", "--replay-window 0.005 s spans fewer than 10 sample periods (0.001 s)",
+                     "at least 0.01 s"},
+                    "--replay-window 0.005");
+  expect_data_error("short_filter.csv", data,
+                    {"short_filter.csv", "--filter-half-width 0.0015 s is shorter than 2 sample periods (0.001 s)"},
+                    "--filter-half-width 0.0015");
 }
 
 TEST(FitCli, CorruptLcmLog) {

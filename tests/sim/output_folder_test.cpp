@@ -16,9 +16,12 @@
 
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
+#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::names;
+using feeddrive::test_support::slurp;
 using feeddrive::output::check_output_dir;
 using feeddrive::output::gnuplot_string;
 using feeddrive::output::is_feeddrive_output;
@@ -27,23 +30,9 @@ using feeddrive::output::normalise;
 using feeddrive::output::StagedFolder;
 
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-output-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("output");
   return dir;
 }
-
-class ScratchCleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(scratch(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 // A fresh folder for one test.
 fs::path fresh(const std::string& name) {
@@ -53,21 +42,7 @@ fs::path fresh(const std::string& name) {
   return d;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
-
-std::vector<std::string> names(const fs::path& dir) {
-  std::vector<std::string> v;
-  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
 
 // The message of the std::invalid_argument that f throws ("" if none).
 template <typename F>
