@@ -318,13 +318,20 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   EXPECT_EQ(slurp(fake / "notes.txt"), "mine");
   EXPECT_EQ(slurp(fake / "findings.json"), "{}");
 
-  // An earlier feeddrive-fit output (it has the marker) is replaced whole, also as "DIR/".
+  // An earlier feeddrive-fit output (it has the marker) that holds a file of the user's is
+  // refused before any work, the file kept; without it, the output is replaced, also as "DIR/".
   EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
-  std::ofstream(out / "stale.txt") << "old";
-  const ProcResult again = run_fit("--scenario " + model.string() + " --data " + data.string() + " --out " +
-                                   out.string() + "/ --position-column x_measured --no-plots -q --max-effects 1");
+  std::ofstream(out / "notes.txt") << "mine";
+  const std::string again_args = "--scenario " + model.string() + " --data " + data.string() + " --out " + out.string() +
+                                 "/ --position-column x_measured --no-plots -q --max-effects 1";
+  const ProcResult kept = run_fit(again_args);
+  EXPECT_EQ(kept.code, 2) << kept.err;
+  EXPECT_EQ(std::count(kept.err.begin(), kept.err.end(), '\n'), 1) << kept.err;
+  EXPECT_NE(kept.err.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << kept.err;
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  fs::remove(out / "notes.txt");
+  const ProcResult again = run_fit(again_args);
   EXPECT_EQ(again.code, 0) << again.err;
-  EXPECT_FALSE(fs::exists(out / "stale.txt"));
   EXPECT_TRUE(fs::exists(out / "findings.json"));
   for (const auto& e : fs::directory_iterator(scratch()))
     EXPECT_EQ(e.path().filename().string().find(".fit_out."), std::string::npos) << "left behind: " << e.path();

@@ -157,15 +157,24 @@ TEST(Cli, EarlierOutputIsReplacedWholeAlsoWithATrailingSlash) {
   fs::remove_all(base);
   fs::create_directories(base);
   const fs::path out = base / "prev";
-  ASSERT_EQ(run_sim(scen.string() + " --out " + out.string() + " --no-plots").code, 0);
+  ASSERT_EQ(run_sim(scen.string() + " --out " + out.string()).code, 0);  // with plots
   EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
-  std::ofstream(out / "stale.txt") << "old";
+  EXPECT_TRUE(fs::exists(out / "position.png"));
   std::ofstream(base / "neighbour.txt") << "mine";
-  // "prev/" is "prev": replaced in place (the old bug wrote the temporary folder inside it and
-  // then deleted both)
+  // A file of the user's put into the earlier output: refused before the run, nothing deleted
+  // (the issue: "a user's own file inside it is lost too").
+  std::ofstream(out / "notes.txt") << "mine";
+  const ProcResult refused = run_sim(scen.string() + " --out " + out.string() + "/ --no-plots");
+  expect_one_line_about_out(refused, out.string() + "/");
+  EXPECT_NE(refused.err.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << refused.err;
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  EXPECT_TRUE(fs::exists(out / "position.png"));
+  fs::remove(out / "notes.txt");
+  // "prev/" is "prev": replaced in place and whole (the old bug wrote the temporary folder inside
+  // it and then deleted both): the earlier run's plots go with it.
   const ProcResult r = run_sim(scen.string() + " --out " + out.string() + "/ --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_FALSE(fs::exists(out / "stale.txt"));
+  EXPECT_FALSE(fs::exists(out / "position.png"));
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
   EXPECT_TRUE(fs::exists(out / "summary.json"));
   EXPECT_EQ(names(base), (std::vector<std::string>{"neighbour.txt", "prev"})) << "no temporary folder left";

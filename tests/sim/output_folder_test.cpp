@@ -308,6 +308,63 @@ TEST(OutputFolder, TrailingSlashReplacesAnEarlierOutputSafely) {
   EXPECT_EQ(names(base), (std::vector<std::string>{"neighbour.txt", "prev"}));
 }
 
+TEST(OutputFolder, AUsersFileInAnEarlierOutputIsNeverDeleted) {
+  const fs::path base = fresh("staged_foreign");
+  {
+    StagedFolder first((base / "prev").string(), "t");
+    put(first.dir() / "old.txt", "old");
+    first.commit();
+  }
+  // the marker lists what was written
+  EXPECT_NE(slurp(base / "prev" / kMarkerFile).find("files:\nfile: old.txt\n"), std::string::npos)
+      << slurp(base / "prev" / kMarkerFile);
+  EXPECT_EQ(feeddrive::output::foreign_entry(base / "prev"), "");
+  EXPECT_NO_THROW(check_output_dir((base / "prev").string()));
+  // a file of the user's: refused before any work, with its name
+  put(base / "prev" / "notes.txt", "mine");
+  EXPECT_EQ(feeddrive::output::foreign_entry(base / "prev"), "notes.txt");
+  const std::string w = refusal([&] { check_output_dir((base / "prev/").string()); });
+  EXPECT_NE(w.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << w;
+  EXPECT_THROW(StagedFolder((base / "prev").string(), "t"), std::invalid_argument);
+  EXPECT_EQ(slurp(base / "prev" / "notes.txt"), "mine");
+  // ... or put there while the next run was going: not replaced, the results kept aside
+  fs::remove(base / "prev" / "notes.txt");
+  {
+    StagedFolder second((base / "prev").string(), "t");
+    put(second.dir() / "new.txt", "new");
+    fs::create_directories(base / "prev" / "mine");
+    try {
+      second.commit();
+      FAIL() << "replaced an output holding a user's folder";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("holds files feeddrive did not write"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(second.dir().string()), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(second.dir() / "new.txt"), "new");
+  }
+  EXPECT_EQ(names(base / "prev"), (std::vector<std::string>{kMarkerFile, "mine", "old.txt"}));
+  // An output whose marker has no list (feeddrive before the list) is replaced whole, as before.
+  const fs::path older = fresh("staged_older") / "run";
+  fs::create_directories(older);
+  put(older / kMarkerFile, feeddrive::output::marker_text("feeddrive-sim"));
+  put(older / "summary.json", "{}");
+  EXPECT_EQ(feeddrive::output::foreign_entry(older), "");
+  {
+    StagedFolder next(older.string(), "t");
+    next.commit();
+  }
+  EXPECT_EQ(names(older), std::vector<std::string>{kMarkerFile});
+  // A folder committed without the list (feeddrive-study's, which grows over reruns) takes new
+  // entries without becoming foreign.
+  const fs::path growing = fresh("staged_growing") / "study";
+  {
+    StagedFolder s(growing.string(), "feeddrive-study");
+    s.commit(false);
+  }
+  put(growing / "results.csv", "a\n");
+  EXPECT_EQ(feeddrive::output::foreign_entry(growing), "");
+}
+
 TEST(OutputFolder, FailureBeforeCommitKeepsThePreviousOutput) {
   const fs::path base = fresh("staged_fail");
   {
