@@ -7,7 +7,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/text.hpp"
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
@@ -541,14 +540,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
 }
 
 Scenario load_scenario(const std::string& path) {
-  std::string text;
-  try {
-    text = text::read_text_file(path, "scenario file");
-  } catch (const interrupt::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    throw ScenarioError(path + ": " + e.what());
-  }
+  const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
   const fs::path p(path);
   Scenario s = parse_scenario(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;

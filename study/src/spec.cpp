@@ -8,7 +8,6 @@
 #include <set>
 #include <sstream>
 
-#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -30,13 +29,7 @@ std::string describe(const YAML::Node& n) {
 [[noreturn]] void fail(const std::string& key, const std::string& what) { throw StudyError(key + what); }
 
 std::string read_file(const std::string& path, const std::string& key) {
-  try {
-    return text::read_text_file(path, "file");
-  } catch (const interrupt::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    fail(key, " = '" + path + "': " + e.what());
-  }
+  return text::read_text_file<StudyError>(path, key + " file");
 }
 
 std::string resolve_path(const std::string& base_dir, const std::string& p) {
@@ -388,14 +381,7 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
 }
 
 Study load_study(const std::string& path) {
-  std::string text;
-  try {
-    text = text::read_text_file(path, "study file");
-  } catch (const interrupt::Interrupted&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    throw StudyError(path + ": " + e.what());
-  }
+  const std::string text = text::read_text_file<StudyError>(path, "study file");
   const fs::path p(path);
   Study s = parse_study(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;

@@ -16,15 +16,16 @@ namespace feeddrive::text {
 /// is under 4 kB.
 inline constexpr std::size_t kMaxTextFileBytes = std::size_t{1} << 20;
 
-/// The bytes of the file `path`, read in 64 kB chunks (Ctrl-C is polled between them). Throws
-/// std::runtime_error "cannot read the WHAT" or "the WHAT is larger than 1 MiB (...)", without
-/// the path: the caller adds it.
-inline std::string read_text_file(const std::string& path, const std::string& what,
-                                  std::size_t max_bytes = kMaxTextFileBytes) {
+/// The bytes of the file `path`, read in 64 kB chunks (Ctrl-C is polled between them: it throws
+/// interrupt::Interrupted). Throws Error("PATH: cannot read the WHAT") or Error("PATH: the WHAT is
+/// larger than ... bytes ..."), one line; Error is the caller's exception type (ScenarioError,
+/// StudyError), constructible from a std::string.
+template <typename Error>
+std::string read_text_file(const std::string& path, const std::string& what, std::size_t max_bytes = kMaxTextFileBytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     interrupt::check();  // a Ctrl-C while open() waited (a FIFO) is an interrupt, not bad input
-    throw std::runtime_error("cannot read the " + what);
+    throw Error(path + ": cannot read the " + what);
   }
   std::string text;
   static constexpr std::size_t kChunk = 1 << 16;
@@ -34,12 +35,12 @@ inline std::string read_text_file(const std::string& path, const std::string& wh
     in.read(buf, kChunk);
     text.append(buf, static_cast<std::size_t>(in.gcount()));
     if (text.size() > max_bytes)
-      throw std::runtime_error("the " + what + " is larger than " + std::to_string(max_bytes) +
-                               " bytes, the limit of a scenario or study file (docs/scenario.md, Limits); is it the right file?");
+      throw Error(path + ": the " + what + " is larger than " + std::to_string(max_bytes) +
+                  " bytes, the limit of a scenario or study file (docs/scenario.md, Limits); is it the right file?");
   }
   if (in.bad()) {
     interrupt::check();
-    throw std::runtime_error("cannot read the " + what);
+    throw Error(path + ": cannot read the " + what);
   }
   return text;
 }
