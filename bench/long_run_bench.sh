@@ -3,7 +3,8 @@
 #   1. speed: the 80 s run of scenarios/paper/beyond_jerk_limited.yaml (800,000 steps), the
 #      whole `feeddrive-sim` with plots against the simulation's own time (bench/sim_only.cpp:
 #      the same loop, records discarded), ROUNDS rounds alternating, medians and their ratio
-#      (goal <= 1.5);
+#      (goal <= 1.5); also the CPU time (user + system) of both, since feeddrive-sim writes the
+#      CSV on a second thread: the CPU ratio is what the output costs on one core;
 #   2. memory: peak RSS (/usr/bin/time -v, "Maximum resident set size") of the whole
 #      `feeddrive-sim` with plots at 1e5, 1e6 and 1e7 steps (10, 100, 1000 s), every row written,
 #      with the time feeddrive-sim reports for the plots.
@@ -21,19 +22,25 @@ scenario() {  # scenario DURATION -> path of beyond_jerk_limited with that durat
   grep -q "^duration: $1 " "$TMP/long_$1.yaml" || { echo "could not set the duration" >&2; exit 1; }
   echo "$TMP/long_$1.yaml"
 }
-wall() { /usr/bin/time -f %e "$@" 2>&1 >/dev/null | tail -1; }
+# wall_cpu COMMAND...: "WALL CPU" in seconds (CPU = user + system, every thread)
+wall_cpu() { /usr/bin/time -f "%e %U %S" "$@" 2>&1 >/dev/null | tail -1 | awk '{ printf "%s %.2f\n", $1, $2 + $3 }'; }
 
 s80=$(scenario 80)
-sims=() wholes=()
+sims=() wholes=() sim_cpu=() whole_cpu=()
 for r in $(seq "$ROUNDS"); do
-  sims+=("$("$BUILD/bin/fd-sim-only" "$s80" | awk '{ print $2 }')")
+  read -r _ c < <(wall_cpu "$BUILD/bin/fd-sim-only" "$s80")
+  sims+=("$("$BUILD/bin/fd-sim-only" "$s80" | awk '{ print $2 }')")  # its own loop time, without start-up
+  sim_cpu+=("$c")
   rm -rf "$TMP/out80"
-  wholes+=("$(wall "$BUILD/bin/feeddrive-sim" "$s80" --out "$TMP/out80" -q)")
-  echo "round $r: simulation alone ${sims[-1]} s, whole feeddrive-sim with plots ${wholes[-1]} s"
+  read -r w c < <(wall_cpu "$BUILD/bin/feeddrive-sim" "$s80" --out "$TMP/out80" -q)
+  wholes+=("$w") whole_cpu+=("$c")
+  echo "round $r: simulation alone ${sims[-1]} s (CPU ${sim_cpu[-1]} s), whole feeddrive-sim with plots ${wholes[-1]} s (CPU ${whole_cpu[-1]} s)"
 done
 ms=$(median "${sims[@]}"); mw=$(median "${wholes[@]}")
+mcs=$(median "${sim_cpu[@]}"); mcw=$(median "${whole_cpu[@]}")
 echo "80 s run (800000 steps): median simulation alone $ms s, median whole feeddrive-sim with plots $mw s"
 awk -v w="$mw" -v s="$ms" 'BEGIN { printf "ratio whole / simulation: %.3f (goal <= 1.5)\n", w / s }'
+awk -v w="$mcw" -v s="$mcs" 'BEGIN { printf "CPU time: simulation alone %.2f s, whole %.2f s, ratio %.3f (the output'"'"'s cost on one core)\n", s, w, w / s }'
 echo "timeseries.csv of the 80 s run: $(du -m "$TMP/out80/timeseries.csv" | cut -f1) MB"
 
 for d in 10 100 1000; do

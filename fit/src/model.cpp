@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "feeddrive/plant/effects.hpp"
@@ -18,6 +19,14 @@ Record prepare(const MeasuredData& d, const RecordOptions& opt) {
                     ? opt.motion_half_window
                     : std::max(3, static_cast<int>(std::lround(2e-3 / r.period)));
   const double L = opt.filter_half_width > 0 ? opt.filter_half_width : std::max(0.01, 10.0 * r.period);
+  // A filter window must hold samples: one shorter than two sample periods averages nothing
+  // (the force is the raw second difference) and makes a bank of one window per sample.
+  if (opt.filter_half_width > 0 && opt.filter_half_width < 2.0 * r.period) {
+    char why[200];
+    std::snprintf(why, sizeof why, ": --filter-half-width %.3g s is shorter than 2 sample periods (%.3g s) of the record; "
+                  "use at least %.3g s, or 0 for the default", opt.filter_half_width, r.period, 2.0 * r.period);
+    throw DataError(d.source + why);
+  }
   if (d.size() < static_cast<std::size_t>(2 * M + 1))
     throw DataError(d.source + ": " + std::to_string(d.size()) + " samples: too few for the motion estimate");
   r.motion = estimate_motion(d.t, d.x, M);

@@ -87,14 +87,9 @@ std::size_t Recorder::flush(const sim::RecordSink& sink) {
       // Real time only: the step ran on a stale command; wait one more step for a late one.
       const bool passed = s1->second.msg.end_of_run || states_.count(next_ + 2) != 0;
       if (!s->second.msg.realtime || !passed) break;
-      control_command_t none{};
-      none.seq = next_;
-      none.t = s->second.msg.t;
-      none.u = none.u_unsaturated = none.sliding = none.z_estimate = std::numeric_limits<double>::quiet_NaN();
-      sink(service::to_record(s->second.msg, r->second.msg, none, s1->second.msg.previous));
-      ++commandless_;
+      add_row(s->second, &r->second.msg, nullptr, s1->second.msg, sink);
     } else {
-      sink(service::to_record(s->second.msg, r->second.msg, c->second.msg, s1->second.msg.previous));
+      add_row(s->second, &r->second.msg, &c->second.msg, s1->second.msg, sink);
       cmds_.erase(c);
     }
     states_.erase(s);

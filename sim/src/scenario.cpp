@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "feeddrive/common/text.hpp"
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
@@ -377,6 +378,15 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
   }
 }
 
+// A step count for a message: exact up to 10^15, else 3 significant digits ("1e+304", never
+// "1.0000000000000001e+304").
+std::string steps_text(double n) {
+  if (n < 1e15) return validate::format_number(n);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", n);
+  return buf;
+}
+
 Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
   if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   MapReader top(root, "", resolved);
@@ -394,7 +404,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
   if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
     throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " + root["control_period"].Scalar() +
-                        ": " + validate::format_number(n) + " steps; a run has at most " + validate::format_number(kMaxSteps) +
+                        ": " + steps_text(n) + " steps; a run has at most " + validate::format_number(kMaxSteps) +
                         " steps (docs/scenario.md, Limits)");
 
   {
@@ -530,13 +540,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
 }
 
 Scenario load_scenario(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ScenarioError(path + ": cannot read the scenario file");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) throw ScenarioError(path + ": cannot read the scenario file");
+  const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
   const fs::path p(path);
-  Scenario s = parse_scenario(buf.str(), p.parent_path().empty() ? "." : p.parent_path().string(), path);
+  Scenario s = parse_scenario(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;
   if (s.name.empty()) {
     s.name = p.stem().string();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace feeddrive::sim {
@@ -11,9 +12,16 @@ SummaryBuilder::SummaryBuilder(const Scenario& s)
   m_.settled_after_s = settled_after_;
 }
 
+namespace {
+// A difference of two finite doubles can exceed the largest double (1e308 - -1e308): the metrics
+// saturate there instead of becoming infinite (NaN, a run without truth, stays NaN).
+constexpr double kLargest = std::numeric_limits<double>::max();
+double saturated(long double v) { return v > kLargest ? kLargest : v < -kLargest ? -kLargest : static_cast<double>(v); }
+}  // namespace
+
 void SummaryBuilder::add(const Record& q) {
-  const double e = q.xd - q.x;
-  const double ev = q.vd - q.v;
+  const double e = saturated(static_cast<long double>(q.xd) - q.x);
+  const double ev = saturated(static_cast<long double>(q.vd) - q.v);
   Summary& m = m_;
   if (n_ == 0) {
     m.control_min = m.control_max = q.u;
@@ -23,17 +31,17 @@ void SummaryBuilder::add(const Record& q) {
   m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
   m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
   if (n_ > 0) m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
-  se_ += e * e;
-  sev_ += ev * ev;
+  se_ += static_cast<long double>(e) * e;
+  sev_ += static_cast<long double>(ev) * ev;
   if (q.t >= settled_after_) {
     m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
     m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
-    se_settled_ += e * e;
+    se_settled_ += static_cast<long double>(e) * e;
     ++n_settled_;
   }
   m.control_min = std::min(m.control_min, q.u);
   m.control_max = std::max(m.control_max, q.u);
-  if (n_ > 0) m.control_total_variation += std::abs(q.u - last_.u);
+  if (n_ > 0) total_variation_ += std::abs(static_cast<long double>(q.u) - last_.u);
   if (q.u != q.u_unsaturated) ++m.control_saturated_steps;
   m.max_position_m = std::max(m.max_position_m, q.x);
   m.min_position_m = std::min(m.min_position_m, q.x);
@@ -52,10 +60,12 @@ Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator
   m.integrator_jac_evals = integrator.jac_evals;
   m.integrator_error_test_fails = integrator.error_test_fails;
   if (n_ == 0) return m;
-  const double n = static_cast<double>(n_);
-  m.position_error_rms_m = std::sqrt(se_ / n);
-  m.velocity_error_rms_mps = std::sqrt(sev_ / n);
-  if (n_settled_ > 0) m.position_error_rms_settled_m = std::sqrt(se_settled_ / static_cast<double>(n_settled_));
+  const long double n = static_cast<long double>(n_);
+  m.position_error_rms_m = static_cast<double>(std::sqrt(se_ / n));
+  m.velocity_error_rms_mps = static_cast<double>(std::sqrt(sev_ / n));
+  m.control_total_variation = saturated(total_variation_);
+  if (n_settled_ > 0)
+    m.position_error_rms_settled_m = static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_settled_)));
   // rank floor(0.95 n) of the n values |e| (the NaN of a run without truth are not ranked)
   if (abs_e_.count() > 0) {
     const auto k = std::min<std::uint64_t>(abs_e_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_e_.count())));

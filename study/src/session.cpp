@@ -65,7 +65,7 @@ fs::path prepare_folder(const std::string& out) {
   if (output::output_tool(dir) != kTool) {
     output::StagedFolder staged(out, kTool);
     fs::create_directories(staged.dir() / "cases");
-    staged.commit();
+    staged.commit(/*list_files=*/false);  // the study adds its cases and reports over reruns
   }
   fs::create_directories(dir / "cases");
   return dir;

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -28,11 +29,7 @@ std::string describe(const YAML::Node& n) {
 [[noreturn]] void fail(const std::string& key, const std::string& what) { throw StudyError(key + what); }
 
 std::string read_file(const std::string& path, const std::string& key) {
-  std::ifstream in(path);
-  if (!in) fail(key, " = '" + path + "': cannot read the file");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  return buf.str();
+  return text::read_text_file<StudyError>(path, key + " file");
 }
 
 std::string resolve_path(const std::string& base_dir, const std::string& p) {
@@ -384,12 +381,9 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
 }
 
 Study load_study(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw StudyError(path + ": cannot read the study file");
-  std::stringstream buf;
-  buf << in.rdbuf();
+  const std::string text = text::read_text_file<StudyError>(path, "study file");
   const fs::path p(path);
-  Study s = parse_study(buf.str(), p.parent_path().empty() ? "." : p.parent_path().string(), path);
+  Study s = parse_study(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;
   return s;
 }

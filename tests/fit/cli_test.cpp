@@ -17,47 +17,23 @@
 #include <vector>
 
 #include "feeddrive/sim/scenario.hpp"
+#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::slurp;
 
 const std::string kFit = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-fit";
 const std::string kSim = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-sim";
 const fs::path kScenarios = fs::path(FEEDDRIVE_SOURCE_DIR) / "scenarios" / "fit";
 
-// A scratch folder of this test process: ctest runs every test in its own process, in parallel,
-// so the folder is named by the pid.
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-fit-cli-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("fit-cli");
   return dir;
 }
 
-// Removes the scratch folder when the test program ends.
-class ScratchCleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(scratch(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
+  return feeddrive::test_support::write_text(scratch() / name, text);
 }
 
 struct ProcResult {
@@ -206,6 +182,20 @@ TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
   EXPECT_EQ(slurp(scratch() / "mine" / "keep.txt"), "mine\n");
 }
 
+TEST(FitCli, WindowsThatHoldTooFewSamplesAreRefused) {
+  // At 1 kHz a replay window of 5 ms holds 6 samples: the start-state correction (offset and
+  // slope) then fits away any gap (the "gap 0 -> 0" at --replay-window 1e-9); a filter
+  // half-width below 2 periods averages nothing. Both are refused with the record's period.
+  const std::string data = csv("t,x,u", good_rows(2000));
+  expect_data_error("short_window.csv", data,
+                    {"short_window.csv", "--replay-window 0.005 s spans fewer than 10 sample periods (0.001 s)",
+                     "at least 0.01 s"},
+                    "--replay-window 0.005");
+  expect_data_error("short_filter.csv", data,
+                    {"short_filter.csv", "--filter-half-width 0.0015 s is shorter than 2 sample periods (0.001 s)"},
+                    "--filter-half-width 0.0015");
+}
+
 TEST(FitCli, CorruptLcmLog) {
   // 4 kB of random bytes: not an LCM log (no sync word at event 0).
   std::mt19937 rng(12345);
@@ -328,13 +318,20 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   EXPECT_EQ(slurp(fake / "notes.txt"), "mine");
   EXPECT_EQ(slurp(fake / "findings.json"), "{}");
 
-  // An earlier feeddrive-fit output (it has the marker) is replaced whole, also as "DIR/".
+  // An earlier feeddrive-fit output (it has the marker) that holds a file of the user's is
+  // refused before any work, the file kept; without it, the output is replaced, also as "DIR/".
   EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
-  std::ofstream(out / "stale.txt") << "old";
-  const ProcResult again = run_fit("--scenario " + model.string() + " --data " + data.string() + " --out " +
-                                   out.string() + "/ --position-column x_measured --no-plots -q --max-effects 1");
+  std::ofstream(out / "notes.txt") << "mine";
+  const std::string again_args = "--scenario " + model.string() + " --data " + data.string() + " --out " + out.string() +
+                                 "/ --position-column x_measured --no-plots -q --max-effects 1";
+  const ProcResult kept = run_fit(again_args);
+  EXPECT_EQ(kept.code, 2) << kept.err;
+  EXPECT_EQ(std::count(kept.err.begin(), kept.err.end(), '\n'), 1) << kept.err;
+  EXPECT_NE(kept.err.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << kept.err;
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  fs::remove(out / "notes.txt");
+  const ProcResult again = run_fit(again_args);
   EXPECT_EQ(again.code, 0) << again.err;
-  EXPECT_FALSE(fs::exists(out / "stale.txt"));
   EXPECT_TRUE(fs::exists(out / "findings.json"));
   for (const auto& e : fs::directory_iterator(scratch()))
     EXPECT_EQ(e.path().filename().string().find(".fit_out."), std::string::npos) << "left behind: " << e.path();

@@ -66,12 +66,22 @@ no_mark "feeddrive-fit"
 pass "feeddrive-fit: model, data, column and --out names ran nothing"
 
 # ---- 2. --out prev/ replaces an earlier output; anything else is refused untouched
-timeout 120 feeddrive-launch "$scen" --out "$work/prev" --no-plots -q --lcm-url "$URL" || fail "launch into prev"
+timeout 120 feeddrive-launch "$scen" --out "$work/prev" -q --lcm-url "$URL" || fail "launch into prev"
 [ -f "$work/prev/.feeddrive-output" ] || fail "no marker in prev"
-echo old > "$work/prev/stale.txt"
+[ -f "$work/prev/position.png" ] || fail "no plots in prev"
+# A file of the user's inside the earlier output: refused before any process starts, kept.
+echo mine > "$work/prev/notes.txt"
+rc=0
+timeout 120 feeddrive-launch "$scen" --out "$work/prev/" --no-plots -q --lcm-url "$URL" 2> "$TMP/notes.err" || rc=$?
+[ "$rc" = 2 ] || fail "launch into prev/ holding notes.txt exited $rc, expected 2"
+[ "$(grep -c "" "$TMP/notes.err")" = 1 ] && grep -q "holds 'notes.txt', which feeddrive did not write" "$TMP/notes.err" ||
+  fail "launch into prev/ holding notes.txt: $(cat "$TMP/notes.err")"
+[ "$(cat "$work/prev/notes.txt")" = mine ] || fail "notes.txt was touched"
+pass "feeddrive-launch --out prev/ holding a file of the user's: $(cat "$TMP/notes.err")"
+rm "$work/prev/notes.txt"
 timeout 120 feeddrive-launch "$scen" --out "$work/prev/" --no-plots -q --lcm-url "$URL" || fail "launch into prev/"
 [ -f "$work/prev/timeseries.csv" ] || fail "prev/ lost its results"
-[ ! -e "$work/prev/stale.txt" ] || fail "prev/ was not replaced"
+[ ! -e "$work/prev/position.png" ] || fail "prev/ was not replaced whole (the earlier plots remain)"
 [ -z "$(find "$work" -maxdepth 1 -name '.prev.*')" ] || fail "temporary folders left: $(ls -a "$work")"
 pass "feeddrive-launch --out prev/: the earlier output replaced in place"
 

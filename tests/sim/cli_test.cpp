@@ -15,20 +15,17 @@
 #include <string>
 #include <vector>
 
+#include "../support/scratch.hpp"
+
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::names;
+using feeddrive::test_support::slurp;
 
 const std::string kSim = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-sim";
 
-// A scratch folder of this test process: ctest runs tests in parallel processes, which must not
-// share file names.
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-cli-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("cli");
   return dir;
 }
 
@@ -59,9 +56,7 @@ ProcResult run(const std::string& command, const fs::path& cwd) {
 }
 
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p) << text;
-  return p;
+  return feeddrive::test_support::write_text(scratch() / name, text);
 }
 
 const char* kGood = R"(
@@ -131,25 +126,23 @@ TEST(Cli, UnreadableScenarioAndMissingArguments) {
   EXPECT_EQ(run_sim("").code, 2);
 }
 
+TEST(Cli, ScenarioFileSizeIsBoundedAsItIsRead) {
+  // The issue's 50 MB name took 4.8 GB and /dev/zero as the scenario was read until the memory
+  // ran out (24 GB, killed): a scenario file is at most 1 MiB, refused as it is read.
+  expect_bad_input(std::string(kGood) + "# " + std::string((1 << 20) + 10, 'a') + "\n",
+                   "bad.yaml: the scenario file is larger than 1048576 bytes");
+  const ProcResult r = run_sim("/dev/zero --out " + (scratch() / "zero").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(r.err, "error: /dev/zero: the scenario file is larger than 1048576 bytes, the limit of a scenario or study "
+                   "file (docs/scenario.md, Limits); is it the right file?\n");
+  EXPECT_FALSE(fs::exists(scratch() / "zero"));
+}
+
 // Quoted for the shell of std::system: any text is one word.
 std::string sh(const std::string& s) {
   std::string q = "'";
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
-}
-
-std::vector<std::string> names(const fs::path& dir) {
-  std::vector<std::string> v;
-  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 void expect_one_line_about_out(const ProcResult& r, const std::string& value) {
@@ -164,15 +157,24 @@ TEST(Cli, EarlierOutputIsReplacedWholeAlsoWithATrailingSlash) {
   fs::remove_all(base);
   fs::create_directories(base);
   const fs::path out = base / "prev";
-  ASSERT_EQ(run_sim(scen.string() + " --out " + out.string() + " --no-plots").code, 0);
+  ASSERT_EQ(run_sim(scen.string() + " --out " + out.string()).code, 0);  // with plots
   EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
-  std::ofstream(out / "stale.txt") << "old";
+  EXPECT_TRUE(fs::exists(out / "position.png"));
   std::ofstream(base / "neighbour.txt") << "mine";
-  // "prev/" is "prev": replaced in place (the old bug wrote the temporary folder inside it and
-  // then deleted both)
+  // A file of the user's put into the earlier output: refused before the run, nothing deleted
+  // (the issue: "a user's own file inside it is lost too").
+  std::ofstream(out / "notes.txt") << "mine";
+  const ProcResult refused = run_sim(scen.string() + " --out " + out.string() + "/ --no-plots");
+  expect_one_line_about_out(refused, out.string() + "/");
+  EXPECT_NE(refused.err.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << refused.err;
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  EXPECT_TRUE(fs::exists(out / "position.png"));
+  fs::remove(out / "notes.txt");
+  // "prev/" is "prev": replaced in place and whole (the old bug wrote the temporary folder inside
+  // it and then deleted both): the earlier run's plots go with it.
   const ProcResult r = run_sim(scen.string() + " --out " + out.string() + "/ --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_FALSE(fs::exists(out / "stale.txt"));
+  EXPECT_FALSE(fs::exists(out / "position.png"));
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
   EXPECT_TRUE(fs::exists(out / "summary.json"));
   EXPECT_EQ(names(base), (std::vector<std::string>{"neighbour.txt", "prev"})) << "no temporary folder left";
@@ -333,7 +335,7 @@ TEST(Cli, BadOutputOptionsAndImpossibleRunsExitTwoBeforeAnyWork) {
                    "duration = 1e12, control_period = 1e-4: 1e+16 steps; a run has at most 1e+10 steps");
   // was "shorter than one control period" (the step count overflowed)
   expect_bad_input(std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1e300"),
-                   "duration = 1e300, control_period = 1e-4: 1.0000000000000001e+304 steps; a run has at most 1e+10 steps");
+                   "duration = 1e300, control_period = 1e-4: 1e+304 steps; a run has at most 1e+10 steps");
 }
 
 TEST(Cli, TimeseriesThatCannotFitTheDiskIsRefusedBeforeAnyWork) {

@@ -16,9 +16,12 @@
 
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
+#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::names;
+using feeddrive::test_support::slurp;
 using feeddrive::output::check_output_dir;
 using feeddrive::output::gnuplot_string;
 using feeddrive::output::is_feeddrive_output;
@@ -27,23 +30,9 @@ using feeddrive::output::normalise;
 using feeddrive::output::StagedFolder;
 
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-output-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("output");
   return dir;
 }
-
-class ScratchCleanup : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(scratch(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 // A fresh folder for one test.
 fs::path fresh(const std::string& name) {
@@ -53,21 +42,7 @@ fs::path fresh(const std::string& name) {
   return d;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
-
-std::vector<std::string> names(const fs::path& dir) {
-  std::vector<std::string> v;
-  for (const auto& e : fs::directory_iterator(dir)) v.push_back(e.path().filename().string());
-  std::sort(v.begin(), v.end());
-  return v;
-}
 
 // The message of the std::invalid_argument that f throws ("" if none).
 template <typename F>
@@ -331,6 +306,63 @@ TEST(OutputFolder, TrailingSlashReplacesAnEarlierOutputSafely) {
   }
   EXPECT_EQ(names(base / "prev"), (std::vector<std::string>{kMarkerFile, "new.txt"}));
   EXPECT_EQ(names(base), (std::vector<std::string>{"neighbour.txt", "prev"}));
+}
+
+TEST(OutputFolder, AUsersFileInAnEarlierOutputIsNeverDeleted) {
+  const fs::path base = fresh("staged_foreign");
+  {
+    StagedFolder first((base / "prev").string(), "t");
+    put(first.dir() / "old.txt", "old");
+    first.commit();
+  }
+  // the marker lists what was written
+  EXPECT_NE(slurp(base / "prev" / kMarkerFile).find("files:\nfile: old.txt\n"), std::string::npos)
+      << slurp(base / "prev" / kMarkerFile);
+  EXPECT_EQ(feeddrive::output::foreign_entry(base / "prev"), "");
+  EXPECT_NO_THROW(check_output_dir((base / "prev").string()));
+  // a file of the user's: refused before any work, with its name
+  put(base / "prev" / "notes.txt", "mine");
+  EXPECT_EQ(feeddrive::output::foreign_entry(base / "prev"), "notes.txt");
+  const std::string w = refusal([&] { check_output_dir((base / "prev/").string()); });
+  EXPECT_NE(w.find("holds 'notes.txt', which feeddrive did not write"), std::string::npos) << w;
+  EXPECT_THROW(StagedFolder((base / "prev").string(), "t"), std::invalid_argument);
+  EXPECT_EQ(slurp(base / "prev" / "notes.txt"), "mine");
+  // ... or put there while the next run was going: not replaced, the results kept aside
+  fs::remove(base / "prev" / "notes.txt");
+  {
+    StagedFolder second((base / "prev").string(), "t");
+    put(second.dir() / "new.txt", "new");
+    fs::create_directories(base / "prev" / "mine");
+    try {
+      second.commit();
+      FAIL() << "replaced an output holding a user's folder";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("holds files feeddrive did not write"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(second.dir().string()), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(second.dir() / "new.txt"), "new");
+  }
+  EXPECT_EQ(names(base / "prev"), (std::vector<std::string>{kMarkerFile, "mine", "old.txt"}));
+  // An output whose marker has no list (feeddrive before the list) is replaced whole, as before.
+  const fs::path older = fresh("staged_older") / "run";
+  fs::create_directories(older);
+  put(older / kMarkerFile, feeddrive::output::marker_text("feeddrive-sim"));
+  put(older / "summary.json", "{}");
+  EXPECT_EQ(feeddrive::output::foreign_entry(older), "");
+  {
+    StagedFolder next(older.string(), "t");
+    next.commit();
+  }
+  EXPECT_EQ(names(older), std::vector<std::string>{kMarkerFile});
+  // A folder committed without the list (feeddrive-study's, which grows over reruns) takes new
+  // entries without becoming foreign.
+  const fs::path growing = fresh("staged_growing") / "study";
+  {
+    StagedFolder s(growing.string(), "feeddrive-study");
+    s.commit(false);
+  }
+  put(growing / "results.csv", "a\n");
+  EXPECT_EQ(feeddrive::output::foreign_entry(growing), "");
 }
 
 TEST(OutputFolder, FailureBeforeCommitKeepsThePreviousOutput) {

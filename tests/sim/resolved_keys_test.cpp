@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/scratch.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::sim {
@@ -14,12 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using feeddrive::test_support::slurp;
 
 TEST(ResolvedKeys, DefaultsAreRecordedWithTheirValues) {
   ResolvedKeys keys;

@@ -12,42 +12,21 @@
 #include <string>
 
 #include "study_util.hpp"
+#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using feeddrive::test_support::slurp;
 
 const std::string kStudy = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-study";
 
 fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::path(::testing::TempDir()) / ("feeddrive-study-cli-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = feeddrive::test_support::make_scratch("study-cli");
   return dir;
 }
 
-// Removes the scratch folder when the test program ends.
-struct ScratchCleanup : ::testing::Environment {
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(scratch(), ec);
-  }
-};
-[[maybe_unused]] ::testing::Environment* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p) << text;
-  return p;
+  return feeddrive::test_support::write_text(scratch() / name, text);
 }
 
 struct ProcResult {

@@ -102,7 +102,7 @@ TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
             std::string::npos);
   EXPECT_NE(study_error(study_text("controllers:\n  - {name: a}\n")).find("give exactly one of controller:"), std::string::npos);
   EXPECT_NE(study_error("name: t\n").find("base: missing"), std::string::npos);
-  EXPECT_NE(study_error("name: t\nbase: /nonexistent.yaml\n").find("base = '/nonexistent.yaml': cannot read the file"), std::string::npos);
+  EXPECT_NE(study_error("name: t\nbase: /nonexistent.yaml\n").find("/nonexistent.yaml: cannot read the base file"), std::string::npos);
   EXPECT_NE(study_error("name: [t\n").find("YAML syntax error"), std::string::npos);
   EXPECT_NE(study_error(study_text("report: {scale: .nan}\n")).find("report.scale = '.nan': NaN is not allowed"), std::string::npos);
 }

@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 #include "feeddrive/output/gnuplot.hpp"
 
@@ -27,6 +29,7 @@ namespace {
 constexpr std::size_t kSiblingExtra = 40;
 constexpr std::size_t kMaxName = NAME_MAX - kSiblingExtra;
 constexpr std::size_t kMaxPath = PATH_MAX - kSiblingExtra;
+constexpr std::uintmax_t kMaxMarkerBytes = 1 << 16;  // the header and the list of a few dozen files
 
 [[noreturn]] void refuse(const std::string& option, const std::string& value, const std::string& why) {
   throw std::invalid_argument(option + " " + shown(value) + ": " + why);
@@ -66,7 +69,33 @@ bool exchange(const fs::path& a, const fs::path& b, int& err) {
   return false;
 }
 
+// The names the marker of `dir` lists ("file: NAME" lines after the three header lines), and
+// whether it lists any: a marker written before the list existed, or by a run still going, has
+// none.
+bool listed_files(const fs::path& dir, std::vector<std::string>& names) {
+  std::ifstream in(dir / kMarkerFile, std::ios::binary);
+  std::string line;
+  bool listed = false;
+  for (int n = 0; std::getline(in, line); ++n) {
+    if (n < 3) continue;
+    if (line == "files:") listed = true;
+    else if (listed && line.rfind("file: ", 0) == 0) names.push_back(line.substr(6));
+  }
+  return listed;
+}
+
 }  // namespace
+
+std::string foreign_entry(const fs::path& dir) {
+  std::vector<std::string> listed;
+  if (!is_feeddrive_output(dir) || !listed_files(dir, listed)) return "";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name != kMarkerFile && std::find(listed.begin(), listed.end(), name) == listed.end()) return name;
+  }
+  return "";
+}
 
 std::string marker_text(const std::string& tool) {
   return "feeddrive-output\nformat: " + std::to_string(kFormatVersion) + "\ntool: " + tool + "\n";
@@ -107,7 +136,7 @@ bool is_feeddrive_output(const fs::path& dir) {
   if (!fs::is_directory(fs::symlink_status(dir, ec))) return false;
   const fs::path marker = dir / kMarkerFile;
   const auto st = fs::symlink_status(marker, ec);
-  if (ec || !fs::is_regular_file(st) || fs::file_size(marker, ec) > 4096 || ec) return false;
+  if (ec || !fs::is_regular_file(st) || fs::file_size(marker, ec) > kMaxMarkerBytes || ec) return false;
   std::ifstream in(marker, std::ios::binary);
   std::string magic, format, tool;
   if (!std::getline(in, magic) || !std::getline(in, format) || !std::getline(in, tool)) return false;
@@ -154,6 +183,9 @@ fs::path check_output_dir(const std::string& out, const std::string& option) {
     if (!empty && !is_feeddrive_output(abs))
       refuse(option, out, std::string("folder exists, is not empty and is not a feeddrive output (no ") + kMarkerFile +
                               " marker); refusing to replace it");
+    if (const std::string f = foreign_entry(abs); !f.empty())
+      refuse(option, out, "holds '" + shown(f) + "', which feeddrive did not write (its " + kMarkerFile +
+                              " lists what it wrote); move it out or choose another folder");
   } else if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
     refuse(option, out, "cannot be checked: " + ec.message());
   }
@@ -215,7 +247,7 @@ int remove_stale_staging(const fs::path& target) noexcept {
 }
 
 StagedFolder::StagedFolder(const std::string& out, const std::string& tool, const std::string& option)
-    : value_(out), option_(option) {
+    : value_(out), option_(option), tool_(tool) {
   target_ = fs::absolute(check_output_dir(out, option));
   std::error_code ec;
   fs::create_directories(target_.parent_path(), ec);
@@ -260,10 +292,25 @@ StagedFolder::~StagedFolder() {
   if (!done_) remove_output(staging_);
 }
 
-void StagedFolder::commit() {
+void StagedFolder::commit(bool list_files) {
   if (done_) throw std::logic_error("StagedFolder::commit called twice");
   const std::string what = option_ + " " + shown(value_) + ": ";
   const std::string kept = "; the results are in " + staging_.string();
+  // The marker lists what this run wrote: a later run replaces the folder only while it holds
+  // nothing else (a user's notes put into it are refused, not deleted).
+  if (list_files) {
+    std::vector<std::string> files;
+    std::error_code lec;
+    for (fs::directory_iterator it(staging_, lec), end; !lec && it != end; it.increment(lec)) {
+      const std::string name = it->path().filename().string();
+      if (name != kMarkerFile && name.find('\n') == std::string::npos) files.push_back(name);
+    }
+    if (lec) throw std::runtime_error(what + "cannot list " + staging_.string() + ": " + lec.message());
+    std::sort(files.begin(), files.end());
+    std::string text = marker_text(tool_) + "files:\n";
+    for (const auto& f : files) text += "file: " + f + "\n";
+    write_file_atomically(staging_ / kMarkerFile, text);
+  }
   // From here on the staging folder is kept on failure: it holds finished results.
   done_ = true;
   std::error_code ec;
@@ -275,9 +322,10 @@ void StagedFolder::commit() {
       throw std::runtime_error(what + "cannot rename the results into place: " + error_text(errno) + kept);
     return;
   }
-  const auto ours = [](const fs::path& d) { return is_feeddrive_output(d) || empty_folder(d); };
+  const auto ours = [](const fs::path& d) { return (is_feeddrive_output(d) && foreign_entry(d).empty()) || empty_folder(d); };
   if (!fs::is_directory(st) || !ours(target_))
-    throw std::runtime_error(what + "changed during the run and is no longer a feeddrive output; not replaced" + kept);
+    throw std::runtime_error(what + "changed during the run: no longer a feeddrive output, or it holds files feeddrive did "
+                             "not write; not replaced" + kept);
 
   int err = 0;
   if (exchange(staging_, target_, err)) {
@@ -285,7 +333,8 @@ void StagedFolder::commit() {
     if (!ours(staging_)) {
       int err2 = 0;
       if (exchange(staging_, target_, err2))
-        throw std::runtime_error(what + "changed during the run and is no longer a feeddrive output; not replaced" + kept);
+        throw std::runtime_error(what + "changed during the run: no longer a feeddrive output, or it holds files feeddrive "
+                                 "did not write; not replaced" + kept);
       throw std::runtime_error(what + "changed during the run; the folder found there was moved to " + staging_.string() +
                                " and could not be moved back (" + error_text(err2) + ")");
     }

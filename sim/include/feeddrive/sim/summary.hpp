@@ -63,7 +63,10 @@ class SummaryBuilder {
   double settled_after_, control_period_;
   Summary m_;
   long n_{0}, n_settled_{0};
-  double se_{0.0}, sev_{0.0}, se_settled_{0.0};
+  // Sums of squares and the control's total variation in long double (x86-64: 64-bit mantissa,
+  // exponent to 1e4932): no finite record can overflow them, so a run that recorded a finite but
+  // absurd value (a corrupt logged state at 1e220 m) still gets finite metrics, never inf/null.
+  long double se_{0.0L}, sev_{0.0L}, se_settled_{0.0L}, total_variation_{0.0L};
   Record last_;
   stats::StreamingQuantile abs_e_;
 };

@@ -7,7 +7,7 @@
 //                          std::invalid_argument "--out DIR: why" (one line; the tools exit 2) if
 //                          DIR names no folder of its own ("", "/", ".", ".."), is too long,
 //                          lies under a file, cannot be written, or exists and is neither empty
-//                          nor a feeddrive output.
+//                          nor a feeddrive output holding only what feeddrive wrote.
 //   StagedFolder           the one writer of every tool's results: a new sibling folder
 //                          ".NAME.partial-PID-N" (marked from the start) that the tool fills
 //                          (write_text, CsvWriter on path(), plot) and commit() swaps into place.
@@ -18,8 +18,10 @@
 //                          removed by the next run that writes the same DIR.
 //
 // A folder is a feeddrive output only if it holds the marker file `.feeddrive-output` that a
-// StagedFolder wrote (first line "feeddrive-output", then "format: 1" and "tool: NAME"). Outputs
-// of feeddrive versions without the marker are refused like any other folder.
+// StagedFolder wrote (first line "feeddrive-output", then "format: 1" and "tool: NAME"; commit()
+// adds "files:" and one "file: NAME" line per entry it wrote). Outputs of feeddrive versions
+// without the marker are refused like any other folder, and so is an output that holds an entry
+// its marker does not list (a user's file put into it): replacing it would delete that file.
 
 #include <filesystem>
 #include <string>
@@ -34,6 +36,10 @@ std::string marker_text(const std::string& tool);
 
 /// True if `dir` is a folder (not a symbolic link) holding a well-formed marker.
 bool is_feeddrive_output(const std::filesystem::path& dir);
+
+/// The first entry of feeddrive output `dir` that its marker does not list (a file the user put
+/// there), or "" if there is none, or the marker has no list (an older output).
+std::string foreign_entry(const std::filesystem::path& dir);
 
 /// The tool named in the marker of `dir` ("feeddrive-sim", ...), or "" if `dir` is not a
 /// feeddrive output.
@@ -85,12 +91,15 @@ class StagedFolder {
   /// renamed to a sibling backup first and restored if the second rename fails), then removes
   /// the old folder, which is a feeddrive output or empty (checked again). If the target has
   /// become something else meanwhile, nothing is replaced: throws std::runtime_error naming the
-  /// temporary folder, which is kept with the results.
-  void commit();
+  /// temporary folder, which is kept with the results. With `list_files` (the default) the
+  /// marker lists every entry written (see the top of this file); a folder that keeps growing
+  /// after the commit (feeddrive-study's, over reruns) is committed without the list.
+  void commit(bool list_files = true);
 
  private:
   std::string value_;   // as the user gave it, for messages
   std::string option_;
+  std::string tool_;
   std::filesystem::path target_;
   std::filesystem::path staging_;
   bool done_{false};

@@ -1,0 +1,64 @@
+// The online summary (sim/summary.hpp) of records that are finite but absurd, as a corrupt
+// logged state or a hostile external plant can deliver (issue 13, point 7: nothing non-finite
+// passes). A 1e220 m position once made the sum of squared errors overflow: rms = inf, written
+// as null by the JSON writer, with exit 0 (found by fuzz.lcm_log).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/summary.hpp"
+
+namespace feeddrive::sim {
+namespace {
+
+Scenario scenario() {
+  Scenario s;
+  s.control_period = 1e-4;
+  s.analysis.settled_after = 0.0;  // every record is in the settled window
+  return s;
+}
+
+Record at(long k, double x, double u) {
+  Record r;
+  r.t = static_cast<double>(k) * 1e-4;
+  r.x = x;
+  r.u = r.u_unsaturated = u;
+  return r;
+}
+
+TEST(Summary, FiniteButHugeRecordsGiveFiniteMetrics) {
+  const Scenario s = scenario();
+  SummaryBuilder b(s);
+  // Three ordinary steps and one position of 1e220 m; commands alternating at +-1e308 V, whose
+  // differences (2e308) overflow a double.
+  b.add(at(0, 0.0, 1e308));
+  b.add(at(1, 0.0, -1e308));
+  b.add(at(2, -1e220, 1e308));
+  b.add(at(3, 0.0, -1e308));
+  const Summary m = b.summary(1.0, {});
+  // rms of (0, 0, 1e220, 0) = 1e220 / sqrt(4) = 5e219 (relative rounding of long double sums)
+  EXPECT_NEAR(m.position_error_rms_m / 5e219, 1.0, 1e-12);
+  EXPECT_NEAR(m.position_error_rms_settled_m / 5e219, 1.0, 1e-12);
+  EXPECT_EQ(m.position_error_max_abs_m, 1e220);
+  // |u| differences of 2e308 and their sum exceed the largest double: saturated there, finite.
+  EXPECT_EQ(m.control_total_variation, std::numeric_limits<double>::max());
+  // The error of xd = 1e308 against x = -1e308 (2e308) saturates too.
+  SummaryBuilder c(s);
+  Record r = at(0, -1e308, 0.0);
+  r.xd = 1e308;
+  c.add(r);
+  const Summary mc = c.summary(1.0, {});
+  EXPECT_EQ(mc.position_error_max_abs_m, std::numeric_limits<double>::max());
+  EXPECT_EQ(mc.position_error_rms_m, std::numeric_limits<double>::max());
+  EXPECT_TRUE(std::isfinite(mc.position_error_p95_abs_m));
+  const auto j = nlohmann::json::parse(summary_json(m, s));
+  EXPECT_TRUE(j["position_error_rms_m"].is_number()) << j.dump();
+  EXPECT_TRUE(j["position_error_rms_settled_m"].is_number()) << j.dump();
+  EXPECT_TRUE(j["control_total_variation"].is_number()) << j.dump();
+}
+
+}  // namespace
+}  // namespace feeddrive::sim
