@@ -21,7 +21,12 @@ struct LaunchOptions {
   /// After one process fails, how long the others get to notice before they are terminated [s].
   double grace_s{10.0};
   /// nice() increment of the monitor and the trajectory, which are off the step's critical path.
-  int off_path_niceness{10};
+  /// 0: measured on the shared 2-core VM (alternating, 5 rounds each, 24 November 2026), nice 10
+  /// made the lockstep run slower, 30,900 against 34,200 steps/s on one core (5 of 5 rounds) and
+  /// 25,700 against 28,700 free (medians): at nice 10 they lose the CPU to other work for longer
+  /// than their batches allow, and the plant (monitor window) and the controller (references)
+  /// wait for them.
+  int off_path_niceness{0};
   /// CPUs every started process is pinned to (sched_setaffinity); empty: no pinning. A lockstep
   /// run is a strict chain (state -> command -> state), so its processes never need to run at
   /// once, and on machines where waking a process on another core is slow (virtual machines)
