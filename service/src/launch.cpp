@@ -159,9 +159,10 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     const std::string exe = bin + "/feeddrive-" + role;
     if (::access(exe.c_str(), X_OK) != 0) throw std::runtime_error("cannot find " + exe);
     // The monitor and the trajectory are off the step's critical path (plant -> controller ->
-    // plant): on a machine with few cores they yield to it.
+    // plant); how much they yield to it depends on the mode (launch.hpp).
     const bool off_path = role == "monitor" || role == "trajectory";
-    running[spawn(exe, args, off_path ? lo.off_path_niceness : 0, lo.cpus)] = role;
+    const int niceness = off_path ? (opt.realtime ? lo.realtime_off_path_niceness : lo.off_path_niceness) : 0;
+    running[spawn(exe, args, niceness, lo.cpus)] = role;
   }
 
   LaunchResult result;
