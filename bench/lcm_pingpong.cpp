@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   const Receive receive = mode == "listen" ? (batched ? Receive::kBatched : Receive::kEvent)
                                            : (liblcm ? Receive::kEvent : Receive::kDirect);
   Bus bus(url, receive);
+  bus.set_run_id(1);  // both ends of the ping-pong are one "run" (Admit::kRun drops messages until it is known)
   if (mode == "listen") {
     bus.subscribe<control_command_t>(prefix + "_NOBODY", [](const control_command_t&, std::int64_t) {});
     const std::int64_t end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);

@@ -17,7 +17,7 @@
 #include <string.h>
 #include <time.h>
 
-enum { kPingBytes = 149, kPongBytes = 56 }; /* drive_state_t / control_command_t encoded sizes */
+enum { kPingBytes = 167, kPongBytes = 66 }; /* drive_state_t / control_command_t encoded sizes (unsigned) */
 
 static int64_t mono_us(void) {
   struct timespec ts;

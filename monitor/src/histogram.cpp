@@ -23,49 +23,6 @@ void Histogram::add(double us, std::int64_t count) {
   }
 }
 
-LatenessHistogram::LatenessHistogram(double period_us)
-    : period_us_(period_us), fine_(static_cast<std::size_t>(std::ceil(16.0 * period_us)) + 1, 0) {}
-
-void LatenessHistogram::add(std::int64_t k, double recv_us) {
-  if (k < 1 || std::isnan(recv_us)) return;
-  const double offset = recv_us - static_cast<double>(k) * period_us_;
-  if (!have_ref_) {
-    have_ref_ = true;
-    ref_ = offset;
-  }
-  const double i = std::floor(offset - ref_ + 4.0 * period_us_);
-  if (i < 0) {
-    ++below_;
-  } else if (i >= static_cast<double>(fine_.size())) {
-    ++above_;
-  } else {
-    ++fine_[static_cast<std::size_t>(i)];
-  }
-}
-
-Histogram LatenessHistogram::result(double bin_us, int bins) const {
-  Histogram h(bin_us, bins);
-  std::int64_t n = below_ + above_;
-  for (const auto c : fine_) n += c;
-  if (n == 0) return h;
-  // The origin: the fine bin holding the 0.1 % quantile (a state stamped early, e.g. across a
-  // clock adjustment, does not shift every other state's lateness). Earlier states count 0 late.
-  const std::int64_t rank = n / 1000;
-  std::int64_t seen = below_;
-  std::size_t origin = 0;
-  if (seen <= rank) {
-    for (; origin < fine_.size(); ++origin) {
-      seen += fine_[origin];
-      if (seen > rank) break;
-    }
-  }
-  h.add(0.0, below_);
-  for (std::size_t i = 0; i < fine_.size(); ++i)
-    if (fine_[i] > 0) h.add(static_cast<double>(i) - static_cast<double>(origin), fine_[i]);
-  h.add(1e300, above_);
-  return h;
-}
-
 std::string histograms_csv(const std::vector<std::string>& names, const std::vector<Histogram>& h) {
   std::string out = "bin_start_us";
   for (const auto& n : names) out += "," + n;

@@ -30,7 +30,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       // Histograms: bins of T/20 up to 2T (5 us at 10 kHz).
       hist_sc_(s.control_period * 1e6 / 20.0, 40),
       hist_cs_(s.control_period * 1e6 / 20.0, 40),
-      lateness_(s.control_period * 1e6) {
+      hist_late_(s.control_period * 1e6 / 20.0, 40) {
   if (mopt.attach) bus().join_first_seen();
   // Every message passes the conflict check first: a second, different message for a step is
   // never recorded (service::Node::admit).
@@ -90,7 +90,7 @@ void MonitorNode::publish_info() {
 void MonitorNode::on_state_timing(const drive_state_t& m, std::int64_t t) {
   if (m.end_of_run || m.seq <= timing_pruned_ || state_recv_.count(m.seq)) return;
   state_recv_[m.seq] = t;
-  if (options().realtime) lateness_.add(m.seq, static_cast<double>(t));
+  if (options().realtime && m.seq >= 1) hist_late_.add(static_cast<double>(m.start_late_us));  // state 0: the start handshake
   if (const auto c = cmd_recv_.find(m.seq - 1); c != cmd_recv_.end() && t >= c->second)
     hist_cs_.add(static_cast<double>(t - c->second));
   prune_timing(m.seq);
@@ -284,6 +284,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["invalid_messages"] = invalid_total;
   l["rejected_commands"] = rec_.rejected_commands();
   l["deadline_misses"] = rec_.missed_deadlines();
+  l["plant_overruns"] = rec_.plant_overruns();
   l["run_id"] = bus().run_id();
   l["authenticated"] = bus().authenticated();
   l["foreign_messages"] = foreign;
@@ -316,13 +317,13 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
                             {"p1", lat(rec_.reference_lead(), 0.01)},
                             {"samples", rec_.reference_lead().count()}};
   // In real time a state_to_command beyond T - guard is a deadline miss, and
-  // period_start_lateness is how late each state went out relative to the earliest (the plant's
-  // timer wake-up and spin, as the monitor sees it).
+  // period_start_lateness is how late the plant sent each state after its period start, on its
+  // own clock (drive_state_t.start_late_us: its timer wake-up and spin).
   std::vector<std::string> hist_names = {"state_to_command", "command_to_state"};
   std::vector<Histogram> hists = {hist_sc_, hist_cs_};
   if (options().realtime) {
     hist_names.push_back("period_start_lateness");
-    hists.push_back(lateness_.result(hist_sc_.bin_us(), static_cast<int>(hist_sc_.counts().size())));
+    hists.push_back(hist_late_);
   }
   {
     auto& h = l["latency_histogram_us"];

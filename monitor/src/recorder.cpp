@@ -16,6 +16,7 @@ void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
   if (m.end_of_run) end_seen_ = true;
   rejected_ = std::max<std::int64_t>(rejected_, m.rejected_commands);
   missed_ = std::max<std::int64_t>(missed_, m.missed_deadlines);
+  overruns_ = std::max<std::int64_t>(overruns_, m.overruns);
   if (m.seq > highest_state_) {
     highest_state_ = m.seq;
     safe_state_ = m.safe_state;

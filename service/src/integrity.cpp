@@ -74,6 +74,8 @@ std::string differing_fields(const drive_state_t& a, const drive_state_t& b) {
   d.f("previous.f_grinding", a.previous.f_grinding, b.previous.f_grinding);
   d.i("rejected_commands", a.rejected_commands, b.rejected_commands);
   d.i("missed_deadlines", a.missed_deadlines, b.missed_deadlines);
+  d.i("overruns", a.overruns, b.overruns);
+  d.f("start_late_us", a.start_late_us, b.start_late_us);
   d.i("safe_state", a.safe_state, b.safe_state);
   return d.names;
 }

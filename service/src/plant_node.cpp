@@ -64,6 +64,7 @@ drive_state_t PlantNode::make_state(std::int64_t k) {
   m.previous = previous_;
   m.rejected_commands = static_cast<std::int32_t>(rejected_);
   m.missed_deadlines = static_cast<std::int32_t>(missed_);
+  m.overruns = static_cast<std::int32_t>(overruns_);
   m.safe_state = safe_state_;
   return m;
 }
@@ -238,8 +239,21 @@ void PlantNode::run_realtime() {
     previous_ = to_applied(k, u_now_, drive_.forces(u_now_));
     drive_.advance(u_now_, t_next);
     if (k + 1 < steps_) {
-      const drive_state_t next = make_state(k + 1);
-      sleep_until(t0_us_ + (k + 1) * period_us, options().realtime_spin_us);
+      drive_state_t next = make_state(k + 1);
+      const std::int64_t w = t0_us_ + (k + 1) * period_us;
+      sleep_until(w, options().realtime_spin_us);
+      const std::int64_t late = mono_us() - w;
+      // An overrun: the plant itself (its timer, its integration, a descheduled virtual CPU)
+      // starts the period more than the guard late. Catching up would give the controller less
+      // than T - guard for each of the next periods and turn one stall of the simulator into a
+      // run of missed deadlines (and the safe state); a real drive's clock does not stall. So the
+      // plant moves its clock on by the delay (the simulated drive waits with it: simulated time
+      // stays k*T) and counts the overrun apart from the controller's deadline misses.
+      if (late > guard_us) {
+        t0_us_ += late;
+        next.overruns = static_cast<std::int32_t>(++overruns_);
+      }
+      next.start_late_us = static_cast<float>(late);
       states_.publish(k + 1, next);  // first thing in the period
       set_seq(k + 1);
     }

@@ -1,5 +1,7 @@
 #include "feeddrive/service/trajectory_node.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include "feeddrive/service/translate.hpp"
 
 namespace feeddrive::service {
@@ -58,6 +60,15 @@ void TrajectoryNode::send_ahead(std::int64_t k) {
 }
 
 void TrajectoryNode::run() {
+  // Real time: the references feed the controller's every period, so the trajectory is part of
+  // the loop too; below the plant (80) and the controller (81), above everything else. At
+  // normal priority, pinned next to them (--cpus 0) on a busy machine, it starved for hundreds of
+  // ms and the controller, waiting for its reference, missed thousands of deadlines.
+  if (options().realtime) {
+    const std::string rt = enter_realtime(79);
+    if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("trajectory: real time: {}", rt);
+    else spdlog::warn("trajectory: real time: {}", rt);
+  }
   set_state("running");
   wait_for_run();  // every block must carry the run's identity
   // Everything, block 0 included, once the plant's first state shows that the run has started:

@@ -21,27 +21,6 @@ TEST(Histogram, BinsOverflowAndNaN) {
   EXPECT_THROW(Histogram(0.0, 4), std::invalid_argument);
 }
 
-TEST(Histogram, PeriodStartLateness) {
-  // T = 100 us; states 1..5 go out at 1000 + k*T plus a lateness of 0, 7, 0, 30, 0 us; state 0
-  // (the start handshake, long before the clock starts) is ignored. The first state added is
-  // late itself in the second case: the origin is still the earliest.
-  LatenessHistogram a(100.0);
-  a.add(0, 10.0);
-  for (const auto& [k, late] : {std::pair{1, 0.0}, {2, 7.0}, {3, 0.0}, {4, 30.0}, {5, 0.0}})
-    a.add(k, 1000.0 + 100.0 * k + late);
-  const Histogram h = a.result(5.0, 10);
-  EXPECT_EQ(h.samples(), 5);
-  EXPECT_EQ(h.counts()[0], 3);
-  EXPECT_EQ(h.counts()[1], 1);  // 7 us
-  EXPECT_EQ(h.counts()[6], 1);  // 30 us
-  LatenessHistogram b(100.0);
-  b.add(1, 1100.0 + 40.0);  // 40 us late, added first
-  b.add(2, 1200.0);
-  const Histogram g = b.result(5.0, 10);
-  EXPECT_EQ(g.counts()[0], 1);
-  EXPECT_EQ(g.counts()[8], 1);  // 40 us
-}
-
 TEST(Histogram, Csv) {
   Histogram a(5.0, 2), b(5.0, 2);
   a.add(1.0);

@@ -81,29 +81,52 @@ double max_error_um(const Scenario& s) {
   return e * 1e6;
 }
 
+// One corner of the robustness study's combination family: the 50 nm encoder with 20 nm noise,
+// 1 ms of computation delay, and the plant's mass, Fs/Fc and sigma0/sigma1 scaled; the controller
+// keeps the nominal model (pinned in both files) and knows its encoder (the study's rule).
+Scenario corner(const std::string& file, double mass, double friction, double bristle) {
+  Scenario s = load_scenario(kRobust + file);
+  s.plant.sensor.quantization = 5e-8;
+  s.plant.sensor.noise_stddev = 2e-8;
+  s.plant.mass *= mass;
+  s.plant.friction.static_force *= friction;
+  s.plant.friction.coulomb_force *= friction;
+  s.plant.friction.bristle_stiffness *= bristle;
+  s.plant.friction.bristle_damping *= bristle;
+  s.controller.computation_delay = 1e-3;
+  s.controller.sliding_mode.computation_delay = 1e-3;
+  s.controller.sliding_mode.model.sensor = s.plant.sensor;  // the observer's dead zone: one count
+  return s;
+}
+
 // The robust configuration keeps the paper's 0.8 um on the jerk-limited move in the hardest
 // corners of the robustness study (docs/controllers.md, "The robust configuration"): 1 ms of
 // computation delay with the 50 nm encoder and 20 nm noise, mass -20 %, and Fs/Fc, sigma0/sigma1
-// 30 % off in opposite directions (measured 0.35 and 0.28 um, the study's worst corners). The
-// controller keeps the nominal model (pinned in the file).
-TEST(RobustConfiguration, KeepsTheClaimInTheHardestCorners) {
+// 30 % off in opposite directions, and it beats the tuned cascade's worst corner of the study
+// (mass -20 %, Fs/Fc +30 %, sigma0/sigma1 -30 %: 0.312 um, docs/robustness.md). Measured: the
+// robust SMC 0.211 um (Fs/Fc -30 %) and 0.226 um (Fs/Fc +30 %, the same corner as the cascade's
+// worst). The bound is the cascade's own error in its worst corner, run here (the noise is seeded:
+// both runs are deterministic, and the cascade's 0.312 is checked to 0.001 um, the rounding of the
+// study's figure, so the test reproduces the study's case), so the test fails if either
+// controller moves the other way.
+TEST(RobustConfiguration, KeepsTheClaimAndBeatsTheTunedCascadesWorstCorner) {
+  Scenario c = corner("cascade_tuned.yaml", 0.8, 1.3, 0.7);
+  c.controller.cascade.computation_delay = 1e-3;
+  // The rule's gains for this delay and sensor (read_cascade sets them at load time, delay 0).
+  const controller::CascadeGains g = controller::cascade_tuning(1e-4, 1e-3, true, 1.0);
+  c.controller.cascade.kp = g.kp;
+  c.controller.cascade.kv = g.kv;
+  c.controller.cascade.ki = g.ki;
+  c.controller.cascade.quantization = 5e-8;
+  const double cascade = max_error_um(c);
+  EXPECT_NEAR(cascade, 0.312, 0.001) << "the study's number for this corner (the same scenario)";
   for (const double friction : {0.7, 1.3}) {
-    Scenario s = load_scenario(kRobust + "robust_smc.yaml");
-    s.plant.sensor.quantization = 5e-8;
-    s.plant.sensor.noise_stddev = 2e-8;
-    s.plant.mass *= 0.8;
-    s.plant.friction.static_force *= friction;
-    s.plant.friction.coulomb_force *= friction;
-    const double bristle = 2.0 - friction;  // the other direction
-    s.plant.friction.bristle_stiffness *= bristle;
-    s.plant.friction.bristle_damping *= bristle;
-    s.controller.computation_delay = 1e-3;
-    s.controller.sliding_mode.computation_delay = 1e-3;
-    s.controller.sliding_mode.model.sensor = s.plant.sensor;  // the observer's dead zone: one count
+    const Scenario s = corner("robust_smc.yaml", 0.8, friction, 2.0 - friction);
     EXPECT_EQ(s.controller.sliding_mode.model.mass, 102.04) << "the model stays nominal";
     const double e = max_error_um(s);
     SCOPED_TRACE("Fs,Fc x" + std::to_string(friction));
     EXPECT_LE(e, 0.8);
+    EXPECT_LT(e, cascade) << "the tuned cascade's worst corner: " << cascade << " um";
   }
 }
 

@@ -27,27 +27,6 @@ class Histogram {
   std::int64_t samples_{0};
 };
 
-/// Period-start lateness of real-time states: state k received at recv_us goes out at
-/// origin + k*T, where the origin (unknown: the plant's clock start as the monitor sees it) is
-/// taken as the 0.1 % quantile of recv_us - k*T over the run, so the earliest states are 0 late.
-/// The offsets are kept in 1 us bins relative to the first state added, over [-4T, 12T)
-/// (outside: counted late beyond the histogram), then binned like Histogram.
-class LatenessHistogram {
- public:
-  explicit LatenessHistogram(double period_us);
-  /// State k (k >= 1: state 0 goes out in the start handshake, before the clock starts).
-  void add(std::int64_t k, double recv_us);
-  /// The lateness histogram with `bins` bins of bin_us.
-  Histogram result(double bin_us, int bins) const;
-
- private:
-  double period_us_;
-  bool have_ref_{false};
-  double ref_{0.0};            ///< offset of the first state added [us]
-  std::vector<std::int64_t> fine_;  ///< 1 us bins of offset - ref, from -4T
-  std::int64_t below_{0}, above_{0};
-};
-
 /// CSV of histograms side by side: "bin_start_us,<name 1>,<name 2>,...", one row per bin.
 std::string histograms_csv(const std::vector<std::string>& names, const std::vector<Histogram>& h);
 

@@ -79,8 +79,7 @@ class MonitorNode : public service::Node {
   std::unique_ptr<LcmLogWriter> log_;
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)
   std::int64_t heartbeats_{0};
-  Histogram hist_sc_, hist_cs_;
-  LatenessHistogram lateness_;
+  Histogram hist_sc_, hist_cs_, hist_late_;
   std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight
   std::int64_t timing_pruned_{-1};                              ///< steps <= this are no longer timed
 };

@@ -89,6 +89,8 @@ class Recorder {
   /// The latest counters the plant reported.
   std::int64_t rejected_commands() const { return rejected_; }
   std::int64_t missed_deadlines() const { return missed_; }
+  /// Real time: periods the plant started more than its guard late (drive_state_t.overruns).
+  std::int64_t plant_overruns() const { return overruns_; }
   bool safe_state() const { return safe_state_; }
 
   /// Per-hop latencies from receive times [us]: state k -> command k, command k -> state k+1.
@@ -126,6 +128,7 @@ class Recorder {
   void maybe_start();
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
+  std::int64_t overruns_{0};
   bool safe_state_{false};
   stats::StreamingQuantile lat_sc_, lat_cs_, lead_;
 };

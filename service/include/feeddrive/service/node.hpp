@@ -32,8 +32,11 @@ struct NodeOptions {
   long monitor_window{4096};         ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
   double linger_s{10.0};             ///< after the end: keep answering resend requests until the monitor is done
   bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
-  int max_bad_commands{10};
-  std::int64_t realtime_spin_us{10};  ///< real time: busy-wait this long before a period start (after clock_nanosleep)          ///< real time: consecutive missed/invalid commands before the safe state
+  int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
+  /// Real time: busy-wait this long before a period start (after clock_nanosleep). 30 us: a timer
+  /// wakes 20-40 us late on the development VM (measured: bench/realtime_bench.sh with 10 us
+  /// gave a median 767 plant overruns and 75 misses of 15,000, with 30 us 156 and 56).
+  std::int64_t realtime_spin_us{30};
   bool quiet{false};
   /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
   /// other process takes it from the plant's first fresh heartbeat.

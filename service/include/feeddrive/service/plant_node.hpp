@@ -14,7 +14,9 @@
 // CVODE there (a jump discontinuity). When command k has arrived, the plant integrates to
 // t_{k+1} at once and prepares state k+1, so that at w_{k+1} it only publishes. Command k must
 // arrive before w_{k+1} - guard (guard: the plant's own computation, realtime_guard()); one
-// that arrives later is a missed deadline, and acts from its arrival in a later period.
+// that arrives later is a missed deadline, and acts from its arrival in a later period. When
+// the plant itself starts a period more than the guard late (an overrun: its own timer or a
+// stalled CPU), it moves its clock on by that delay instead of catching up, and counts it apart.
 // After max_bad_commands missed or invalid commands in a row it goes to the safe state (0 V)
 // and says so, in its status and in every following state message, until a valid command
 // arrives on time. Lockstep keeps the idealisation: command k acts over all of [t_k, t_{k+1}].
@@ -42,6 +44,7 @@ class PlantNode : public Node {
 
   std::int64_t rejected_commands() const { return rejected_; }
   std::int64_t missed_deadlines() const { return missed_; }
+  std::int64_t overruns() const { return overruns_; }
 
  private:
   void run_lockstep();
@@ -70,6 +73,7 @@ class PlantNode : public Node {
   applied_t previous_;
   std::int64_t rejected_{0};
   std::int64_t missed_{0};
+  std::int64_t overruns_{0};  ///< real time: periods the plant started more than the guard late
   int bad_in_a_row_{0};
   bool safe_state_{false};
   double last_good_u_{0.0};
