@@ -212,6 +212,18 @@ TEST(FitCli, WindowsThatHoldTooFewSamplesAreRefused) {
                     "--filter-half-width 0.0015");
 }
 
+TEST(FitCli, FinitePositionOutliersTooLargeForAFiniteFitAreNamed) {
+  // A position of 1e308 m made the motion estimate NaN, blamed on "plant.initial.bristle = -nan"
+  // after two lines of Ceres logging; one of 1e200 m gave a findings.json with null (inf) gaps.
+  // Both: exit 2, one line naming the sample (found by the fuzz suite, seed 30055).
+  for (const std::string big : {"1e308", "1e200"}) {
+    auto rows = good_rows(2000);
+    rows[700] = "0.7," + big + ",0.05";
+    expect_data_error("outlier_" + big + ".csv", csv("t,x,u", rows),
+                      {"outlier_" + big + ".csv", "at t = 0.7 s", "is the position column in metres and free of outliers?"});
+  }
+}
+
 TEST(FitCli, CorruptLcmLog) {
   // 4 kB of random bytes: not an LCM log (no sync word at event 0).
   std::mt19937 rng(12345);
