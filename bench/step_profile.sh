@@ -52,4 +52,10 @@ for r in $(seq "$ROUNDS"); do
         busy = 0; for (p in tot) if (p != "idle") { busy += tot[p]; printf "  total %-54s %7.2f us/step\n", p, tot[p] }
         printf "  CPU busy %.2f us/step; sampled idle %.2f us/step\n", busy, tot["idle"]
       }'
+  # The kernel part of the two processes on the step's critical path, by function (top 12).
+  for comm in feeddrive-plant feeddrive-contr; do
+    echo "  $comm, kernel functions [us/step]:"
+    perf report -i "$TMP/perf$r.data" --stdio --comms "$comm" --dsos '[kernel.kallsyms]' --sort sym -F sample,sym 2> /dev/null |
+      awk -v rate="$RATE" -v steps="$steps" '/^#/ || NF < 2 { next } { printf "    %6.2f %s\n", $1 / rate * 1e6 / steps, $NF }' | sort -rn | head -n 12
+  done
 done
