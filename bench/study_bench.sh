@@ -13,12 +13,15 @@
 # cores one copy among `cores` takes as long as one alone; on a shared one (other work on the cores,
 # shared caches, a VM's vCPUs) it takes longer, and no runner can beat cases x that time / cores.
 # The printed "machine" ratio and "ratio against the parallel ideal" tell the runner apart from it.
-# Run it alone: flock /tmp/feeddrive-bench.lock bash bench/study_bench.sh [BUILD_DIR] [CASES] [RUNS]
+# With SERIAL > 0 it also runs a study of SERIAL cases with -j 1 against SERIAL x one case: the
+# runner on one thread, which no other work on the second core can slow down.
+# Run it alone: flock /tmp/feeddrive-bench.lock bash bench/study_bench.sh [BUILD_DIR] [CASES] [RUNS] [SERIAL]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 CASES=${2:-1000}
 RUNS=${3:-5}
+SERIAL=${4:-0}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 SCEN=$PWD/scenarios/paper/smc_bl_jerk_limited.yaml
@@ -56,6 +59,12 @@ parallel_case > "$TMP/par.txt"
 s=$(date +%s%N)
 "$BUILD/bin/feeddrive-study" "$TMP/bench.yaml" --out "$TMP/study" -q
 e=$(date +%s%N)
+if [ "$SERIAL" -gt 0 ]; then
+  sed "s/draws: $CASES/draws: $SERIAL/" "$TMP/bench.yaml" > "$TMP/serial.yaml"
+  s1=$(date +%s%N)
+  "$BUILD/bin/feeddrive-study" "$TMP/serial.yaml" --out "$TMP/serial" -q -j 1
+  e1=$(date +%s%N)
+fi
 one_case >> "$TMP/one.txt"
 parallel_case >> "$TMP/par.txt"
 t1=$(median < "$TMP/one.txt")
@@ -73,3 +82,9 @@ awk -v n="$CASES" -v t="$t1" -v c="$CORES" -v w="$wall" -v s="$sum" -v p="$tp" '
   printf "(wall / (sum of the cases'\'' own times / cores) = %.3f: the runner'\''s own overhead)\n", w / (s / c)
   printf "(machine = one case among %d at once / one case alone = %.3f; ratio against the parallel ideal cases x %.4f / %d: %.3f)\n", c, p / t, p, c, w / (n * p / c)
 }'
+if [ "$SERIAL" -gt 0 ]; then
+  awk -v n="$SERIAL" -v t="$t1" -v a="$s1" -v b="$e1" 'BEGIN {
+    w = (b - a) / 1e9
+    printf "one thread: %d cases with -j 1: wall %.2f s against %d x one case = %.2f s: ratio %.3f\n", n, w, n, n * t, w / (n * t)
+  }'
+fi

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/workflow.hpp"
@@ -38,7 +39,8 @@ int main(int argc, char** argv) {
           if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return "'" + s + "' is not a finite number";
           if (zero && v == 0.0) return "";
           if (v < lo || v > hi)
-            return "'" + s + "' is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + (zero ? " (or 0)" : "");
+            return "'" + s + "' is outside [" + validate::format_number(lo) + ", " + validate::format_number(hi) + "]" +
+                   (zero ? " (or 0 for the default)" : "");
           return "";
         },
         "");

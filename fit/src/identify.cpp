@@ -371,6 +371,11 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
       problem.SetManifold(theta.data(), new ceres::SubsetManifold(dim, fixed));
     }
   }
+  // Ceres reports a failed evaluation (a NaN residual) through glog on stderr at level ERROR,
+  // with "Logging before InitGoogleLogging()": the tools promise one line on stderr, and the
+  // solver's outcome is read from its summary here. Only a fatal glog message is shown.
+  static const bool glog_quiet = (FLAGS_minloglevel = google::GLOG_FATAL, true);
+  (void)glog_quiet;
   ceres::Solver::Options opt;
   opt.max_num_iterations = max_iterations;
   opt.linear_solver_type = ceres::DENSE_QR;

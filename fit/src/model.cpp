@@ -35,6 +35,27 @@ Record prepare(const MeasuredData& d, const RecordOptions& opt) {
   } catch (const std::invalid_argument& e) {
     throw DataError(d.source + ": " + e.what() + " (too few samples for the fit)");
   }
+  // Finite samples can still be too large to fit (a position outlier of 1e200 m or 1e308 m):
+  // the estimated velocity and acceleration and the filtered acceleration must have finite
+  // squares (|y| < 1e150), else the fit fails later on a NaN or a CVODE error blamed on a model
+  // key, or writes an infinite gap. Named with the sample that led there.
+  const auto not_finite = [](const std::vector<double>& v) {
+    return std::find_if(v.begin(), v.end(), [](double y) { return !(std::abs(y) < 1e150); }) - v.begin();
+  };
+  const long bad_v = not_finite(r.motion.v), bad_a = not_finite(r.motion.a), bad_f = not_finite(r.bank.accel);
+  const long n = static_cast<long>(d.size());
+  if (bad_v < n || bad_a < n || bad_f < static_cast<long>(r.bank.accel.size())) {
+    const long k = bad_v < n ? bad_v : bad_a < n ? bad_a : r.bank.nearest[static_cast<std::size_t>(bad_f)];
+    // the largest |x| within the estimate's reach of sample k
+    long worst = k;
+    for (long j = std::max(0L, k - 2 * M - 1); j < std::min(n, k + 2 * M + 2); ++j)
+      if (std::abs(d.x[static_cast<std::size_t>(j)]) > std::abs(d.x[static_cast<std::size_t>(worst)])) worst = j;
+    char why[240];
+    std::snprintf(why, sizeof why, ": the velocity or acceleration estimated from the position is beyond 1e150 near t = %.6g s "
+                  "(position %.6g m at t = %.6g s): is the position column in metres and free of outliers?",
+                  d.t[static_cast<std::size_t>(k)], d.x[static_cast<std::size_t>(worst)], d.t[static_cast<std::size_t>(worst)]);
+    throw DataError(d.source + why);
+  }
   r.input.resize(static_cast<long>(d.size()) - 1);
   for (long j = 0; j + 1 < static_cast<long>(d.size()); ++j) r.input[j] = d.input[static_cast<std::size_t>(j)];
   const auto [xmin, xmax] = std::minmax_element(d.x.begin(), d.x.end());

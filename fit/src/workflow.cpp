@@ -102,6 +102,17 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   Replay rp = replay(rec, current, opt.replay_window);
   out.replay_initial = replay(rec, model, opt.replay_window);
   out.force_rms_initial = rms(force_residual(rec, model), n);
+  if (!std::isfinite(out.replay_initial.gap) || !std::isfinite(out.force_rms_initial)) {
+    // Finite samples whose squares are not (a position outlier of 1e200 m): no finite metric.
+    const MeasuredData& d = *rec.data;
+    std::size_t worst = 0;
+    for (std::size_t k = 0; k < d.size(); ++k)
+      if (std::abs(d.x[k]) > std::abs(d.x[worst])) worst = k;
+    throw DataError(d.source + fmt(": the replay gap or the force residual of the model is not finite on this record (its "
+                                   "largest position is %.6g m at t = %.6g s): is the position column in metres and free of "
+                                   "outliers?",
+                                   d.x[worst], d.t[worst]));
+  }
   say("initial model: gap " + fmt("%.4g um, force residual RMS %.4g N", out.replay_initial.gap * 1e6, out.force_rms_initial));
   std::vector<std::string> added;  // in the order found; removed ones are taken out
   int additions = 0;

@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
     const monitor::Recorder& rec = c.recorder;
     if (out.steps() == 0)
       throw std::invalid_argument(log_path + ": no complete step on channels " + opt.prefix + "_STATE/_REF/_CMD (" +
-                                  std::to_string(c.events) + " events read; wrong --prefix?)");
+                                  std::to_string(c.events) + " events read; " +
+                                  (c.cut_bytes > 0 ? monitor::describe_cut(c) : std::string("wrong --prefix?")) + ")");
     nlohmann::ordered_json j;
     auto& l = j["log"];
     l["events"] = c.events;
@@ -51,10 +52,12 @@ int main(int argc, char** argv) {
     l["undecodable_events"] = c.undecodable;
     l["non_finite_messages"] = c.non_finite;
     l["foreign_events"] = c.foreign_events;
+    l["cut_event_bytes"] = c.cut_bytes;
     out.finish(out.summary(0.0, {}), plots, j.dump());
     spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
                  log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
                  out_dir);
+    if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, monitor::describe_cut(c));
     if (!rec.gaps().empty())
       spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, monitor::describe_gaps(rec.gaps()),
                    rec.steps(), out.steps(), out_dir);

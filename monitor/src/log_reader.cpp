@@ -1,5 +1,6 @@
 #include "feeddrive/monitor/log_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -35,11 +36,21 @@ class LogParser {
     in_.seekg(0);
   }
 
-  // Reads the next event into `ev`; false at the clean end of the file. Throws on corruption.
+  // Reads the next event into `ev`; false at the end of the file (also at a last event cut
+  // short: see cut_tail()). Throws on corruption.
   bool next(Event& ev, long events_so_far) {
     if (offset_ == size_) return false;
+    const std::int64_t left = size_ - offset_;
     std::uint8_t h[kLcmLogHeaderSize];
-    if (size_ - offset_ < static_cast<std::int64_t>(sizeof h)) corrupt(events_so_far, "truncated event header");
+    if (left < static_cast<std::int64_t>(sizeof h)) {
+      // A logger stopped in the middle of writing its last event (killed, disk full): what is
+      // left is shorter than a header. If it starts like one, it is that cut event.
+      std::uint8_t start[4] = {0, 0, 0, 0};
+      in_.read(reinterpret_cast<char*>(start), std::min<std::int64_t>(left, 4));
+      const std::uint8_t sync[4] = {0xED, 0xA1, 0xDA, 0x01};
+      if (!std::equal(start, start + std::min<std::int64_t>(left, 4), sync)) corrupt(events_so_far, "truncated event header");
+      return cut(left);
+    }
     in_.read(reinterpret_cast<char*>(h), sizeof h);
     const LcmLogHeader header = decode_lcm_log_header(h);
     if (header.sync != kLcmLogSync) corrupt(events_so_far, "bad sync word");
@@ -48,8 +59,13 @@ class LogParser {
     const std::int32_t data_len = header.data_length;
     if (channel_len <= 0 || channel_len > kMaxChannel) corrupt(events_so_far, "bad channel length");
     if (data_len < 0 || data_len > kMaxData) corrupt(events_so_far, "bad data length");
-    if (size_ - offset_ - static_cast<std::int64_t>(sizeof h) < std::int64_t{channel_len} + data_len)
+    if (left - static_cast<std::int64_t>(sizeof h) < std::int64_t{channel_len} + data_len) {
+      // The last event cut short, if it would be one of ours (at most kMaxTail bytes, so less
+      // than that is left of the file); a corrupt length in the middle of a log, with more of
+      // the log behind it, stays an error.
+      if (std::int64_t{channel_len} + data_len + static_cast<std::int64_t>(sizeof h) <= kMaxTail) return cut(left);
       corrupt(events_so_far, "truncated event");
+    }
     ev.channel.resize(static_cast<std::size_t>(channel_len));
     in_.read(ev.channel.data(), channel_len);
     ev.data.resize(static_cast<std::size_t>(data_len));
@@ -59,7 +75,22 @@ class LogParser {
     return true;
   }
 
+  /// Bytes of a last event cut short that were left unread (0: none), and where it began.
+  std::int64_t cut_bytes() const { return cut_bytes_; }
+  std::int64_t cut_offset() const { return cut_offset_; }
+
  private:
+  // An LCM event of ours is under 16 kB (a reference block of 256 steps and its mac); the stock
+  // logger writes an event in one call, so a cut leaves less than one event.
+  static constexpr std::int64_t kMaxTail = 64 * 1024;
+
+  bool cut(std::int64_t left) {
+    cut_bytes_ = left;
+    cut_offset_ = offset_;
+    offset_ = size_;
+    return false;
+  }
+
   [[noreturn]] void corrupt(long events, const char* what) const {
     throw std::invalid_argument(path_ + ": corrupt LCM log after event " + std::to_string(events) + " (" + what +
                                 " at byte " + std::to_string(offset_) + " of " + std::to_string(size_) + ")");
@@ -69,6 +100,7 @@ class LogParser {
   std::ifstream in_;
   std::int64_t size_{0};
   std::int64_t offset_{0};
+  std::int64_t cut_bytes_{0}, cut_offset_{-1};
 };
 
 template <typename Msg, typename F>
@@ -142,7 +174,15 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
     }
   }
   out.recorder.flush_final(sink, need_reference);
+  out.cut_bytes = log.cut_bytes();
+  out.cut_offset = log.cut_offset();
   return out;
+}
+
+std::string describe_cut(const LogConversion& c) {
+  if (c.cut_bytes == 0) return "";
+  return "the log ends inside an event (byte " + std::to_string(c.cut_offset) + ", its last " +
+         std::to_string(c.cut_bytes) + " bytes; the logger stopped mid-write?): that event is ignored";
 }
 
 }  // namespace feeddrive::monitor

@@ -146,8 +146,15 @@ bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char*
 
 void Node::check_peers() const {
   interrupt::check();
-  for (const auto& [role, st] : peers_)
-    if (st.state == "failed") throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
+  for (const auto& [role, st] : peers_) {
+    if (st.state != "failed") continue;
+    // Under feeddrive-launch a Ctrl-C reaches every process, but not at the same instant: a
+    // peer's "interrupted by SIGINT" can arrive before this process's own signal. It is the
+    // same interrupt, which the launcher reports once (this process stays quiet, exit 130).
+    if (std::getenv(interrupt::kQuietEnv) != nullptr && st.message.rfind("interrupted by SIG", 0) == 0)
+      throw interrupt::Interrupted(st.message == "interrupted by SIGTERM" ? SIGTERM : SIGINT);
+    throw RunFailure(role + " failed at step " + std::to_string(st.seq) + ": " + st.message);
+  }
 }
 
 const process_status_t* Node::peer(const std::string& role) const {

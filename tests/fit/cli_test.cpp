@@ -170,6 +170,22 @@ TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": [" << r.err << "]";
     EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
   }
+  // The invalid options (once accepted: a negative window, a NaN threshold, a negative
+  // reduction, a window of 1 ns that reported "gap 0 -> 0"): one line naming option and value.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"--replay-window -1", "--replay-window: '-1' is outside [0.001, 1000] (or 0 for the default)"},
+      {"--replay-window 1e-9", "--replay-window: '1e-9' is outside [0.001, 1000]"},
+      {"--score-threshold nan", "--score-threshold: 'nan' is not a finite number"},
+      {"--min-gap-reduction -5", "--min-gap-reduction: '-5' is outside [0, 0.99]"},
+      {"--filter-half-width inf", "--filter-half-width: 'inf' is not a finite number"},
+  };
+  for (const auto& [option, message] : bad) {
+    const ProcResult r = run_fit("--scenario x.yaml --data y.csv --out z " + option);
+    EXPECT_EQ(r.code, 2) << option << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << option << ": [" << r.err << "]";
+    EXPECT_EQ(r.err.rfind("error: " + message, 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists("z"));
+  }
   // --out naming an unrelated folder is refused before anything is loaded: the data file need
   // not even exist for the message to be about the folder.
   fs::create_directories(scratch() / "mine");
@@ -196,14 +212,29 @@ TEST(FitCli, WindowsThatHoldTooFewSamplesAreRefused) {
                     "--filter-half-width 0.0015");
 }
 
+TEST(FitCli, FinitePositionOutliersTooLargeForAFiniteFitAreNamed) {
+  // A position of 1e308 m made the motion estimate NaN, blamed on "plant.initial.bristle = -nan"
+  // after two lines of Ceres logging; one of 1e200 m gave a findings.json with null (inf) gaps.
+  // Both: exit 2, one line naming the sample (found by the fuzz suite, seed 30055).
+  for (const std::string big : {"1e308", "1e200"}) {
+    auto rows = good_rows(2000);
+    rows[700] = "0.7," + big + ",0.05";
+    expect_data_error("outlier_" + big + ".csv", csv("t,x,u", rows),
+                      {"outlier_" + big + ".csv", "at t = 0.7 s", "is the position column in metres and free of outliers?"});
+  }
+}
+
 TEST(FitCli, CorruptLcmLog) {
   // 4 kB of random bytes: not an LCM log (no sync word at event 0).
   std::mt19937 rng(12345);
   std::string bytes(4096, '\0');
   for (auto& c : bytes) c = static_cast<char>(rng() & 0xff);
   expect_data_error("garbage.lcm", bytes, {"garbage.lcm", "corrupt LCM log"});
-  // A file holding only part of one event header.
-  expect_data_error("stub.lcmlog", std::string("\xED\xA1\xDA\x01\x00\x00", 6), {"stub.lcmlog", "corrupt LCM log"});
+  // A file holding only part of one event header: a log cut inside its first event.
+  expect_data_error("stub.lcmlog", std::string("\xED\xA1\xDA\x01\x00\x00", 6),
+                    {"stub.lcmlog", "no complete step", "the log ends inside an event (byte 0, its last 6 bytes"});
+  // ... and the same bytes not starting like an event: corrupt.
+  expect_data_error("stub2.lcmlog", std::string("\xED\xA1\xDA\x02\x00\x00", 6), {"stub2.lcmlog", "corrupt LCM log"});
 }
 
 TEST(FitCli, MalformedScenario) {

@@ -203,6 +203,41 @@ TEST(LogGaps, LogEndingEarlyReportsTheRest) {
   EXPECT_EQ(c.recorder.gaps()[0].last, kSteps - 1);
 }
 
+TEST(LogGaps, LastEventCutShortEndsTheLogAndIsReported) {
+  // A logger killed (or out of disk) mid-write leaves its last event incomplete. The steps before
+  // it are used; the cut event is counted with its offset; the steps after are the end gap.
+  auto msgs = run_messages();
+  msgs.resize(find(msgs, "FD_STATE", 3500) + 1);  // ends with the state of step 3500
+  const std::string path = write_log("cut", msgs);
+  const auto full = fs::file_size(path);
+  std::size_t last = 0;  // where the last event begins
+  for (std::size_t i = 0; i + 1 < msgs.size(); ++i) last += 28 + msgs[i].channel.size() + msgs[i].data.size();
+  for (const std::uintmax_t keep : {full - 5, static_cast<std::uintmax_t>(last + 30), static_cast<std::uintmax_t>(last + 10),
+                                    static_cast<std::uintmax_t>(last + 2)}) {
+    SCOPED_TRACE(keep);
+    fs::resize_file(path, keep);
+    const auto [c, rows] = read_all(path);
+    EXPECT_EQ(c.cut_bytes, static_cast<std::int64_t>(keep - last));
+    EXPECT_EQ(c.cut_offset, static_cast<std::int64_t>(last));
+    EXPECT_NE(describe_cut(c).find("byte " + std::to_string(last)), std::string::npos) << describe_cut(c);
+    EXPECT_EQ(rows.size(), 3499u);  // step 3499 waits for the state of 3500, which was cut
+    ASSERT_EQ(c.recorder.gaps().size(), 1u);
+    EXPECT_EQ(c.recorder.gaps()[0].first, 3499);
+    EXPECT_EQ(c.recorder.gaps()[0].last, kSteps - 1);
+  }
+  // What is left is not the start of an event: corrupt, named with its offset.
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<long>(last));
+    f.put('\x55');
+  }
+  EXPECT_THROW(read_all(path), std::invalid_argument);
+  // An intact log has nothing cut.
+  const auto whole = read_all(write_log("uncut", run_messages(100)));
+  EXPECT_EQ(whole.c.cut_bytes, 0);
+  EXPECT_EQ(describe_cut(whole.c), "");
+}
+
 TEST(LogGaps, NonFiniteValuesAreDroppedAndCounted) {
   auto msgs = run_messages();
   drive_state_t s;
