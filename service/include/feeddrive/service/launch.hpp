@@ -20,13 +20,12 @@ struct LaunchOptions {
   std::string bin_dir;  ///< where the feeddrive-* executables are (default: next to the launcher)
   /// After one process fails, how long the others get to notice before they are terminated [s].
   double grace_s{10.0};
-  /// nice() increment of the monitor and the trajectory, which are off the step's critical path.
-  /// 0: measured on the shared 2-core VM (alternating, 5 rounds each, 24 November 2026), nice 10
-  /// made the lockstep run slower, 30,900 against 34,200 steps/s on one core (5 of 5 rounds) and
-  /// 25,700 against 28,700 free (medians): at nice 10 they lose the CPU to other work for longer
-  /// than their batches allow, and the plant (monitor window) and the controller (references)
-  /// wait for them.
-  int off_path_niceness{0};
+  /// nice() increment of the monitor and the trajectory, which are off the step's critical path:
+  /// they yield to it. Measured on the shared 2-core VM (alternating, 5 rounds each, 24 November
+  /// 2026), nice 0 made the lockstep run faster (34,200 against 30,900 steps/s on one core, 5 of
+  /// 5 rounds), but then an attached monitor (--attach, which never asks for resends) lost
+  /// datagrams under load (tests/service/attach_test.sh failed 2 of 8 times), so it stays 10.
+  int off_path_niceness{10};
   /// The same in real-time mode, where the plant, the controller and the trajectory run at
   /// SCHED_FIFO and nice only affects the monitor: 10, measured (alternating, 5 rounds each)
   /// 30 against 33 median deadline misses of 15,000 at nice 0, fewer in 4 of 5 rounds.
