@@ -388,6 +388,9 @@ local function try_answer()
 end
 
 local function request_resend(channel, seq)
+  -- Not joined yet: a request stamped with no run is foreign to every process (and counted so);
+  -- the plant repeats its state until we answer.
+  if not run_id then return end
   local r = feeddrive.resend_request_t:new()
   r.requester = ROLE
   r.channel = channel

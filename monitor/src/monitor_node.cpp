@@ -52,6 +52,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     if (!bus().batched())
       throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
                                   opt.lcm_url);
+    output::check_outside(mopt_.lcm_log, "--lcm-log", mopt_.out_dir);
     log_ = std::make_unique<LcmLogWriter>(mopt_.lcm_log);
     const std::string run_channels = opt.prefix + "_";
     bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {

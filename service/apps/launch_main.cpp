@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
     const sim::Scenario s = sim::load_scenario(lo.scenario);  // bad input fails here, before any process starts
     const auto out = output::check_output_dir(lo.out_dir);  // and this, before any process starts
+    output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
     sim::check_run_size(s, lo.out_dir);
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);
     // The monitor's marker before the run: a successful run leaves a new one (a new file).

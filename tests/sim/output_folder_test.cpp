@@ -365,6 +365,22 @@ TEST(OutputFolder, AUsersFileInAnEarlierOutputIsNeverDeleted) {
   EXPECT_EQ(feeddrive::output::foreign_entry(growing), "");
 }
 
+TEST(OutputFolder, AnotherOutputOfTheRunMustLieOutsideTheFolder) {
+  // feeddrive-launch --out out/run --lcm-log out/run/run.lcmlog: the log would be written into the
+  // folder that the run replaces at its end (and lost with the earlier output).
+  using feeddrive::output::check_outside;
+  const fs::path base = fresh("outside");
+  EXPECT_NO_THROW(check_outside("", "--lcm-log", (base / "run").string()));
+  EXPECT_NO_THROW(check_outside((base / "run.lcmlog").string(), "--lcm-log", (base / "run").string()));
+  EXPECT_NO_THROW(check_outside((base / "run2/x.lcmlog").string(), "--lcm-log", (base / "run").string()));
+  for (const std::string f : {"run/run.lcmlog", "run/sub/x.lcmlog", "other/../run/x.lcmlog"}) {
+    const std::string w = refusal([&] { check_outside((base / f).string(), "--lcm-log", (base / "run/").string()); });
+    EXPECT_EQ(w.rfind("--lcm-log " + (base / f).string() + ": lies inside --out", 0), 0u) << w;
+  }
+  EXPECT_NE(refusal([&] { check_outside((base / "run").string(), "--lcm-log", (base / "run").string()); }).find("itself"),
+            std::string::npos);
+}
+
 TEST(OutputFolder, FailureBeforeCommitKeepsThePreviousOutput) {
   const fs::path base = fresh("staged_fail");
   {

@@ -208,6 +208,22 @@ fs::path check_output_dir(const std::string& out, const std::string& option) {
   return p;
 }
 
+void check_outside(const std::string& file, const std::string& file_option, const std::string& out,
+                   const std::string& option) {
+  if (file.empty()) return;
+  std::error_code ec;
+  const fs::path f = fs::absolute(fs::path(file), ec).lexically_normal();
+  const fs::path d = fs::absolute(normalise(out, option), ec).lexically_normal();
+  if (ec) return;
+  // f lies in d if d's components are a prefix of f's
+  auto fi = f.begin();
+  for (auto di = d.begin(); di != d.end(); ++di, ++fi)
+    if (fi == f.end() || *fi != *di) return;
+  if (fi == f.end()) refuse(file_option, file, "is the output folder " + option + " " + shown(out) + " itself; name a file next to it");
+  refuse(file_option, file, "lies inside " + option + " " + shown(out) +
+                                ", which is replaced when the run ends (the file would be lost); put it next to the folder");
+}
+
 bool remove_output(const fs::path& dir) noexcept {
   try {
     std::error_code ec;

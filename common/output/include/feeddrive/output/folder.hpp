@@ -63,6 +63,12 @@ std::filesystem::path normalise(const std::string& out, const std::string& optio
 /// normalised path. Throws std::invalid_argument, one line naming the option and the value.
 std::filesystem::path check_output_dir(const std::string& out, const std::string& option = "--out");
 
+/// Throws std::invalid_argument ("<file_option> <file>: lies inside --out DIR ...") if the file
+/// `file` (another output of the same run, e.g. --lcm-log) lies inside the output folder `out`,
+/// which commit() replaces whole. "" is never inside.
+void check_outside(const std::string& file, const std::string& file_option, const std::string& out,
+                   const std::string& option = "--out");
+
 /// A new output folder written in a sibling temporary folder and swapped into place by commit().
 class StagedFolder {
  public:
