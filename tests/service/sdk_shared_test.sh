@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The SDK as shared libraries (issue 12: BUILD_SHARED_LIBS honoured): configures this source tree
+# again with -DBUILD_SHARED_LIBS=ON, builds only what `cmake --install` installs (the drive model,
+# the plant, the controllers, the trajectories and the generated message headers), checks that the
+# installed libraries are shared objects, and runs the SDK checks of sdk_test.sh on it: the
+# out-of-tree example built against the installed prefix, linking libfeeddrive_controller.so and
+# no SUNDIALS library, as the controller of a four-process run.
+source "$(dirname "$0")/lib.sh" "$@"
+source "$(dirname "$0")/sdk_check.sh"
+tree=$TMP/shared
+launcher=()
+command -v ccache > /dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+cmake -S "$SRC" -B "$tree" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON "${launcher[@]}" > "$TMP/shared-configure.log" 2>&1 ||
+  { tail -30 "$TMP/shared-configure.log" >&2; fail "configure with BUILD_SHARED_LIBS=ON failed"; }
+cmake --build "$tree" -j"$(nproc)" --target feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory \
+  feeddrive_lcmtypes_gen > "$TMP/shared-build.log" 2>&1 || { tail -30 "$TMP/shared-build.log" >&2; fail "shared build failed"; }
+sdk_check "$tree"
+prefix=$TMP/sdk-shared/prefix
+for l in model plant controller trajectory; do
+  f=$prefix/lib/libfeeddrive_$l.so
+  [ -f "$f" ] || fail "not installed: $f"
+  readelf -h "$f" | grep -q 'Type: *DYN' || fail "not a shared object: $f"
+done
+ldd "$exe" | grep -q "libfeeddrive_controller.so => $prefix/lib" || { ldd "$exe" >&2; fail "the example does not load the installed libfeeddrive_controller.so"; }
+pass "shared SDK: libfeeddrive_{model,plant,controller,trajectory}.so installed; the example loads libfeeddrive_controller.so from the prefix, no SUNDIALS"
