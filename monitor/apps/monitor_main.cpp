@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--attach", mopt.attach,
                "join a running system or an lcm-logplayer playback: record from the first state seen, "
-               "never ask for resends or acknowledge");
+               "ask for what it missed but never acknowledge; its failure never stops the run (docs/lcm-contract.md)");
   app.add_option("--lcm-log", mopt.lcm_log,
                  "also write every message of the run to FILE in the standard LCM log format (as lcm-logger, "
                  "without its cost; lcm-logplayer, lcm-spy and feeddrive-log2csv read it)");

@@ -23,7 +23,7 @@ using service::mono_us;
 using service::us;
 
 MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
-    : Node(mopt.attach ? "monitor-attached" : "monitor", opt, service::Receive::kBatched),
+    : Node(mopt.attach ? service::kAttachedMonitorRole : "monitor", opt, service::Receive::kBatched),
       s_(s),
       mopt_(mopt),
       rec_(mopt.attach),
@@ -35,6 +35,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   // Every message passes the conflict check first: a second, different message for a step is
   // never recorded (service::Node::admit).
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
+    last_state_us_ = mono_us();
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     rec_.on_state(m, t);
     on_state_timing(m, t);
@@ -114,7 +115,7 @@ void MonitorNode::prune_timing(std::int64_t seq) {
 }
 
 void MonitorNode::request_missing() {
-  if (mopt_.attach) return;
+  if (!rec_.started()) return;  // attach mode: the first step is not chosen yet
   const std::int64_t now = mono_us();
   // Something is missing if later steps are already flowing, or nothing came for a while.
   const bool behind = rec_.highest_state() > rec_.next() + 1;
@@ -122,18 +123,42 @@ void MonitorNode::request_missing() {
   if (!behind && !quiet) return;
   if (now - last_request_us_ < us(options().resend_interval_s)) return;
   last_request_us_ = now;
-  const std::string* channel = nullptr;
-  for (const Missing& m : rec_.missing()) {
-    if (m.what == "state") channel = &channels().state;
-    if (m.what == "reference") channel = &channels().reference;
-    if (m.what == "command") channel = &channels().command;
-    // Only ask for what was sent already: the step after the newest state is not lost, it is
-    // not there yet.
-    if (m.seq > rec_.highest_state()) continue;
-    if (m.what == "command" && m.seq == rec_.highest_state()) continue;
-    request_resend(*channel, m.seq);
+  if (asking_seq_ != rec_.next()) {
+    asking_seq_ = rec_.next();
+    asking_since_us_ = now;
+    asking_requests_ = 0;
+  }
+  ++asking_requests_;
+  // Only ask for what was sent already: the step after the newest state is not lost, it is not
+  // there yet. A monitor far behind (an attached one whose socket overflowed) asks for up to
+  // kPerRound messages of each kind a round, not one.
+  constexpr std::size_t kPerRound = 64;
+  for (const Missing& m : rec_.missing_until(rec_.highest_state(), kPerRound)) {
+    const std::string& channel = m.what == "state" ? channels().state : m.what == "reference" ? channels().reference : channels().command;
+    request_resend(channel, m.seq);
     ++lost_;
   }
+}
+
+bool MonitorNode::attached_stalled(std::int64_t now, double limit) {
+  const auto sink = [this](const sim::Record& r) { out_->add(r); };
+  if (now - last_state_us_ > us(limit)) {
+    // Nothing for `limit`: the run (or the log played back) is over, or gone. Whatever can
+    // still be completed is recorded, the rest is a gap.
+    rec_.flush_final(sink);
+    if (!rec_.end_seen())
+      throw service::RunFailure("no message on " + channels().state + " for " + service::seconds_text(limit) + " s after step " +
+                                std::to_string(rec_.highest_state()) + ": the run stopped before its end");
+    return true;
+  }
+  // States still come in: a step asked for this often and this long is not kept any more.
+  if (asking_seq_ == rec_.next() && asking_requests_ >= kLostAfterRequests && now - asking_since_us_ >= us(kLostAfter_s)) {
+    const std::size_t gaps = rec_.gaps().size();
+    if (rec_.skip_lost(sink) > 0 || rec_.gaps().size() != gaps) last_row_us_ = now;
+    if (rec_.gaps().size() != gaps && !options().quiet)
+      spdlog::warn("{}: {} (not re-sent after {} requests)", role(), describe_gaps({rec_.gaps().back()}), asking_requests_);
+  }
+  return rec_.complete();
 }
 
 void MonitorNode::progress(bool force) {
@@ -170,6 +195,9 @@ bool MonitorNode::run() {
         const bool due = acked_seq - last_ack_sent_ >= std::max<long>(options().monitor_window / 4, 1);
         heartbeat(due);
         if (due) last_ack_sent_ = acked_seq;
+      } else {
+        set_seq(rec_.next());
+        heartbeat();  // "running": the publishers linger after the end while it still records
       }
       progress(false);
       if (!log_error_.empty()) throw service::RunFailure(log_error_);
@@ -177,6 +205,10 @@ bool MonitorNode::run() {
       request_missing();
       check_peers();
       const double limit = rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
+      if (mopt_.attach && rec_.highest_state() >= 0 && now - last_row_us_ > us(kLostAfter_s)) {
+        if (attached_stalled(now, limit)) break;
+        continue;
+      }
       if (now - last_row_us_ > us(limit)) {
         if (mopt_.attach && rec_.highest_state() < 0)
           throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) + " s");
@@ -292,6 +324,11 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["conflicts"] = conflicts_seen;
   l["unauthenticated_messages"] = unauthenticated;
   l["steps_without_command"] = rec_.commandless_rows();
+  if (mopt_.attach) {  // an observer records across what it could not get (the run's monitor never does)
+    l["missing_steps"] = rec_.missing_steps();
+    l["gaps"] = nlohmann::ordered_json::array();
+    for (const Gap& g : rec_.gaps()) l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
+  }
   l["steps_per_second"] = rec_.steps_per_second();
   {
     // One step on the wire: state + command + 1/16 of a block of 16 references, each an LCM
@@ -357,6 +394,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   } else {
     announce_failure(why);
   }
+  if (!rec_.gaps().empty())
+    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), describe_gaps(rec_.gaps()), sum.steps, output::shown(mopt_.out_dir));
   if (!options().quiet)
     spdlog::info("monitor: {} steps recorded{} -> {}", sum.steps,
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",

@@ -136,52 +136,67 @@ std::size_t Recorder::flush_final(const sim::RecordSink& sink, bool need_referen
   for (const auto& [n, v] : steps_votes_)
     if (v > votes) steps = n, votes = v;
   steps_ = steps;
-  // Messages of steps outside the run (a corrupt sequence number) can never make a row.
-  const auto in_run = [&](std::int64_t k) { return steps < 0 || k <= steps; };
-  const auto add_gap = [&](std::int64_t first, std::int64_t last, const std::string& why) {
-    if (!gaps_.empty() && gaps_.back().last + 1 == first) {
-      gaps_.back().last = last;
-    } else {
-      gaps_.push_back({first, last, why});
-    }
-  };
   for (;;) {
-    if (steps >= 0 && next_ >= steps) break;
-    const auto s = states_.find(next_);
-    const auto s1 = states_.find(next_ + 1);
-    const auto r = refs_.find(next_);
-    const auto c = cmds_.find(next_);
-    const bool have_ref = r != refs_.end();
-    if (s != states_.end() && s1 != states_.end() && (have_ref || !need_reference)) {
-      add_row(s->second, have_ref ? &r->second.msg : nullptr, c == cmds_.end() ? nullptr : &c->second.msg, s1->second.msg, sink);
-      states_.erase(s);
-      if (have_ref) refs_.erase(r);
-      if (c != cmds_.end()) cmds_.erase(c);
-      ++added;
-      ++next_;
-      continue;
-    }
-    // Step next_ cannot be completed. Where does the next step that might start?
-    std::int64_t resume = std::numeric_limits<std::int64_t>::max();
-    const auto after = states_.upper_bound(next_);
-    if (after != states_.end() && in_run(after->first)) resume = after->first;
-    if (s != states_.end() && s1 != states_.end()) resume = next_ + 1;  // only the reference is missing
-    const std::string why = s == states_.end()    ? "no state " + std::to_string(next_) + " from the plant"
-                            : s1 == states_.end() ? "no state " + std::to_string(next_ + 1) + " from the plant"
-                                                  : "no reference " + std::to_string(next_) + " from the trajectory";
-    if (resume == std::numeric_limits<std::int64_t>::max()) {
-      // Nothing after it: the log ends before the run does.
-      if (steps >= 0) add_gap(next_, steps - 1, why + (s == states_.end() ? " (the log ends)" : ""));
-      next_ = steps >= 0 ? steps : next_;
-      break;
-    }
-    add_gap(next_, resume - 1, why);
-    next_ = resume;
-    states_.erase(states_.begin(), states_.lower_bound(next_));
-    refs_.erase(refs_.begin(), refs_.lower_bound(next_));
-    cmds_.erase(cmds_.begin(), cmds_.lower_bound(next_));
+    if (steps_ >= 0 && next_ >= steps_) break;
+    const Advance a = advance(sink, need_reference, true);
+    if (a == Advance::kRow) ++added;
+    if (a == Advance::kEnd) break;
   }
   return added;
+}
+
+std::size_t Recorder::skip_lost(const sim::RecordSink& sink) {
+  if (!started() || (steps_ >= 0 && next_ >= steps_)) return 0;
+  const Advance a = advance(sink, true, false);
+  return (a == Advance::kRow ? 1 : 0) + (a == Advance::kWait ? 0 : flush(sink));
+}
+
+void Recorder::add_gap(std::int64_t first, std::int64_t last, const std::string& why) {
+  if (!gaps_.empty() && gaps_.back().last + 1 == first) {
+    gaps_.back().last = last;
+  } else {
+    gaps_.push_back({first, last, why});
+  }
+}
+
+Recorder::Advance Recorder::advance(const sim::RecordSink& sink, bool need_reference, bool ended) {
+  // Messages of steps outside the run (a corrupt sequence number) can never make a row.
+  const auto in_run = [&](std::int64_t k) { return steps_ < 0 || k <= steps_; };
+  const auto s = states_.find(next_);
+  const auto s1 = states_.find(next_ + 1);
+  const auto r = refs_.find(next_);
+  const auto c = cmds_.find(next_);
+  const bool have_ref = r != refs_.end();
+  if (s != states_.end() && s1 != states_.end() && (have_ref || !need_reference)) {
+    add_row(s->second, have_ref ? &r->second.msg : nullptr, c == cmds_.end() ? nullptr : &c->second.msg, s1->second.msg, sink);
+    states_.erase(s);
+    if (have_ref) refs_.erase(r);
+    if (c != cmds_.end()) cmds_.erase(c);
+    ++next_;
+    ++rows_;
+    return Advance::kRow;
+  }
+  // Step next_ cannot be completed. Where does the next step that might start?
+  std::int64_t resume = std::numeric_limits<std::int64_t>::max();
+  const auto after = states_.upper_bound(next_);
+  if (after != states_.end() && in_run(after->first)) resume = after->first;
+  if (s != states_.end() && s1 != states_.end()) resume = next_ + 1;  // only the reference is missing
+  const std::string why = s == states_.end()    ? "no state " + std::to_string(next_) + " from the plant"
+                          : s1 == states_.end() ? "no state " + std::to_string(next_ + 1) + " from the plant"
+                                                : "no reference " + std::to_string(next_) + " from the trajectory";
+  if (resume == std::numeric_limits<std::int64_t>::max()) {
+    if (!ended) return Advance::kWait;
+    // Nothing after it: the log ends before the run does.
+    if (steps_ >= 0) add_gap(next_, steps_ - 1, why + (s == states_.end() ? " (the log ends)" : ""));
+    next_ = steps_ >= 0 ? steps_ : next_;
+    return Advance::kEnd;
+  }
+  add_gap(next_, resume - 1, why);
+  next_ = resume;
+  states_.erase(states_.begin(), states_.lower_bound(next_));
+  refs_.erase(refs_.begin(), refs_.lower_bound(next_));
+  cmds_.erase(cmds_.begin(), cmds_.lower_bound(next_));
+  return Advance::kGap;
 }
 
 std::int64_t Recorder::missing_steps() const {
@@ -211,6 +226,24 @@ std::vector<Missing> Recorder::missing() const {
   const bool realtime = s != states_.end() && s->second.msg.realtime;
   if (!cmds_.count(next_) && !realtime) out.push_back({"command", "controller", next_});
   if (!states_.count(next_ + 1)) out.push_back({"state", "plant", next_ + 1});
+  return out;
+}
+
+std::vector<Missing> Recorder::missing_until(std::int64_t upto, std::size_t per_kind) const {
+  std::vector<Missing> out;
+  std::size_t states = 0, commands = 0, refs = 0;
+  std::int64_t last_block = -1;
+  const auto s = states_.find(next_);
+  const bool realtime = s != states_.end() && s->second.msg.realtime;
+  const std::int64_t end = std::min(upto, next_ + 4096);
+  for (std::int64_t k = next_; k <= end && (states < per_kind || commands < per_kind || refs < per_kind); ++k) {
+    if (states < per_kind && !states_.count(k)) out.push_back({"state", "plant", k}), ++states;
+    if (refs < per_kind && k / 16 != last_block && !refs_.count(k)) {
+      out.push_back({"reference", "trajectory", k}), ++refs;
+      last_block = k / 16;
+    }
+    if (commands < per_kind && k < upto && !realtime && !cmds_.count(k)) out.push_back({"command", "controller", k}), ++commands;
+  }
   return out;
 }
 

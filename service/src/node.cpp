@@ -144,10 +144,14 @@ bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char*
   return false;
 }
 
+bool is_run_role(const std::string& role) {
+  return role == "plant" || role == "controller" || role == "trajectory" || role == "monitor";
+}
+
 void Node::check_peers() const {
   interrupt::check();
   for (const auto& [role, st] : peers_) {
-    if (st.state != "failed") continue;
+    if (st.state != "failed" || !is_run_role(role)) continue;
     // Under feeddrive-launch a Ctrl-C reaches every process, but not at the same instant: a
     // peer's "interrupted by SIGINT" can arrive before this process's own signal. It is the
     // same interrupt, which the launcher reports once (this process stays quiet, exit 130).
@@ -178,7 +182,13 @@ void Node::linger(const std::function<void()>& every_100ms) {
   set_state("done");
   const std::int64_t start = mono_us();
   std::int64_t last_sent = start;
-  while (!monitor_done() && mono_us() - start < us(opt_.linger_s)) {
+  // An attached monitor still recording (heard within the last second) may yet ask for what it
+  // missed: wait for it too, within the same limit.
+  const auto recording = [this] {
+    const process_status_t* a = peer(kAttachedMonitorRole);
+    return a != nullptr && a->state == "running" && peer_alive(kAttachedMonitorRole, 1.0);
+  };
+  while ((!monitor_done() || recording()) && mono_us() - start < us(opt_.linger_s)) {
     if (every_100ms && mono_us() - last_sent > 100000) {
       every_100ms();
       last_sent = mono_us();

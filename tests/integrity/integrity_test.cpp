@@ -196,6 +196,37 @@ TEST(NodeAdmit, ConflictFailsByDefaultOrKeepsTheFirst) {
   EXPECT_THROW(parse_conflict_policy("ignore"), std::invalid_argument);
 }
 
+// An observer's failure never stops a run: a "monitor-attached" (or any role outside the run)
+// announcing "failed" is heard and kept as a peer, but only the run's own roles (plant,
+// controller, trajectory, monitor) make check_peers() throw. Over memq://, where the node hears
+// what its own bus publishes; the CI failure this guards against: an attached monitor that lost
+// a datagram under load failed, and the whole run stopped with it.
+TEST(NodePeers, AnObserversFailureDoesNotStopTheRun) {
+  Node plant("plant", memq_options(1));
+  const auto failed = [&](const std::string& role) {
+    process_status_t m{};
+    m.role = role;
+    m.state = "failed";
+    m.seq = 6860;
+    m.message = "step 6860 incomplete";
+    plant.bus().publish(plant.channels().status, m);
+    plant.bus().poll(std::chrono::milliseconds(10));
+  };
+  failed("monitor-attached");
+  ASSERT_NE(plant.peer("monitor-attached"), nullptr) << "heard";
+  EXPECT_EQ(plant.peer("monitor-attached")->state, "failed");
+  EXPECT_NO_THROW(plant.check_peers());
+  EXPECT_FALSE(is_run_role("monitor-attached"));
+  for (const char* role : {"plant", "controller", "trajectory", "monitor"}) EXPECT_TRUE(is_run_role(role)) << role;
+  failed("controller");
+  try {
+    plant.check_peers();
+    FAIL() << "a failed controller must stop the run";
+  } catch (const RunFailure& e) {
+    EXPECT_STREQ(e.what(), "controller failed at step 6860: step 6860 incomplete");
+  }
+}
+
 // Over memq:// (one LCM instance hears its own messages): a message of another run is counted
 // and not dispatched; before the run is known nothing is dispatched; join_first_seen() joins.
 TEST(BusRunIdentity, ForeignMessagesAreCountedAndIgnored) {

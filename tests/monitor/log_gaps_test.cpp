@@ -123,6 +123,61 @@ Read read_all(const std::string& path) {
   return r;
 }
 
+// The live attached monitor (MonitorNode --attach) on a run it joined mid-way, fed in arrival
+// order: a step whose messages are lost for good is recorded without its command if only that
+// is missing (the applied u is in the next state), or skipped as a gap to the next state; a step
+// with nothing after it yet is late, not lost, and is not skipped.
+TEST(LiveAttach, LostStepsAreSkippedAsGapsAndLateOnesAreNot) {
+  auto msgs = run_messages();
+  msgs.erase(msgs.begin() + static_cast<long>(find(msgs, "FD_CMD", 2000)));
+  msgs.erase(msgs.begin() + static_cast<long>(find(msgs, "FD_STATE", 3000)));
+  Recorder rec(true);  // attach, live
+  std::vector<sim::Record> rows;
+  const auto sink = [&](const sim::Record& r) { rows.push_back(r); };
+  const auto feed = [&](const Msg& m) {
+    const auto* d = m.data.data();
+    const int n = static_cast<int>(m.data.size());
+    if (m.channel == "FD_STATE") {
+      drive_state_t x;
+      ASSERT_GE(x.decode(d, 0, n), 0);
+      rec.on_state(x, 0);
+    } else if (m.channel == "FD_CMD") {
+      control_command_t x;
+      ASSERT_GE(x.decode(d, 0, n), 0);
+      rec.on_command(x, 0);
+    } else {
+      reference_block_t x;
+      ASSERT_GE(x.decode(d, 0, n), 0);
+      for (const reference_t& r : x.refs) rec.on_reference(r, 0);
+    }
+  };
+  // Joins after the state of step 100: its first block of references is the one of step 112.
+  const std::size_t join = find(msgs, "FD_STATE", 100);
+  const std::size_t before_3000 = find(msgs, "FD_STATE", 2999) + 1;
+  for (std::size_t i = join; i < before_3000; ++i) feed(msgs[i]);
+  rec.flush(sink);
+  ASSERT_TRUE(rec.started());
+  ASSERT_FALSE(rows.empty());
+  EXPECT_DOUBLE_EQ(rows.front().t, 112 * kT) << "the first step with both its state and its reference";
+  EXPECT_EQ(rec.next(), 2000) << "waits for command 2000";
+  rec.skip_lost(sink);  // command 2000 is lost: the row is written, diagnostics NaN
+  EXPECT_EQ(rec.next(), 2999) << "step 2999 needs state 3000, not sent yet";
+  EXPECT_TRUE(std::isnan(rows[2000 - 112].u_unsaturated));
+  EXPECT_DOUBLE_EQ(rows[2000 - 112].u, 0.1 * std::sin(20.0)) << "the applied input, from state 2001";
+  EXPECT_EQ(rec.skip_lost(sink), 0u) << "nothing after step 2999 yet: late, not lost";
+  EXPECT_TRUE(rec.gaps().empty());
+  for (std::size_t i = before_3000; i < msgs.size(); ++i) feed(msgs[i]);
+  EXPECT_EQ(rec.flush(sink), 0u) << "state 3000 never came";
+  rec.skip_lost(sink);
+  ASSERT_EQ(rec.gaps().size(), 1u);
+  EXPECT_EQ(rec.gaps()[0].first, 2999);
+  EXPECT_EQ(rec.gaps()[0].last, 3000);
+  EXPECT_EQ(rec.gaps()[0].why, "no state 3000 from the plant");
+  EXPECT_TRUE(rec.complete());
+  EXPECT_EQ(rows.size(), static_cast<std::size_t>(kSteps - 112 - 2));
+  EXPECT_DOUBLE_EQ(rows.back().t, (kSteps - 1) * kT);
+}
+
 TEST(LogGaps, CompleteLogHasEveryStepAndNoGap) {
   const auto [c, rows] = read_all(write_log("complete", run_messages()));
   EXPECT_EQ(rows.size(), static_cast<std::size_t>(kSteps));

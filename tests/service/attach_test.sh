@@ -1,22 +1,35 @@
 #!/usr/bin/env bash
 # The monitor attaches to a running system: a second feeddrive-monitor --attach joins a lockstep
 # run mid-way. It records from the first state it sees to the end, and every row it writes is
-# identical to the same step's row of the run's own monitor (it never asks for resends, so the
-# run's monitor is what guarantees delivery; on loopback nothing is lost).
+# identical to the same step's row of the run's own monitor. It asks for what it missed (a
+# datagram its socket dropped under load: CI once lost one, and the attached monitor's failure
+# then stopped the whole run), so no step is missing; its failure could not stop the run any
+# more either (tests/integrity NodePeers).
 source "$(dirname "$0")/lib.sh" "$@"
 # 10 s of the jerk-limited move (100,000 steps, about 3 s of lockstep at 33,000 steps/s): long
-# enough to join after 1 s.
+# enough to join after 1 s and be stopped for 1 s.
 scen=$TMP/long.yaml
 sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
 timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --lcm-url "$URL" & l=$!
 sleep 1.0
 timeout 120 feeddrive-monitor "$scen" --attach --out "$TMP/attached" --no-plots --lcm-url "$URL" --step-timeout 5 2> "$TMP/attached.err" & m=$!
+# Then it loses the CPU for 1 s (SIGSTOP: what a loaded machine does to it), while the run goes
+# on: its 4 MB socket buffer holds about 0.1 s of the run, the rest is dropped by the kernel, and
+# it must get every step back by asking (the publishers keep the last 65,536 steps and linger
+# after the end while it still records).
+sleep 0.5
+mon=$(pgrep -P $m) || fail "no feeddrive-monitor --attach under timeout $m"
+kill -STOP "$mon"; sleep 1.0; kill -CONT "$mon"
 wait $l || fail "the run failed"
 wait $m || { tail -5 "$TMP/attached.err" >&2; fail "the attached monitor failed"; }
 total=$(( $(wc -l < "$TMP/run/timeseries.csv") - 1 ))
 rows=$(( $(wc -l < "$TMP/attached/timeseries.csv") - 1 ))
 [ "$total" = 100000 ] || fail "the run recorded $total rows, expected 100000"
 [ "$rows" -gt 0 ] && [ "$rows" -lt "$total" ] || fail "the attached monitor recorded $rows rows (joined mid-way: 0 < rows < $total)"
+missing=$(json "$TMP/attached/summary.json" .lockstep.missing_steps)
+asked=$(json "$TMP/attached/summary.json" .lockstep.lost)
+[ "$asked" -gt 0 ] || fail "the attached monitor, stopped for 1 s, asked for nothing again: did its socket not overflow?"
+[ "$missing" = 0 ] || fail "the attached monitor skipped $missing steps: $(jq -c .lockstep.gaps "$TMP/attached/summary.json")"
 # The attached rows are the last $rows rows of the run, byte for byte (same header too).
 same_csv <(head -n 1 "$TMP/run/timeseries.csv"; tail -n "$rows" "$TMP/run/timeseries.csv") "$TMP/attached/timeseries.csv"
-pass "attached mid-run: recorded the last $rows of $total steps, identical to the run's monitor"
+pass "attached mid-run: recorded the last $rows of $total steps (stopped for 1 s; $asked messages asked for again), identical to the run's monitor"

@@ -16,13 +16,23 @@ nft add chain inet fdloss out '{ type filter hook output priority 0; }'
 nft add rule inet fdloss out ip daddr 239.0.0.0/8 numgen random mod 100 '<' 3 counter drop
 scen=$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml
 sim_run "$scen" "$TMP/sim"
+# An attached monitor (an observer, which never acknowledges) joins too: under the same loss it
+# must recover every step it missed by asking, as the run's monitor does.
+timeout 600 feeddrive-monitor "$scen" --attach --out "$TMP/attached" --no-plots -q --lcm-url "$URL" 2> "$TMP/attached.err" & m=$!
 timeout 600 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --lcm-url "$URL" --lcm-log "$LOGDIR/mon.lcmlog"
+wait $m || { tail -5 "$TMP/attached.err" >&2; fail "the attached monitor failed"; }
 dropped=$(nft list chain inet fdloss out | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
 [ "${dropped:-0}" -gt 100 ] || fail "the rule dropped only ${dropped:-0} packets"
 same_csv "$TMP/sim/timeseries.csv" "$TMP/mp/timeseries.csv"
 resends=$(json "$TMP/mp/summary.json" .lockstep.resends)
 [ "$resends" -gt 0 ] || fail "no resends recorded although $dropped packets were dropped"
 pass "$dropped packets dropped; $resends resends, $(json "$TMP/mp/summary.json" .lockstep.lost) recovered by the monitor, $(json "$TMP/mp/summary.json" .lockstep.duplicates) duplicates ignored; identical"
+rows=$(( $(wc -l < "$TMP/attached/timeseries.csv") - 1 ))
+missing=$(json "$TMP/attached/summary.json" .lockstep.missing_steps)
+[ "$missing" = 0 ] || fail "the attached monitor skipped $missing steps under loss: $(jq -c .lockstep.gaps "$TMP/attached/summary.json")"
+[ "$rows" -gt 0 ] || fail "the attached monitor recorded no row"
+same_csv <(head -n 1 "$TMP/mp/timeseries.csv"; tail -n "$rows" "$TMP/mp/timeseries.csv") "$TMP/attached/timeseries.csv"
+pass "the attached monitor under loss: $rows steps, $(json "$TMP/attached/summary.json" .lockstep.lost) asked for again, identical to the run's"
 timeout 120 feeddrive-log2csv "$LOGDIR/mon.lcmlog" --scenario "$scen" --out "$TMP/conv" -q
 same_csv "$TMP/mp/timeseries.csv" "$TMP/conv/timeseries.csv"
 pass "the monitor's --lcm-log under loss converts to the same timeseries.csv"

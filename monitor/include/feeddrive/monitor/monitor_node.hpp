@@ -6,8 +6,13 @@
 // in every case it writes what it recorded and says where the run stopped.
 //
 // attach = true joins a running system or a log played back by lcm-logplayer: it records from
-// the first state it sees, never asks for resends, and does not acknowledge (the plant's flow
-// control stays with the run's own monitor).
+// the first state it sees and asks for what it missed like the run's monitor, but it does not
+// acknowledge (the plant's flow control stays with the run's own monitor) and it is an observer:
+// its failure never stops the run (service::is_run_role). A step it cannot get any more (asked
+// for kLostAfterRequests times over kLostAfter_s while later states come in: the publishers no
+// longer keep it) is skipped and reported as a gap, as feeddrive-log2csv does; when nothing
+// comes for --step-timeout (the run or the played-back log is over) it records what it can and
+// ends.
 
 #include <memory>
 #include <string>
@@ -49,6 +54,9 @@ class MonitorNode : public service::Node {
 
  private:
   void request_missing();
+  /// Attach mode, no row for a while: skips a step lost for good, or ends when nothing comes.
+  /// Returns true when the recording is over.
+  bool attached_stalled(std::int64_t now, double limit);
   void publish_info();
   void on_state_timing(const drive_state_t& m, std::int64_t t);
   void on_command_timing(const control_command_t& m, std::int64_t t);
@@ -71,6 +79,11 @@ class MonitorNode : public service::Node {
   std::int64_t last_progress_us_{0};
   std::int64_t last_ack_sent_{-1};
   std::int64_t lost_{0};
+  // Attach mode: the step whose messages are being asked for, since when and how often.
+  static constexpr int kLostAfterRequests = 50;
+  static constexpr double kLostAfter_s = 0.5;
+  std::int64_t asking_seq_{-1}, asking_since_us_{0}, asking_requests_{0};
+  std::int64_t last_state_us_{0};  ///< attach mode: when the last state arrived (mono_us)
   run_summary_t summary_{};
   service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
   service::StepLedger<reference_t> reference_ledger_;

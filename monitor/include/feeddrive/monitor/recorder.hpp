@@ -68,6 +68,12 @@ class Recorder {
   /// is the step count most states carry (one corrupt message cannot move it); steps after the
   /// last message are a gap too. Returns the rows added.
   std::size_t flush_final(const sim::RecordSink& sink, bool need_reference = true);
+  /// Live, attach mode: step next() will never be complete (its messages were lost and no one
+  /// re-sends them any more) but later steps are in. Records it as flush_final() would (a
+  /// missing command costs only its diagnostic fields), or skips it and the steps that cannot
+  /// start to the next state received, as a gap; then flushes what follows. Returns the rows
+  /// added. Nothing after it yet: nothing is skipped (the step is late, not lost).
+  std::size_t skip_lost(const sim::RecordSink& sink);
   /// The steps flush_final() could not record, in order.
   const std::vector<Gap>& gaps() const { return gaps_; }
   /// Sum of gaps()' steps.
@@ -78,8 +84,15 @@ class Recorder {
   std::int64_t highest_state() const { return highest_state_; }
   bool end_seen() const { return end_seen_; }
   bool complete() const { return end_seen_ && next_ >= steps_; }
+  /// Attach mode: whether the first row's step is chosen (messages before it are dropped).
+  bool started() const { return !attach_ || started_; }
   /// What row next() is waiting for.
   std::vector<Missing> missing() const;
+  /// The messages that steps next()..upto still lack, oldest first, at most `per_kind` states,
+  /// commands and references each, looking at most 4096 steps ahead: states up to `upto`,
+  /// commands below it (real time: none, a step may run without one), and one reference per
+  /// block of 16 (a publisher re-sends the whole block). What a monitor asks for again.
+  std::vector<Missing> missing_until(std::int64_t upto, std::size_t per_kind) const;
 
   std::int64_t rows() const { return rows_; }  ///< rows handed out so far
   std::int64_t duplicates() const { return duplicates_; }
@@ -121,6 +134,13 @@ class Recorder {
   std::int64_t commandless_{0};
   std::vector<Gap> gaps_;
   std::map<std::int64_t, long> steps_votes_;  ///< how many states carried each step count
+  /// What advance() did with step next_.
+  enum class Advance { kRow, kGap, kWait, kEnd };
+  /// Records step next_ if its states (and, if need_reference, its reference) are in; else
+  /// skips to the next step that may start and records the gap. With nothing after it:
+  /// ended = true skips to the end of the run (kEnd), ended = false leaves it (kWait).
+  Advance advance(const sim::RecordSink& sink, bool need_reference, bool ended);
+  void add_gap(std::int64_t first, std::int64_t last, const std::string& why);
   void add_row(const Seen<drive_state_t>& s, const reference_t* r, const control_command_t* c, const drive_state_t& s1,
                const sim::RecordSink& sink);
   std::int64_t first_state_seq_{-1}, first_state_us_{0}, last_state_us_{0};

@@ -23,7 +23,7 @@ struct LaunchOptions {
   /// nice() increment of the monitor and the trajectory, which are off the step's critical path:
   /// they yield to it. Measured on the shared 2-core VM (alternating, 5 rounds each, 24 November
   /// 2026), nice 0 made the lockstep run faster (34,200 against 30,900 steps/s on one core, 5 of
-  /// 5 rounds), but then an attached monitor (--attach, which never asks for resends) lost
+  /// 5 rounds), but then an attached monitor (--attach, which then never asked for resends) lost
   /// datagrams under load (tests/service/attach_test.sh failed 2 of 8 times), so it stays 10.
   int off_path_niceness{10};
   /// The same in real-time mode, where the plant, the controller and the trajectory run at

@@ -45,6 +45,13 @@ struct NodeOptions {
   ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 
+/// The roles of a run (plant, controller, trajectory, monitor): a failure of one stops the
+/// others. Any other role on the status channel (an attached monitor, a tool) is an observer:
+/// its status is heard, its failure never stops the run.
+bool is_run_role(const std::string& role);
+/// The role of feeddrive-monitor --attach on the status channel.
+inline constexpr const char* kAttachedMonitorRole = "monitor-attached";
+
 /// Thrown when a run cannot go on: another role failed or stopped answering.
 struct RunFailure : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -95,7 +102,8 @@ class Node {
   bool peer_alive(const std::string& role, double seconds) const;
   bool monitor_done() const;
   /// After the end: state "done", then keep answering resend requests and sending heartbeats
-  /// until the monitor is done or --linger seconds have passed. `every_100ms` (if given) runs
+  /// until the monitor is done (and an attached monitor heard within the last second too) or
+  /// --linger seconds have passed. `every_100ms` (if given) runs
   /// about every 100 ms meanwhile (the plant re-publishes its end-of-run state).
   void linger(const std::function<void()>& every_100ms = {});
 
