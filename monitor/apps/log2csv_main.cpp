@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
     l["foreign_events"] = c.foreign_events;
     l["cut_event_bytes"] = c.cut_bytes;
     out.finish(out.summary(0.0, {}), plots, j.dump());
+    if (!out.plot_error().empty())
+      spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
     spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
                  log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
                  out_dir);

@@ -379,7 +379,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
     out_->finish(sum, mopt_.plots, j.dump(),
-                 [&](const output::StagedFolder& dir) { write_histograms(dir.dir().string(), hist_names, hists, plots); });
+                 [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); });
+    if (!out_->plot_error().empty())
+      spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), output::shown(mopt_.out_dir));
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -403,15 +405,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   return written;
 }
 
-void MonitorNode::write_histograms(const std::string& dir, const std::vector<std::string>& names,
+void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::vector<std::string>& names,
                                    const std::vector<Histogram>& h, bool plot) const {
-  {
-    std::FILE* f = std::fopen((dir + "/latency_histogram.csv").c_str(), "w");
-    if (f == nullptr) throw std::runtime_error(dir + "/latency_histogram.csv: cannot open for writing");
-    const std::string csv = histograms_csv(names, h);
-    const bool ok = std::fwrite(csv.data(), 1, csv.size(), f) == csv.size();
-    if (std::fclose(f) != 0 || !ok) throw std::runtime_error(dir + "/latency_histogram.csv: write failed");
-  }
+  dir.write_text("latency_histogram.csv", histograms_csv(names, h));
   if (!plot) return;
   const double period_us = s_.control_period * 1e6;
   const std::string bin = std::to_string(h.front().bin_us());
@@ -428,7 +424,13 @@ void MonitorNode::write_histograms(const std::string& dir, const std::vector<std
     gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us() / 2) +
           "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
   gp += "\n";
-  output::run_gnuplot(dir, gp, "latency_histogram.gp");
+  try {  // a view of the data: its failure loses nothing
+    output::run_gnuplot(dir.dir(), gp, "latency_histogram.gp");
+  } catch (const interrupt::Interrupted&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    spdlog::warn("monitor: latency histogram not drawn ({})", e.what());
+  }
 }
 
 }  // namespace feeddrive::monitor

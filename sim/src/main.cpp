@@ -49,7 +49,10 @@ int main(int argc, char** argv) {
     const auto stats = feeddrive::sim::run(scenario, [&](const feeddrive::sim::Record& r) { out.add(r); });
     const auto summary = out.summary(stats.wall_time_s, stats.integrator);
     out.finish(summary, !no_plots);
-    if (!no_plots) spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
+    if (!out.plot_error().empty())
+      spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), feeddrive::output::shown(out_dir));
+    else if (!no_plots)
+      spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
     spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",
                  summary.position_error_max_abs_m, summary.position_error_rms_m, summary.control_min,
                  summary.control_max, summary.wall_time_s, out_dir);

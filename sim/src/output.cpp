@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
@@ -189,8 +190,16 @@ void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_
   csv_->close();
   folder_.write_text("summary.json", summary_json(sum, s_, extra_json));
   if (plots && written_ > 0) {
+    // The plots are a view of the data: if gnuplot fails, the run's files are still put in
+    // place (plot_error() says why; an interrupt still ends the writing).
     const auto t0 = std::chrono::steady_clock::now();
-    write_plots(folder_, plot_, s_.name);
+    try {
+      write_plots(folder_, plot_, s_.name);
+    } catch (const interrupt::Interrupted&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      plot_error_ = e.what();
+    }
     plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (extra_files) extra_files(folder_);
@@ -199,11 +208,26 @@ void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_
 
 void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title) {
   reduced.write_csv(dir.path("plot.csv"), curve_names());
-  // Curve c of plot.csv: time in column 2c+1, value in 2c+2 (MinMaxReducer::write_csv).
-  auto use = [](Curve c, const char* scale) {
-    std::ostringstream u;
-    u << "using " << 2 * c + 1 << ":($" << 2 * c + 2 << scale << ")";
-    return u.str();
+  // Curve c of plot.csv: time in column 2c+1, value in 2c+2 (MinMaxReducer::write_csv). A panel
+  // draws only the curves with samples; one with none (a run without the true state, e.g. from
+  // hardware) is an empty frame saying so: gnuplot refuses a plot with no point in range.
+  struct Line {
+    Curve c;
+    const char* scale;
+    const char* style;
+    const char* title;
+  };
+  auto panel = [&](const std::vector<Line>& lines, const char* none) {
+    std::ostringstream p;
+    bool first = true;
+    for (const Line& l : lines) {
+      if (!reduced.has_samples(l.c)) continue;
+      p << (first ? "plot data" : ", ''") << " every ::1 using " << 2 * l.c + 1 << ":($" << 2 * l.c + 2 << l.scale
+        << ") with lines " << l.style << "title '" << l.title << "'";
+      first = false;
+    }
+    if (first) return "set label 1 '" + std::string(none) + "' at graph 0.5,0.5 center\nplot [0:1][0:1] NaN notitle\nunset label 1\n";
+    return p.str() + "\n";
   };
   // Fixed data file name, the title through the one escaping rule (feeddrive/output/gnuplot.hpp).
   const std::string t = output::gnuplot_string(title);
@@ -211,18 +235,14 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   gp << "data = 'plot.csv'\nset xlabel 't [s]'\n";
   gp << "set output 'position.png'\nset multiplot layout 2,1 title " << t << "\n"
      << "set ylabel 'position [mm]'\n"
-     << "plot data every ::1 " << use(kXd, "*1e3") << " with lines lw 2 title 'x_d',"
-     << " '' every ::1 " << use(kX, "*1e3") << " with lines title 'x'\n"
+     << panel({{kXd, "*1e3", "lw 2 ", "x_d"}, {kX, "*1e3", "", "x"}}, "no position recorded")
      << "set ylabel 'error x_d - x [um]'\n"
-     << "plot data every ::1 " << use(kE, "*1e6") << " with lines title 'e'\nunset multiplot\n";
+     << panel({{kE, "*1e6", "", "e"}}, "no true position: no error to draw") << "unset multiplot\n";
   gp << "set output 'velocity_error.png'\nset title " << t << "\nset ylabel 'velocity error v_d - v [um/s]'\n"
-     << "plot data every ::1 " << use(kEv, "*1e6") << " with lines title 'e_v'\n";
-  gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n"
-     << "plot data every ::1 " << use(kU, "") << " with lines title 'u'\n";
+     << panel({{kEv, "*1e6", "", "e_v"}}, "no true velocity: no error to draw");
+  gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n" << panel({{kU, "", "", "u"}}, "no command recorded");
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
-     << "plot data every ::1 " << use(kFriction, "") << " with lines title 'friction',"
-     << " '' every ::1 " << use(kRipple, "") << " with lines title 'ripple',"
-     << " '' every ::1 " << use(kGrinding, "") << " with lines title 'grinding'\n";
+     << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}}, "no forces recorded");
   dir.plot(gp.str());
 }
 

@@ -129,4 +129,17 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
+bool is_wall_clock_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }
+
+std::vector<std::string> summary_metric_names() {
+  Summary m;
+  m.steps = 2;
+  m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
+  std::vector<std::string> names;
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.value().is_number() && !is_wall_clock_metric(it.key())) names.push_back(it.key());
+  return names;
+}
+
 }  // namespace feeddrive::sim

@@ -1,6 +1,8 @@
 #include "feeddrive/sim/yaml_reader.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -228,8 +230,10 @@ void MapReader::integer(const std::string& key, long& out) {
   if (n.IsDefined()) {
     const std::string& s = n.Scalar();
     char* end = nullptr;
+    errno = 0;
     const long v = std::strtol(s.c_str(), &end, 10);
     if (s.empty() || end != s.c_str() + s.size()) fail(key, " = " + describe(n) + ": not an integer");
+    if (errno == ERANGE) fail(key, " = " + describe(n) + ": out of range (" + std::to_string(LONG_MIN) + " to " + std::to_string(LONG_MAX) + ")");
     out = v;
   }
   record(key, std::to_string(out), false);
@@ -240,9 +244,12 @@ void MapReader::unsigned_integer(const std::string& key, std::uint64_t& out) {
   if (n.IsDefined()) {
     const std::string& s = n.Scalar();
     char* end = nullptr;
+    errno = 0;
     const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
     if (s.empty() || s[0] == '-' || end != s.c_str() + s.size())
       fail(key, " = " + describe(n) + ": not a non-negative integer");
+    if (errno == ERANGE)
+      fail(key, " = " + describe(n) + ": out of range (0 to " + std::to_string(std::numeric_limits<std::uint64_t>::max()) + ")");
     out = v;
   }
   record(key, std::to_string(out), false);

@@ -226,9 +226,12 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
     }
   };
   // Layers without the variations: the nominal case of this controller and family.
+  // The study's set comes after the controller block it would otherwise be replaced by: what it
+  // sets holds for every controller (docs/study.md, "How a case is made").
   YAML::Node doc = YAML::Clone(m.base);
-  for (const Setting& st : s.set) apply(doc, st.key, st.value, "set");
   if (!s.controllers[c.controller].block.empty()) doc["controller"] = YAML::Clone(m.controller_blocks[c.controller]);
+  for (const Setting& st : s.controllers[c.controller].block_set) apply(doc, st.key, st.value, "controllers scenario");
+  for (const Setting& st : s.set) apply(doc, st.key, st.value, "set");
   for (const Setting& st : s.controllers[c.controller].set) apply(doc, st.key, st.value, "controllers set");
   for (const Setting& st : s.families[c.family].set) apply(doc, st.key, st.value, "family set");
   const sim::ResolvedKeys nominal = m.load(doc, origin + " (without its variations)");
@@ -246,6 +249,9 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
     if (it->second.is_string || it->second.text == "true" || it->second.text == "false")
       throw StudyError(origin + ": " + v.key + " = '" + it->second.text + "': cannot scale a value that is not a number");
     const double nominal_value = std::strtod(it->second.text.c_str(), nullptr);
+    // Every factor of 0 is 0: the cases would silently all be the nominal one.
+    if (nominal_value == 0.0)
+      throw StudyError(origin + ": " + v.key + " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a distribution without scale: true)");
     values.emplace_back(v.key, validate::format_number(nominal_value * v.factor));
   }
 

@@ -13,8 +13,6 @@
 
 namespace feeddrive::study {
 
-bool is_timing_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }
-
 Outcome run_case(const std::string& yaml) {
   Outcome o;
   const auto start = std::chrono::steady_clock::now();
@@ -26,7 +24,7 @@ Outcome run_case(const std::string& yaml) {
     const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(sim::summary_json(sum, s));
     for (auto it = j.begin(); it != j.end(); ++it) {
-      if (!it.value().is_number() || is_timing_metric(it.key())) continue;
+      if (!it.value().is_number() || sim::is_wall_clock_metric(it.key())) continue;
       o.metrics.emplace_back(it.key(), it.value().get<double>());
     }
     o.ok = true;

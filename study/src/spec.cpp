@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/summary.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::study {
@@ -244,7 +246,7 @@ ControllerEntry read_controller(const std::string& where, const YAML::Node& n, c
     YAML::Emitter em;
     em << s["controller"];
     c.block = em.c_str();
-    if (s["control_period"].IsDefined()) c.set.push_back({"control_period", scalar_text(where + ".scenario control_period", s["control_period"])});
+    if (s["control_period"].IsDefined()) c.block_set.push_back({"control_period", scalar_text(where + ".scenario control_period", s["control_period"])});
   }
   r.known("set");
   for (Setting& st : read_settings(where + ".set", n["set"])) c.set.push_back(std::move(st));
@@ -306,6 +308,21 @@ void Study::validate() const {
     total += n * static_cast<long>(controllers.size());
   }
   if (report.metric.empty()) fail("report.metric", ": must not be empty");
+  const std::vector<std::string> metrics = sim::summary_metric_names();
+  if (std::find(metrics.begin(), metrics.end(), report.metric) == metrics.end()) {
+    std::string hint;
+    std::size_t best = 4;  // suggest only close matches (<= 3 edits)
+    for (const std::string& m : metrics) {
+      const std::size_t d = sim::edit_distance(report.metric, m);
+      if (d < best) {
+        best = d;
+        hint = " (did you mean '" + m + "'?)";
+      }
+    }
+    if (hint.empty())
+      for (const std::string& m : metrics) hint += (hint.empty() ? "; one of " : ", ") + m;
+    fail("report.metric", " = '" + report.metric + "': not a metric of summary.json" + hint);
+  }
   validate::require_positive("report.scale", report.scale);
   if (!std::isnan(report.limit)) validate::require_finite("report.limit", report.limit);
 }
@@ -350,7 +367,7 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
       if (!cs.IsSequence() || cs.size() == 0) fail("controllers", " = " + describe(cs) + ": expected a non-empty list");
       for (std::size_t i = 0; i < cs.size(); ++i) s.controllers.push_back(read_controller("controllers[" + std::to_string(i) + "]", cs[i], base_dir));
     } else {
-      s.controllers.push_back({"base", "", {}});
+      s.controllers.push_back({"base", "", {}, {}});
     }
     top.known("families");
     const YAML::Node fs_ = root["families"];

@@ -208,6 +208,48 @@ TEST(StudyCases, WrongKeysAndValuesAreTheLoadersOneLineErrors) {
   EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: reference.frequency, scale: [2]}]}\n")
                 .find("reference.frequency: cannot scale a key the scenario does not have"),
             std::string::npos);
+  // A factor on a zero (the default computation delay) would make every case the nominal one.
+  EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: controller.computation_delay, scale: [2, 3]}]}\n")
+                .find("family 'f', point 0: controller.computation_delay = 0: scaling a zero value gives 0 for every factor"),
+            std::string::npos);
+  EXPECT_NE(error_of("families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, parameters: [{key: controller.computation_delay,"
+                     " distribution: uniform, low: 0.5, high: 2, scale: true}]}\n")
+                .find("controller.computation_delay = 0: scaling a zero value"),
+            std::string::npos);
+}
+
+TEST(StudyCases, TheStudysSetHoldsForEveryControllerAndAControllersOwnSetIsMoreSpecific) {
+  // Before: the controller block and its scenario's control_period replaced what the study's set
+  // said, silently (a 1 ms delay in set: ran with none).
+  const std::string t = "set: {duration: 0.02, control_period: 2.0e-4, controller.computation_delay: 1.0e-3, controller.lambda: 77}\n"
+                        "controllers:\n"
+                        "  - {name: sgn, scenario: " + test::scenarios() + "/smc_jerk_limited.yaml}\n"
+                        "  - {name: bl, controller: {type: sliding_mode, switching: sat, lambda: 1000},"
+                        " set: {controller.lambda: 500}}\n";
+  const Study s = parse_study("name: t\nbase: " + test::scenarios() + "/smc_bl_jerk_limited.yaml\n" + t, ".", "s.yaml");
+  Resolver r(s);
+  const auto cases = expand(s);
+  ASSERT_EQ(cases.size(), 2u);
+  const sim::Scenario a = sim::parse_scenario(r.resolve(cases[0]).yaml, ".", "case");
+  EXPECT_DOUBLE_EQ(a.control_period, 2e-4);  // not the 20 us of its scenario file
+  EXPECT_DOUBLE_EQ(a.controller.computation_delay, 1e-3);
+  EXPECT_DOUBLE_EQ(a.controller.sliding_mode.lambda, 77);
+  const sim::Scenario b = sim::parse_scenario(r.resolve(cases[1]).yaml, ".", "case");
+  EXPECT_DOUBLE_EQ(b.control_period, 2e-4);
+  EXPECT_DOUBLE_EQ(b.controller.computation_delay, 1e-3);
+  EXPECT_DOUBLE_EQ(b.controller.sliding_mode.lambda, 500);  // the controller's own set wins
+  // A study-level set naming a key another controller type does not have is the loader's
+  // one-line error, not dropped.
+  const Study c = parse_study("name: t\nbase: " + test::scenarios() + "/smc_bl_jerk_limited.yaml\n"
+                              "set: {controller.lambda: 77}\ncontrollers:\n  - {name: c, controller: {type: cascade}}\n",
+                              ".", "s.yaml");
+  Resolver rc(c);
+  try {
+    rc.resolve(expand(c)[0]);
+    ADD_FAILURE() << "controller.lambda on a cascade was accepted";
+  } catch (const StudyError& e) {
+    EXPECT_NE(std::string(e.what()).find("controller.lambda: unknown key"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -26,10 +26,33 @@ TEST(StudySpec, ControllerFromScenarioTakesItsBlockAndControlPeriod) {
                               ".", "s.yaml");
   ASSERT_EQ(s.controllers.size(), 1u);
   EXPECT_NE(s.controllers[0].block.find("sgn"), std::string::npos);
-  ASSERT_EQ(s.controllers[0].set.size(), 2u);
-  EXPECT_EQ(s.controllers[0].set[0].key, "control_period");
-  EXPECT_EQ(s.controllers[0].set[0].value, "2e-5");
-  EXPECT_EQ(s.controllers[0].set[1].key, "plant.mass");
+  ASSERT_EQ(s.controllers[0].block_set.size(), 1u);
+  EXPECT_EQ(s.controllers[0].block_set[0].key, "control_period");
+  EXPECT_EQ(s.controllers[0].block_set[0].value, "2e-5");
+  ASSERT_EQ(s.controllers[0].set.size(), 1u);
+  EXPECT_EQ(s.controllers[0].set[0].key, "plant.mass");
+}
+
+TEST(StudySpec, AMisspeltReportMetricIsRefusedWithTheNearestName) {
+  // Before: the study ran and its report showed every case as failed.
+  const std::string e = study_error(study_text("report: {metric: position_eror_max_abs_m}\n"));
+  EXPECT_NE(e.find("report.metric = 'position_eror_max_abs_m': not a metric of summary.json (did you mean "
+                   "'position_error_max_abs_m'?)"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(study_error(study_text("report: {metric: wall_time_s}\n")).find("report.metric = 'wall_time_s': not a metric"),
+            std::string::npos);  // a wall-clock metric is not in results.csv
+  EXPECT_NE(study_error(study_text("report: {metric: overshoot}\n")).find("; one of control_period_s, steps, sim_time_s, position_error_max_abs_m, "),
+            std::string::npos);  // nothing close: the list
+  EXPECT_NO_THROW(parse_study(study_text("report: {metric: control_total_variation}\n"), ".", "s.yaml"));
+}
+
+TEST(StudySpec, ASeedBeyondSixtyFourBitsIsRefusedNotClamped) {
+  const std::string mc = "families:\n  - name: f\n    monte_carlo:\n      draws: 2\n      parameters:\n"
+                         "        - {key: plant.mass, distribution: uniform, low: 90, high: 110}\n      seed: ";
+  EXPECT_NO_THROW(parse_study(study_text(mc + "18446744073709551615\n"), ".", "s.yaml"));
+  const std::string e = study_error(study_text(mc + "18446744073709551616\n"));
+  EXPECT_NE(e.find("seed = '18446744073709551616': out of range (0 to 18446744073709551615)"), std::string::npos) << e;
 }
 
 TEST(StudySpec, CaseCountIsGridTimesDrawsTimesControllers) {

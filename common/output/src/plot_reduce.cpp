@@ -22,6 +22,12 @@ std::size_t MinMaxReducer::bucket_of(double t) const {
   return static_cast<std::size_t>(b);
 }
 
+bool MinMaxReducer::has_samples(std::size_t curve) const {
+  for (std::size_t b = 0; b < buckets_; ++b)
+    if (at(b, curve).n > 0) return true;
+  return false;
+}
+
 void MinMaxReducer::add(double t, const double* values) {
   Extremes* row = &e_[bucket_of(t) * curves_];
   for (std::size_t c = 0; c < curves_; ++c) {

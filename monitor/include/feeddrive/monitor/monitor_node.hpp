@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "feeddrive/monitor/lcm_log.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/monitor/histogram.hpp"
 #include "feeddrive/monitor/recorder.hpp"
 #include "feeddrive/control_command_t.hpp"
@@ -64,9 +65,10 @@ class MonitorNode : public service::Node {
   void progress(bool force);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
-  /// latency_histogram.csv (and .png when `plot`) into the staged output folder `dir`.
-  void write_histograms(const std::string& dir, const std::vector<std::string>& names, const std::vector<Histogram>& h,
-                        bool plot) const;
+  /// latency_histogram.csv (and .png when `plot`; a gnuplot failure is a warning) into the
+  /// staged output folder `dir`.
+  void write_histograms(const output::StagedFolder& dir, const std::vector<std::string>& names,
+                        const std::vector<Histogram>& h, bool plot) const;
 
   sim::Scenario s_;
   MonitorOptions mopt_;

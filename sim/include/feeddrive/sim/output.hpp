@@ -69,6 +69,9 @@ class RunWriter {
               const std::function<void(const output::StagedFolder&)>& extra_files = {});
   /// Wall time finish() spent on the plots [s] (0 without plots).
   double plot_seconds() const { return plot_seconds_; }
+  /// Why the plots could not be drawn ("" if they were or were not asked for); the data were
+  /// written all the same.
+  const std::string& plot_error() const { return plot_error_; }
 
  private:
   const Scenario& s_;
@@ -79,6 +82,7 @@ class RunWriter {
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
   double plot_seconds_{0.0};
+  std::string plot_error_;
 
   // the caller's side
   std::vector<Record> block_;

@@ -77,4 +77,11 @@ Summary summarize(const RunResult& r, const Scenario& s);
 /// empty, is a JSON object whose keys are appended (the monitor's lockstep statistics).
 std::string summary_json(const Summary& sum, const Scenario& s, const std::string& extra = "");
 
+/// summary.json keys that measure the computer, not the drive (wall_time_s, realtime_factor).
+bool is_wall_clock_metric(const std::string& key);
+/// The drive's metrics: the keys summary_json writes as numbers for a run with steps (nulls of
+/// an empty window included), except the wall-clock ones, in the order written. What a study
+/// records per case and what its report.metric may name.
+std::vector<std::string> summary_metric_names();
+
 }  // namespace feeddrive::sim

@@ -26,9 +26,6 @@ struct Outcome {
   bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
 };
 
-/// summary.json keys that measure the computer, not the drive: never in results.csv.
-bool is_timing_metric(const std::string& key);
-
 /// Loads the resolved scenario YAML, runs it in-process (sim::run, streamed into the online
 /// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
 /// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.

@@ -96,7 +96,8 @@ struct Family {
 struct ControllerEntry {
   std::string name;
   std::string block;  ///< YAML text of the controller map ("" keeps the base's)
-  std::vector<Setting> set;
+  std::vector<Setting> block_set;  ///< taken with the block: its scenario file's control_period
+  std::vector<Setting> set;        ///< the entry's own set
 };
 
 struct ReportParams {

@@ -36,6 +36,8 @@ class MinMaxReducer {
   std::size_t curves() const { return curves_; }
   std::size_t bucket_of(double t) const;
   const Extremes& at(std::size_t bucket, std::size_t curve) const { return e_[bucket * curves_ + curve]; }
+  /// Whether curve `curve` has a finite sample anywhere (a plot of none has no axis range).
+  bool has_samples(std::size_t curve) const;
 
   /// The plot data: header "t_<name>,<name>" for each curve, then two rows per non-empty bucket,
   /// each curve's two extremes in time order ("nan,nan" for a curve without samples there).
