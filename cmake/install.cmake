@@ -7,6 +7,11 @@
 # works. feeddrive::controller needs feeddrive::model and feeddrive::trajectory only, not CVODE.
 include(CMakePackageConfigHelpers)
 set(FEEDDRIVE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/feeddrive)
+# Shared builds: each installed library finds the others next to it ($ORIGIN), so a program that
+# links only feeddrive::controller starts without LD_LIBRARY_PATH (its own RUNPATH does not reach
+# the libraries its libraries need).
+set_target_properties(feeddrive_common feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory
+  feeddrive_lcmtypes PROPERTIES INSTALL_RPATH "$ORIGIN")
 install(TARGETS feeddrive_common feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory feeddrive_lcmtypes
   EXPORT feeddriveTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

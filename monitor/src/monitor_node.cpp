@@ -375,13 +375,22 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
 
   bool written = true;
   std::string why = failure;
+  std::string where = output::shown(mopt_.out_dir);
   try {
     if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
-    out_->finish(sum, mopt_.plots, j.dump(),
-                 [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); });
-    if (!out_->plot_error().empty())
-      spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), output::shown(mopt_.out_dir));
+    // An incomplete record (interrupted, failed) never replaces an earlier output: it goes beside
+    // it, to DIR.incomplete-N, and both are kept.
+    const std::filesystem::path dest = out_->finish(
+        sum, mopt_.plots, j.dump(), [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); },
+        completed);
+    if (!completed && dest != output::normalise(mopt_.out_dir)) {
+      where = dest.string();
+      if (!options().quiet)  // an interrupt's one line stays one line with -q
+        spdlog::info("monitor: the run did not complete; the earlier output in {} is kept, this record is in {}",
+                     output::shown(mopt_.out_dir), where);
+    }
+    if (!out_->plot_error().empty()) spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -397,11 +406,10 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     announce_failure(why);
   }
   if (!rec_.gaps().empty())
-    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), describe_gaps(rec_.gaps()), sum.steps, output::shown(mopt_.out_dir));
+    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), describe_gaps(rec_.gaps()), sum.steps, where);
   if (!options().quiet)
     spdlog::info("monitor: {} steps recorded{} -> {}", sum.steps,
-                 completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")",
-                 output::shown(mopt_.out_dir));
+                 completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")", where);
   return written;
 }
 

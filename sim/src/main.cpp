@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
   }
   try {
     spdlog::info("{}: {} steps of {} s", scenario.name, scenario.steps(), scenario.control_period);
+    if (scenario.controller.type == feeddrive::sim::ControllerType::kCascade)
+      spdlog::info("cascade gains: kp = {:.6g} 1/s, kv = {:.6g} 1/s, ki = {:.6g} 1/s^2", scenario.controller.cascade.kp,
+                   scenario.controller.cascade.kv, scenario.controller.cascade.ki);
     feeddrive::sim::RunWriter out(out_dir, scenario, "feeddrive-sim");
     const auto stats = feeddrive::sim::run(scenario, [&](const feeddrive::sim::Record& r) { out.add(r); });
     const auto summary = out.summary(stats.wall_time_s, stats.integrator);

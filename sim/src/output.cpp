@@ -178,8 +178,9 @@ Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Sta
   return summary_.summary(wall_time_s, integrator);
 }
 
-void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json,
-                       const std::function<void(const output::StagedFolder&)>& extra_files) {
+std::filesystem::path RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_json,
+                                        const std::function<void(const output::StagedFolder&)>& extra_files,
+                                        bool replace_earlier) {
   drain();
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -203,7 +204,9 @@ void RunWriter::finish(const Summary& sum, bool plots, const std::string& extra_
     plot_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (extra_files) extra_files(folder_);
+  if (!replace_earlier) return folder_.commit_keeping_earlier("incomplete");
   folder_.commit();
+  return folder_.target();
 }
 
 void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title) {

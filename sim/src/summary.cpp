@@ -120,6 +120,9 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["integrator_rhs_evals"] = m.integrator_rhs_evals;
   j["integrator_jac_evals"] = m.integrator_jac_evals;
   j["integrator_error_test_fails"] = m.integrator_error_test_fails;
+  // The gains a cascade runs with (tuning: rule chooses them: docs/controllers.md).
+  if (s.controller.type == ControllerType::kCascade)
+    j["cascade_gains"] = {{"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
   if (!extra.empty()) {
     const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
     for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();

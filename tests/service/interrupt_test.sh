@@ -67,3 +67,17 @@ interrupt launch_run $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
 [ "$(json launch_run/summary.json .lockstep.completed)" = false ] || fail "launch_run: summary does not say completed: false"
 json launch_run/summary.json .lockstep.failure | grep -q "interrupted by SIGINT" || fail "launch_run: the failure is not the interrupt"
 pass "launch_run: the monitor kept $(json launch_run/summary.json .steps) recorded steps"
+
+# An interrupted rerun into a complete earlier output: the earlier output stays as it was, the
+# interrupted record goes beside it (launch_run2.incomplete-1). It once replaced the earlier one.
+timeout 120 feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plots -q
+[ "$(json launch_run2/summary.json .lockstep.completed)" = true ] || fail "launch_run2: the first run did not complete"
+before=$(md5sum < launch_run2/timeseries.csv)
+feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plots -q 2> launch_run2.err &
+p=$!
+interrupt launch_run2 $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
+[ "$(md5sum < launch_run2/timeseries.csv)" = "$before" ] || fail "launch_run2: the earlier output was changed"
+[ "$(json launch_run2/summary.json .lockstep.completed)" = true ] || fail "launch_run2: the earlier summary was replaced"
+[ "$(json launch_run2.incomplete-1/summary.json .lockstep.completed)" = false ] ||
+  fail "launch_run2: the interrupted record is not in launch_run2.incomplete-1"
+pass "launch_run2: the earlier output kept, the interrupted record ($(json launch_run2.incomplete-1/summary.json .steps) steps) beside it"

@@ -110,25 +110,35 @@ for v in "" / . "$work/user/thesis.tex/out"; do
 done
 pass "feeddrive-launch: a folder with a fake summary.json and unwritable --out values refused with exit 2, one line, untouched"
 
-# ---- 3. the monitor cannot write (gnuplot fails): launch fails, the earlier output survives
-mkdir -p "$TMP/fakebin"
-printf '#!/bin/sh\necho "fake gnuplot: cannot plot" >&2\nexit 1\n' > "$TMP/fakebin/gnuplot"
-chmod +x "$TMP/fakebin/gnuplot"
+# ---- 3. the monitor cannot write (the file-size limit, ulimit -f, stops timeseries.csv at 100 KB of its ~240 KB):
+# launch fails, the earlier output survives
 before=$(md5sum < "$work/prev/timeseries.csv")
 set +e
-PATH="$TMP/fakebin:$PATH" timeout 120 feeddrive-launch "$scen" --out "$work/prev" -q --lcm-url "$URL" 2> "$TMP/err.txt"
+(ulimit -f 100; timeout 120 feeddrive-launch "$scen" --out "$work/prev" -q --lcm-url "$URL" 2> "$TMP/err.txt")
 rc=$?
 set -e
 [ "$rc" != 0 ] || fail "feeddrive-launch exited 0 although its monitor could not write"
-grep -q "fake gnuplot" "$TMP/err.txt" || fail "the monitor's error is not reported: $(cat "$TMP/err.txt")"
+grep -q "File too large" "$TMP/err.txt" || fail "the monitor's error is not reported: $(cat "$TMP/err.txt")"
 [ "$(md5sum < "$work/prev/timeseries.csv")" = "$before" ] || fail "the earlier output changed"
 [ -f "$work/prev/.feeddrive-output" ] || fail "the earlier output lost its marker"
 [ -z "$(find "$work" -maxdepth 1 -name '.prev.*')" ] || fail "temporary folders left: $(ls -a "$work")"
 # and into a new folder: non-zero, no folder
 set +e
-PATH="$TMP/fakebin:$PATH" timeout 120 feeddrive-launch "$scen" --out "$work/fresh" -q --lcm-url "$URL" 2> "$TMP/err.txt"
+(ulimit -f 100; timeout 120 feeddrive-launch "$scen" --out "$work/fresh" -q --lcm-url "$URL" 2> "$TMP/err.txt")
 rc=$?
 set -e
 [ "$rc" != 0 ] || fail "feeddrive-launch exited 0 with no output folder"
 [ ! -e "$work/fresh" ] || fail "a half-written folder"
 pass "feeddrive-launch exits $rc when the monitor cannot write; the earlier output is intact"
+
+# ---- 3b. gnuplot fails: the plots are a view of the data, which are written all the same
+mkdir -p "$TMP/fakebin"
+printf '#!/bin/sh\necho "fake gnuplot: cannot plot" >&2\nexit 1\n' > "$TMP/fakebin/gnuplot"
+chmod +x "$TMP/fakebin/gnuplot"
+PATH="$TMP/fakebin:$PATH" timeout 120 feeddrive-launch "$scen" --out "$work/noplots" -q --lcm-url "$URL" 2> "$TMP/err.txt" ||
+  fail "feeddrive-launch failed because gnuplot did: $(cat "$TMP/err.txt")"
+grep -q "plots not drawn (.*fake gnuplot" "$TMP/err.txt" || fail "no warning about the plots: $(cat "$TMP/err.txt")"
+[ "$(json "$work/noplots/summary.json" .lockstep.completed)" = true ] || fail "noplots: not completed"
+[ "$(($(wc -l < "$work/noplots/timeseries.csv") - 1))" = "$(json "$work/noplots/summary.json" .steps)" ] ||
+  fail "noplots: timeseries.csv does not hold every step"
+pass "a failing gnuplot costs the plots only: the record is complete and a warning says why"

@@ -20,9 +20,16 @@ for l in model plant controller trajectory; do
   f=$prefix/lib/libfeeddrive_$l.so
   [ -f "$f" ] || fail "not installed: $f"
   readelf -h "$f" | grep -q 'Type: *DYN' || fail "not a shared object: $f"
+  # Each finds the others next to it: a program linking only libfeeddrive_controller.so (whose
+  # RUNPATH does not reach its libraries' dependencies) once failed to start with
+  # "libfeeddrive_model.so: cannot open shared object file".
+  ldd "$f" > "$TMP/ldd-$l.txt"
+  if grep -q "not found" "$TMP/ldd-$l.txt"; then cat "$TMP/ldd-$l.txt" >&2; fail "$f: a library it needs is not found"; fi
+  grep -q "libfeeddrive_model.so => $prefix/lib" "$TMP/ldd-$l.txt" || [ $l = model ] ||
+    { cat "$TMP/ldd-$l.txt" >&2; fail "$f does not find libfeeddrive_model.so next to it"; }
 done
 # ldd into a file first: `ldd | grep -q` fails under pipefail when grep exits at the first match
 # and ldd gets SIGPIPE (it did, 1 run in 3 under ctest -j4).
 ldd "$exe" > "$TMP/ldd.txt"
 grep -q "libfeeddrive_controller.so => $prefix/lib" "$TMP/ldd.txt" || { cat "$TMP/ldd.txt" >&2; fail "the example does not load the installed libfeeddrive_controller.so"; }
-pass "shared SDK: libfeeddrive_{model,plant,controller,trajectory}.so installed; the example loads libfeeddrive_controller.so from the prefix, no SUNDIALS"
+pass "shared SDK: libfeeddrive_{model,plant,controller,trajectory}.so installed, each finding the others next to it; the example loads libfeeddrive_controller.so from the prefix, no SUNDIALS"

@@ -290,6 +290,29 @@ TEST(OutputFolder, StagedCommitCreatesAMarkedFolder) {
   EXPECT_EQ(names(base / "a/b"), std::vector<std::string>{"run"}) << "no temporary folder left";
 }
 
+TEST(OutputFolder, AnIncompleteRecordNeverReplacesAnEarlierOutput) {
+  // The monitor's record of an interrupted rerun once replaced a complete earlier output.
+  const fs::path base = fresh("keep_earlier");
+  {
+    StagedFolder out((base / "run").string(), "test-tool");
+    put(out.dir() / "result.txt", "complete");
+    EXPECT_EQ(out.commit_keeping_earlier("incomplete"), base / "run");  // nothing there: the target
+  }
+  fs::create_directory(base / "run.incomplete-1");  // an empty folder is not taken either
+  for (const char* expect : {"run.incomplete-2", "run.incomplete-3"}) {
+    StagedFolder out((base / "run").string(), "test-tool");
+    put(out.dir() / "result.txt", expect);
+    EXPECT_EQ(out.commit_keeping_earlier("incomplete"), base / expect);
+  }
+  EXPECT_EQ(slurp(base / "run/result.txt"), "complete");
+  EXPECT_EQ(slurp(base / "run.incomplete-2/result.txt"), "run.incomplete-2");
+  EXPECT_EQ(slurp(base / "run.incomplete-3/result.txt"), "run.incomplete-3");
+  EXPECT_TRUE(is_feeddrive_output(base / "run.incomplete-3"));
+  EXPECT_TRUE(fs::is_empty(base / "run.incomplete-1"));
+  EXPECT_EQ(names(base), (std::vector<std::string>{"run", "run.incomplete-1", "run.incomplete-2", "run.incomplete-3"}))
+      << "no temporary folder left";
+}
+
 TEST(OutputFolder, TrailingSlashReplacesAnEarlierOutputSafely) {
   const fs::path base = fresh("staged_replace");
   {

@@ -62,3 +62,26 @@ TEST(Summary, FiniteButHugeRecordsGiveFiniteMetrics) {
 
 }  // namespace
 }  // namespace feeddrive::sim
+
+namespace feeddrive::sim {
+namespace {
+
+TEST(Summary, ACascadeReportsTheGainsItRunsWith) {
+  // tuning: rule chooses kp, kv, ki (docs/controllers.md): summary.json says which.
+  const Scenario c = parse_scenario("name: c\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: cascade, tuning: rule}\n", ".", "c");
+  Summary m;
+  m.steps = 1;
+  const auto j = nlohmann::json::parse(summary_json(m, c));
+  ASSERT_TRUE(j.contains("cascade_gains"));
+  EXPECT_EQ(j["cascade_gains"]["kv"].get<double>(), c.controller.cascade.kv);
+  EXPECT_EQ(j["cascade_gains"]["kp"].get<double>(), c.controller.cascade.kp);
+  EXPECT_EQ(j["cascade_gains"]["ki"].get<double>(), c.controller.cascade.ki);
+  // Ideal sensor, T = 100 us: tau = T/2, crossover ~10,800 rad/s, kv ~10,490 1/s (docs/controllers.md,
+  // "Cascade tuning rule"); 1 % covers the rounding of the documented figure.
+  EXPECT_NEAR(c.controller.cascade.kv, 10490.0, 105.0);
+  const Scenario smc = parse_scenario("name: s\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: sliding_mode}\n", ".", "s");
+  EXPECT_FALSE(nlohmann::json::parse(summary_json(m, smc)).contains("cascade_gains"));
+}
+
+}  // namespace
+}  // namespace feeddrive::sim

@@ -63,6 +63,33 @@ bool empty_folder(const fs::path& dir) {
   return !ec && e;
 }
 
+// fsync of one file or folder (opened read-only); errno on failure, 0 on success.
+int sync_path(const fs::path& p, bool folder) {
+  const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | (folder ? O_DIRECTORY : 0));
+  if (fd < 0) return errno;
+  const int rc = ::fsync(fd) == 0 ? 0 : errno;
+  ::close(fd);
+  return rc;
+}
+
+// Durability: every regular file of `dir` and `dir` itself reach the disk before the folder is
+// renamed into place, so that a power cut after the rename cannot leave DIR holding empty or
+// short files (the rename is then made durable by syncing the parent, sync_parent).
+void sync_folder(const fs::path& dir, const std::string& what) {
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const bool folder = it->is_directory(ec);
+    if (!folder && !it->is_regular_file(ec)) continue;
+    if (const int e = sync_path(it->path(), folder))
+      throw std::runtime_error(what + "cannot flush " + it->path().string() + " to disk: " + error_text(e));
+  }
+  if (ec) throw std::runtime_error(what + "cannot list " + dir.string() + ": " + ec.message());
+  if (const int e = sync_path(dir, true)) throw std::runtime_error(what + "cannot flush " + dir.string() + " to disk: " + error_text(e));
+}
+
+// After a rename: the parent's entry is durable too. Best effort (the results are in place).
+void sync_parent(const fs::path& target) { (void)sync_path(target.parent_path(), true); }
+
 bool exchange(const fs::path& a, const fs::path& b, int& err) {
   if (::renameat2(AT_FDCWD, a.c_str(), AT_FDCWD, b.c_str(), RENAME_EXCHANGE) == 0) return true;
   err = errno;
@@ -308,10 +335,8 @@ StagedFolder::~StagedFolder() {
   if (!done_) remove_output(staging_);
 }
 
-void StagedFolder::commit(bool list_files) {
-  if (done_) throw std::logic_error("StagedFolder::commit called twice");
+void StagedFolder::finish_marker(bool list_files) {
   const std::string what = option_ + " " + shown(value_) + ": ";
-  const std::string kept = "; the results are in " + staging_.string();
   // The marker lists what this run wrote: a later run replaces the folder only while it holds
   // nothing else (a user's notes put into it are refused, not deleted).
   if (list_files) {
@@ -327,6 +352,45 @@ void StagedFolder::commit(bool list_files) {
     for (const auto& f : files) text += "file: " + f + "\n";
     write_file_atomically(staging_ / kMarkerFile, text);
   }
+  sync_folder(staging_, what);
+}
+
+fs::path StagedFolder::commit_keeping_earlier(const std::string& kind, bool list_files) {
+  if (done_) throw std::logic_error("StagedFolder::commit called twice");
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(target_, ec))) {
+    commit(list_files);
+    return target_;
+  }
+  finish_marker(list_files);
+  done_ = true;  // kept on failure from here: it holds the results
+  const std::string what = option_ + " " + shown(value_) + ": ";
+  for (int n = 1;; ++n) {
+    const fs::path p = target_.parent_path() / (target_.filename().string() + "." + kind + "-" + std::to_string(n));
+    // RENAME_NOREPLACE: never onto anything, not even an empty folder (rename(2) would take it).
+    if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, p.c_str(), RENAME_NOREPLACE) == 0) {
+      sync_parent(p);
+      return p;
+    }
+    const int e = errno;
+    if (e == EEXIST) continue;
+    if (e == EINVAL || e == ENOSYS || e == EOPNOTSUPP) {  // no RENAME_NOREPLACE here: check, then rename
+      if (fs::exists(fs::symlink_status(p, ec))) continue;
+      if (::rename(staging_.c_str(), p.c_str()) == 0) {
+        sync_parent(p);
+        return p;
+      }
+    }
+    throw std::runtime_error(what + "cannot rename the results beside the earlier output: " + error_text(errno) +
+                             "; the results are in " + staging_.string());
+  }
+}
+
+void StagedFolder::commit(bool list_files) {
+  if (done_) throw std::logic_error("StagedFolder::commit called twice");
+  const std::string what = option_ + " " + shown(value_) + ": ";
+  const std::string kept = "; the results are in " + staging_.string();
+  finish_marker(list_files);
   // From here on the staging folder is kept on failure: it holds finished results.
   done_ = true;
   std::error_code ec;
@@ -336,6 +400,7 @@ void StagedFolder::commit(bool list_files) {
   if (!fs::exists(st)) {
     if (::rename(staging_.c_str(), target_.c_str()) != 0)
       throw std::runtime_error(what + "cannot rename the results into place: " + error_text(errno) + kept);
+    sync_parent(target_);
     return;
   }
   const auto ours = [](const fs::path& d) { return (is_feeddrive_output(d) && foreign_entry(d).empty()) || empty_folder(d); };
@@ -345,6 +410,7 @@ void StagedFolder::commit(bool list_files) {
 
   int err = 0;
   if (exchange(staging_, target_, err)) {
+    sync_parent(target_);
     // staging_ now holds the previous output. Check it again: a folder that is not ours goes back.
     if (!ours(staging_)) {
       int err2 = 0;
@@ -374,6 +440,7 @@ void StagedFolder::commit(bool list_files) {
                                "); the previous output is in " + backup.string() + kept);
     throw std::runtime_error(what + "cannot rename the results into place: " + error_text(e) + kept);
   }
+  sync_parent(target_);
   if (!remove_output(backup))
     std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),
                  backup.c_str());

@@ -22,7 +22,9 @@ inline volatile std::sig_atomic_t g_signal = 0;
 extern "C" inline void on_signal(int sig) { g_signal = sig; }
 }  // namespace detail
 
-/// Installs the SIGINT/SIGTERM handlers (idempotent).
+/// Installs the SIGINT/SIGTERM handlers (idempotent). SIGXFSZ is ignored: a file grown past
+/// the file-size limit (ulimit -f) is then a write error (EFBIG) reported as such, with the
+/// staging folder removed, not a process killed mid-write.
 inline void install_handlers() {
   struct sigaction sa {};
   sa.sa_handler = detail::on_signal;
@@ -30,6 +32,7 @@ inline void install_handlers() {
   sa.sa_flags = 0;  // no SA_RESTART: a blocking call returns EINTR
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGXFSZ, SIG_IGN);
 }
 
 /// The signal that interrupted the process, or 0.

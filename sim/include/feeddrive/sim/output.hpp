@@ -18,6 +18,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -65,8 +66,12 @@ class RunWriter {
   /// extra_json) and the plots (when asked and there is at least one record), and swaps the
   /// folder into place. On failure the previous output is kept and the staged folder removed.
   /// `extra_files` (if given) writes the caller's own files into the staged folder first.
-  void finish(const Summary& sum, bool plots, const std::string& extra_json = "",
-              const std::function<void(const output::StagedFolder&)>& extra_files = {});
+  /// `replace_earlier` false (an incomplete record): an earlier output in out_dir is kept and
+  /// the record goes beside it, to "out_dir.incomplete-N" (StagedFolder::commit_keeping_earlier).
+  /// Returns the folder the results went to.
+  std::filesystem::path finish(const Summary& sum, bool plots, const std::string& extra_json = "",
+                               const std::function<void(const output::StagedFolder&)>& extra_files = {},
+                               bool replace_earlier = true);
   /// Wall time finish() spent on the plots [s] (0 without plots).
   double plot_seconds() const { return plot_seconds_; }
   /// Why the plots could not be drawn ("" if they were or were not asked for); the data were

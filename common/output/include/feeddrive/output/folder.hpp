@@ -99,10 +99,19 @@ class StagedFolder {
   /// become something else meanwhile, nothing is replaced: throws std::runtime_error naming the
   /// temporary folder, which is kept with the results. With `list_files` (the default) the
   /// marker lists every entry written (see the top of this file); a folder that keeps growing
-  /// after the commit (feeddrive-study's, over reruns) is committed without the list.
+  /// after the commit (feeddrive-study's, over reruns) is committed without the list. Every file
+  /// and folder in it is flushed to disk (fsync) before the rename, and the parent after it: a
+  /// power cut never leaves the target with empty or short files.
   void commit(bool list_files = true);
+  /// Like commit(), but an earlier output in the target is kept: the folder goes to the target
+  /// if there is none, else to the first free sibling "TARGET.KIND-N" (N = 1, 2, ...; never onto
+  /// anything). Returns where it went. For a record that must not replace a complete one (the
+  /// monitor's record of an interrupted or failed run).
+  std::filesystem::path commit_keeping_earlier(const std::string& kind, bool list_files = true);
 
  private:
+  // Writes the marker's file list (when asked) and flushes every file and the folder to disk.
+  void finish_marker(bool list_files);
   std::string value_;   // as the user gave it, for messages
   std::string option_;
   std::string tool_;
