@@ -5,6 +5,9 @@
 // Exit 2 (one line) for a log that cannot be read, is corrupt (the event's byte offset), or holds
 // no complete step.
 #include <spdlog/spdlog.h>
+#include <algorithm>
+#include <limits>
+#include <filesystem>
 
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -32,8 +35,14 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     const sim::Scenario s = sim::load_scenario(scenario_path);
     output::check_output_dir(out_dir);
-    sim::check_run_size(s, out_dir);
+    // A step of a log is at least a state and a command event, each over 40 bytes (the 28-byte
+    // event header, the channel name, the message's 8-byte fingerprint): the log bounds its steps.
+    std::error_code ec;
+    const auto log_bytes = std::filesystem::file_size(log_path, ec);
+    const double log_steps = ec ? std::numeric_limits<double>::infinity() : static_cast<double>(log_bytes) / 64.0;
+    sim::check_run_size(s, out_dir, log_steps);
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
+    out.set_expected_steps(std::min(static_cast<double>(s.steps()), log_steps));
     const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
     const monitor::Recorder& rec = c.recorder;
     if (out.steps() == 0)

@@ -68,6 +68,9 @@ int main(int argc, char** argv) {
   } catch (const feeddrive::sim::ScenarioError& e) {  // a non-finite value at run time (check_finite_step)
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
+  } catch (const std::invalid_argument& e) {  // the run's CSV cannot fit (RunWriter's check on its first rows)
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -56,8 +56,8 @@ double plot_end(const Scenario& s) { return std::max(1.0, static_cast<double>(s.
 
 }  // namespace
 
-void check_run_size(const Scenario& s, const std::string& out_dir) {
-  const double rows = std::ceil(static_cast<double>(s.steps()) / static_cast<double>(s.output.every));
+void check_run_size(const Scenario& s, const std::string& out_dir, double max_steps) {
+  const double rows = std::ceil(std::min(static_cast<double>(s.steps()), max_steps) / static_cast<double>(s.output.every));
   const double cols = static_cast<double>(s.output.columns.empty() ? kRecordColumns : s.output.columns.size());
   const double least = rows * cols * 2.0;
   fs::path up = fs::absolute(output::normalise(out_dir));
@@ -80,6 +80,7 @@ RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::s
       folder_(out_dir, tool),
       columns_(column_indices(s)),
       every_(s.output.every),
+      expected_steps_(static_cast<double>(s.steps())),
       summary_(s),
       plot_(0.0, plot_end(s), kPlotBuckets, kCurves) {
   std::vector<std::string> header;
@@ -160,17 +161,41 @@ void RunWriter::work() {
 }
 
 void RunWriter::write(const Record& r) {
-  if (written_ % every_ == 0) {
+  // output.every keeps the rows of steps k = 0, N, 2N, ... by the step's own number, so a record
+  // with gaps (a log, an attached monitor) keeps the same steps as a complete one.
+  const double k = std::round(r.t / s_.control_period);
+  if (every_ == 1 || std::fmod(k, static_cast<double>(every_)) == 0.0) {
     double all[kRecordColumns], row[kRecordColumns];
     record_values(r, all);
     for (std::size_t c = 0; c < columns_.size(); ++c) row[c] = all[columns_[c]];
     csv_->row(row, columns_.size());
+    if (csv_->rows() == kProjectAfterRows) check_projected_size();
   }
   double y[kCurves];
   curve_values(r, y);
   plot_.add(r.t, y);
   summary_.add(r);
   ++written_;
+}
+
+void RunWriter::check_projected_size() const {
+  // check_run_size's bound takes 2 bytes a value; the rows written so far say what the run's
+  // values really take (about 12 bytes each in shortest round-trip form).
+  const double rows_total = std::ceil(expected_steps_ / static_cast<double>(every_));
+  const double per_row = static_cast<double>(csv_->bytes()) / static_cast<double>(csv_->rows());
+  const double to_come = (rows_total - static_cast<double>(csv_->rows())) * per_row;
+  struct statvfs st {};
+  if (::statvfs(folder_.dir().c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
+  const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
+  if (to_come > free_bytes) {
+    const auto gb = [](double b) { return validate::format_number(std::round(b / 1e7) / 100.0) + " GB"; };
+    throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv would take about " +
+                                gb(to_come + static_cast<double>(csv_->bytes())) + " (" + validate::format_number(rows_total) +
+                                " rows of " + validate::format_number(std::round(per_row)) + " bytes, measured on the first " +
+                                std::to_string(kProjectAfterRows) + "), only " + gb(free_bytes) + " free in " +
+                                folder_.target().parent_path().string() +
+                                "; record fewer rows (output.every) or columns (output.columns)");
+  }
 }
 
 Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) {

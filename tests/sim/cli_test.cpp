@@ -1,6 +1,7 @@
 // feeddrive-sim end to end: outputs, exit codes, no half-written output folder, --out checked
 // before the run and never replacing a folder feeddrive did not write, names never run as code.
 #include <gtest/gtest.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <signal.h>
 #include <unistd.h>
@@ -356,6 +357,32 @@ bool has_staging(const std::string& name) {
     if (e.path().filename().string().rfind("." + name + ".partial-", 0) == 0) return true;
   return false;
 }
+
+TEST(Cli, ACsvThatCannotFitIsRefusedOnItsFirstRowsWithExitTwo) {
+  // The bound before the run takes 2 bytes a value; real rows take about 12. A run sized to
+  // pass that bound (free / 100 bytes' worth of rows: 40 % of the disk at 2 bytes x 20 values)
+  // but needing ~2.5x the free space once written is refused after its first 1,000 rows.
+  struct statvfs st {};
+  ASSERT_EQ(::statvfs(scratch().c_str(), &st), 0);
+  const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
+  const double steps = std::min(1e10, std::floor(free_bytes / 100.0));
+  if (steps * 20 * 2 > 0.9 * free_bytes) GTEST_SKIP() << "disk too small for this check";
+  // Rows of this scenario take ~250 bytes: skip where even that would fit (a disk over 2 TB free,
+  // where the 1e10-step limit comes first), rather than start a run that long.
+  if (steps * 200 < 1.2 * free_bytes) GTEST_SKIP() << "disk too large for this check";
+  std::string s = kGood;
+  const std::string text =
+      std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: " + std::to_string(steps * 1e-4));
+  const fs::path out = scratch() / "cli_projected";
+  const ProcResult r = run_sim(write_file("projected.yaml", text).string() + " --out " + out.string() + " --no-plots");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("duration, control_period, output.every, output.columns: timeseries.csv would take about"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("measured on the first 1000"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(has_staging("cli_projected"));
+}
+
 
 TEST(Cli, InterruptLeavesNoOutputAndNoStagingFolder) {
   std::string s = kGood;

@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -72,6 +75,30 @@ TEST(RunWriter, AFailingGnuplotLosesNoData) {
   EXPECT_TRUE(fs::exists(out / "timeseries.csv"));
   EXPECT_TRUE(fs::exists(out / "summary.json"));
   EXPECT_FALSE(fs::exists(out / "position.png"));
+}
+
+TEST(RunWriter, OutputEveryKeepsStepsByTheirNumberAcrossGaps) {
+  // output.every: N keeps steps k = 0, N, 2N, ... A record with gaps (a log, an attached
+  // monitor) once kept every N-th row written instead, so its rows drifted off the multiples.
+  const fs::path out = test_support::make_scratch("run_writer") / "every";
+  Scenario s;
+  s.control_period = 1e-4;
+  s.duration = 0.01;
+  s.output.every = 7;
+  RunWriter w(out.string(), s, "test");
+  for (long k = 0; k < 100; ++k) {
+    if (k >= 3 && k <= 10) continue;  // a gap: steps 3-10 lost
+    Record r;
+    r.t = s.time_of(k);
+    w.add(r);
+  }
+  w.finish(w.summary(0.0, {}), false);
+  std::istringstream csv(test_support::slurp(out / "timeseries.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  std::vector<long> kept;
+  while (std::getline(csv, line)) kept.push_back(std::lround(std::stod(line.substr(0, line.find(','))) / 1e-4));
+  EXPECT_EQ(kept, (std::vector<long>{0, 14, 21, 28, 35, 42, 49, 56, 63, 70, 77, 84, 91, 98}));
 }
 
 }  // namespace

@@ -16,10 +16,12 @@
 // On a machine with a free core the output costs the simulation nothing but the copy.
 
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -40,8 +42,11 @@ inline constexpr std::size_t kPlotBuckets = 2000;
 /// Throws std::invalid_argument (one line naming the keys and the figure; the tools exit 2) if
 /// timeseries.csv cannot fit: rows x columns x 2 bytes (the least a value takes, a digit and a
 /// separator) above the free space of the file system that will hold out_dir. Call after
-/// output::check_output_dir, before any work.
-void check_run_size(const Scenario& s, const std::string& out_dir);
+/// output::check_output_dir, before any work. `max_steps`: a bound of the record's own where it
+/// can be shorter than the scenario (a log holds what it holds). RunWriter checks again on the
+/// first rows' real size.
+void check_run_size(const Scenario& s, const std::string& out_dir,
+                    double max_steps = std::numeric_limits<double>::infinity());
 
 class RunWriter {
  public:
@@ -54,8 +59,13 @@ class RunWriter {
   static constexpr std::size_t kBlockRows = 4096;
   static constexpr std::size_t kQueuedBlocks = 4;
 
-  /// One record, in step order. Rethrows a write error of the writer thread.
+  /// One record, in step order. Rethrows a write error of the writer thread, and
+  /// std::invalid_argument once the first kProjectAfterRows rows show that the run's CSV
+  /// (expected_steps() rows, default the scenario's) cannot fit the free disk.
   void add(const Record& r);
+  static constexpr std::uint64_t kProjectAfterRows = 1000;
+  /// How many steps the record will have (a log's own bound where it is shorter than the scenario).
+  void set_expected_steps(double steps) { expected_steps_ = steps; }
   long steps() const { return added_; }
   /// The most recent record (undefined before the first add).
   const Record& last() const { return last_; }
@@ -84,10 +94,13 @@ class RunWriter {
   std::unique_ptr<output::CsvWriter> csv_;
   std::vector<std::size_t> columns_;  // indices into record_columns()
   long every_;
+  double expected_steps_;
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
   double plot_seconds_{0.0};
   std::string plot_error_;
+
+  void check_projected_size() const;  // the writer thread, after kProjectAfterRows rows
 
   // the caller's side
   std::vector<Record> block_;

@@ -39,7 +39,8 @@ class CsvWriter {
   /// Flushes and closes; throws std::runtime_error on any write error.
   void close();
   std::uint64_t rows() const { return rows_; }
-  std::uint64_t bytes() const { return bytes_; }
+  /// Bytes of text so far, header included (written to the file or still in the buffer).
+  std::uint64_t bytes() const { return bytes_ + used_; }
 
  private:
   void flush();
