@@ -212,9 +212,18 @@ bool MonitorNode::run() {
       if (now - last_row_us_ > us(limit)) {
         if (mopt_.attach && rec_.highest_state() < 0)
           throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) + " s");
+        // A role whose heartbeat still comes is waiting on another and runs its own timeout: it
+        // will name the culprit (check_peers above), as the trajectory and the controller do. So
+        // wait for it (at most three timeouts), then name only the roles that went silent.
+        const std::vector<Missing> missing = rec_.missing();
+        bool someone_waits = false;
+        for (const Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
+        if (someone_waits && now - last_row_us_ <= 3 * us(limit)) continue;
         std::string who;
-        for (const Missing& m : rec_.missing())
-          who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+        for (const Missing& m : missing)
+          if (!peer_alive(m.role, 0.5)) who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+        if (who.empty())
+          for (const Missing& m : missing) who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
         throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " + service::seconds_text(limit) +
                                   " s: no " + who);
       }

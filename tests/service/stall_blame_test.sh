@@ -4,6 +4,7 @@
 #    names the controller, and so must every other process (trajectory, monitor, and the
 #    controller itself, which finds the plant's failure when it wakes), never "no state from the
 #    plant" (the race the trajectory's and the controller's own timeouts used to win).
+# 1b. The controller killed (SIGKILL): the run's failure names it, never the plant.
 # 2. A controller that answers with a stale step number (state k answered as k - 1, with a new
 #    u) gets a counted error naming the stale step at once, not a silent drop and a timeout: a
 #    second, different command for a step already answered is a conflict (service::Node::admit),
@@ -33,6 +34,21 @@ done
 grep -q "no state from the plant" "$TMP/errors" && fail "a process blamed the plant"
 json "$TMP/stall/summary.json" .lockstep.failure | grep -q "controller" || fail "summary failure does not name the controller"
 pass "stalled controller: every process names it"
+
+# 1b. The controller killed (SIGKILL): the monitor, whose own step timeout runs alongside the
+# plant's, must not name the plant (it once wrote "no command k from the controller, state k+1
+# from the plant" in 1 of 3 runs): the plant's heartbeat still comes, so it waits for the plant,
+# which names the controller.
+timeout 60 feeddrive-launch "$scen" --out "$TMP/kill" --no-plots --external controller "${opts[@]}" 2> "$TMP/kill.err" & l=$!
+feeddrive-controller "$scen" "${opts[@]}" 2> /dev/null & c=$!
+sleep 1.5
+kill -KILL $c
+set +e; wait $l; rl=$?; wait $c; set -e
+[ $rl -ne 0 ] || fail "launch exited 0 with its controller killed"
+failure=$(json "$TMP/kill/summary.json" .lockstep.failure)
+printf "%s" "$failure" | grep -q "controller" || fail "killed controller: the failure does not name it: $failure"
+printf "%s" "$failure" | grep -q "from the plant" && fail "killed controller: the monitor blames the plant too: $failure"
+pass "killed controller: $failure"
 
 timeout 60 feeddrive-launch "$scen" --out "$TMP/stale" --no-plots --external controller "${opts[@]}" 2> "$TMP/stale.err" & l=$!
 timeout 60 "$BUILD/tests/fd-test-peer" stale-controller --steps 100 --lcm-url "$URL" > /dev/null & p=$!
