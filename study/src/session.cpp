@@ -229,8 +229,7 @@ int run_study(const Options& o, Transport* t) {
       std::error_code ec;
       fs::remove_all(partial, ec);
       plots_md = write_plots(partial, "plots/", study, cases);
-      fs::remove_all(dir / "plots", ec);
-      fs::rename(partial, dir / "plots");
+      output::replace_folder(partial, dir / "plots");  // never a moment without plots/
     }
     output::write_file_atomically(dir / "report.md", report_md(study, cases, o.command, plots_md));
     nlohmann::ordered_json timing;

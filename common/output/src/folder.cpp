@@ -251,6 +251,27 @@ void check_outside(const std::string& file, const std::string& file_option, cons
                                 ", which is replaced when the run ends (the file would be lost); put it next to the folder");
 }
 
+void replace_folder(const fs::path& fresh, const fs::path& target) {
+  sync_folder(fresh, target.string() + ": ");
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(target, ec))) {
+    if (::rename(fresh.c_str(), target.c_str()) != 0)
+      throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() + " into place: " + error_text(errno));
+  } else {
+    int err = 0;
+    if (exchange(fresh, target, err)) {
+      fs::remove_all(fresh, ec);  // now the old folder
+    } else if (err == EINVAL || err == ENOSYS || err == EOPNOTSUPP) {
+      fs::remove_all(target, ec);
+      if (::rename(fresh.c_str(), target.c_str()) != 0)
+        throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() + " into place: " + error_text(errno));
+    } else {
+      throw std::runtime_error(target.string() + ": cannot swap " + fresh.string() + " into place: " + error_text(err));
+    }
+  }
+  sync_parent(target);
+}
+
 bool remove_output(const fs::path& dir) noexcept {
   try {
     std::error_code ec;

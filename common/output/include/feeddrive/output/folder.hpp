@@ -125,6 +125,11 @@ class StagedFolder {
 /// Returns how many were removed. StagedFolder's constructor calls it.
 int remove_stale_staging(const std::filesystem::path& target) noexcept;
 
+/// Puts folder `fresh` in the place of `target` (a folder inside an output that this process
+/// owns, e.g. a study's plots/): flushed to disk, then renamed, or exchanged atomically with the
+/// old one (renameat2 RENAME_EXCHANGE), which is then removed. Throws std::runtime_error.
+void replace_folder(const std::filesystem::path& fresh, const std::filesystem::path& target);
+
 /// Removes `dir` with everything in it only if it is a feeddrive output or an empty folder;
 /// returns false (and removes nothing) otherwise or on failure.
 bool remove_output(const std::filesystem::path& dir) noexcept;
