@@ -2,6 +2,7 @@
 // *.png} (feeddrive-sim's format plus lockstep statistics). Wiring only: scenario -> MonitorNode.
 #include "feeddrive/monitor/monitor_node.hpp"
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -31,6 +32,8 @@ int main(int argc, char** argv) {
     output::check_output_dir(mopt.out_dir);  // before the run
     sim::check_run_size(s, mopt.out_dir);
     monitor::MonitorNode node(s, opt, mopt);
-    return node.run() ? 0 : 1;
+    const bool ok = node.run();
+    interrupt::check();  // a Ctrl-C while the plots were drawn: the data are written, the exit says interrupted
+    return ok ? 0 : node.record_too_big() ? 2 : 1;
   });
 }

@@ -79,6 +79,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     };
   }
   out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
+  out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
 
 void MonitorNode::publish_info() {
@@ -240,6 +241,9 @@ bool MonitorNode::run() {
     throw interrupt::Interrupted(e.signal());
   } catch (const std::runtime_error& e) {  // writing a row failed (disk full, ...)
     failure = e.what();
+  } catch (const std::invalid_argument& e) {  // the record cannot fit the disk (RunWriter, first rows)
+    failure = e.what();
+    too_big_ = true;
   }
   if (log_) {
     // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
@@ -399,7 +403,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
         spdlog::info("monitor: the run did not complete; the earlier output in {} is kept, this record is in {}",
                      output::shown(mopt_.out_dir), where);
     }
-    if (!out_->plot_error().empty()) spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
+    if (!out_->plot_error().empty() && !interrupt::interrupted())  // an interrupt is reported once, as such
+      spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
     written = false;
@@ -425,7 +430,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
 void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::vector<std::string>& names,
                                    const std::vector<Histogram>& h, bool plot) const {
   dir.write_text("latency_histogram.csv", histograms_csv(names, h));
-  if (!plot) return;
+  if (!plot || interrupt::interrupted()) return;  // interrupted while plotting: the data still go in place
   const double period_us = s_.control_period * 1e6;
   const std::string bin = std::to_string(h.front().bin_us());
   std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
@@ -441,12 +446,10 @@ void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::v
     gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us() / 2) +
           "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
   gp += "\n";
-  try {  // a view of the data: its failure loses nothing
+  try {  // a view of the data: its failure (or an interrupt: the flag stays set) loses nothing
     output::run_gnuplot(dir.dir(), gp, "latency_histogram.gp");
-  } catch (const interrupt::Interrupted&) {
-    throw;
   } catch (const std::runtime_error& e) {
-    spdlog::warn("monitor: latency histogram not drawn ({})", e.what());
+    if (!interrupt::interrupted()) spdlog::warn("monitor: latency histogram not drawn ({})", e.what());
   }
 }
 

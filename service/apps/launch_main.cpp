@@ -49,22 +49,22 @@ int main(int argc, char** argv) {
     };
     const ino_t before = marker_id();
     const service::LaunchResult r = service::launch(lo, opt);
-    std::ifstream in(lo.out_dir + "/summary.json");
-    if (in) {
-      const auto j = nlohmann::json::parse(in, nullptr, false);
-      if (!j.is_discarded() && j.contains("lockstep"))
-        spdlog::info("{} steps, max |e| {:.4g} m, resends {}, lost {}, state->command p50 {} us -> {}",
-                     j.value("steps", 0L), j.value("position_error_max_abs_m", 0.0),
-                     j["lockstep"].value("resends", 0L), j["lockstep"].value("lost", 0L),
-                     j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(), lo.out_dir);
-    }
     for (const auto& f : r.failed) spdlog::error("failed: {}", f);
+    // A failed run's record is where the monitor said (DIR, or DIR.incomplete-N beside an
+    // earlier output): DIR's summary may be the earlier run's, so it is not shown as this one's.
     if (r.exit_code != 0) return r.exit_code;
     // Every process exited 0: the monitor's new results must be there.
     if (!output::is_feeddrive_output(out) || marker_id() == before) {
       spdlog::error("--out {}: the monitor wrote no results", output::shown(lo.out_dir));
       return 1;
     }
+    std::ifstream in(lo.out_dir + "/summary.json");
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (!j.is_discarded() && j.contains("lockstep"))
+      spdlog::info("{} steps, max |e| {} m, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
+                   j["position_error_max_abs_m"].dump(), j["lockstep"].value("resends", 0L),
+                   j["lockstep"].value("lost", 0L), j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(),
+                   lo.out_dir);
     return 0;
   });
 }

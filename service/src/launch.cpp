@@ -50,7 +50,17 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   argv.push_back(const_cast<char*>(exe.c_str()));
   for (const auto& s : args) argv.push_back(const_cast<char*>(s.c_str()));
   argv.push_back(nullptr);
+  // SIGINT and SIGTERM stay blocked from before the fork until the new program has installed its
+  // handlers (interrupt::install_handlers unblocks them): a Ctrl-C that reaches the child between
+  // fork and exec stays pending instead of being lost with the launcher's handler at exec (the
+  // child then ran on to its 10 s start timeout).
+  sigset_t stop, old;
+  sigemptyset(&stop);
+  sigaddset(&stop, SIGINT);
+  sigaddset(&stop, SIGTERM);
+  ::pthread_sigmask(SIG_BLOCK, &stop, &old);
   const pid_t pid = ::fork();
+  if (pid != 0) ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     if (niceness != 0 && ::nice(niceness) == -1) std::fprintf(stderr, "warning: nice(%d) failed\n", niceness);
@@ -141,6 +151,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
 
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
+    if (interrupted_by() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
       spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}", role, opt.lcm_url, opt.prefix,
                    opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
@@ -166,6 +177,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   }
 
   LaunchResult result;
+  bool monitor_refused = false;  // the monitor exited 2: the run's record cannot fit (bad input)
   int forwarded = 0;
   std::int64_t first_failure_us = -1;
   bool terminated = false;
@@ -177,6 +189,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       running.erase(pid);
       const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       if (code != 0) {
+        if (role == "monitor" && code == 2) monitor_refused = true;
         result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
         if (first_failure_us < 0) first_failure_us = mono_us();
       }
@@ -200,7 +213,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   }
   // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
   interrupt::check();
-  result.exit_code = result.failed.empty() ? 0 : 1;
+  result.exit_code = result.failed.empty() ? 0 : monitor_refused ? 2 : 1;
   return result;
 }
 

@@ -18,6 +18,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A size for a message: 290.49 GB, 2.1 MB, 512 kB (two decimals at most).
+std::string size_text(double bytes) {
+  const auto in = [&](double unit, const char* name) {
+    return validate::format_number(std::round(bytes / unit * 100.0) / 100.0) + " " + name;
+  };
+  return bytes >= 1e9 ? in(1e9, "GB") : bytes >= 1e6 ? in(1e6, "MB") : in(1e3, "kB");
+}
+
 // The curves of the plots, computed from a record before the reduction (so the reduction keeps
 // the extremes of exactly what is drawn).
 enum Curve { kXd, kX, kE, kEv, kU, kFriction, kRipple, kGrinding, kCurves };
@@ -67,10 +75,9 @@ void check_run_size(const Scenario& s, const std::string& out_dir, double max_st
   if (::statvfs(up.c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
   const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
   if (least > free_bytes) {
-    const auto gb = [](double b) { return validate::format_number(std::round(b / 1e7) / 100.0) + " GB"; };
     throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv needs at least " +
-                                gb(least) + " (" + validate::format_number(rows) + " rows x " +
-                                validate::format_number(cols) + " columns x 2 bytes), only " + gb(free_bytes) +
+                                size_text(least) + " (" + validate::format_number(rows) + " rows x " +
+                                validate::format_number(cols) + " columns x 2 bytes), only " + size_text(free_bytes) +
                                 " free in " + up.string() + "; record fewer rows (output.every) or columns (output.columns)");
   }
 }
@@ -188,11 +195,10 @@ void RunWriter::check_projected_size() const {
   if (::statvfs(folder_.dir().c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
   const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
   if (to_come > free_bytes) {
-    const auto gb = [](double b) { return validate::format_number(std::round(b / 1e7) / 100.0) + " GB"; };
     throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv would take about " +
-                                gb(to_come + static_cast<double>(csv_->bytes())) + " (" + validate::format_number(rows_total) +
+                                size_text(to_come + static_cast<double>(csv_->bytes())) + " (" + validate::format_number(rows_total) +
                                 " rows of " + validate::format_number(std::round(per_row)) + " bytes, measured on the first " +
-                                std::to_string(kProjectAfterRows) + "), only " + gb(free_bytes) + " free in " +
+                                std::to_string(kProjectAfterRows) + "), only " + size_text(free_bytes) + " free in " +
                                 folder_.target().parent_path().string() +
                                 "; record fewer rows (output.every) or columns (output.columns)");
   }
@@ -221,8 +227,10 @@ std::filesystem::path RunWriter::finish(const Summary& sum, bool plots, const st
     const auto t0 = std::chrono::steady_clock::now();
     try {
       write_plots(folder_, plot_, s_.name);
-    } catch (const interrupt::Interrupted&) {
-      throw;
+    } catch (const interrupt::Interrupted& e) {
+      // The interrupt flag stays set: the caller ends as interrupted once the data are in place.
+      if (!keep_on_interrupt_) throw;
+      plot_error_ = e.what();
     } catch (const std::runtime_error& e) {
       plot_error_ = e.what();
     }

@@ -27,18 +27,34 @@ void SummaryBuilder::add(const Record& q) {
     m.control_min = m.control_max = q.u;
     m.max_position_m = m.min_position_m = q.x;
   }
-  abs_e_.add(std::abs(e));
-  m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
-  m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
-  if (n_ > 0) m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
-  se_ += static_cast<long double>(e) * e;
-  sev_ += static_cast<long double>(ev) * ev;
-  if (q.t >= settled_after_) {
-    m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
-    m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
-    se_settled_ += static_cast<long double>(e) * e;
-    ++n_settled_;
+  // The error metrics are over the steps that have a true state (a record from hardware has
+  // none: truth.valid = 0 gives NaN): a metric over no such step has no value (null), never 0.
+  const bool settled = q.t >= settled_after_;
+  if (std::isfinite(e)) {
+    abs_e_.add(std::abs(e));
+    m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
+    se_ += static_cast<long double>(e) * e;
+    ++n_e_;
+    if (settled) {
+      m.position_error_max_abs_settled_m = std::max(m.position_error_max_abs_settled_m, std::abs(e));
+      se_settled_ += static_cast<long double>(e) * e;
+      ++n_e_settled_;
+    }
   }
+  if (std::isfinite(ev)) {
+    m.velocity_error_max_abs_mps = std::max(m.velocity_error_max_abs_mps, std::abs(ev));
+    if (n_ > 0) {
+      m.velocity_error_max_abs_after_first_mps = std::max(m.velocity_error_max_abs_after_first_mps, std::abs(ev));
+      ++n_ev_after_first_;
+    }
+    sev_ += static_cast<long double>(ev) * ev;
+    ++n_ev_;
+    if (settled) {
+      m.velocity_error_max_abs_settled_mps = std::max(m.velocity_error_max_abs_settled_mps, std::abs(ev));
+      ++n_ev_settled_;
+    }
+  }
+  if (settled) ++n_settled_;
   m.control_min = std::min(m.control_min, q.u);
   m.control_max = std::max(m.control_max, q.u);
   if (n_ > 0) total_variation_ += std::abs(static_cast<long double>(q.u) - last_.u);
@@ -60,17 +76,23 @@ Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator
   m.integrator_jac_evals = integrator.jac_evals;
   m.integrator_error_test_fails = integrator.error_test_fails;
   if (n_ == 0) return m;
-  const long double n = static_cast<long double>(n_);
-  m.position_error_rms_m = static_cast<double>(std::sqrt(se_ / n));
-  m.velocity_error_rms_mps = static_cast<double>(std::sqrt(sev_ / n));
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();  // written as null
+  m.position_error_rms_m = n_e_ > 0 ? static_cast<double>(std::sqrt(se_ / static_cast<long double>(n_e_))) : kNone;
+  m.velocity_error_rms_mps = n_ev_ > 0 ? static_cast<double>(std::sqrt(sev_ / static_cast<long double>(n_ev_))) : kNone;
   m.control_total_variation = saturated(total_variation_);
   if (n_settled_ > 0)
-    m.position_error_rms_settled_m = static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_settled_)));
-  // rank floor(0.95 n) of the n values |e| (the NaN of a run without truth are not ranked)
+    m.position_error_rms_settled_m =
+        n_e_settled_ > 0 ? static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_e_settled_))) : kNone;
+  // rank floor(0.95 n) of the n finite values |e|
   if (abs_e_.count() > 0) {
     const auto k = std::min<std::uint64_t>(abs_e_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_e_.count())));
     m.position_error_p95_abs_m = abs_e_.value_at_rank(k);
   }
+  if (n_e_ == 0) m.position_error_max_abs_m = m.position_error_p95_abs_m = kNone;
+  if (n_e_settled_ == 0) m.position_error_max_abs_settled_m = kNone;
+  if (n_ev_ == 0) m.velocity_error_max_abs_mps = kNone;
+  if (n_ev_after_first_ == 0) m.velocity_error_max_abs_after_first_mps = kNone;
+  if (n_ev_settled_ == 0) m.velocity_error_max_abs_settled_mps = kNone;
   m.final_position_m = last_.x;
   m.final_velocity_mps = last_.v;
   m.final_bristle_m = last_.z;

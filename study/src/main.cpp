@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   feeddrive::study::Options o;
   bool no_plots = false;
   app.add_option("study", o.study, "study YAML file (docs/study.md)")->required();
-  app.add_option("--out,-o", o.out, "output folder; a rerun into it skips the finished cases")->required();
+  app.add_option("--out,-o", o.out, "output folder; a rerun into it skips the finished cases (not needed with --list)");
   app.add_option("-j,--jobs", o.jobs, "worker threads (default: every core; per MPI rank: the host's cores / its ranks)")
       ->check(CLI::Range(1, 4096));
   app.add_flag("--no-plots", no_plots, "skip the plots");
@@ -41,6 +41,10 @@ int main(int argc, char** argv) {
     // Every rank parses the same arguments: only rank 0 (or the process alone) speaks.
     const int rc = (!transport || transport->rank() == 0) ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
     return rc == 0 ? 0 : 2;
+  }
+  if (o.out.empty() && !o.list) {
+    if (!transport || transport->rank() == 0) std::fprintf(stderr, "error: --out is required (except with --list)\n");
+    return 2;
   }
   o.plots = !no_plots;
   // Ctrl-C / SIGTERM: the running cases stop, the finished ones stay in DIR/cases.

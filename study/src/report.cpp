@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "feeddrive/output/csv.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 
 namespace feeddrive::study {
@@ -59,7 +60,8 @@ double median(std::vector<double> v) {
 
 struct Cell {
   std::vector<double> values;
-  long failed{0};
+  long failed{0};    ///< cases that failed (ok = false)
+  long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than settled_after)
   long total{0};
 };
 
@@ -70,8 +72,10 @@ std::vector<std::vector<Cell>> table(const Study& s, const std::vector<CaseRecor
     Cell& x = t[c.spec.family][c.spec.controller];
     ++x.total;
     const double v = shown_metric(s, c);
-    if (std::isnan(v)) {
+    if (!c.outcome.ok) {
       ++x.failed;
+    } else if (std::isnan(v)) {
+      ++x.no_value;
     } else {
       x.values.push_back(v);
     }
@@ -85,11 +89,6 @@ bool parse_number(const std::string& text, double& out) {
   return !text.empty() && end == text.c_str() + text.size() && std::isfinite(out);
 }
 
-void write_text(const fs::path& p, const std::string& text) {
-  std::ofstream f(p, std::ios::binary);
-  f << text;
-  if (!f) throw std::runtime_error(p.string() + ": write failed");
-}
 
 }  // namespace
 
@@ -165,7 +164,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
         }
       if (n == 0) continue;
       const std::string file = "box_" + std::to_string(f) + "_" + std::to_string(c) + ".dat";
-      write_text(dir / file, data.str());
+      output::write_file_atomically(dir / file, data.str());
       const double x = static_cast<double>(f + 1) + (static_cast<double>(c) - 0.5 * static_cast<double>(nc - 1)) * width;
       items.push_back("'" + file + "' using (" + output::number_text(x) + "):1:(" + output::number_text(0.9 * width) +
                       ") with boxplot linecolor " + std::to_string(c + 1) + " notitle");
@@ -203,7 +202,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
       }
       if (n == 0) continue;
       const std::string file = "param_" + std::to_string(p) + "_" + std::to_string(c) + ".dat";
-      write_text(dir / file, data.str());
+      output::write_file_atomically(dir / file, data.str());
       series.push_back("'" + file + "' using 1:2 with points pointtype 7 pointsize 0.8 linecolor " + std::to_string(c + 1) +
                        " title " + output::gnuplot_string(s.controllers[c].name, 60));
     }
@@ -285,6 +284,7 @@ std::string report_md(const Study& s, const std::vector<CaseRecord>& cases, cons
         const bool over = !std::isnan(s.report.limit) && (v > s.report.limit || x.failed > 0);
         md << " " << (over ? "**" : "") << num(v) << (over ? "**" : "");
         if (x.failed) md << " (" << x.failed << " failed)";
+        if (x.no_value) md << " (" << x.no_value << " without a value)";
         md << " |";
       }
       md << "\n";

@@ -228,8 +228,17 @@ int run_study(const Options& o, Transport* t) {
       const fs::path partial = dir / ".plots.partial";
       std::error_code ec;
       fs::remove_all(partial, ec);
-      plots_md = write_plots(partial, "plots/", study, cases);
-      output::replace_folder(partial, dir / "plots");  // never a moment without plots/
+      try {
+        plots_md = write_plots(partial, "plots/", study, cases);
+        output::replace_folder(partial, dir / "plots");  // never a moment without plots/
+      } catch (const interrupt::Interrupted&) {
+        fs::remove_all(partial, ec);
+        throw;
+      } catch (const std::runtime_error& e) {  // a view of the results: results.csv and report.md still go
+        fs::remove_all(partial, ec);
+        std::fprintf(stderr, "warning: plots not drawn (%s); the results are in %s\n", e.what(), dir.c_str());
+        plots_md = "Plots not drawn: " + std::string(e.what()) + "\n\n";
+      }
     }
     output::write_file_atomically(dir / "report.md", report_md(study, cases, o.command, plots_md));
     nlohmann::ordered_json timing;

@@ -81,3 +81,23 @@ interrupt launch_run2 $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
 [ "$(json launch_run2.incomplete-1/summary.json .lockstep.completed)" = false ] ||
   fail "launch_run2: the interrupted record is not in launch_run2.incomplete-1"
 pass "launch_run2: the earlier output kept, the interrupted record ($(json launch_run2.incomplete-1/summary.json .steps) steps) beside it"
+
+# Ctrl-C while the launcher starts its processes (50 ms in): a signal that reached a child
+# between fork and exec was lost, and the child ran on to its 10 s start timeout.
+feeddrive-launch "$scen" --out launch_early --lcm-url "$URL" --no-plots -q 2> launch_early.err &
+p=$!
+interrupt launch_early $p "sleep 0.05; true"
+[ -z "$(pgrep -P $p)" ] || fail "launch_early: a child process still runs"
+
+# Ctrl-C while the monitor draws the plots of a complete run: what it recorded cannot be made
+# again, so the data go in place without the plots (it once threw the whole record away).
+mkdir -p slowplot
+printf '#!/bin/sh\nexec sleep 30\n' > slowplot/gnuplot
+chmod +x slowplot/gnuplot
+PATH="$TMP/slowplot:$PATH" feeddrive-launch "$scen" --out launch_plot --lcm-url "$URL" -q 2> launch_plot.err &
+p=$!
+interrupt launch_plot $p "pgrep -f slowplot/gnuplot > /dev/null"
+[ "$(json launch_plot/summary.json .lockstep.completed)" = true ] || fail "launch_plot: the complete record was not kept"
+[ "$(($(wc -l < launch_plot/timeseries.csv) - 1))" = "$(json launch_plot/summary.json .steps)" ] ||
+  fail "launch_plot: timeseries.csv does not hold every step"
+pass "launch_plot: interrupted while plotting, the complete record ($(json launch_plot/summary.json .steps) steps) kept"

@@ -85,3 +85,45 @@ TEST(Summary, ACascadeReportsTheGainsItRunsWith) {
 
 }  // namespace
 }  // namespace feeddrive::sim
+
+namespace feeddrive::sim {
+namespace {
+
+TEST(Summary, ARecordWithoutTrueStateHasNoErrorMetricsNotZero) {
+  // Hardware reports no true state (truth.valid = 0: x, v NaN). Its error metrics once read 0
+  // (max of nothing), i.e. perfect tracking, and a study would rank such a run best.
+  Scenario s;
+  s.control_period = 1e-4;
+  s.analysis.settled_after = 0.0;
+  SummaryBuilder b(s);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (long k = 0; k < 10; ++k) {
+    Record r;
+    r.t = k * 1e-4;
+    r.xd = 1e-3;
+    r.x = r.v = nan;
+    b.add(r);
+  }
+  const auto j = nlohmann::json::parse(summary_json(b.summary(0.0, {}), s));
+  for (const char* key : {"position_error_max_abs_m", "position_error_rms_m", "position_error_p95_abs_m",
+                          "velocity_error_max_abs_mps", "velocity_error_max_abs_after_first_mps", "velocity_error_rms_mps",
+                          "position_error_max_abs_settled_m", "position_error_rms_settled_m",
+                          "velocity_error_max_abs_settled_mps"})
+    EXPECT_TRUE(j[key].is_null()) << key << " = " << j[key];
+  EXPECT_EQ(j["steps"], 10);
+  // Truth on some steps only: the metrics are over those (here e = 1e-3 - 0 on two steps).
+  SummaryBuilder c(s);
+  for (long k = 0; k < 10; ++k) {
+    Record r;
+    r.t = k * 1e-4;
+    r.xd = 1e-3;
+    r.x = (k == 3 || k == 7) ? 0.0 : nan;
+    c.add(r);
+  }
+  const Summary m = c.summary(0.0, {});
+  EXPECT_DOUBLE_EQ(m.position_error_max_abs_m, 1e-3);
+  EXPECT_NEAR(m.position_error_rms_m, 1e-3, 1e-18);  // rms of two equal errors
+}
+
+}  // namespace
+}  // namespace feeddrive::sim

@@ -152,4 +152,31 @@ TEST(StudyCli, ReplacesTheOutputOfAnotherFeeddriveTool) {
   EXPECT_NE(slurp(dir / ".feeddrive-output").find("tool: feeddrive-study"), std::string::npos);
 }
 
+TEST(StudyCli, WithoutGnuplotTheResultsAndReportAreStillWritten) {
+  // Plots are a view: a missing gnuplot once cost the report (exit 1, a stray .plots.partial).
+  const fs::path dir = scratch() / "no_gnuplot";
+  const fs::path f = write_file("nogp.yaml", feeddrive::study::test::study_text(""));
+  const int status = std::system(("PATH=/nonexistent " + kStudy + " -q " + f.string() + " --out " + dir.string() +
+                                  " -j 1 2> " + (scratch() / "nogp.err").string() + " > /dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << slurp(scratch() / "nogp.err");
+  EXPECT_NE(slurp(scratch() / "nogp.err").find("warning: plots not drawn"), std::string::npos) << slurp(scratch() / "nogp.err");
+  EXPECT_TRUE(fs::exists(dir / "results.csv"));
+  EXPECT_NE(slurp(dir / "report.md").find("Plots not drawn"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / ".plots.partial"));
+}
+
+TEST(StudyCli, ACaseWithoutAValueOfTheMetricIsNotCountedAsFailed) {
+  // A settled metric of a run shorter than settled_after (0.02 s < 0.25 s) has no value: the
+  // report once counted such cases as failed while results.csv said ok.
+  const fs::path dir = scratch() / "no_value";
+  const fs::path f = write_file("novalue.yaml", feeddrive::study::test::study_text(
+                                                    "report: {metric: position_error_max_abs_settled_m}\n"));
+  const ProcResult r = study("-q --no-plots " + f.string() + " --out " + dir.string() + " -j 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string md = slurp(dir / "report.md");
+  EXPECT_EQ(md.find("failed)"), std::string::npos) << md;
+  EXPECT_NE(md.find("(1 without a value)"), std::string::npos) << md;
+}
+
 }  // namespace

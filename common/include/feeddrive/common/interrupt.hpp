@@ -33,6 +33,13 @@ inline void install_handlers() {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   signal(SIGXFSZ, SIG_IGN);
+  // feeddrive-launch starts its processes with the two blocked (so a Ctrl-C during their start
+  // is kept pending, not lost): from here on the handlers take them.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
 }
 
 /// The signal that interrupted the process, or 0.

@@ -51,6 +51,8 @@ class MonitorNode : public service::Node {
   /// Returns true if the run completed and its results were written; tries to write the
   /// results in every case.
   bool run();
+  /// The run was stopped because its record cannot fit the disk (bad input: the tool exits 2).
+  bool record_too_big() const { return too_big_; }
   const run_summary_t& summary() const { return summary_; }
 
  private:
@@ -72,6 +74,7 @@ class MonitorNode : public service::Node {
 
   sim::Scenario s_;
   MonitorOptions mopt_;
+  bool too_big_{false};
   Recorder rec_;
   std::unique_ptr<sim::RunWriter> out_;
   std::string open_error_;  // why out_ could not be opened

@@ -64,6 +64,10 @@ class RunWriter {
   /// (expected_steps() rows, default the scenario's) cannot fit the free disk.
   void add(const Record& r);
   static constexpr std::uint64_t kProjectAfterRows = 1000;
+  /// A record that cannot be made again (the monitor's): a Ctrl-C while the plots are drawn
+  /// skips them and the data are still put in place (plot_error() says so; the interrupt flag
+  /// stays set for the caller). Otherwise (feeddrive-sim) the interrupt ends finish() unwritten.
+  void keep_data_on_interrupt(bool keep) { keep_on_interrupt_ = keep; }
   /// How many steps the record will have (a log's own bound where it is shorter than the scenario).
   void set_expected_steps(double steps) { expected_steps_ = steps; }
   long steps() const { return added_; }
@@ -95,6 +99,7 @@ class RunWriter {
   std::vector<std::size_t> columns_;  // indices into record_columns()
   long every_;
   double expected_steps_;
+  bool keep_on_interrupt_{false};
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
   double plot_seconds_{0.0};

@@ -63,6 +63,8 @@ class SummaryBuilder {
   double settled_after_, control_period_;
   Summary m_;
   long n_{0}, n_settled_{0};
+  // steps with a finite position / velocity error (all, settled, after the first)
+  long n_e_{0}, n_e_settled_{0}, n_ev_{0}, n_ev_settled_{0}, n_ev_after_first_{0};
   // Sums of squares and the control's total variation in long double (x86-64: 64-bit mantissa,
   // exponent to 1e4932): no finite record can overflow them, so a run that recorded a finite but
   // absurd value (a corrupt logged state at 1e220 m) still gets finite metrics, never inf/null.
