@@ -92,11 +92,11 @@ interrupt launch_early $p "sleep 0.05; true"
 # Ctrl-C while the monitor draws the plots of a complete run: what it recorded cannot be made
 # again, so the data go in place without the plots (it once threw the whole record away).
 mkdir -p slowplot
-printf '#!/bin/sh\nexec sleep 30\n' > slowplot/gnuplot
+printf '#!/bin/sh\ntouch "%s/slowplot/started"\nexec sleep 30\n' "$TMP" > slowplot/gnuplot
 chmod +x slowplot/gnuplot
 PATH="$TMP/slowplot:$PATH" feeddrive-launch "$scen" --out launch_plot --lcm-url "$URL" -q 2> launch_plot.err &
 p=$!
-interrupt launch_plot $p "pgrep -f slowplot/gnuplot > /dev/null"
+interrupt launch_plot $p "[ -e slowplot/started ]"
 [ "$(json launch_plot/summary.json .lockstep.completed)" = true ] || fail "launch_plot: the complete record was not kept"
 [ "$(($(wc -l < launch_plot/timeseries.csv) - 1))" = "$(json launch_plot/summary.json .steps)" ] ||
   fail "launch_plot: timeseries.csv does not hold every step"
