@@ -220,11 +220,13 @@ bool MonitorNode::run() {
         bool someone_waits = false;
         for (const Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
         if (someone_waits && now - last_row_us_ <= 3 * us(limit)) continue;
-        std::string who;
-        for (const Missing& m : missing)
-          if (!peer_alive(m.role, 0.5)) who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
-        if (who.empty())
-          for (const Missing& m : missing) who += (who.empty() ? "" : ", ") + m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+        std::string silent, all;
+        for (const Missing& m : missing) {
+          const std::string what = m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+          all += (all.empty() ? "" : ", ") + what;
+          if (!peer_alive(m.role, 0.5)) silent += (silent.empty() ? "" : ", ") + what;
+        }
+        const std::string& who = silent.empty() ? all : silent;
         throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " + service::seconds_text(limit) +
                                   " s: no " + who);
       }

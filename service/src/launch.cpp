@@ -177,7 +177,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   }
 
   LaunchResult result;
-  bool monitor_refused = false;  // the monitor exited 2: the run's record cannot fit (bad input)
+  bool refused = false;  // a process exited 2 (bad input, e.g. a record that cannot fit the disk)
   int forwarded = 0;
   std::int64_t first_failure_us = -1;
   bool terminated = false;
@@ -189,7 +189,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       running.erase(pid);
       const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       if (code != 0) {
-        if (role == "monitor" && code == 2) monitor_refused = true;
+        if (code == 2) refused = true;
         result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
         if (first_failure_us < 0) first_failure_us = mono_us();
       }
@@ -213,7 +213,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   }
   // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
   interrupt::check();
-  result.exit_code = result.failed.empty() ? 0 : monitor_refused ? 2 : 1;
+  result.exit_code = result.failed.empty() ? 0 : refused ? 2 : 1;
   return result;
 }
 

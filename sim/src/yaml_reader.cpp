@@ -312,16 +312,7 @@ void MapReader::finish() const {
   for (const auto& kv : node_) {
     const std::string key = kv.first.Scalar();
     if (read_.count(key)) continue;
-    std::string hint;
-    std::size_t best = 3;  // suggest only close matches (<= 2 edits)
-    for (const auto& known : read_) {
-      const std::size_t d = edit_distance(key, known);
-      if (d < best) {
-        best = d;
-        hint = " (did you mean '" + known + "'?)";
-      }
-    }
-    throw ScenarioError(key_path(key) + ": unknown key" + hint);
+    throw ScenarioError(key_path(key) + ": unknown key" + did_you_mean(key, read_));
   }
 }
 

@@ -310,15 +310,7 @@ void Study::validate() const {
   if (report.metric.empty()) fail("report.metric", ": must not be empty");
   const std::vector<std::string> metrics = sim::summary_metric_names();
   if (std::find(metrics.begin(), metrics.end(), report.metric) == metrics.end()) {
-    std::string hint;
-    std::size_t best = 4;  // suggest only close matches (<= 3 edits)
-    for (const std::string& m : metrics) {
-      const std::size_t d = sim::edit_distance(report.metric, m);
-      if (d < best) {
-        best = d;
-        hint = " (did you mean '" + m + "'?)";
-      }
-    }
+    std::string hint = sim::did_you_mean(report.metric, metrics);
     if (hint.empty())
       for (const std::string& m : metrics) hint += (hint.empty() ? "; one of " : ", ") + m;
     fail("report.metric", " = '" + report.metric + "': not a metric of summary.json" + hint);

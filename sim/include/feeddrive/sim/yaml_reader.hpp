@@ -76,4 +76,20 @@ class MapReader {
 /// Levenshtein distance, for "did you mean" hints.
 std::size_t edit_distance(const std::string& a, const std::string& b);
 
+/// " (did you mean 'X'?)" for the candidate X closest to `word` within two edits (the first of
+/// equally close ones), "" if none is that close.
+template <typename Names>
+std::string did_you_mean(const std::string& word, const Names& candidates) {
+  std::string hint;
+  std::size_t best = 3;
+  for (const std::string& known : candidates) {
+    const std::size_t d = edit_distance(word, known);
+    if (d < best) {
+      best = d;
+      hint = " (did you mean '" + known + "'?)";
+    }
+  }
+  return hint;
+}
+
 }  // namespace feeddrive::sim
