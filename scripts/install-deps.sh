@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # Installs every build, test and run dependency of feeddrive on Debian 12 (bookworm).
 # Idempotent: apt-get skips what is already installed. Uses sudo when not root.
-# Optional, not installed here: a JDK (default-jdk-headless). With one, the build also writes the
-# jar of the message types that lcm-spy needs (docs/lcm-contract.md); without, that jar and its
-# test (tests/service/lcm_spy_jar_test.sh) are skipped with a message.
+# The JDK (default-jdk-headless) builds the jar of the message types that lcm-spy needs
+# (docs/lcm-contract.md), tested by tests/service/lcm_spy_jar_test.sh; a build without one skips
+# that jar and its test with a message.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PACKAGES=(
   build-essential cmake pkg-config git
-  liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java libglib2.0-dev default-jdk-headless
   libeigen3-dev libsundials-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libbenchmark-dev libceres-dev libssl-dev
@@ -17,7 +17,6 @@ PACKAGES=(
   gnuplot-nox jq python3 python3-yaml
   iproute2 nftables util-linux procps
   lua5.2 liblcm-lua lua-luaossl
-  libssl-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
