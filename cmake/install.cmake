@@ -24,6 +24,7 @@ install(DIRECTORY
   ${PROJECT_SOURCE_DIR}/controller/include/feeddrive
   ${PROJECT_SOURCE_DIR}/trajectory/include/feeddrive
   ${PROJECT_BINARY_DIR}/lcmtypes/include/feeddrive
+  ${PROJECT_SOURCE_DIR}/lcmtypes/include/feeddrive
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/lcmtypes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/feeddrive/lcmtypes
   FILES_MATCHING PATTERN "*.lcm")

@@ -11,6 +11,7 @@
 #include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
+#include "feeddrive/wire.hpp"
 
 namespace feeddrive::monitor {
 namespace {
@@ -106,13 +107,7 @@ class LogParser {
 template <typename Msg, typename F>
 void decode_into(const Event& ev, LogConversion& out, F&& f) {
   Msg m;
-  bool ok = false;
-  try {
-    ok = m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) >= 0;
-  } catch (const std::exception&) {  // a corrupt array length: lcm-gen's decode allocates it first
-    ok = false;
-  }
-  if (!ok) {
+  if (!wire::decode_untrusted(ev.data.data(), ev.data.size(), m)) {  // bounds first, never throws
     ++out.undecodable;
     return;
   }

@@ -1,3 +1,4 @@
+#include "feeddrive/wire.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
 
 #include <spdlog/spdlog.h>
@@ -290,9 +291,9 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     }
   }
   const auto lat = [](const stats::StreamingQuantile& v, double q) { return v.quantile(q); };
-  summary_.scenario = s_.name;
+  summary_.scenario = wire::fit(s_.name, wire::Check<run_summary_t>::kMax_scenario);
   summary_.completed = completed;
-  summary_.failure = failure;
+  summary_.failure = wire::fit(failure, wire::Check<run_summary_t>::kMax_failure);
   summary_.steps = static_cast<std::int64_t>(sum.steps);
   summary_.stopped_at_seq = rec_.next();
   summary_.sim_time_s = sum.sim_time_s;
@@ -413,7 +414,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     completed = false;
     if (why.empty()) why = std::string("results not written: ") + e.what();
     summary_.completed = false;
-    summary_.failure = why;
+    summary_.failure = wire::fit(why, wire::Check<run_summary_t>::kMax_failure);
   }
   bus().publish(channels().summary, summary_);
   if (completed) {

@@ -58,6 +58,28 @@ void Bus::count_foreign(const std::string& channel, std::int64_t run_id) {
                  static_cast<long long>(run_id_), channel.c_str(), static_cast<long long>(foreign_));
 }
 
+bool Bus::publish_raw(const std::string& channel, const std::uint8_t* data, std::size_t size) {
+  if (lcm_.publish(channel, data, static_cast<unsigned int>(size)) != 0) {
+    ++send_errors_;
+    return false;
+  }
+  return true;
+}
+
+void Bus::count_invalid(const std::string& channel, const std::string& why) {
+  ++invalid_;
+  ++invalid_by_channel_[channel];
+  if (log_due(last_invalid_log_us_))
+    std::fprintf(stderr, "feeddrive: dropped an invalid message on %s: %s (%lld so far)\n", channel.c_str(),
+                 why.c_str(), static_cast<long long>(invalid_));
+}
+
+std::map<std::string, std::int64_t> Bus::invalid_by_channel() const {
+  std::map<std::string, std::int64_t> m = invalid_by_channel_;
+  if (reader_ && reader_->malformed() > 0) m[""] += reader_->malformed();
+  return m;
+}
+
 void Bus::subscribe_raw(const std::string& channel,
                         std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f) {
   raws_.push_back(std::make_unique<Raw>(Raw{std::move(f)}));

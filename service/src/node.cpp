@@ -1,3 +1,4 @@
+#include "feeddrive/wire.hpp"
 #include "feeddrive/service/node.hpp"
 
 #include <sched.h>
@@ -82,7 +83,7 @@ process_status_t Node::status_message(const std::string& state, const std::strin
   m.state = state;
   m.seq = seq_;
   m.acked_seq = acked_seq;
-  m.message = message;
+  m.message = wire::fit(message, wire::Check<process_status_t>::kMax_message);
   m.resends = resends;
   m.duplicates = duplicates;
   m.invalid = bus_.invalid() + invalid_content;
@@ -113,7 +114,7 @@ void Node::announce_failure(const std::string& message) {
 void Node::request_resend(const std::string& channel, std::int64_t seq) {
   resend_request_t m{};
   m.requester = role_;
-  m.channel = channel;
+  m.channel = wire::fit(channel, wire::Check<resend_request_t>::kMax_channel);
   m.seq = seq;
   bus_.publish(ch_.resend, m);
 }

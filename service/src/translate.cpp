@@ -1,3 +1,4 @@
+#include "feeddrive/wire.hpp"
 #include "feeddrive/service/translate.hpp"
 
 #include <limits>
@@ -87,7 +88,7 @@ run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_i
   run_info_t m;
   m.run_id = run_id;
   m.utime = 0;
-  m.scenario = s.name;
+  m.scenario = wire::fit(s.name, wire::Check<run_info_t>::kMax_scenario);
   m.mode = realtime ? "realtime" : "lockstep";
   m.control_period = s.control_period;
   m.steps = s.steps();

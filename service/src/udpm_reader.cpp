@@ -19,7 +19,11 @@ constexpr std::size_t kShortHeader = 8;
 constexpr std::size_t kLongHeader = 20;
 constexpr std::size_t kMaxDatagram = 65536;
 constexpr std::size_t kBatch = 16;                       // datagrams per recvmmsg call
-constexpr std::size_t kMaxPayload = 256u * 1024u * 1024u;  // refuse absurd fragment sizes
+// Fragmented messages: feeddrive's own are all below 2 kB (wire_check.hpp's kMaxEncoded) and never
+// fragmented, so a fragmented one is another application's or forged. At most kMaxPartial of at
+// most kMaxPayload bytes are kept while their fragments come: 8 MB per process, whatever is sent.
+constexpr std::size_t kMaxPayload = 1024u * 1024u;
+constexpr std::size_t kMaxPartial = 8;
 
 std::uint32_t be32(const std::uint8_t* p) {
   return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
@@ -117,6 +121,10 @@ bool Reassembler::feed(const std::uint8_t* d, std::size_t n, std::uint64_t sende
     // never come (LCM does not resend).
     for (auto old = partial_.begin(); old != partial_.end();)
       old = old->first.first == sender ? partial_.erase(old) : std::next(old);
+    if (partial_.size() >= kMaxPartial) {  // many senders at once: the bound wins over completeness
+      partial_.erase(partial_.begin());
+      ++malformed_;
+    }
     Partial p;
     p.data.resize(size);
     p.have.assign(count, false);

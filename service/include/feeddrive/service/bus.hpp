@@ -29,6 +29,7 @@
 
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/udpm_reader.hpp"
+#include "feeddrive/wire.hpp"
 
 namespace feeddrive::service {
 
@@ -84,6 +85,10 @@ class Bus {
   template <typename Msg>
   bool publish(const std::string& channel, const Msg& msg);
 
+  /// Publishes bytes as they are (no stamp, no mac): a recorded message replayed, or a test's
+  /// malformed datagram. Returns false (and counts) when LCM reports a send error.
+  bool publish_raw(const std::string& channel, const std::uint8_t* data, std::size_t size);
+
   /// The run this bus belongs to. Until it is set, Admit::kRun subscriptions get nothing.
   void set_run_id(std::int64_t id) {
     run_id_ = id;
@@ -113,9 +118,13 @@ class Bus {
   /// it is dispatched, whatever its channel: a recorder's tap (the monitor's --lcm-log).
   void set_tap(MessageSink tap) { tap_ = std::move(tap); }
 
-  /// Messages that did not decode as their channel's type, and (kBatched) datagrams that are
-  /// not LCM's framing.
+  /// Messages that did not decode as their channel's type or broke the contract's bounds, and
+  /// datagrams that are not LCM's framing (kDirect, kBatched).
   std::int64_t invalid() const { return invalid_ + (reader_ ? reader_->malformed() : 0); }
+  /// invalid() by channel; datagrams without LCM's framing (no channel) under "" .
+  std::map<std::string, std::int64_t> invalid_by_channel() const;
+  /// Counts (and logs, at most once a second) a message of `channel` that did not decode.
+  void count_invalid(const std::string& channel, const std::string& why);
   std::int64_t send_errors() const { return send_errors_; }
   /// Messages of another run (Admit::kRun subscriptions, and count_foreign()).
   std::int64_t foreign() const { return foreign_; }
@@ -144,6 +153,7 @@ class Bus {
   MessageSink tap_;
   std::unordered_map<std::string, std::vector<Raw*>> batched_subs_;
   std::int64_t invalid_{0};
+  std::map<std::string, std::int64_t> invalid_by_channel_;
   std::int64_t send_errors_{0};
   std::int64_t last_invalid_log_us_{-1};
   std::int64_t foreign_{0};
@@ -222,13 +232,13 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
                      "publisher without the key)\n", ch.c_str(), static_cast<long long>(unauthenticated_));
       return;
     }
+    // Every received byte is untrusted: decode_untrusted walks the encoding against the
+    // contract's bounds before anything is allocated and never throws (lcmtypes/.../wire.hpp).
     Msg msg;
     const std::int64_t now = mono_us();
-    if (msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) {
-      ++invalid_;
-      if (log_due(last_invalid_log_us_))
-        std::fprintf(stderr, "feeddrive: ignored a message on %s that is not a %s (%u bytes)\n",
-                     ch.c_str(), Msg::getTypeName(), rbuf->data_size);
+    std::string why;
+    if (!wire::decode_untrusted(rbuf->data, rbuf->data_size, msg, &why)) {
+      count_invalid(ch, why);
       return;
     }
     if (admit == Admit::kRun) {
