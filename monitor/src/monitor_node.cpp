@@ -85,6 +85,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
 
 void MonitorNode::publish_info() {
   info_.utime = service::wall_utime();
+  info_.run_nonce = run_nonce();
   bus().publish(channels().info, info_);
 }
 
@@ -331,6 +332,10 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["lost"] = lost_;
   l["duplicates"] = duplicates_total;
   l["invalid_messages"] = invalid_total;
+  // The monitor hears every channel of the run: its own count per channel says where they came
+  // ("" : datagrams without LCM's framing). invalid_messages adds the other processes' counts.
+  l["invalid_messages_by_channel"] = nlohmann::ordered_json::object();
+  for (const auto& [ch, n] : bus().invalid_by_channel()) l["invalid_messages_by_channel"][ch.empty() ? "(not LCM)" : ch] = n;
   l["rejected_commands"] = rec_.rejected_commands();
   l["deadline_misses"] = rec_.missed_deadlines();
   l["plant_overruns"] = rec_.plant_overruns();

@@ -43,6 +43,10 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
   app.add_option("--key", opt.key_file,
                  "authenticate every message with HMAC-SHA256 and this key file (mode 0600; docs/security.md)")
       ->type_name("FILE");
+  app.add_option("--run-nonce", opt.run_nonce,
+                 "with --key: the run's nonce, which binds the run id on the wire to this run (docs/security.md); "
+                 "default: feeddrive-launch draws it, a plant started alone draws it, the others take the plant's")
+      ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
   app.add_option_function<std::string>(
          "--on-conflict", [&opt](const std::string& v) { opt.on_conflict = parse_conflict_policy(v); },
          "a second, different message for a step: fail (default) or keep-first (count and log it)")

@@ -99,6 +99,22 @@ std::int64_t draw_run_id() {
   return static_cast<std::int64_t>(v);
 }
 
+namespace {
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+}  // namespace
+
+std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce) {
+  if (nonce == 0) return run_id;
+  const std::uint64_t m = (std::uint64_t{1} << 53) - 1;
+  const std::uint64_t h = splitmix64(static_cast<std::uint64_t>(run_id) ^ splitmix64(static_cast<std::uint64_t>(nonce)));
+  return static_cast<std::int64_t>(1 + h % m);
+}
+
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size) {
   std::array<std::uint8_t, 32> out{};
   unsigned int n = 0;

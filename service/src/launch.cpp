@@ -41,6 +41,7 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   if (opt.realtime) a.push_back("--realtime");
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
+  if (!opt.key_file.empty() && opt.run_nonce != 0) a.insert(a.end(), {"--run-nonce", std::to_string(opt.run_nonce)});
   if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
   return a;
 }
@@ -144,6 +145,8 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     // docs/security.md, "Concurrent runs"). An external plant is expected there, so no check.
     if (lo.busy_check_s > 0) check_group_free(opt, lo.busy_check_s);
     if (opt.run_id == 0) opt.run_id = draw_run_id();
+    // With a key, a fresh nonce binds the run id on the wire to this run (docs/security.md).
+    if (!opt.key_file.empty() && opt.run_nonce == 0) opt.run_nonce = draw_run_id();
     spdlog::info("run id {}{}", opt.run_id, opt.key_file.empty() ? "" : " (messages authenticated with " + opt.key_file + ")");
   } else if (opt.run_id == 0) {
     spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
@@ -153,9 +156,10 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   for (const auto& role : roles) {
     if (interrupted_by() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}", role, opt.lcm_url, opt.prefix,
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{}", role, opt.lcm_url, opt.prefix,
                    opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
-                   opt.key_file.empty() ? "" : " --key " + opt.key_file);
+                   opt.key_file.empty() ? "" : " --key " + opt.key_file,
+                   opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "");
       continue;
     }
     std::vector<std::string> args = {lo.scenario};

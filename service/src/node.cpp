@@ -51,22 +51,67 @@ std::string seconds_text(double s) {
 Node::Node(std::string role, const NodeOptions& opt, Receive receive)
     : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive), ch_(opt.prefix) {
   if (!opt.key_file.empty()) bus_.set_auth(read_key_file(opt.key_file));
-  if (opt.run_id != 0) bus_.set_run_id(opt.run_id);
+  const bool keyed = !opt.key_file.empty();
+  if (keyed && opt.run_id != 0 && opt.run_nonce != 0) {
+    // The launcher gave the run's nonce: the run id on the wire is known from the start.
+    run_nonce_ = opt.run_nonce;
+    bus_.set_run_id(keyed_run_id(opt.run_id, run_nonce_));
+  } else if (keyed && role_ == "plant") {
+    // A fresh nonce binds this run's identity: a replay of an earlier run with the same
+    // --run-id carries another run id (docs/security.md, "Replays across runs").
+    run_nonce_ = opt.run_nonce != 0 ? opt.run_nonce : draw_run_id();
+    bus_.set_run_id(keyed_run_id(opt.run_id != 0 ? opt.run_id : draw_run_id(), run_nonce_));
+  } else if (opt.run_id != 0 && !keyed) {
+    bus_.set_run_id(opt.run_id);
+  }
   bus_.subscribe<process_status_t>(
       ch_.status,
-      [this](const process_status_t& m, std::int64_t recv_us) {
+      [this, keyed](const process_status_t& m, std::int64_t recv_us) {
         if (!bus_.run_known()) {
           // Join the run of the first plant whose heartbeat is fresh (its wall clock within 5 s
           // of ours): a log replayed by lcm-logplayer carries the old times and is not joined.
+          // Under --key the heartbeat is signed (checked before decode) and must carry the run's
+          // nonce, its run id bound to our --run-id by it.
           if (m.role != "plant" || std::llabs(m.utime - wall_utime()) > 5000000) return;
+          if (keyed && m.run_nonce == 0) {
+            if (!warned_no_nonce_)
+              spdlog::error("{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
+                            "contract's version 4 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
+                            role_);
+            warned_no_nonce_ = true;
+            return;
+          }
+          if (keyed && opt_.run_id != 0 && keyed_run_id(opt_.run_id, m.run_nonce) != m.run_id) {
+            bus_.count_foreign(ch_.status, m.run_id);
+            return;
+          }
           bus_.set_run_id(m.run_id);
-          spdlog::info("{}: joined run {} (taken from the plant's heartbeat)", role_, m.run_id);
+          run_nonce_ = m.run_nonce;
+          spdlog::info("{}: joined run {} (taken from the plant's heartbeat{})", role_, m.run_id,
+                       keyed ? ", bound to its nonce" : "");
         }
         if (m.run_id != bus_.run_id()) {
           bus_.count_foreign(ch_.status, m.run_id);
           return;
         }
         if (m.role == role_) return;
+        // A run role's state only moves forward (starting, running, then done or failed): a
+        // "running" after its own "done" is a forged or replayed heartbeat, not the process. It
+        // is a conflict, and the state it claims is ignored, so no heartbeat can hold a run
+        // open (docs/security.md, "Heartbeats").
+        if (const auto it = peers_.find(m.role); it != peers_.end() && is_run_role(m.role)) {
+          const std::string& was = it->second.state;
+          if ((was == "done" || was == "failed") && (m.state == "starting" || m.state == "running")) {
+            ++conflicts;
+            const std::int64_t now = mono_us();
+            if (now - last_conflict_log_us_ > 1000000) {
+              last_conflict_log_us_ = now;
+              spdlog::warn("{}: conflict on {}: a heartbeat of the {} says '{}' after its own '{}' (forged or replayed; "
+                           "ignored, {} conflicts so far)", role_, ch_.status, m.role, m.state, was, conflicts);
+            }
+            return;
+          }
+        }
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
       },
@@ -79,6 +124,7 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
 process_status_t Node::status_message(const std::string& state, const std::string& message) const {
   process_status_t m{};
   m.utime = wall_utime();
+  m.run_nonce = run_nonce_;
   m.role = role_;
   m.state = state;
   m.seq = seq_;

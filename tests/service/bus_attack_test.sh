@@ -9,6 +9,14 @@
 #   3. a replayed log (stock lcm-logplayer of an earlier run, started mid-run): its messages are
 #      foreign (another run id), counted and ignored; the run completes identical, and
 #      summary.json says how many. With --key, the replay of a signed run is foreign too.
+#   3b. with --key and the same --run-id reused (docs/deployment.md's fixed run id across
+#      machines), a replayed signed log is foreign too: the plant binds the run id to a fresh
+#      nonce (docs/security.md, "Replays across runs").
+#   5. the malformed datagrams that once killed every process (issue 19: a status whose role has
+#      length 0, reference blocks with count -1 and 10^7, a command and a state with mac_size -1),
+#      sent every 5 ms through a whole run: counted invalid per channel, the run identical.
+#   6. a forged monitor heartbeat saying "running" every 10 ms: it does not hold the others open
+#      after the real monitor is done (with --linger 60, the launch ends long before 60 s).
 #   4. concurrent runs with the default settings: the second launch refuses at once, in one
 #      line, naming the run that holds the group and how to choose another (exit 2); with
 #      another --prefix both complete identical. Two launches started at the same instant
@@ -143,6 +151,47 @@ completed_identical replayed_key
 n=$(json "$TMP/replayed_key/summary.json" .lockstep.foreign_messages)
 [ "$n" -gt 100 ] || fail "replayed_key: only $n foreign messages counted"
 pass "with --key, a replayed signed log (valid macs, old run id): $n foreign messages ignored; identical"
+
+# 3b. The same --run-id for both runs, with --key.
+lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/signed_fixed.lcmlog" > /dev/null 2>&1 & lg=$!
+wait_on_bus $lg
+launch signed_fixed --key "$KEY" --run-id 4242
+kill -INT $lg; wait $lg || true
+completed_identical signed_fixed
+replay_into replayed_fixed "$LOGDIR/signed_fixed.lcmlog" --key "$KEY" --run-id 4242
+completed_identical replayed_fixed
+n=$(json "$TMP/replayed_fixed/summary.json" .lockstep.foreign_messages)
+[ "$n" -gt 100 ] || fail "replayed_fixed: only $n foreign messages counted (a replay with the run id reused)"
+[ "$(json "$TMP/replayed_fixed/summary.json" .lockstep.run_id)" != "$(json "$TMP/signed_fixed/summary.json" .lockstep.run_id)" ] ||
+  fail "replayed_fixed: the same run id on the wire as the earlier run with --run-id 4242"
+pass "with --key and --run-id reused, a replayed signed log is another run's: $n foreign messages ignored; identical"
+
+# 5. The malformed datagrams, all through a run.
+timeout 300 "$BUILD/tests/fd-test-peer" malformed --seconds 20 --lcm-url "$URL" > "$TMP/peer.log" 2>&1 & peer_pid=$!
+wait_on_bus $peer_pid
+launch malformed
+kill $peer_pid 2> /dev/null || true
+wait $peer_pid 2> /dev/null || true
+[ "$rc" = 0 ] || { tail -5 "$TMP/malformed.log" >&2; fail "malformed: launch exited $rc"; }
+completed_identical malformed
+for c in FD_STATUS FD_REF FD_CMD FD_STATE; do
+  n=$(json "$TMP/malformed/summary.json" ".lockstep.invalid_messages_by_channel.$c // 0")
+  [ "$n" -gt 0 ] || fail "malformed: no invalid message counted on $c ($(json "$TMP/malformed/summary.json" .lockstep.invalid_messages_by_channel))"
+done
+pass "malformed datagrams through a run: counted $(jq -c .lockstep.invalid_messages_by_channel "$TMP/malformed/summary.json") and dropped; identical to feeddrive-sim"
+
+# 6. A forged "running" heartbeat of the monitor.
+timeout 300 "$BUILD/tests/fd-test-peer" fake-monitor --seconds 120 --lcm-url "$URL" > "$TMP/peer.log" 2>&1 & peer_pid=$!
+wait_on_bus $peer_pid
+start=$(date +%s)
+launch fake_monitor --linger 60
+took=$(( $(date +%s) - start ))
+kill $peer_pid 2> /dev/null || true
+wait $peer_pid 2> /dev/null || true
+[ "$rc" = 0 ] || { tail -5 "$TMP/fake_monitor.log" >&2; fail "fake_monitor: launch exited $rc"; }
+# 30 s: the run itself takes a few seconds even on a loaded machine; a held linger takes 60 s.
+[ "$took" -lt 30 ] || fail "fake_monitor: the launch took $took s with --linger 60: the forged heartbeat held the run open"
+pass "a forged 'running' heartbeat of the monitor: the run ended in $took s (--linger 60)"
 
 # 4. Concurrent runs.
 timeout 300 feeddrive-launch "$scen" --out "$TMP/first" --no-plots -q --lcm-url "$URL" > "$TMP/first.log" 2>&1 & first=$!

@@ -20,7 +20,7 @@ TMP=$(mktemp -d "${TMPDIR:-/tmp}/feeddrive-test.XXXXXX")
 # writing their results) would cost it steps.
 LOGDIR=$TMP
 if [ -d /dev/shm ] && [ -w /dev/shm ]; then LOGDIR=$(mktemp -d /dev/shm/feeddrive-log.XXXXXX); fi
-trap 'jobs -p | xargs -r kill -9 2>/dev/null || true; rm -rf "$TMP" "$LOGDIR"' EXIT
+trap 'jobs -p | xargs -r kill -9 2>/dev/null || true; [ -n "${FD_KEEP_TMP:-}" ] || rm -rf "$TMP" "$LOGDIR"' EXIT
 export PATH="$BIN:$PATH"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }

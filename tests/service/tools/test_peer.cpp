@@ -11,16 +11,25 @@
 //                   the states (no key: with --key on the run, its messages are unauthenticated)
 //   forge-reference an attacker ahead of the trajectory: on every state k, a reference_block_t
 //                   of position --u m for the aligned block 512 steps ahead (before the real one)
+//   malformed       the datagrams that once killed every process of a run (issue 19), each in the
+//                   run's identity, every 5 ms for --seconds: a process_status_t whose role has
+//                   length 0, reference_block_t with count -1 and 10^7, a control_command_t and a
+//                   drive_state_t with mac_size -1. Each must be counted invalid and dropped.
+//   fake-monitor    a forged heartbeat of the run's monitor saying "running", every 10 ms for
+//                   --seconds: after the real monitor's "done" it must not hold the run open.
 // Every peer joins the run of the first message it hears (or --run-id).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 #include <random>
 #include <thread>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/process_status_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
 
@@ -36,7 +45,8 @@ int main(int argc, char** argv) {
   std::int64_t run_id = 0;
   app.add_option("mode", mode)
       ->required()
-      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller", "forge-reference"}));
+      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
+                             "forge-reference", "malformed", "fake-monitor"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -52,6 +62,76 @@ int main(int argc, char** argv) {
     bus.join_first_seen();
   }
   const Channels ch(prefix);
+  if (mode == "malformed" || mode == "fake-monitor") {
+    bus.subscribe<drive_state_t>(ch.state, [](const drive_state_t&, std::int64_t) {});
+    const auto give_up = mono_us() + 60000000;
+    while (!bus.run_known() && mono_us() < give_up) bus.poll(std::chrono::milliseconds(10));
+    if (!bus.run_known()) {
+      std::printf("%s: heard no run\n", mode.c_str());
+      return 1;
+    }
+    const std::int64_t run = bus.run_id();
+    // be(b, at, v, n): v big-endian into n bytes at `at` (LCM's byte order).
+    const auto be = [](std::vector<std::uint8_t>& b, std::size_t at, std::int64_t v, std::size_t n) {
+      for (std::size_t i = 0; i < n; ++i) b[at + i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(v) >> (8 * (n - 1 - i)));
+    };
+    const auto bytes = [](const auto& m) {
+      std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
+      m.encode(b.data(), 0, static_cast<int>(b.size()));
+      return b;
+    };
+    process_status_t st{};
+    st.run_id = run;
+    st.role = mode == "fake-monitor" ? "monitor" : "plant";
+    st.state = "running";
+    std::vector<std::vector<std::uint8_t>> status_bad, ref_bad, cmd_bad, state_bad;
+    if (mode == "malformed") {
+      auto b = bytes(st);
+      // The role's length field: the big-endian 6 right before "plant" and its NUL.
+      for (std::size_t i = 8; i + 10 <= b.size(); ++i)
+        if (b[i] == 0 && b[i + 1] == 0 && b[i + 2] == 0 && b[i + 3] == 6 && std::memcmp(&b[i + 4], "plant", 6) == 0) {
+          be(b, i, 0, 4);
+          break;
+        }
+      status_bad.push_back(b);
+      reference_block_t rb{};
+      rb.run_id = run;
+      rb.count = 1;
+      rb.refs.resize(1);
+      b = bytes(rb);
+      be(b, 24, -1, 4);  // fingerprint, run_id, first_seq, then count
+      ref_bad.push_back(b);
+      be(b, 24, 10000000, 4);
+      ref_bad.push_back(b);
+      control_command_t c{};
+      c.run_id = run;
+      b = bytes(c);
+      be(b, b.size() - 2, -1, 2);  // mac_size is the last field (no mac)
+      cmd_bad.push_back(b);
+      drive_state_t d{};
+      d.run_id = run;
+      b = bytes(d);
+      be(b, b.size() - 2, -1, 2);
+      state_bad.push_back(b);
+    }
+    const auto end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    long n = 0;
+    while (mono_us() < end) {
+      if (mode == "fake-monitor") {
+        st.utime = wall_utime();
+        bus.publish(ch.status, st);
+      } else {
+        for (const auto& b : status_bad) bus.publish_raw(ch.status, b.data(), b.size());
+        for (const auto& b : ref_bad) bus.publish_raw(ch.reference, b.data(), b.size());
+        for (const auto& b : cmd_bad) bus.publish_raw(ch.command, b.data(), b.size());
+        for (const auto& b : state_bad) bus.publish_raw(ch.state, b.data(), b.size());
+      }
+      ++n;
+      bus.poll(std::chrono::milliseconds(mode == "fake-monitor" ? 10 : 5));
+    }
+    std::printf("%s: %ld rounds in run %lld\n", mode.c_str(), n, static_cast<long long>(run));
+    return 0;
+  }
   if (mode == "junk") {
     lcm::LCM raw(url);
     std::mt19937 rng(7);

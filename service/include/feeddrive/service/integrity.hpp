@@ -87,6 +87,14 @@ class StepLedger {
 /// in a double, so bindings without 64-bit integers (Lua 5.2) carry it unchanged.
 std::int64_t draw_run_id();
 
+/// Under --key, the run id on the wire: a run's given identity R (--run-id, or drawn) bound to
+/// the nonce N the plant draws at its start,
+///     keyed_run_id(R, N) = 1 + (splitmix64(R xor splitmix64(N)) mod (2^53 - 1)),
+/// so a log of an earlier run with the same --run-id (another nonce) is another run's: foreign.
+/// splitmix64: Steele, Lea and Flood, "Fast splittable pseudorandom number generators" (2014).
+/// N = 0 (no nonce: no key) gives R itself.
+std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce);
+
 /// HMAC-SHA256(key, data) (RFC 2104 over FIPS 180-4), for tests and tools.
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size);
 

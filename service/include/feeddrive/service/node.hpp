@@ -42,6 +42,9 @@ struct NodeOptions {
   /// other process takes it from the plant's first fresh heartbeat.
   std::int64_t run_id{0};
   std::string key_file;              ///< --key: authenticate every message with this key; "": off
+  /// --run-nonce, with --key: the run's nonce (feeddrive-launch draws it and gives it to every
+  /// process it starts); 0: the plant draws one and the others take it from its fresh heartbeat.
+  std::int64_t run_nonce{0};
   ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 
@@ -68,6 +71,8 @@ class Node {
   Bus& bus() { return bus_; }
   const Channels& channels() const { return ch_; }
   const NodeOptions& options() const { return opt_; }
+  /// Under --key, the run's nonce (process_status_t.run_nonce); 0 without a key or before the run is known.
+  std::int64_t run_nonce() const { return run_nonce_; }
 
   /// Publishes the heartbeat if due (every 100 ms) or when forced.
   void heartbeat(bool force = false);
@@ -125,6 +130,10 @@ class Node {
 
   std::string role_;
   NodeOptions opt_;
+  /// Under --key: the nonce of the run (the plant draws it; the others take it from the plant's
+  /// fresh, signed heartbeat whose run id is keyed_run_id(--run-id, nonce)); 0 without a key.
+  std::int64_t run_nonce_{0};
+  bool warned_no_nonce_{false};
   Bus bus_;
   Channels ch_;
   std::string state_{"starting"};
