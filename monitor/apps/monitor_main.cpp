@@ -28,8 +28,10 @@ int main(int argc, char** argv) {
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     mopt.plots = !no_plots;
-    const sim::Scenario s = sim::load_scenario(scenario_path);
+    const sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
     output::check_output_dir(mopt.out_dir);  // before the run
+    output::check_outside(mopt.lcm_log, "--lcm-log", mopt.out_dir);
+    output::check_output_file(mopt.lcm_log, "--lcm-log");
     sim::check_run_size(s, mopt.out_dir);
     monitor::MonitorNode node(s, opt, mopt);
     const bool ok = node.run();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/monitor/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/service/bus.hpp"
@@ -29,8 +30,13 @@ constexpr std::int32_t kMaxChannel = 4096;        // far above LCM's 63-characte
 constexpr std::int32_t kMaxData = 64 * 1024 * 1024;  // our messages are < 1 KB
 
 class LogParser {
+  // A FIFO or a device would block the stream's open(): refused first, in one line.
+  static void check_regular(const std::string& path) {
+    ::close(text::open_regular_file<std::invalid_argument>(path, "LCM log"));
+  }
+
  public:
-  explicit LogParser(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  explicit LogParser(const std::string& path) : path_(path), in_((check_regular(path), path), std::ios::binary) {
     if (!in_) throw std::invalid_argument(path + ": cannot open the LCM log");
     in_.seekg(0, std::ios::end);
     size_ = static_cast<std::int64_t>(in_.tellg());

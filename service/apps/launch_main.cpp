@@ -37,9 +37,15 @@ int main(int argc, char** argv) {
     lo.external.insert(external.begin(), external.end());
     lo.plots = !no_plots;
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
-    const sim::Scenario s = sim::load_scenario(lo.scenario);  // bad input fails here, before any process starts
-    const auto out = output::check_output_dir(lo.out_dir);  // and this, before any process starts
+    // Read once, here: bad input fails before any process starts, and every process checks that
+    // its copy hashes the same (one run, one scenario).
+    const service::RunScenario rs = service::load_run_scenario(lo.scenario, opt);
+    const sim::Scenario& s = rs.scenario;
+    opt.scenario_sha256 = rs.sha256;
+    const auto out = output::check_output_dir(lo.out_dir);  // and these, before any process starts
     output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
+    output::check_output_file(lo.lcm_log, "--lcm-log");
+    if (!opt.key_file.empty()) service::read_key_file(opt.key_file);
     sim::check_run_size(s, lo.out_dir);
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);
     // The monitor's marker before the run: a successful run leaves a new one (a new file).
@@ -50,6 +56,9 @@ int main(int argc, char** argv) {
     const ino_t before = marker_id();
     const service::LaunchResult r = service::launch(lo, opt);
     for (const auto& f : r.failed) spdlog::error("failed: {}", f);
+    if (!r.partial_record.empty())
+      spdlog::error("the monitor was killed: its record up to then (not flushed at the kill: the last rows may be "
+                    "missing) is in {}", r.partial_record);
     // A failed run's record is where the monitor said (DIR, or DIR.incomplete-N beside an
     // earlier output): DIR's summary may be the earlier run's, so it is not shown as this one's.
     if (r.exit_code != 0) return r.exit_code;

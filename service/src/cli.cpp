@@ -47,11 +47,26 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "with --key: the run's nonce, which binds the run id on the wire to this run (docs/security.md); "
                  "default: feeddrive-launch draws it, a plant started alone draws it, the others take the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+  app.add_option("--scenario-sha256", opt.scenario_sha256,
+                 "refuse to start unless the scenario file's SHA-256 is this (feeddrive-launch passes the hash of "
+                 "what it read: one run, one scenario; run_info_t.scenario_sha256 carries it)")
+      ->type_name("HEX");
   app.add_option_function<std::string>(
          "--on-conflict", [&opt](const std::string& v) { opt.on_conflict = parse_conflict_policy(v); },
          "a second, different message for a step: fail (default) or keep-first (count and log it)")
       ->check(CLI::IsMember({"fail", "keep-first"}))
       ->type_name("fail|keep-first");
+}
+
+RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
+  std::string text;
+  RunScenario r{sim::load_scenario(path, &text), ""};
+  r.sha256 = sha256_hex(text);
+  if (!opt.scenario_sha256.empty() && opt.scenario_sha256 != r.sha256)
+    throw std::invalid_argument(path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
+                                "..., the launcher read " + opt.scenario_sha256.substr(0, 12) +
+                                "...): the file changed while the run started; one run, one scenario: launch again");
+  return r;
 }
 
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body) {

@@ -1,7 +1,9 @@
 #include "feeddrive/service/integrity.hpp"
+#include "feeddrive/common/text_file.hpp"
 
 #include <fcntl.h>
 #include <openssl/core_names.h>
+#include <openssl/sha.h>
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
@@ -115,6 +117,18 @@ std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce) {
   return static_cast<std::int64_t>(1 + h % m);
 }
 
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char md[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), md);
+  static const char* digits = "0123456789abcdef";
+  std::string hex;
+  for (unsigned char c : md) {
+    hex.push_back(digits[c >> 4]);
+    hex.push_back(digits[c & 15]);
+  }
+  return hex;
+}
+
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size) {
   std::array<std::uint8_t, 32> out{};
   unsigned int n = 0;
@@ -125,12 +139,13 @@ std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint
 
 std::string read_key_file(const std::string& path) {
   const std::string where = "--key " + path + ": ";
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);  // a FIFO must not block
   if (fd < 0) throw std::invalid_argument(where + "cannot open it (" + std::strerror(errno) + ")");
   struct stat st {};
   std::string key;
   try {
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) throw std::invalid_argument(where + "not a regular file");
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+      throw std::invalid_argument(where + "not a regular file (" + text::non_regular_kind(st.st_mode) + ")");
     if (st.st_uid != ::geteuid())
       throw std::invalid_argument(where + "owned by another user (uid " + std::to_string(st.st_uid) + "); a key must be its user's own");
     if ((st.st_mode & 077) != 0) {

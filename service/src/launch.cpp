@@ -1,6 +1,7 @@
 #include "feeddrive/service/launch.hpp"
 
 #include <sched.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <sys/wait.h>
@@ -12,6 +13,7 @@
 #include <map>
 #include <optional>
 
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/service/bus.hpp"
@@ -42,6 +44,7 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
   if (!opt.key_file.empty() && opt.run_nonce != 0) a.insert(a.end(), {"--run-nonce", std::to_string(opt.run_nonce)});
+  if (!opt.scenario_sha256.empty()) a.insert(a.end(), {"--scenario-sha256", opt.scenario_sha256});
   if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
   return a;
 }
@@ -55,6 +58,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   // handlers (interrupt::install_handlers unblocks them): a Ctrl-C that reaches the child between
   // fork and exec stays pending instead of being lost with the launcher's handler at exec (the
   // child then ran on to its 10 s start timeout).
+  const pid_t launcher = ::getpid();
   sigset_t stop, old;
   sigemptyset(&stop);
   sigaddset(&stop, SIGINT);
@@ -64,6 +68,11 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   if (pid != 0) ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    // Children die with their launcher, even a SIGKILLed one (which cannot forward anything):
+    // the kernel sends them SIGTERM (their handlers stop the run and keep what is recorded). If
+    // the launcher died before this line, the parent is no longer it: stop at once.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != launcher) ::_exit(143);
     if (niceness != 0 && ::nice(niceness) == -1) std::fprintf(stderr, "warning: nice(%d) failed\n", niceness);
     if (!cpus.empty()) {
       cpu_set_t set;
@@ -192,6 +201,14 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       const std::string role = running[pid];
       running.erase(pid);
       const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      if (role == "monitor" && WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) {
+        // A killed monitor could not put its record in place: the launcher does, beside --out.
+        try {
+          result.partial_record = output::rescue_staging(lo.out_dir, pid).string();
+        } catch (const std::exception& e) {
+          spdlog::error("monitor killed: {}", e.what());
+        }
+      }
       if (code != 0) {
         if (code == 2) refused = true;
         result.failed.push_back(role + " (exit " + std::to_string(code) + ")");

@@ -539,8 +539,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
   }
 }
 
-Scenario load_scenario(const std::string& path) {
+Scenario load_scenario(const std::string& path, std::string* text_out) {
   const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
+  if (text_out != nullptr) *text_out = text;
   const fs::path p(path);
   Scenario s = parse_scenario(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
   s.path = path;

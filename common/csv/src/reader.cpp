@@ -1,3 +1,4 @@
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/csv/reader.hpp"
 
 #include <fcntl.h>
@@ -226,7 +227,7 @@ Table parse(std::string_view text, const std::string& origin, const Options& opt
 
 Table read_file(const std::string& path, const Options& opt) {
   const std::string who = shown(path, 200);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);  // a FIFO must not block open()
   if (fd < 0) throw CsvError(who + ": cannot open the file: " + std::strerror(errno));
   struct Closer {
     int fd;
@@ -235,6 +236,8 @@ Table read_file(const std::string& path, const Options& opt) {
   struct stat st {};
   if (::fstat(fd, &st) == 0) {
     if (S_ISDIR(st.st_mode)) throw CsvError(who + ": is a folder, not a data file");
+    if (!S_ISREG(st.st_mode)) throw CsvError(who + ": is " + text::non_regular_kind(st.st_mode) + ", not a regular file");
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
     if (S_ISREG(st.st_mode) && static_cast<std::uint64_t>(st.st_size) > opt.limits.max_file_bytes)
       throw CsvError(who + ": " + std::to_string(st.st_size) + " bytes, larger than the reader's limit of " +
                      std::to_string(opt.limits.max_file_bytes) + " bytes");

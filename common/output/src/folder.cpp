@@ -251,6 +251,24 @@ void check_outside(const std::string& file, const std::string& file_option, cons
                                 ", which is replaced when the run ends (the file would be lost); put it next to the folder");
 }
 
+void check_output_file(const std::string& file, const std::string& option) {
+  if (file.empty()) return;
+  struct stat st {};
+  if (::stat(file.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) refuse(option, file, "is a folder; name a file");
+    if (S_ISFIFO(st.st_mode)) refuse(option, file, "is a FIFO (a writer would block on it); name a regular file");
+    if (!S_ISREG(st.st_mode)) refuse(option, file, "is a device or socket, not a regular file");
+    if (::access(file.c_str(), W_OK) != 0) refuse(option, file, "exists and is not writable (" + error_text(errno) + ")");
+    return;
+  }
+  if (errno != ENOENT) refuse(option, file, "cannot be examined (" + error_text(errno) + ")");
+  const fs::path parent = fs::path(file).parent_path().empty() ? fs::path(".") : fs::path(file).parent_path();
+  if (::stat(parent.c_str(), &st) != 0) refuse(option, file, "its folder " + parent.string() + " does not exist");
+  if (!S_ISDIR(st.st_mode)) refuse(option, file, parent.string() + " is not a folder");
+  if (::access(parent.c_str(), W_OK | X_OK) != 0)
+    refuse(option, file, "its folder " + parent.string() + " is not writable (" + error_text(errno) + ")");
+}
+
 void replace_folder(const fs::path& fresh, const fs::path& target) {
   sync_folder(fresh, target.string() + ": ");
   std::error_code ec;
@@ -282,6 +300,41 @@ bool remove_output(const fs::path& dir) noexcept {
   } catch (...) {
     return false;
   }
+}
+
+// Moves folder `from` to the first free TARGET.KIND-N beside `target` and returns it.
+static fs::path move_beside(const fs::path& from, const fs::path& target, const std::string& kind, const std::string& what) {
+  std::error_code ec;
+  for (int n = 1;; ++n) {
+    const fs::path p = target.parent_path() / (target.filename().string() + "." + kind + "-" + std::to_string(n));
+    // RENAME_NOREPLACE: never onto anything, not even an empty folder (rename(2) would take it).
+    if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, p.c_str(), RENAME_NOREPLACE) == 0) {
+      sync_parent(p);
+      return p;
+    }
+    const int e = errno;
+    if (e == EEXIST) continue;
+    if (e == EINVAL || e == ENOSYS || e == EOPNOTSUPP) {  // no RENAME_NOREPLACE here: check, then rename
+      if (fs::exists(fs::symlink_status(p, ec))) continue;
+      if (::rename(from.c_str(), p.c_str()) == 0) {
+        sync_parent(p);
+        return p;
+      }
+    }
+    throw std::runtime_error(what + "cannot rename the results beside the earlier output: " + error_text(errno) +
+                             "; the results are in " + from.string());
+  }
+}
+
+fs::path rescue_staging(const std::string& out, pid_t pid) {
+  const fs::path target = fs::absolute(normalise(out));
+  const std::string prefix = "." + target.filename().string() + ".partial-" + std::to_string(pid) + "-";
+  std::error_code ec;
+  for (fs::directory_iterator it(target.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->path().filename().string().rfind(prefix, 0) != 0) continue;
+    return move_beside(it->path(), target, "incomplete", "--out " + shown(out) + ": ");
+  }
+  return {};
 }
 
 int remove_stale_staging(const fs::path& target) noexcept {
@@ -385,26 +438,7 @@ fs::path StagedFolder::commit_keeping_earlier(const std::string& kind, bool list
   }
   finish_marker(list_files);
   done_ = true;  // kept on failure from here: it holds the results
-  const std::string what = option_ + " " + shown(value_) + ": ";
-  for (int n = 1;; ++n) {
-    const fs::path p = target_.parent_path() / (target_.filename().string() + "." + kind + "-" + std::to_string(n));
-    // RENAME_NOREPLACE: never onto anything, not even an empty folder (rename(2) would take it).
-    if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, p.c_str(), RENAME_NOREPLACE) == 0) {
-      sync_parent(p);
-      return p;
-    }
-    const int e = errno;
-    if (e == EEXIST) continue;
-    if (e == EINVAL || e == ENOSYS || e == EOPNOTSUPP) {  // no RENAME_NOREPLACE here: check, then rename
-      if (fs::exists(fs::symlink_status(p, ec))) continue;
-      if (::rename(staging_.c_str(), p.c_str()) == 0) {
-        sync_parent(p);
-        return p;
-      }
-    }
-    throw std::runtime_error(what + "cannot rename the results beside the earlier output: " + error_text(errno) +
-                             "; the results are in " + staging_.string());
-  }
+  return move_beside(staging_, target_, kind, option_ + " " + shown(value_) + ": ");
 }
 
 void StagedFolder::commit(bool list_files) {

@@ -3,8 +3,13 @@
 // interruptible, so a wrong path (/dev/zero, a log, a disk image) is refused in one line instead
 // of filling the memory. Header-only.
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstddef>
-#include <fstream>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -16,32 +21,62 @@ namespace feeddrive::text {
 /// is under 4 kB.
 inline constexpr std::size_t kMaxTextFileBytes = std::size_t{1} << 20;
 
+/// What kind of file `mode` is, when it is not a regular file ("a FIFO", "a folder", ...).
+inline std::string non_regular_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+/// Opens `path` for reading without blocking (a FIFO would block a plain open() until a writer
+/// comes) and returns the descriptor of a regular file. Throws Error("PATH: cannot read the WHAT
+/// (...)") or Error("PATH: the WHAT is a FIFO, not a regular file"), one line.
+template <typename Error>
+int open_regular_file(const std::string& path, const std::string& what) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw Error(path + ": cannot read the " + what + " (" + std::strerror(errno) + ")");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    const std::string kind = non_regular_kind(st.st_mode);
+    ::close(fd);
+    throw Error(path + ": the " + what + " is " + kind + ", not a regular file");
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  return fd;
+}
+
 /// The bytes of the file `path`, read in 64 kB chunks (Ctrl-C is polled between them: it throws
-/// interrupt::Interrupted). Throws Error("PATH: cannot read the WHAT") or Error("PATH: the WHAT is
-/// larger than ... bytes ..."), one line; Error is the caller's exception type (ScenarioError,
-/// StudyError), constructible from a std::string.
+/// interrupt::Interrupted). Throws Error("PATH: cannot read the WHAT"), Error("PATH: the WHAT is
+/// a FIFO, not a regular file") or Error("PATH: the WHAT is larger than ... bytes ..."), one
+/// line; Error is the caller's exception type (ScenarioError, StudyError), constructible from a
+/// std::string. Never blocks in open().
 template <typename Error>
 std::string read_text_file(const std::string& path, const std::string& what, std::size_t max_bytes = kMaxTextFileBytes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    interrupt::check();  // a Ctrl-C while open() waited (a FIFO) is an interrupt, not bad input
-    throw Error(path + ": cannot read the " + what);
-  }
+  const int fd = open_regular_file<Error>(path, what);
   std::string text;
   static constexpr std::size_t kChunk = 1 << 16;
   char buf[kChunk];
-  while (in) {
+  for (;;) {
+    if (interrupt::interrupted()) ::close(fd);
     interrupt::check();
-    in.read(buf, kChunk);
-    text.append(buf, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > max_bytes)
+    const ssize_t n = ::read(fd, buf, kChunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      throw Error(path + ": cannot read the " + what + " (" + std::strerror(err) + ")");
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+    if (text.size() > max_bytes) {
+      ::close(fd);
       throw Error(path + ": the " + what + " is larger than " + std::to_string(max_bytes) +
                   " bytes, the limit of a scenario or study file (docs/scenario.md, Limits); is it the right file?");
+    }
   }
-  if (in.bad()) {
-    interrupt::check();
-    throw Error(path + ": cannot read the " + what);
-  }
+  ::close(fd);
   return text;
 }
 

@@ -9,6 +9,7 @@
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/service/node.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
 
@@ -20,6 +21,15 @@ void add_node_options(CLI::App& app, NodeOptions& opt);
 /// (bad input) gives 2, RunFailure and other exceptions 1, interrupt::Interrupted 130 (SIGINT) or
 /// 143 (SIGTERM), each as one line on stderr.
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body);
+
+/// The scenario of a run process: loaded once, its bytes hashed (SHA-256, FIPS 180-4, by
+/// libcrypto). With opt.scenario_sha256 set (feeddrive-launch sets it), a file whose bytes hash
+/// otherwise (replaced while the run started) throws std::invalid_argument, one line: exit 2.
+struct RunScenario {
+  sim::Scenario scenario;
+  std::string sha256;  ///< hex
+};
+RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt);
 
 /// Runs node.run() and returns 0; a RunFailure is first announced on <prefix>_STATUS (so the
 /// other processes stop at once) and then passed on to run_process.

@@ -95,6 +95,9 @@ std::int64_t draw_run_id();
 /// N = 0 (no nonce: no key) gives R itself.
 std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce);
 
+/// SHA-256 (FIPS 180-4) of `bytes`, as 64 lowercase hex digits (libcrypto).
+std::string sha256_hex(const std::string& bytes);
+
 /// HMAC-SHA256(key, data) (RFC 2104 over FIPS 180-4), for tests and tools.
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size);
 

@@ -50,6 +50,9 @@ std::vector<int> parse_cpu_list(const std::string& text);
 struct LaunchResult {
   int exit_code{0};             ///< 0 if every started process exited 0
   std::vector<std::string> failed;  ///< "role (exit n)" of each process that did not exit 0
+  /// The monitor was killed (no unwinding, e.g. SIGKILL): where its record so far was moved
+  /// (DIR.incomplete-N, output::rescue_staging); "" otherwise.
+  std::string partial_record;
 };
 
 /// Throws std::invalid_argument (one line: who holds it, how to choose another) if another

@@ -45,6 +45,9 @@ struct NodeOptions {
   /// --run-nonce, with --key: the run's nonce (feeddrive-launch draws it and gives it to every
   /// process it starts); 0: the plant draws one and the others take it from its fresh heartbeat.
   std::int64_t run_nonce{0};
+  /// --scenario-sha256: the SHA-256 (hex) of the scenario file's bytes as feeddrive-launch read
+  /// them; a process whose file hashes otherwise refuses to start (one run, one scenario). "": no check.
+  std::string scenario_sha256;
   ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 

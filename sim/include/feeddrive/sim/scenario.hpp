@@ -101,7 +101,9 @@ struct Scenario {
 };
 
 /// Loads and validates a scenario file. Throws ScenarioError("<file>: <key> = <value>: <why>").
-Scenario load_scenario(const std::string& path);
+/// `text`, if given, receives the file's bytes as read (a process that must prove it runs the
+/// same scenario as others hashes exactly these).
+Scenario load_scenario(const std::string& path, std::string* text = nullptr);
 /// Parses and validates YAML text; base_dir resolves relative file names; origin names the
 /// source in messages. If `resolved` is given it receives every scalar key the loader read with
 /// its effective value (given or default; file names resolved against base_dir): the complete

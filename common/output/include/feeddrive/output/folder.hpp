@@ -23,6 +23,8 @@
 // without the marker are refused like any other folder, and so is an output that holds an entry
 // its marker does not list (a user's file put into it): replacing it would delete that file.
 
+#include <sys/types.h>
+
 #include <filesystem>
 #include <string>
 
@@ -68,6 +70,17 @@ std::filesystem::path check_output_dir(const std::string& out, const std::string
 /// which commit() replaces whole. "" is never inside.
 void check_outside(const std::string& file, const std::string& file_option, const std::string& out,
                    const std::string& option = "--out");
+
+/// Everything about an output file (--lcm-log) that can be checked before any work: its folder
+/// exists and is writable, and the file, if it exists, is a regular file this user can write
+/// (not a FIFO, which would block the writer's open(), a device or a folder). Throws
+/// std::invalid_argument, one line naming the option, the value and what is wrong. "" passes.
+void check_output_file(const std::string& file, const std::string& option);
+
+/// After the process `pid` that wrote `out` died unfinished (SIGKILL: no unwinding), moves the
+/// staging folder it left (its record so far) to the first free OUT.incomplete-N beside `out`
+/// and returns that path; "" when it left none. A later run would otherwise remove it as stale.
+std::filesystem::path rescue_staging(const std::string& out, pid_t pid);
 
 /// A new output folder written in a sibling temporary folder and swapped into place by commit().
 class StagedFolder {
