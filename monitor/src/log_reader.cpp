@@ -32,7 +32,9 @@ constexpr std::int32_t kMaxData = 64 * 1024 * 1024;  // our messages are < 1 KB
 class LogParser {
   // A FIFO or a device would block the stream's open(): refused first, in one line.
   static void check_regular(const std::string& path) {
-    ::close(text::open_regular_file<std::invalid_argument>(path, "LCM log"));
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw std::invalid_argument(path + ": the LCM log is " + text::non_regular_kind(st.st_mode) + ", not a regular file");
   }
 
  public:

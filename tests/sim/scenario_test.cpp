@@ -168,8 +168,7 @@ TEST(Scenario, BadTablesAreOneLineScenarioErrors) {
   EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv}")),
             "s.yaml: controller.file = '': kind = csv needs a file");
   EXPECT_EQ(error_of(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}", "reference: {type: waypoints, file: /dev/zero}")),
-            "s.yaml: /dev/zero:1:1: not a text file: byte 0x00 in \"\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00"
-            "\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00\\x00...\"");
+            "s.yaml: /dev/zero: is a device, not a regular file");  // refused before it is opened for reading
 }
 
 TEST(Scenario, OutputOptions) {
