@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "feeddrive/common/validate.hpp"
+#include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::study {
 namespace {
@@ -171,13 +172,16 @@ struct Resolver::Impl {
 
   explicit Impl(const Study& st) : s(st) {
     varied = varied_keys(s);
+    // The one YAML loader (yaml_reader.hpp): a base file with a recursive alias or a merge key is
+    // refused here, before any copy of it is made.
     try {
-      base = YAML::Load(s.base_yaml);
-    } catch (const YAML::Exception& e) {
-      throw StudyError(s.path + ": base: line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+      base = sim::load_yaml_strict(s.base_yaml);
+      for (const ControllerEntry& c : s.controllers)
+        controller_blocks.push_back(c.block.empty() ? YAML::Node() : sim::load_yaml_strict(c.block));
+    } catch (const sim::ScenarioError& e) {
+      throw StudyError(s.path + ": base: " + e.what());
     }
     if (!base.IsMap()) throw StudyError(s.path + ": base: the scenario must be a YAML map");
-    for (const ControllerEntry& c : s.controllers) controller_blocks.push_back(c.block.empty() ? YAML::Node() : YAML::Load(c.block));
   }
 
   sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin) const {
