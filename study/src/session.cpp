@@ -182,7 +182,7 @@ int run_study(const Options& o, Transport* t) {
   std::map<std::size_t, Slot> slots;  // handed out, row not yet written
   std::deque<std::size_t> ready;      // resolved, to run
   std::deque<int> waiting;            // ranks that asked for a case while none was ready
-  std::size_t next_case = 0, next_row = 0, cached = 0, ran = 0;
+  std::size_t next_case = 0, next_row = 0, cached = 0, ran = 0, unresolved = 0;
   double case_time = 0.0;
   Progress progress(total, 0, !o.quiet);
   ReportData report(study);
@@ -205,6 +205,9 @@ int run_study(const Options& o, Transport* t) {
       // here: a failed case in results.csv, like a run that fails (docs/study.md, Validation).
       Outcome out;
       out.error = e.what();
+      ++unresolved;
+      for (const Variation& v : c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
+        if (!v.scale) c.resolved.parameters[v.key] = v.value;
       for (char& ch : out.error)
         if (ch == '\n' || ch == '\r') ch = ' ';
       finished(i, std::move(out));
@@ -349,8 +352,9 @@ int run_study(const Options& o, Transport* t) {
     nlohmann::ordered_json timing;
     timing["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     timing["cases"] = total;
-    timing["cases_run"] = total - cached;
+    timing["cases_run"] = ran;
     timing["cases_reused"] = cached;
+    timing["cases_not_resolved"] = unresolved;  // failed before running: their scenario is invalid
     timing["case_time_sum_s"] = case_time;
     timing["threads_per_rank"] = jobs;
     timing["ranks"] = ranks;
