@@ -117,4 +117,40 @@ TEST(StudyMillion, StartsAtOnceStaysSmallAndStopsOnCtrlC) {
   fs::remove_all(dir);
 }
 
+// SIGTERM half a second after the start: the study is still checking its probe cases (about a
+// second of resolving) or has just started running; either way it stops at once with 128 + 15.
+TEST(StudyMillion, SigtermDuringSetUpStopsAtOnce) {
+  const fs::path dir = fs::temp_directory_path() / ("feeddrive-million-term-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path study = write_study(dir);
+  const fs::path out = dir / "out";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open((dir / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 2);
+    ::execl(kStudy.c_str(), kStudy.c_str(), study.c_str(), "--out", out.c_str(), "--no-plots", "-q", nullptr);
+    ::_exit(127);
+  }
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_EQ(::kill(pid, SIGTERM), 0);
+  const auto sent = Clock::now();
+  int status = 0;
+  pid_t done = 0;
+  while ((done = ::waitpid(pid, &status, WNOHANG)) == 0 && Clock::now() - sent < std::chrono::seconds(20))
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const double stop_s = std::chrono::duration<double>(Clock::now() - sent).count();
+  if (done == 0) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    FAIL() << "still running 20 s after SIGTERM";
+  }
+  std::printf("exit %.3f s after SIGTERM\n", stop_s);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 143);
+  EXPECT_LT(stop_s, 5.0);  // goal 1 s; generous for a loaded machine (see the top)
+  fs::remove_all(dir);
+}
+
 }  // namespace
