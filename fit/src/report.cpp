@@ -10,15 +10,19 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
+#include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::fit {
 namespace fs = std::filesystem;
 
 std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::PlantParams& fitted) {
-  YAML::Node root = YAML::LoadFile(scenario_path);
+  // The one YAML loader (its checks: recursive aliases, merge keys, duplicate keys, size).
+  YAML::Node root = sim::load_yaml_strict(text::read_text_file<sim::ScenarioError>(scenario_path, "scenario file"));
   const fs::path base = fs::absolute(scenario_path).parent_path();
   if (root["reference"] && root["reference"]["file"]) {
     const fs::path f = root["reference"]["file"].as<std::string>();

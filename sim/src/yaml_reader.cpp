@@ -7,10 +7,13 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <sstream>
 #include <string_view>
 
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 
 namespace feeddrive::sim {
 namespace {
@@ -143,6 +146,107 @@ void check_duplicate_keys(const YAML::Node& n, const std::string& path, long& bu
   }
 }
 
+
+// The parser's events of the first document, checked before any node is built: yaml-cpp 0.7 makes
+// an alias the same node as its anchor, so an alias inside its own anchor ("&f {inner: *f}") is a
+// cycle in the node graph on which every traversal (copy, emit, our checks) recurses until the
+// stack overflows; and it reads a merge key ("<<: *a") as an ordinary key named "<<".
+// Both are refused here, at the alias's or the key's own line and column.
+class ConstructCheck : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {
+    begin_node();
+    end_node("", false);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    begin_node();
+    for (const Frame& f : stack_)
+      if (f.anchor == anchor && anchor != YAML::NullAnchor)
+        throw ScenarioError(where(mark) + path() + ": recursive YAML alias *" + name(anchor) + " inside its own anchor &" +
+                            name(anchor) + " (line " + std::to_string(f.line) + "): not supported (an alias may only repeat a finished node)");
+    end_node("", false);
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t, const std::string& value) override {
+    begin_node();
+    if (value == "<<" && tag == "?" && !stack_.empty() && stack_.back().map && stack_.back().expect_key)
+      throw ScenarioError(where(mark) + path() + (path().empty() ? "" : ".") + "<<: YAML merge key (<<) not supported: write the keys out");
+    end_node(value, true);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor, false);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor, true);
+  }
+  void OnMapEnd() override { close(); }
+  void OnAnchor(const YAML::Mark&, const std::string& anchor_name) override { names_.push_back(anchor_name); }
+
+ private:
+  struct Frame {
+    bool map{false};
+    YAML::anchor_t anchor{YAML::NullAnchor};
+    long line{0};
+    bool expect_key{true};  // map: the next node is a key
+    std::string key;        // map: the current key; sequence: the current index
+    long index{-1};
+  };
+  static std::string where(const YAML::Mark& m) {
+    return "line " + std::to_string(m.line + 1) + ", column " + std::to_string(m.column + 1) + ": ";
+  }
+  std::string name(YAML::anchor_t a) const {
+    return a >= 1 && a <= names_.size() ? names_[a - 1] : std::to_string(a);  // anchors are numbered from 1
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : stack_) {
+      if (f.map) {
+        if (!f.expect_key) p += (p.empty() ? "" : ".") + f.key;
+      } else if (f.index >= 0) {
+        p += "[" + std::to_string(f.index) + "]";
+      }
+    }
+    return p;
+  }
+  // A node begins in the current collection: a key or a value of a map, an item of a sequence.
+  void begin_node() {
+    if (stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (!f.map) ++f.index;
+  }
+  // A node ended: in a map, a key is followed by its value and a value by the next key.
+  void end_node(const std::string& scalar, bool is_scalar) {
+    if (stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (!f.map) return;
+    if (f.expect_key) f.key = is_scalar ? scalar : std::string("(a complex key)");
+    f.expect_key = !f.expect_key;
+  }
+  void open(const YAML::Mark& mark, YAML::anchor_t anchor, bool map) {
+    begin_node();
+    Frame f;
+    f.map = map;
+    f.anchor = anchor;
+    f.line = mark.line + 1;
+    stack_.push_back(f);
+  }
+  void close() {
+    stack_.pop_back();
+    end_node("", false);
+  }
+  std::vector<Frame> stack_;
+  std::vector<std::string> names_;
+};
+
+void check_constructs(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  ConstructCheck check;
+  parser.HandleNextDocument(check);  // YAML::Load reads the first document only
+}
+
 }  // namespace
 
 YAML::Node load_yaml_strict(const std::string& text) {
@@ -154,6 +258,7 @@ YAML::Node load_yaml_strict(const std::string& text) {
                         std::to_string(q.closed_on) + " (a quoted value must end on the line where it starts)");
   YAML::Node root;
   try {
+    check_constructs(text);
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ScenarioError("line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "feeddrive/common/validate.hpp"
+#include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::study {
 namespace {
@@ -86,32 +88,61 @@ std::vector<Variation> grid_point(const Family& f, long point) {
   return out;
 }
 
+std::size_t case_count(const Study& s) { return static_cast<std::size_t>(s.total_cases()); }
+
+CaseSpec case_at(const Study& s, std::size_t index) {
+  if (index >= case_count(s)) throw std::out_of_range("case " + std::to_string(index) + " of " + std::to_string(case_count(s)));
+  long rest = static_cast<long>(index);
+  long per_controller = 0;
+  for (std::size_t f = 0; f < s.families.size(); ++f) per_controller += s.family_cases(f);
+  CaseSpec cs;
+  cs.controller = static_cast<std::size_t>(rest / per_controller);
+  rest %= per_controller;
+  while (rest >= s.family_cases(cs.family)) rest -= s.family_cases(cs.family++);
+  const Family& fam = s.families[cs.family];
+  const long draws = fam.monte_carlo.draws;
+  cs.point = draws > 0 ? rest / draws : rest;
+  cs.draw = draws > 0 ? rest % draws : -1;
+  cs.variations = grid_point(fam, cs.point);
+  if (cs.draw >= 0) {
+    for (std::size_t i = 0; i < fam.monte_carlo.parameters.size(); ++i) {
+      const DrawSpec& ds = fam.monte_carlo.parameters[i];
+      const double x = draw_value(ds, fam.monte_carlo.seed, cs.draw, i);
+      for (const std::string& key : ds.keys) cs.variations.push_back({key, validate::format_number(x), ds.scale, x});
+    }
+  }
+  return cs;
+}
+
 std::vector<CaseSpec> expand(const Study& s) {
   std::vector<CaseSpec> out;
-  out.reserve(static_cast<std::size_t>(s.total_cases()));
+  out.reserve(case_count(s));
+  for (std::size_t i = 0; i < case_count(s); ++i) out.push_back(case_at(s, i));
+  return out;
+}
+
+std::vector<std::size_t> probe_cases(const Study& s, std::size_t budget) {
+  std::vector<std::size_t> out;
+  std::size_t family_start = 0;  // index of the first case of (controller, family)
   for (std::size_t c = 0; c < s.controllers.size(); ++c) {
     for (std::size_t f = 0; f < s.families.size(); ++f) {
       const Family& fam = s.families[f];
-      long points = 1;
-      for (const GridAxis& a : fam.grid) points *= static_cast<long>(a.values.size());
-      const long draws = fam.monte_carlo.draws;
-      for (long p = 0; p < points; ++p) {
-        const std::vector<Variation> grid = grid_point(fam, p);
-        for (long d = draws > 0 ? 0 : -1; d < std::max(draws, 0L); ++d) {
-          CaseSpec cs{c, f, p, d, grid};
-          if (d >= 0) {
-            for (std::size_t i = 0; i < fam.monte_carlo.parameters.size(); ++i) {
-              const DrawSpec& ds = fam.monte_carlo.parameters[i];
-              const double x = draw_value(ds, fam.monte_carlo.seed, d, i);
-              for (const std::string& key : ds.keys)
-                cs.variations.push_back({key, validate::format_number(x), ds.scale, x});
-            }
-          }
-          out.push_back(std::move(cs));
-        }
+      const long draws = std::max(1L, fam.monte_carlo.draws);
+      out.push_back(family_start);
+      // Each value of each axis once, the other axes at their first value (mixed radix, the last
+      // axis fastest: axis i's stride is the product of the later axes' sizes).
+      long stride = 1;
+      for (std::size_t i = fam.grid.size(); i-- > 0;) {
+        for (long v = 1; v < static_cast<long>(fam.grid[i].values.size()); ++v)
+          out.push_back(family_start + static_cast<std::size_t>(v * stride * draws));
+        stride *= static_cast<long>(fam.grid[i].values.size());
       }
+      family_start += static_cast<std::size_t>(s.family_cases(f));
     }
   }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  if (out.size() > budget) out.resize(budget);
   return out;
 }
 
@@ -167,17 +198,21 @@ struct Resolver::Impl {
   std::vector<YAML::Node> controller_blocks;
   // Loads by document text: the same layers are shared by many cases.
   std::map<std::string, sim::ResolvedKeys> loads;
+  static constexpr std::size_t kMaxLoads = 256;
   std::vector<std::string> varied;  // every key a grid or draw of the study varies
 
   explicit Impl(const Study& st) : s(st) {
     varied = varied_keys(s);
+    // The one YAML loader (yaml_reader.hpp): a base file with a recursive alias or a merge key is
+    // refused here, before any copy of it is made.
     try {
-      base = YAML::Load(s.base_yaml);
-    } catch (const YAML::Exception& e) {
-      throw StudyError(s.path + ": base: line " + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+      base = sim::load_yaml_strict(s.base_yaml);
+      for (const ControllerEntry& c : s.controllers)
+        controller_blocks.push_back(c.block.empty() ? YAML::Node() : sim::load_yaml_strict(c.block));
+    } catch (const sim::ScenarioError& e) {
+      throw StudyError(s.path + ": base: " + e.what());
     }
     if (!base.IsMap()) throw StudyError(s.path + ": base: the scenario must be a YAML map");
-    for (const ControllerEntry& c : s.controllers) controller_blocks.push_back(c.block.empty() ? YAML::Node() : YAML::Load(c.block));
   }
 
   sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin) const {
@@ -199,6 +234,10 @@ struct Resolver::Impl {
     auto it = loads.find(text);
     if (it != loads.end()) return it->second;
     sim::ResolvedKeys keys = load_uncached(text, origin);
+    // Bounded: a study that varies controller.* keys together with plant.* keys has a nominal
+    // model per case; the cache keeps at most kMaxLoads (cases come in order, so a reset costs
+    // one load per layer).
+    if (loads.size() >= kMaxLoads) loads.clear();
     return loads.emplace(std::move(text), std::move(keys)).first->second;
   }
 };

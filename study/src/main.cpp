@@ -1,7 +1,8 @@
 // feeddrive-study: runs a study (a base scenario plus variations, docs/study.md) on all cores, or
 // on all ranks of an MPI job (mpirun, srun), and writes DIR/{results.csv, report.md, plots/}.
 //
-//   study.yaml --> load_study --> expand + resolve --> cases in parallel --> results.csv, report.md
+//   study.yaml --> load_study --> probe cases --> case_at + resolve, one at a time --> cases in parallel
+//              --> results.csv (streamed in study order), report.md
 //
 // Exit codes: 0 done (failed cases are reported in results.csv), 2 bad input (study, options,
 // output folder), 1 a failure of the machine.

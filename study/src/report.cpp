@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <fstream>
 #include <map>
 #include <set>
@@ -11,6 +12,7 @@
 #include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
+#include "feeddrive/sim/summary.hpp"
 
 namespace feeddrive::study {
 namespace {
@@ -18,9 +20,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // The metric of the report (scaled to its unit), NaN if the case failed or lacks it.
-double shown_metric(const Study& s, const CaseRecord& c) {
-  if (!c.outcome.ok) return NAN;
-  for (const auto& [k, v] : c.outcome.metrics)
+double shown_metric(const Study& s, const Outcome& o) {
+  if (!o.ok) return NAN;
+  for (const auto& [k, v] : o.metrics)
     if (k == s.report.metric) return v * s.report.scale;
   return NAN;
 }
@@ -58,30 +60,7 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-struct Cell {
-  std::vector<double> values;
-  long failed{0};    ///< cases that failed (ok = false)
-  long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than settled_after)
-  long total{0};
-};
-
-// values[family][controller]
-std::vector<std::vector<Cell>> table(const Study& s, const std::vector<CaseRecord>& cases) {
-  std::vector<std::vector<Cell>> t(s.families.size(), std::vector<Cell>(s.controllers.size()));
-  for (const CaseRecord& c : cases) {
-    Cell& x = t[c.spec.family][c.spec.controller];
-    ++x.total;
-    const double v = shown_metric(s, c);
-    if (!c.outcome.ok) {
-      ++x.failed;
-    } else if (std::isnan(v)) {
-      ++x.no_value;
-    } else {
-      x.values.push_back(v);
-    }
-  }
-  return t;
-}
+using Cell = ReportData::Cell;
 
 bool parse_number(const std::string& text, double& out) {
   char* end = nullptr;
@@ -102,41 +81,83 @@ std::string csv_field(const std::string& value) {
   return out + "\"";
 }
 
-std::string results_csv(const Study& s, const std::vector<CaseRecord>& cases) {
-  const std::vector<std::string> params = varied_keys(s);
-  std::vector<std::string> metrics;
-  for (const CaseRecord& c : cases) {
-    if (!c.outcome.ok) continue;
-    for (const auto& [k, v] : c.outcome.metrics) metrics.push_back(k);
-    break;
-  }
-  std::ostringstream out;
-  out << "case,controller,family,point,draw,hash";
-  for (const std::string& p : params) out << ',' << csv_field(p);
-  out << ",ok,error";
-  for (const std::string& m : metrics) out << ',' << csv_field(m);
-  out << '\n';
-  for (std::size_t i = 0; i < cases.size(); ++i) {
-    const CaseRecord& c = cases[i];
-    out << i << ',' << csv_field(s.controllers[c.spec.controller].name) << ',' << csv_field(s.families[c.spec.family].name)
-        << ',' << c.spec.point << ',' << (c.spec.draw >= 0 ? std::to_string(c.spec.draw) : "") << ','
-        << c.resolved.hash.substr(0, 16);
-    for (const std::string& p : params) {
-      const auto it = c.resolved.parameters.find(p);
-      out << ',' << (it == c.resolved.parameters.end() ? "" : csv_field(it->second));
-    }
-    out << ',' << (c.outcome.ok ? "true" : "false") << ',' << csv_field(c.outcome.error);
-    for (const std::string& m : metrics) {
-      out << ',';
-      for (const auto& [k, v] : c.outcome.metrics)
-        if (k == m) out << output::number_text(v);
-    }
-    out << '\n';
-  }
-  return out.str();
+ResultsWriter::ResultsWriter(const Study& s, const fs::path& dir)
+    : s_(s), partial_(dir / "results.csv.partial"), final_(dir / "results.csv"), params_(varied_keys(s)),
+      metrics_(sim::summary_metric_names()) {
+  out_.open(partial_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw std::runtime_error(partial_.string() + ": cannot write");
+  out_ << "case,controller,family,point,draw,hash";
+  for (const std::string& p : params_) out_ << ',' << csv_field(p);
+  out_ << ",ok,error";
+  for (const std::string& m : metrics_) out_ << ',' << csv_field(m);
+  out_ << '\n';
 }
 
-std::string write_plots(const fs::path& dir, const std::string& prefix, const Study& s, const std::vector<CaseRecord>& cases) {
+ResultsWriter::~ResultsWriter() {
+  if (done_) return;
+  out_.close();
+  std::error_code ec;
+  fs::remove(partial_, ec);
+}
+
+void ResultsWriter::add(std::size_t index, const CaseRecord& c) {
+  out_ << index << ',' << csv_field(s_.controllers[c.spec.controller].name) << ',' << csv_field(s_.families[c.spec.family].name)
+       << ',' << c.spec.point << ',' << (c.spec.draw >= 0 ? std::to_string(c.spec.draw) : "") << ','
+       << c.resolved.hash.substr(0, 16);
+  for (const std::string& p : params_) {
+    const auto it = c.resolved.parameters.find(p);
+    out_ << ',' << (it == c.resolved.parameters.end() ? "" : csv_field(it->second));
+  }
+  out_ << ',' << (c.outcome.ok ? "true" : "false") << ',' << csv_field(c.outcome.error);
+  for (const std::string& m : metrics_) {
+    out_ << ',';
+    for (const auto& [k, v] : c.outcome.metrics)
+      if (k == m) out_ << output::number_text(v);
+  }
+  out_ << '\n';
+  if (!out_) throw std::runtime_error(partial_.string() + ": write failed");
+}
+
+void ResultsWriter::finish() {
+  out_.close();
+  if (!out_) throw std::runtime_error(partial_.string() + ": write failed");
+  if (::rename(partial_.c_str(), final_.c_str()) != 0) throw std::runtime_error(final_.string() + ": cannot rename into place");
+  done_ = true;
+}
+
+ReportData::ReportData(const Study& st)
+    : s(st), params(varied_keys(st)), table(st.families.size(), std::vector<Cell>(st.controllers.size())),
+      worst(st.controllers.size()) {}
+
+void ReportData::add(std::size_t index, const CaseRecord& c) {
+  ++cases;
+  failed += c.outcome.ok ? 0 : 1;
+  cached += c.cached ? 1 : 0;
+  const double v = shown_metric(s, c.outcome);
+  Cell& cell_of = table[c.spec.family][c.spec.controller];
+  ++cell_of.total;
+  if (!c.outcome.ok) {
+    ++cell_of.failed;
+    if (failures.size() < kListedFailures) failures.push_back({index, c.spec.controller, c.spec.family, c.outcome.error});
+  } else if (std::isnan(v)) {
+    ++cell_of.no_value;
+  } else {
+    cell_of.values.push_back(v);
+    Worst& w = worst[c.spec.controller];
+    if (!w.any || v > w.value) w = {true, index, c.spec.family, v, c.resolved.parameters};
+  }
+  controller.push_back(static_cast<std::uint32_t>(c.spec.controller));
+  shown.push_back(v);
+  for (const std::string& p : params) {
+    const auto it = c.resolved.parameters.find(p);
+    double px = NAN;
+    if (it == c.resolved.parameters.end() || !parse_number(it->second, px)) px = NAN;
+    x.push_back(static_cast<float>(px));
+  }
+}
+
+std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d) {
+  const Study& s = d.s;
   fs::create_directories(dir);
   const std::size_t nc = s.controllers.size(), nf = s.families.size();
   const std::string ylabel = output::gnuplot_string(s.report.metric + " [" + s.report.unit + "]");
@@ -150,7 +171,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
                 output::number_text(s.report.limit) + " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
 
   // Box plots: one box per family and controller, grouped by family.
-  const auto t = table(s, cases);
+  const auto& t = d.table;
   std::vector<std::string> items;
   const double width = 0.8 / static_cast<double>(nc);
   for (std::size_t f = 0; f < nf; ++f) {
@@ -185,18 +206,16 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
   }
 
   // The metric against each varied parameter, one series per controller.
-  const std::vector<std::string> params = varied_keys(s);
+  const std::vector<std::string>& params = d.params;
   for (std::size_t p = 0; p < params.size(); ++p) {
     std::vector<std::string> series;
     for (std::size_t c = 0; c < nc; ++c) {
       std::ostringstream data;
       long n = 0;
-      for (const CaseRecord& r : cases) {
-        if (r.spec.controller != c) continue;
-        const auto it = r.resolved.parameters.find(params[p]);
-        double x = 0.0;
-        const double y = shown_metric(s, r);
-        if (it == r.resolved.parameters.end() || !parse_number(it->second, x) || !(y > 0.0)) continue;
+      for (std::size_t i = 0; i < d.cases; ++i) {
+        if (d.controller[i] != c) continue;
+        const double x = d.x[i * params.size() + p], y = d.shown[i];
+        if (!std::isfinite(x) || !(y > 0.0)) continue;
         data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
         ++n;
       }
@@ -220,22 +239,18 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const St
   return md.str();
 }
 
-std::string report_md(const Study& s, const std::vector<CaseRecord>& cases, const std::string& command,
-                      const std::string& plots_markdown) {
+std::string report_md(const ReportData& d, const std::string& command, const std::string& plots_markdown) {
+  const Study& s = d.s;
   std::ostringstream md;
-  long failed = 0, cached = 0;
-  for (const CaseRecord& c : cases) {
-    failed += c.outcome.ok ? 0 : 1;
-    cached += c.cached ? 1 : 0;
-  }
+  const std::size_t failed = d.failed, cached = d.cached;
   const std::string unit = s.report.unit;
   md << "# Study: " << cell(s.name) << "\n\n"
      << "Written by `feeddrive-study`. Command:\n\n```bash\n" << command << "\n```\n\n"
-     << cases.size() << " cases (" << s.controllers.size() << " controllers x " << s.families.size() << " families), "
+     << d.cases << " cases (" << s.controllers.size() << " controllers x " << s.families.size() << " families), "
      << failed << " failed, " << cached << " reused from an earlier run into this folder. Every number below is "
      << "`" << s.report.metric << "` in " << unit << " (one row per case in `results.csv`).\n\n";
 
-  const auto t = table(s, cases);
+  const auto& t = d.table;
   const std::size_t nc = s.controllers.size();
   // Per controller: worst over everything.
   md << "## Worst case per controller\n\n| controller | cases | failed | worst [" << unit << "] | family of the worst | median ["
@@ -297,33 +312,22 @@ std::string report_md(const Study& s, const std::vector<CaseRecord>& cases, cons
   // The worst case of each controller, with its parameters.
   md << "\n## The worst case of each controller\n\n| controller | family | case | " << unit << " | parameters |\n|---|---|---|---|---|\n";
   for (std::size_t c = 0; c < nc; ++c) {
-    const CaseRecord* w = nullptr;
-    std::size_t wi = 0;
-    for (std::size_t i = 0; i < cases.size(); ++i) {
-      if (cases[i].spec.controller != c) continue;
-      const double v = shown_metric(s, cases[i]);
-      if (std::isnan(v)) continue;
-      if (!w || v > shown_metric(s, *w)) {
-        w = &cases[i];
-        wi = i;
-      }
-    }
-    if (!w) continue;
+    const ReportData::Worst& w = d.worst[c];
+    if (!w.any) continue;
     std::string params;
-    for (const auto& [k, v] : w->resolved.parameters) params += (params.empty() ? "" : ", ") + k + " = " + v;
-    md << "| " << cell(s.controllers[c].name) << " | " << cell(s.families[w->spec.family].name) << " | " << wi << " | "
-       << num(shown_metric(s, *w)) << " | " << cell(params) << " |\n";
+    for (const auto& [k, v] : w.parameters) params += (params.empty() ? "" : ", ") + k + " = " + v;
+    md << "| " << cell(s.controllers[c].name) << " | " << cell(s.families[w.family].name) << " | " << w.index << " | "
+       << num(w.value) << " | " << cell(params) << " |\n";
   }
 
   md << "\n## Plots\n\n" << plots_markdown;
   if (failed > 0) {
     md << "## Failed cases\n\n| case | controller | family | error |\n|---|---|---|---|\n";
-    for (std::size_t i = 0; i < cases.size(); ++i) {
-      const CaseRecord& c = cases[i];
-      if (c.outcome.ok) continue;
-      md << "| " << i << " | " << cell(s.controllers[c.spec.controller].name) << " | " << cell(s.families[c.spec.family].name)
-         << " | " << cell(c.outcome.error) << " |\n";
-    }
+    for (const ReportData::Failure& f : d.failures)
+      md << "| " << f.index << " | " << cell(s.controllers[f.controller].name) << " | " << cell(s.families[f.family].name)
+         << " | " << cell(f.error) << " |\n";
+    if (failed > d.failures.size())
+      md << "\nThe first " << d.failures.size() << " of " << failed << " failed cases; `results.csv` lists every one (ok = false).\n";
     md << "\n";
   }
   md << "Each case's complete scenario is `cases/<hash>.yaml` (the hash column of `results.csv` is its first 16 digits); "

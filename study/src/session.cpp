@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -80,36 +81,76 @@ int available_cores() {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
+namespace {
+
+// Cases resolved before any case runs (probe_cases): about 1 ms each, so the check takes about a
+// second at most, and a 10^6-case study starts its first case within seconds.
+constexpr std::size_t kProbeBudget = 1000;
+
+// The exit of a Ctrl-C or SIGTERM: the message, the other ranks told, 128 + the signal.
+int interrupted_exit(Transport* t, const std::string& what) {
+  const int sig = interrupt::signal_number();
+  std::fprintf(stderr, "interrupted by %s%s\n", interrupt::signal_name(sig).c_str(), what.c_str());
+  if (t) t->abort(128 + sig);
+  return 128 + sig;
+}
+
+// A case and what became of it, while it is between being handed out and its row.
+struct Slot {
+  CaseRecord record;
+  bool finished{false};
+};
+
+}  // namespace
+
 int run_study(const Options& o, Transport* t) {
   const auto start = std::chrono::steady_clock::now();
   Study study;
-  std::vector<CaseRecord> cases;
+  std::size_t total = 0;
+  std::unique_ptr<Resolver> resolver;
   fs::path dir;
   std::unique_ptr<FolderLock> lock;
   // Everything that can be wrong with the input, before any case runs: exit 2, and the other
-  // ranks are told to stop.
+  // ranks are told to stop. The cases are made and resolved one at a time as they are handed out
+  // (a study has up to 10^6: never all at once); here only the probe cases (cases.hpp) are
+  // resolved, so the usual mistakes still stop the study before it writes anything.
   try {
     study = load_study(o.study);
     if (!o.list) output::check_output_dir(o.out);
-    const std::vector<CaseSpec> specs = expand(study);
-    Resolver resolver(study);
-    cases.reserve(specs.size());
-    for (const CaseSpec& c : specs) cases.push_back({c, resolver.resolve(c), {}, false});
+    total = case_count(study);
+    resolver = std::make_unique<Resolver>(study);
+    for (std::size_t i : probe_cases(study, kProbeBudget)) {
+      interrupt::check();
+      resolver->resolve(case_at(study, i));
+    }
+  } catch (const interrupt::Interrupted&) {
+    return interrupted_exit(t, " while checking the study; nothing written");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     if (t) t->broadcast(2);
     return 2;
   }
   if (o.list) {
-    std::printf("%zu cases\n", cases.size());
-    for (std::size_t i = 0; i < cases.size(); ++i) {
-      const CaseRecord& c = cases[i];
-      std::string params;
-      for (const auto& v : c.spec.variations) params += " " + v.key + "=" + c.resolved.parameters.at(v.key);
-      std::printf("%zu %s %s %s%s\n", i, c.resolved.hash.substr(0, 16).c_str(), study.controllers[c.spec.controller].name.c_str(),
-                  study.families[c.spec.family].name.c_str(), params.c_str());
-    }
     if (t) t->broadcast(2);
+    std::printf("%zu cases\n", total);
+    try {
+      for (std::size_t i = 0; i < total; ++i) {
+        interrupt::check();
+        const CaseSpec c = case_at(study, i);
+        const ResolvedCase r = resolver->resolve(c);
+        std::string params;
+        for (const auto& v : c.variations) params += " " + v.key + "=" + r.parameters.at(v.key);
+        std::printf("%zu %s %s %s%s\n", i, r.hash.substr(0, 16).c_str(), study.controllers[c.controller].name.c_str(),
+                    study.families[c.family].name.c_str(), params.c_str());
+      }
+    } catch (const interrupt::Interrupted&) {
+      std::fflush(stdout);
+      return interrupted_exit(nullptr, "");
+    } catch (const std::exception& e) {
+      std::fflush(stdout);
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
     return 0;
   }
   try {
@@ -126,92 +167,161 @@ int run_study(const Options& o, Transport* t) {
   }
   if (t) t->broadcast(0);
 
-  // Finished cases of an earlier run; the rest is pending, in study order.
-  std::deque<std::size_t> pending;
-  std::size_t cached = 0;
-  try {
-    for (std::size_t i = 0; i < cases.size(); ++i) {
-      CaseRecord& c = cases[i];
-      const fs::path yaml = dir / "cases" / (c.resolved.hash + ".yaml");
-      const fs::path json = dir / "cases" / (c.resolved.hash + ".json");
-      std::error_code ec;
-      if (fs::exists(json, ec)) {
-        if (auto prev = parse_outcome(slurp(json), c.resolved.hash); prev && (prev->ok || !o.retry_failed)) {
-          c.outcome = *prev;
-          c.cached = true;
-          ++cached;
-          continue;
-        }
-      }
-      if (!fs::exists(yaml, ec)) output::write_file_atomically(yaml, c.resolved.yaml);
-      pending.push_back(i);
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    if (t) t->abort(1);
-    return 1;
-  }
-
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1, available_cores() / (t ? t->local_size() : 1));
   const int ranks = t ? t->size() : 1;
   if (!o.quiet)
-    std::fprintf(stderr, "%s: %zu cases (%zu to run, %zu finished earlier) on %d thread%s x %d rank%s -> %s\n",
-                 study.name.c_str(), cases.size(), pending.size(), cached, jobs, jobs == 1 ? "" : "s", ranks,
-                 ranks == 1 ? "" : "s", dir.c_str());
+    std::fprintf(stderr, "%s: %zu cases on %d thread%s x %d rank%s -> %s\n", study.name.c_str(), total, jobs,
+                 jobs == 1 ? "" : "s", ranks, ranks == 1 ? "" : "s", dir.c_str());
 
-  Progress progress(cases.size(), cached, !o.quiet);
+  // Streaming, in study order: case i is made (case_at), resolved and looked up in DIR/cases when
+  // it is handed out; its row goes to results.csv when every earlier case has its row. At most
+  // `window` cases are between being handed out and their row, so memory does not grow with the
+  // study (report.md keeps a few numbers per case: ReportData).
+  const std::size_t workers = static_cast<std::size_t>(jobs) * static_cast<std::size_t>(ranks);
+  const std::size_t window = std::max<std::size_t>(256, 16 * workers);
+  std::map<std::size_t, Slot> slots;  // handed out, row not yet written
+  std::deque<std::size_t> ready;      // resolved, to run
+  std::deque<int> waiting;            // ranks that asked for a case while none was ready
+  std::size_t next_case = 0, next_row = 0, cached = 0, ran = 0, unresolved = 0;
   double case_time = 0.0;
-  std::size_t remaining = pending.size();
+  Progress progress(total, 0, !o.quiet);
+  ReportData report(study);
+  std::unique_ptr<ResultsWriter> results;
+  const auto finished = [&](std::size_t i, Outcome out) {
+    Slot& sl = slots.at(i);
+    sl.record.outcome = std::move(out);
+    sl.finished = true;
+  };
+  // Makes and resolves the next case: reused from DIR/cases, failed (it does not resolve), or ready.
+  const auto prepare_next = [&]() {
+    const std::size_t i = next_case++;
+    Slot& sl = slots[i];
+    CaseRecord& c = sl.record;
+    c.spec = case_at(study, i);
+    try {
+      c.resolved = resolver->resolve(c.spec);
+    } catch (const StudyError& e) {
+      // Only a case the probes did not cover (another draw, another combination of axes) gets
+      // here: a failed case in results.csv, like a run that fails (docs/study.md, Validation).
+      Outcome out;
+      out.error = e.what();
+      ++unresolved;
+      for (const Variation& v : c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
+        if (!v.scale) c.resolved.parameters[v.key] = v.value;
+      for (char& ch : out.error)
+        if (ch == '\n' || ch == '\r') ch = ' ';
+      finished(i, std::move(out));
+      return;
+    }
+    const fs::path yaml = dir / "cases" / (c.resolved.hash + ".yaml");
+    const fs::path json = dir / "cases" / (c.resolved.hash + ".json");
+    std::error_code ec;
+    if (fs::exists(json, ec)) {
+      if (auto prev = parse_outcome(slurp(json), c.resolved.hash); prev && (prev->ok || !o.retry_failed)) {
+        c.cached = true;
+        finished(i, std::move(*prev));
+        return;
+      }
+    }
+    if (!fs::exists(yaml, ec)) output::write_file_atomically(yaml, c.resolved.yaml);
+    ready.push_back(i);
+  };
+  // Writes the rows of the finished cases at the head of the study order.
+  const auto write_rows = [&]() {
+    for (auto it = slots.begin(); it != slots.end() && it->first == next_row && it->second.finished; it = slots.erase(it)) {
+      const CaseRecord& c = it->second.record;
+      results->add(it->first, c);
+      report.add(it->first, c);
+      if (c.cached) {
+        ++cached;
+        progress.reused();
+      } else {
+        progress.step(!c.outcome.ok);
+      }
+      ++next_row;
+    }
+  };
   const auto record = [&](std::size_t i, Outcome out) {
     if (out.interrupted) return;  // not an outcome: the case runs again next time
-    CaseRecord& c = cases[i];
-    c.outcome = std::move(out);
-    case_time += c.outcome.wall_s;
-    output::write_file_atomically(dir / "cases" / (c.resolved.hash + ".json"), outcome_json(c.resolved.hash, c.outcome));
-    progress.step(!c.outcome.ok);
-    --remaining;
+    const Slot& sl = slots.at(i);
+    case_time += out.wall_s;
+    ++ran;
+    output::write_file_atomically(dir / "cases" / (sl.record.resolved.hash + ".json"), outcome_json(sl.record.resolved.hash, out));
+    finished(i, std::move(out));
   };
   try {
-    Pool pool(jobs, [&cases](std::size_t i) { return run_case(cases[i].resolved.yaml); });
+    results = std::make_unique<ResultsWriter>(study, dir);
+    // The scenarios handed to the threads (slots belongs to this thread alone).
+    std::map<std::size_t, std::string> to_run;
+    std::mutex to_run_mu;
+    Pool pool(jobs, [&to_run, &to_run_mu](std::size_t i) {
+      std::string text;
+      {
+        std::lock_guard<std::mutex> g(to_run_mu);
+        text = std::move(to_run.at(i));
+        to_run.erase(i);
+      }
+      return run_case(text);
+    });
     int released = 0;  // ranks told there is no more work
-    while (remaining > 0 || (t && released < t->size() - 1)) {
+    while (next_row < total || (t && released < t->size() - 1)) {
       if (interrupt::interrupted()) {
         // Ctrl-C or SIGTERM: the running cases stop at their next poll; what finished is kept.
         while (pool.in_flight() > 0)
           if (auto r = pool.pop(std::chrono::milliseconds(100))) record(r->first, std::move(r->second));
         progress.finish();
-        const int sig = interrupt::signal_number();
-        std::fprintf(stderr, "interrupted by %s: %zu of %zu cases finished and kept in %s; run the same command to go on\n",
-                     interrupt::signal_name(sig).c_str(), cases.size() - remaining, cases.size(), dir.c_str());
-        if (t) t->abort(128 + sig);
-        return 128 + sig;
+        return interrupted_exit(t, ": " + std::to_string(next_row) + " of " + std::to_string(total) +
+                                       " cases finished in order (and every case run is kept in " + dir.string() +
+                                       "/cases); run the same command to go on");
       }
-      while (pool.in_flight() < static_cast<std::size_t>(jobs) && !pending.empty()) {
-        pool.push(pending.front());
-        pending.pop_front();
+      // Hand out cases in order, within the window, as long as a thread or a rank can take one.
+      const std::size_t want = static_cast<std::size_t>(jobs) + waiting.size() + (t ? 1 : 0);
+      while (next_case < total && next_case - next_row < window && ready.size() < want && !interrupt::interrupted())
+        prepare_next();
+      while (pool.in_flight() < static_cast<std::size_t>(jobs) && !ready.empty()) {
+        {
+          std::lock_guard<std::mutex> g(to_run_mu);
+          to_run[ready.front()] = slots.at(ready.front()).record.resolved.yaml;
+        }
+        pool.push(ready.front());
+        ready.pop_front();
       }
-      if (auto r = pool.pop(std::chrono::milliseconds(t ? 2 : 200))) record(r->first, std::move(r->second));
+      while (t && !waiting.empty() && (!ready.empty() || next_case == total)) {
+        const int rank = waiting.front();
+        waiting.pop_front();
+        if (ready.empty()) {
+          t->send(rank, kAssign, "");
+          ++released;
+        } else {
+          const std::size_t i = ready.front();
+          ready.pop_front();
+          t->send(rank, kAssign, pack(i, slots.at(i).record.resolved.yaml));
+        }
+      }
+      write_rows();
+      const bool busy = pool.in_flight() > 0 || t;
+      if (busy) {
+        if (auto r = pool.pop(std::chrono::milliseconds(t ? 2 : 200))) record(r->first, std::move(r->second));
+      }
       while (t) {
         auto m = t->poll();
         if (!m) break;
         if (m->tag == kRequest) {
-          if (pending.empty()) {
-            t->send(m->from, kAssign, "");
-            ++released;
-          } else {
-            const std::size_t i = pending.front();
-            pending.pop_front();
-            t->send(m->from, kAssign, pack(i, cases[i].resolved.yaml));
-          }
+          waiting.push_back(m->from);
         } else if (m->tag == kResult) {
           auto [i, text] = unpack(m->payload);
-          if (i >= cases.size()) throw std::runtime_error("rank " + std::to_string(m->from) + " sent an outcome for no case");
+          if (!slots.count(i) || slots.at(i).finished)
+            throw std::runtime_error("rank " + std::to_string(m->from) + " sent an outcome for no case it was given");
           auto out = parse_outcome(text, "");  // the other ranks do not hash: the index names the case
           if (!out) throw std::runtime_error("rank " + std::to_string(m->from) + " sent a malformed outcome for case " + std::to_string(i));
           record(i, std::move(*out));
         }
       }
+      write_rows();
     }
+  } catch (const interrupt::Interrupted&) {
+    progress.finish();
+    return interrupted_exit(t, ": " + std::to_string(next_row) + " of " + std::to_string(total) + " cases finished in order; run the same command to go on");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "\nerror: %s\n", e.what());
     if (t) t->abort(1);
@@ -219,17 +329,15 @@ int run_study(const Options& o, Transport* t) {
   }
   progress.finish();
 
-  std::size_t failed = 0;
-  for (const CaseRecord& c : cases) failed += c.outcome.ok ? 0 : 1;
   try {
-    output::write_file_atomically(dir / "results.csv", results_csv(study, cases));
+    results->finish();
     std::string plots_md = "Plots skipped (--no-plots).\n\n";
     if (o.plots) {
       const fs::path partial = dir / ".plots.partial";
       std::error_code ec;
       fs::remove_all(partial, ec);
       try {
-        plots_md = write_plots(partial, "plots/", study, cases);
+        plots_md = write_plots(partial, "plots/", report);
         output::replace_folder(partial, dir / "plots");  // never a moment without plots/
       } catch (const interrupt::Interrupted&) {
         fs::remove_all(partial, ec);
@@ -240,23 +348,26 @@ int run_study(const Options& o, Transport* t) {
         plots_md = "Plots not drawn: " + std::string(e.what()) + "\n\n";
       }
     }
-    output::write_file_atomically(dir / "report.md", report_md(study, cases, o.command, plots_md));
+    output::write_file_atomically(dir / "report.md", report_md(report, o.command, plots_md));
     nlohmann::ordered_json timing;
     timing["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    timing["cases"] = cases.size();
-    timing["cases_run"] = cases.size() - cached;
+    timing["cases"] = total;
+    timing["cases_run"] = ran;
     timing["cases_reused"] = cached;
+    timing["cases_not_resolved"] = unresolved;  // failed before running: their scenario is invalid
     timing["case_time_sum_s"] = case_time;
     timing["threads_per_rank"] = jobs;
     timing["ranks"] = ranks;
     output::write_file_atomically(dir / "timing.json", timing.dump(2) + "\n");
+  } catch (const interrupt::Interrupted&) {
+    return interrupted_exit(t, ": every case finished and is kept in " + dir.string() + "/cases; run the same command to write the report");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
   }
-  if (!o.quiet || failed > 0)
-    std::fprintf(stderr, "%s: %zu cases, %zu failed (see results.csv) -> %s/results.csv, report.md\n", study.name.c_str(),
-                 cases.size(), failed, dir.c_str());
+  if (!o.quiet || report.failed > 0)
+    std::fprintf(stderr, "%s: %zu cases (%zu run, %zu reused), %zu failed (see results.csv) -> %s/results.csv, report.md\n",
+                 study.name.c_str(), total, ran, cached, report.failed, dir.c_str());
   return 0;
 }
 

@@ -332,6 +332,11 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
     if (base.IsScalar()) {
       const std::string path = resolve_path(base_dir, base.Scalar());
       s.base_yaml = read_file(path, "base");
+      try {
+        sim::load_yaml_strict(s.base_yaml);  // its YAML errors name the file (its keys are checked per case)
+      } catch (const sim::ScenarioError& e) {
+        fail("base", " = '" + base.Scalar() + "': " + e.what());
+      }
       s.base_dir = fs::path(path).parent_path().string();
       if (s.base_dir.empty()) s.base_dir = ".";
     } else if (base.IsMap()) {

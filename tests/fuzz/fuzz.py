@@ -13,6 +13,13 @@ Modes (each a ctest entry, tests/CMakeLists.txt):
             network namespace) run by feeddrive-log2csv and feeddrive-fit: truncation, bit flips
             (anywhere, in event headers, in channel names, in sequence numbers), dropped,
             duplicated and swapped events.
+  yaml      YAML constructs in scenarios/paper/*.yaml (issue 19, point 8): a recursive alias (a map
+            or list holding its own ancestor, anywhere in the tree), a merge key (<<: a map or a
+            list of maps), a shared (non-recursive) alias, each read by every tool that reads YAML:
+            feeddrive-sim, feeddrive-study (the scenario as the study's base file, or inline as its
+            base map) and feeddrive-fit (the scenario as its model). A recursive alias or a merge
+            key must give exit 2 and one line naming the construct ("recursive YAML alias",
+            "merge key"); before the fix yaml-cpp's cycle crashed every tool (exit 139).
 
 Every case must end in one of two ways:
   * exit 2, exactly one line on stderr, and no output folder (nor a staging folder);
@@ -548,6 +555,110 @@ def case_lcm(args, seed, base):
     return None if why is None else fail_report("lcm", seed, why, desc, rc, out, err)
 
 
+# ---------------------------------------------------------------- YAML constructs (issue 19, point 8)
+def containers(node, path=()):
+    """(path, node) of every map and list of the tree, the root first."""
+    if isinstance(node, (dict, list)):
+        yield path, node
+        items = node.items() if isinstance(node, dict) else enumerate(node)
+        for k, v in items:
+            yield from containers(v, path + (k,))
+
+
+def mutate_yaml(rng, text):
+    """Returns (mutated text, the construct the tools must name, or None if none is refused)."""
+    doc = yaml.safe_load(text)
+    kind = rng.choice(["recursive", "recursive", "merge", "merge", "shared"])
+    spots = list(containers(doc))
+    path, node = rng.choice(spots)
+    if kind == "recursive":
+        # The node itself or one of its ancestors, held inside it: PyYAML writes &id001 ... *id001.
+        ancestor = get(doc, path[:rng.randint(0, len(path))])
+        if isinstance(node, dict):
+            node[rng.choice(["inner", "extra", "model"])] = ancestor
+        else:
+            node.insert(rng.randint(0, len(node)), ancestor)
+        want = "recursive YAML alias"
+    elif kind == "merge":
+        maps = [n for _, n in spots if isinstance(n, dict)]
+        target = rng.choice(maps)
+        source = copy.deepcopy(rng.choice(maps))
+        value = source if rng.random() < 0.7 else [source, {"extra": 1}]
+        target[MERGE] = value
+        want = "merge key"
+    else:
+        other_path, other = rng.choice(spots)
+        if rng.random() < 0.2:
+            other, other_path = copy.deepcopy(other), None  # a copy: no alias at all
+        if isinstance(node, dict):
+            node[rng.choice(["extra", "shared"])] = other
+        else:
+            node.append(other)
+        # `other` may be an ancestor of `node`: then the alias is recursive after all.
+        want = "recursive YAML alias" if other_path is not None and other_path == path[:len(other_path)] else None
+    out = yaml.dump(doc, Dumper=MergeDumper, sort_keys=False, allow_unicode=True, width=10**9)
+    return out, want
+
+
+class MergeKey(str):
+    """A key written as a plain << (PyYAML quotes a str '<<', which is an ordinary key)."""
+
+
+MERGE = MergeKey("<<")
+
+
+class MergeDumper(yaml.SafeDumper):
+    pass
+
+
+MergeDumper.add_representer(MergeKey, lambda d, v: yaml.ScalarNode("tag:yaml.org,2002:merge", "<<", style=None))
+MergeDumper.add_implicit_resolver("tag:yaml.org,2002:merge", __import__("re").compile(r"^(?:<<)$"), ["<"])
+
+
+def case_yaml(args, seed, base):
+    rng = random.Random(seed)
+    name = rng.choice(sorted(base["scenarios"]))
+    case_dir = tempfile.mkdtemp(prefix=f"fuzz-{seed}-", dir=args.work)
+    text, want = mutate_yaml(rng, base["scenarios"][name])
+    path = os.path.join(case_dir, "s.yaml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+    tools = ["sim", "study_file", "study_inline"] + (["fit"] if want else [])  # the fit runs only to refuse
+    why = None
+    for tool in tools:
+        out_dir = os.path.join(case_dir, "out-" + tool)
+        if tool == "sim":
+            cmd = [os.path.join(args.bin, "feeddrive-sim"), path, "--out", out_dir, "-q", "--no-plots"]
+        elif tool == "fit":
+            cmd = [os.path.join(args.bin, "feeddrive-fit"), "-s", path, "-d", base["csv"], "--out", out_dir, "-q",
+                   "--no-plots", "--max-effects", "1"]
+        else:
+            study = os.path.join(case_dir, tool + ".yaml")
+            with open(study, "w", encoding="utf-8") as f:
+                if tool == "study_file":
+                    f.write("name: fuzz\nbase: s.yaml\nset: {duration: 0.01}\n")
+                else:  # the scenario text indented under base: (its anchors and aliases inside the study)
+                    f.write("name: fuzz\nset: {duration: 0.01}\nbase:\n" + "".join("  " + l + "\n" for l in text.splitlines()))
+            cmd = [os.path.join(args.bin, "feeddrive-study"), study, "--out", out_dir, "-q", "--no-plots", "-j", "1"]
+        rc, out, err = run(cmd, case_dir, args.timeout)
+        if rc is None:
+            why = f"{tool}: timeout (hang)"
+        elif want:
+            if rc != 2 or len(err.splitlines()) != 1 or want not in err:
+                why = f"{tool}: expected exit 2 and one line naming the {want!r}"
+            elif os.path.exists(out_dir):
+                why = f"{tool}: exit 2 but an output folder was created"
+        else:
+            why = judge(case_dir, out_dir, rc, err, lambda: None)
+            why = why and f"{tool}: {why}"
+        if why:
+            why += f"\n  command: {' '.join(cmd)}"
+            break
+    if why is None and not args.keep:
+        shutil.rmtree(case_dir, ignore_errors=True)
+    return None if why is None else fail_report("yaml", seed, why, f"(from {name}, expected: {want})\n" + text, rc, out, err)
+
+
 def make_fit_base(args):
     """A short record of the docs/fit.md "real drive" (truth_cogging.yaml, 1.5 s) as CSV t,x,u."""
     d = tempfile.mkdtemp(prefix="fuzz-base-", dir=args.work)
@@ -576,7 +687,7 @@ def make_fit_base(args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("mode", choices=["scenario", "csv", "lcm"])
+    ap.add_argument("mode", choices=["scenario", "csv", "lcm", "yaml"])
     ap.add_argument("--src", required=True, help="source folder")
     ap.add_argument("--bin", required=True, help="folder of the feeddrive executables")
     ap.add_argument("--seed", type=int, default=1, help="first seed")
@@ -598,6 +709,14 @@ def main():
     elif args.mode == "csv":
         base = make_fit_base(args)
         fn = case_csv
+    elif args.mode == "yaml":
+        folder = os.path.join(args.src, "scenarios/paper")
+        scenarios = {n: open(os.path.join(folder, n), encoding="utf-8").read() for n in os.listdir(folder) if n.endswith(".yaml")}
+        csv = os.path.join(args.work, "d.csv")  # read only if the fit got past the scenario (it must not)
+        with open(csv, "w", encoding="utf-8") as f:
+            f.write("t,x,u\n" + "".join(f"{i * 1e-3!r},0.0,0.0\n" for i in range(100)))
+        base = {"scenarios": scenarios, "csv": csv}
+        fn = case_yaml
     else:
         data = open(args.log, "rb").read()
         base = {"log": data, "events": lcm_events(data), "scenario": args.scenario}

@@ -58,5 +58,40 @@ TEST(YamlStrict, NameIsBoundedPrintableUtf8) {
   EXPECT_EQ(parse_scenario("name: " + std::string(kMaxNameBytes, 'x') + "\n" + kTail).name.size(), kMaxNameBytes);
 }
 
+// Issue 19, point 8: yaml-cpp makes an alias the very node of its anchor, so an alias inside its
+// own anchor is a cycle that every traversal followed until the stack overflowed (exit 139). The
+// loader refuses it, and merge keys, from the parser's events, at the alias's or key's own place.
+TEST(YamlStrict, RecursiveAliasIsRefusedAtTheAlias) {
+  EXPECT_EQ(error_of(kTail + "friction: &f {model: lugre, inner: *f}\n"),
+            "s.yaml: line 4, column 36: friction.inner: recursive YAML alias *f inside its own anchor &f (line 4): not "
+            "supported (an alias may only repeat a finished node)");
+  // In a list, deeper down, and through an ancestor rather than the node itself.
+  EXPECT_EQ(error_of(kTail + "k: &s [1, [2, *s]]\n"),
+            "s.yaml: line 4, column 15: k[1][1]: recursive YAML alias *s inside its own anchor &s (line 4): not "
+            "supported (an alias may only repeat a finished node)");
+  EXPECT_EQ(error_of(kTail + "plant: &p\n  mass: 1\n  friction:\n    inner: [*p]\n"),
+            "s.yaml: line 7, column 13: plant.friction.inner[0]: recursive YAML alias *p inside its own anchor &p "
+            "(line 4): not supported (an alias may only repeat a finished node)");
+  // The root itself.
+  EXPECT_NE(error_of("&r\n" + kTail + "x: *r\n").find("x: recursive YAML alias *r"), std::string::npos);
+}
+
+TEST(YamlStrict, MergeKeyIsRefusedAtTheKey) {
+  EXPECT_EQ(error_of(kTail + "a: &a {x: 1}\nb:\n  <<: *a\n  y: 2\n"),
+            "s.yaml: line 6, column 3: b.<<: YAML merge key (<<) not supported: write the keys out");
+  EXPECT_EQ(error_of("<<: {duration: 1}\n" + kTail),
+            "s.yaml: line 1, column 1: <<: YAML merge key (<<) not supported: write the keys out");
+  EXPECT_NE(error_of(kTail + "plant: {<<: [{mass: 1}, {mass: 2}]}\n").find("plant.<<: YAML merge key"), std::string::npos);
+  // A quoted '<<' is an ordinary key (YAML 1.1): the loader's unknown-key rule names it.
+  EXPECT_EQ(error_of(kTail + "'<<': 1\n"), "s.yaml: <<: unknown key");
+}
+
+TEST(YamlStrict, AliasesOfFinishedNodesStillWork) {
+  // An alias that repeats a finished node is no cycle: it loads like the written-out copy.
+  const Scenario a = parse_scenario(kTail + "plant: {friction: {model: lugre, static_force: &v 150, coulomb_force: *v}}\n");
+  EXPECT_EQ(a.plant.friction.static_force, 150.0);
+  EXPECT_EQ(a.plant.friction.coulomb_force, 150.0);
+}
+
 }  // namespace
 }  // namespace feeddrive::sim

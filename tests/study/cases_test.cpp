@@ -59,6 +59,42 @@ TEST(StudyCases, ExpansionOrderAndGridMixedRadix) {
   EXPECT_EQ(p4[2].value, "110");
 }
 
+// Issue 19, point 9: a case is made from its index alone (a study of 10^6 is never expanded at
+// once). The same cases as the nested loops of the documented order: controller, family, grid
+// point, draw.
+TEST(StudyCases, CaseAtIndexIsTheDocumentedOrder) {
+  const Study s = families();
+  ASSERT_EQ(case_count(s), 114u);
+  std::size_t i = 0;
+  for (std::size_t c = 0; c < 2; ++c)
+    for (std::size_t f = 0; f < 3; ++f) {
+      const long points = f == 1 ? 6 : 1, draws = f == 2 ? 50 : 0;
+      for (long p = 0; p < points; ++p)
+        for (long d = draws > 0 ? 0 : -1; d < draws; ++d, ++i) {
+          const CaseSpec cs = case_at(s, i);
+          ASSERT_EQ(cs.controller, c) << i;
+          ASSERT_EQ(cs.family, f) << i;
+          ASSERT_EQ(cs.point, p) << i;
+          ASSERT_EQ(cs.draw, d) << i;
+        }
+    }
+  EXPECT_EQ(i, case_count(s));
+  EXPECT_THROW(case_at(s, case_count(s)), std::out_of_range);
+  // The variations too: case_at(113) is the last draw of the cascade's Monte Carlo family.
+  const CaseSpec last = case_at(s, 113);
+  ASSERT_EQ(last.variations.size(), 4u);
+  EXPECT_EQ(last.variations[0].value, validate::format_number(draw_value(s.families[2].monte_carlo.parameters[0], 11, 49, 0)));
+}
+
+TEST(StudyCases, ProbesCoverEveryAxisValueOnceWithinTheBudget) {
+  const Study s = families();
+  // Per controller: nominal (0), grid (first case 1; mass value 1 = point 3, case 4: stride 3; friction
+  // values 1, 2 = points 1, 2), mc (its first case 7); the cascade's the same + 57.
+  const std::vector<std::size_t> want = {0, 1, 2, 3, 4, 7, 57, 58, 59, 60, 61, 64};
+  EXPECT_EQ(probe_cases(s, 1000), want);
+  EXPECT_EQ(probe_cases(s, 3), std::vector<std::size_t>(want.begin(), want.begin() + 3));
+}
+
 TEST(StudyCases, DrawsAreTheSameForEveryControllerAndInsideTheirBounds) {
   const Study s = families();
   const auto cases = expand(s);

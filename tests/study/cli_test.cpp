@@ -111,6 +111,27 @@ TEST(StudyCli, SameBytesForAnyJobsAndRerunsSkipFinishedCases) {
   EXPECT_EQ(csv2.find(",81.632"), std::string::npos);  // 102.04 x 0.8 is gone
 }
 
+// Issue 19, point 9: the cases are resolved as they are handed out; before any runs, only the
+// probe cases (each grid value once, cases.hpp). A case that fails to resolve later (here only
+// the combination static 50 N < Coulomb 80 N is invalid; each value alone is fine) is a failed
+// case in results.csv, named by the loader's one line, and the others run.
+TEST(StudyCli, ACaseThatDoesNotResolveIsAFailedCase) {
+  const fs::path s = write_file("combo.yaml", feeddrive::study::test::study_text(
+                                                  "families:\n  - name: f\n    grid:\n"
+                                                  "      - {key: plant.friction.static_force, values: [100, 50]}\n"
+                                                  "      - {key: plant.friction.coulomb_force, values: [40, 80]}\n"));
+  const fs::path out = scratch() / "combo";
+  const ProcResult r = study(s.string() + " --out " + out.string() + " --no-plots -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(out / "results.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5) << csv;
+  EXPECT_NE(csv.find("\n3,base,f,3,,,50,80,false,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("plant.friction.static_force = 50: must be >= coulomb_force"), std::string::npos) << csv;
+  EXPECT_EQ(timing(out)["cases_run"], 3);
+  EXPECT_EQ(timing(out)["cases_not_resolved"], 1);
+  EXPECT_NE(slurp(out / "report.md").find("| 3 | base | f |"), std::string::npos);
+}
+
 TEST(StudyCli, BadStudiesAndFoldersExit2WithOneLine) {
   const auto one_line = [](const ProcResult& r) {
     EXPECT_EQ(r.code, 2) << r.err;

@@ -28,7 +28,12 @@ using ResolvedKeys = std::map<std::string, ResolvedValue>;
 ///     swallow the rest of the file into it: "name: \"abc" then reported "duration: missing");
 ///   * a key that appears twice in one map ("duration: duplicate key on lines 2 and 7"; yaml-cpp
 ///     keeps the first silently);
-///   * more than 100000 nodes (aliases that expand exponentially).
+///   * more than 100000 nodes (aliases that expand exponentially);
+///   * a recursive alias, inside its own anchor ("line 1, column 37: friction.inner: recursive YAML
+///     alias *f inside its own anchor &f (line 1): ..."): yaml-cpp would build a cycle that every
+///     traversal follows until the stack overflows;
+///   * a merge key ("line 3, column 3: b.<<: YAML merge key (<<) not supported ...").
+/// The one YAML loader of every tool (scenario, study, fit): nothing else calls YAML::Load.
 YAML::Node load_yaml_strict(const std::string& text);
 
 class MapReader {

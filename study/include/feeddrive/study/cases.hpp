@@ -47,8 +47,22 @@ struct CaseSpec {
   std::vector<Variation> variations;
 };
 
-/// Every case of the study in order. Pure; the study must have passed validate().
+/// The number of cases of the study (Study::total_cases, at most kMaxCases).
+std::size_t case_count(const Study& s);
+
+/// Case `index` (0 <= index < case_count) of the study, made from its index alone: the cases are
+/// generated lazily, one at a time, never all at once (a study has up to 10^6). Pure; the study
+/// must have passed validate().
+CaseSpec case_at(const Study& s, std::size_t index);
+
+/// Every case of the study in order (case_at for each index; for tests and small studies).
 std::vector<CaseSpec> expand(const Study& s);
+
+/// The cases resolved before any case runs, so the usual mistakes exit 2 before anything is
+/// written: for each controller and family its first case and one case per further value of each
+/// grid axis (the other axes at their first value, draw 0), in study order, at most `budget`.
+/// The other cases are resolved as they are handed out; one that fails is a failed case.
+std::vector<std::size_t> probe_cases(const Study& s, std::size_t budget);
 
 /// Grid point `point` of family f: one variation per key of every axis.
 std::vector<Variation> grid_point(const Family& f, long point);

@@ -71,6 +71,8 @@ class Progress {
  public:
   Progress(std::size_t total, std::size_t already_done, bool enabled);
   void step(bool failed);
+  /// A case finished in an earlier run (no time spent on it here).
+  void reused() { ++done_; }
   void finish();
 
  private:
