@@ -6,7 +6,8 @@
 //     a median period ~1000x or ~1e6x the scenario's control period is a time column in ms or us;
 //   * position: a travel above kMaxTravel or a speed above kMaxSpeed is beyond a feed drive (a
 //     column in mm, um or nm); a step whose acceleration is beyond 20x what the peak thrust gives
-//     the mass (and beyond the sensor's own second difference) is a discontinuity;
+//     the mass (and beyond 50x the sensor's own second difference and 20x the record's 99th
+//     percentile of it) is a discontinuity;
 //   * force: the thrust must move the model's mass. The filtered thrust is regressed on
 //     m * (filtered acceleration), a constant, sgn v and v (the modulating-function balance of
 //     model.hpp with a generic friction); the ratio of thrust to m*a must lie within a factor
