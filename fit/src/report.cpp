@@ -76,11 +76,15 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["force_residual_rms_initial_N"] = r.force_rms_initial;
   j["force_residual_rms_final_N"] = r.force_rms_final;
   j["effects"] = nlohmann::json::array();
-  for (const StepResult& st : r.steps) {
-    if (!st.accepted) continue;
-    Effect final = st.effect;
-    for (const Effect& e : r.effects)
-      if (e.name == st.effect.name) final = e;
+  // the named effects with their final (jointly refitted) parameters, each with the step that
+  // brought it in: the step that added it, or the one whose swap move turned an earlier effect into it
+  for (const Effect& final : r.effects) {
+    const StepResult* from = nullptr;
+    for (const StepResult& st : r.steps) {
+      if (!st.accepted) continue;
+      const std::string into = st.swap.empty() ? "" : st.swap.substr(st.swap.rfind(' ') + 1);
+      if (st.effect.name == final.name || into == final.name) from = &st;
+    }
     nlohmann::json ci = nlohmann::json::object();
     if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
       for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
@@ -90,9 +94,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
                             {"ci95", ci},
                             {"tentative", tent != r.tentative.end()},
                             {"caveat", tent != r.tentative.end() ? tent->second : std::string()},
-                            {"score", st.score},
-                            {"gap_before", st.gap_before},
-                            {"gap_after", st.gap_after}});
+                            {"score", from ? nlohmann::json(from->score) : nlohmann::json()},
+                            {"gap_before", from ? nlohmann::json(from->gap_before) : nlohmann::json()},
+                            {"gap_after", from ? nlohmann::json(from->gap_after) : nlohmann::json()}});
   }
   j["verdict"] = verdict_name(r.verdict);
   j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;

@@ -266,7 +266,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
           c.reason = Reason::kImplausible;
           break;
         }
-        c.swap = swap_from + " -> " + (simple.name == swap_from ? swap_from + " of a third of the pitch" : simple.name);
+        c.swap = swap_from + (simple.name == swap_from ? " (its fundamental vanished: its harmonic)" : "") + " -> " + simple.name;
         jf = js;
         fs = fs2;
       }
