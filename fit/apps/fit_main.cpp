@@ -110,6 +110,7 @@ int main(int argc, char** argv) {
     // sanity before fitting: units, gaps and jumps (fit/sanity.hpp)
     fit::check_record(data, scenario.plant, scenario.control_period);
     const fit::Record rec = fit::prepare(data, opt.record);
+    fit::check_options(rec, opt);
     fit::check_force_scale(rec, scenario.plant);
     for (const std::string& n : data.notes) spdlog::warn("{}: {}", data_path, n);
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),

@@ -63,8 +63,12 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
     }
   }
   // 3. the position scale: travel and speed a feed drive can have
-  const auto [lo, hi] = std::minmax_element(d.x.begin(), d.x.end());
-  const double travel = *hi - *lo;
+  // the range between the 0.1th and 99.9th percentiles: an isolated outlier is no unit (it is
+  // named by the jump check below, or by prepare()'s finiteness check)
+  std::vector<double> xs = d.x;
+  std::sort(xs.begin(), xs.end());
+  const double travel = xs[static_cast<std::size_t>(0.999 * static_cast<double>(n - 1))] -
+                        xs[static_cast<std::size_t>(0.001 * static_cast<double>(n - 1))];
   std::vector<double> speed;
   speed.reserve(n);
   for (std::size_t k = 1; k < n; ++k) speed.push_back(std::abs(d.x[k] - d.x[k - 1]) / (d.t[k] - d.t[k - 1]));
@@ -118,6 +122,15 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
     }
   }
   if (jump > 0) {
+    // an isolated outlier (a spike: the samples around it agree) rather than a jump
+    for (std::size_t k = std::max<std::size_t>(jump, 1) - 0; k <= jump + 1 && k + 1 < n; ++k) {
+      const double off = std::abs(d.x[k] - 0.5 * (d.x[k - 1] + d.x[k + 1]));
+      if (std::abs(d.x[k + 1] - d.x[k - 1]) < 0.1 * off)
+        throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
+                        fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
+                            "column in metres and free of outliers?",
+                            d.x[k], d.t[k] + d.time_offset, off));
+    }
     // the step of the jump is the larger of the two around sample `jump`
     const std::size_t k = std::abs(d.x[jump + 1] - d.x[jump]) > std::abs(d.x[jump] - d.x[jump - 1]) ? jump + 1 : jump;
     // the step less the motion around it (the mean of the neighbouring steps)

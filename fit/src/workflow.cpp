@@ -58,13 +58,17 @@ double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v
 
 }  // namespace
 
-FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const FitOptions& opt, const Log& log) {
+void check_options(const Record& rec, const FitOptions& opt) {
   // A replay window must hold more samples than the two its start-state correction fits
   // (offset and slope): a window of 2 or 3 samples replays any model with a gap of 0.
-  if (opt.replay_window > 0 && opt.replay_window < 10.0 * rec_in.period)
-    throw DataError(rec_in.data->source + fmt(": --replay-window %.3g s spans fewer than 10 sample periods (%.3g s) of the "
-                                              "record; use at least %.3g s, or 0 for the default",
-                                              opt.replay_window, rec_in.period, 10.0 * rec_in.period));
+  if (opt.replay_window > 0 && opt.replay_window < 10.0 * rec.period)
+    throw DataError(rec.data->source + fmt(": --replay-window %.3g s spans fewer than 10 sample periods (%.3g s) of the "
+                                           "record; use at least %.3g s, or 0 for the default",
+                                           opt.replay_window, rec.period, 10.0 * rec.period));
+}
+
+FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const FitOptions& opt, const Log& log) {
+  check_options(rec_in, opt);
   Record rec = rec_in;
   mask_stiction(rec, model);
   const long n = rec.active_points();

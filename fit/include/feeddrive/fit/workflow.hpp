@@ -84,6 +84,10 @@ struct FitResult {
   std::vector<std::string> ties;
 };
 
+/// The options against the record (e.g. a replay window of at least 10 sample periods). Throws
+/// DataError. run_fit calls it first; feeddrive-fit calls it before the sanity checks.
+void check_options(const Record& rec, const FitOptions& opt);
+
 using Log = std::function<void(const std::string&)>;
 FitResult run_fit(const Record& rec, const plant::PlantParams& model, const FitOptions& opt, const Log& log = {});
 
