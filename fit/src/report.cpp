@@ -87,16 +87,19 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
     }
     nlohmann::json ci = nlohmann::json::object();
     if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
-      for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+      for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
     const auto tent = r.tentative.find(final.name);
-    j["effects"].push_back({{"name", final.name},
-                            {"parameters", params_json(final)},
-                            {"ci95", ci},
-                            {"tentative", tent != r.tentative.end()},
-                            {"caveat", tent != r.tentative.end() ? tent->second : std::string()},
-                            {"score", from ? nlohmann::json(from->score) : nlohmann::json()},
-                            {"gap_before", from ? nlohmann::json(from->gap_before) : nlohmann::json()},
-                            {"gap_after", from ? nlohmann::json(from->gap_after) : nlohmann::json()}});
+    nlohmann::json e = {{"name", final.name},
+                        {"parameters", params_json(final)},
+                        {"ci95", ci},
+                        {"tentative", tent != r.tentative.end()},
+                        {"caveat", tent != r.tentative.end() ? tent->second : std::string()}};
+    if (from) {
+      e["score"] = from->score;
+      e["gap_before"] = from->gap_before;
+      e["gap_after"] = from->gap_after;
+    }
+    j["effects"].push_back(e);
   }
   j["verdict"] = verdict_name(r.verdict);
   j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
