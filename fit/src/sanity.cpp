@@ -1,4 +1,5 @@
 #include "feeddrive/fit/sanity.hpp"
+#include "text.hpp"
 
 #include "feeddrive/plant/effects.hpp"
 
@@ -10,13 +11,9 @@
 #include <vector>
 
 namespace feeddrive::fit {
+using text::fmt;
+using text::par;
 namespace {
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[400];
-  std::snprintf(buf, sizeof buf, f, a, b, c, d);
-  return buf;
-}
 
 // The power of 1000 nearest to r: round(log10(r) / 3).
 int thousands(double r) { return static_cast<int>(std::lround(std::log10(r) / 3.0)); }

@@ -1,4 +1,5 @@
 #include "feeddrive/fit/verdict.hpp"
+#include "text.hpp"
 
 #include "feeddrive/plant/effects.hpp"
 
@@ -8,21 +9,8 @@
 #include <set>
 
 namespace feeddrive::fit {
-namespace {
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[400];
-  std::snprintf(buf, sizeof buf, f, a, b, c, d);
-  return buf;
-}
-
-double par(const Effect& e, const char* k) {
-  const auto it = e.parameters.find(k);
-  return it == e.parameters.end() ? 0.0 : it->second;
-}
-
-}  // namespace
-
+using text::fmt;
+using text::par;
 NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
   const MeasuredData& d = *rec.data;
   NoiseFloor f;

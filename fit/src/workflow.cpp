@@ -1,4 +1,5 @@
 #include "feeddrive/fit/workflow.hpp"
+#include "text.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -10,14 +11,10 @@
 #include <optional>
 
 namespace feeddrive::fit {
+using text::fmt;
+using text::par;
 
 namespace {
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, f, a, b, c, d);
-  return buf;
-}
 
 double bic_of(double rss, int k, long n) {
   const double nn = static_cast<double>(n);

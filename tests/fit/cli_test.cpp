@@ -535,17 +535,31 @@ fs::path drivegen(const std::string& name, const std::string& args) {
   return dir;
 }
 
+// fd-drivegen ARGS into scratch()/gen_NAME, then feeddrive-fit on its model.yaml and data.csv
+// into scratch()/NAME: the run and its findings.json (empty if none was written).
+struct GeneratedFit {
+  ProcResult run;
+  nlohmann::json findings;
+  fs::path out;
+};
+GeneratedFit generate_and_fit(const std::string& name, const std::string& args) {
+  const fs::path dir = drivegen("gen_" + name, args);
+  GeneratedFit g{run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
+                         " --out " + (scratch() / name).string() + " --no-plots -q"),
+                 {}, scratch() / name};
+  if (fs::exists(g.out / "findings.json")) g.findings = issue20::findings(g.out);
+  return g;
+}
+
 // "Unexplained": a 49.5 mm ripple over 79 mm of travel (1.6 periods) and a 30 % mass error. The
 // ripple cannot be resolved; the gap stays at ~23 um against a 0.04 um floor: exit 3, and the
 // report says where, what it resembles, why not and what record would settle it.
 TEST(FitVerdict, UnexplainedSaysWhatWouldSettleItAndExitsThree) {
   using namespace issue20;
-  const fs::path dir = drivegen("gen_unexplained", "5 10 cogging_ripple,mass_error periods=1.6");
-  const fs::path out = scratch() / "verdict_unexplained";
-  const ProcResult r = run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
-                               " --out " + out.string() + " --no-plots -q");
+  const GeneratedFit g = generate_and_fit("verdict_unexplained", "5 10 cogging_ripple,mass_error periods=1.6");
+  const ProcResult& r = g.run;
   ASSERT_EQ(r.code, 3) << r.err << r.out;
-  const auto j = findings(out);
+  const auto& j = g.findings;
   EXPECT_EQ(j["verdict"], "unexplained");
   EXPECT_EQ(j["exit_code"], 3);
   EXPECT_GT(j["gap_final"].get<double>(), 3.0 * j["noise_floor"]["gap_m"].get<double>());
@@ -557,7 +571,7 @@ TEST(FitVerdict, UnexplainedSaysWhatWouldSettleItAndExitsThree) {
   EXPECT_NE(all.find("a force periodic in position, pitch about"), std::string::npos) << all;
   EXPECT_NE(all.find("record a travel of at least 3 periods"), std::string::npos) << all;
   EXPECT_EQ(j["conclusion"].get<std::string>().find("within its noise"), std::string::npos);
-  EXPECT_NE(slurp(out / "report.md").find("## Unexplained discrepancy"), std::string::npos);
+  EXPECT_NE(slurp(g.out / "report.md").find("## Unexplained discrepancy"), std::string::npos);
 }
 
 // The issue's first case: a 40.2 mm ripple over 78.7 mm (pitch 2.2 % above travel/2) and a
@@ -566,12 +580,10 @@ TEST(FitVerdict, UnexplainedSaysWhatWouldSettleItAndExitsThree) {
 // gap reaches the floor. Every parameter has its 95 % interval.
 TEST(FitVerdict, BorderlinePitchIsTentativeAndASpringWithoutSlopeIsSwapped) {
   using namespace issue20;
-  const fs::path dir = drivegen("gen_tentative", "5 10 cogging_ripple,constant_force periods=1.97");
-  const fs::path out = scratch() / "verdict_tentative";
-  const ProcResult r = run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
-                               " --out " + out.string() + " --no-plots -q");
+  const GeneratedFit g = generate_and_fit("verdict_tentative", "5 10 cogging_ripple,constant_force periods=1.97");
+  const ProcResult& r = g.run;
   ASSERT_EQ(r.code, 0) << r.err << r.out;
-  const auto j = findings(out);
+  const auto& j = g.findings;
   std::map<std::string, nlohmann::json> named;
   for (const auto& e : j["effects"]) named[e["name"].get<std::string>()] = e;
   ASSERT_TRUE(named.count("cogging_ripple")) << j["conclusion"];
@@ -595,12 +607,10 @@ TEST(FitVerdict, BorderlinePitchIsTentativeAndASpringWithoutSlopeIsSwapped) {
 // report names both and says a reversal would separate them.
 TEST(FitVerdict, OneDirectionCoulombAndConstantForceAreReportedAsATie) {
   using namespace issue20;
-  const fs::path dir = drivegen("gen_tie", "2 10 coulomb_friction onedir");
-  const fs::path out = scratch() / "verdict_tie";
-  const ProcResult r = run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
-                               " --out " + out.string() + " --no-plots -q");
+  const GeneratedFit g = generate_and_fit("verdict_tie", "2 10 coulomb_friction onedir");
+  const ProcResult& r = g.run;
   ASSERT_TRUE(r.code == 0 || r.code == 3) << r.err << r.out;
-  const auto j = findings(out);
+  const auto& j = g.findings;
   ASSERT_EQ(j["ties"].size(), 1u) << j.dump().substr(0, 3000);
   const std::string tie = j["ties"][0];
   EXPECT_NE(tie.find("coulomb_friction"), std::string::npos) << tie;
