@@ -580,9 +580,19 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         if (!settle.empty()) line += "; to settle it: " + settle;
         out.unexplained.push_back(line);
       }
-      if (shown == 0)
-        out.unexplained.push_back("no candidate of the vocabulary reduces the residual: an effect outside the vocabulary, "
-                                  "or a sensor noisier than plant.sensor says (" + out.floor.source + ")");
+      if (shown == 0) {
+        // no candidate resembles it: say where to look, by the regime where the rest concentrates
+        const Bin* where = nullptr;
+        for (const Bin& b : out.final_localisation.velocity)
+          if (b.points >= 3 && (!where || b.concentration > where->concentration)) where = &b;
+        const std::string regime = where ? where->label : std::string("the record");
+        out.unexplained.push_back(
+            "no candidate of the vocabulary reduces the residual: an effect outside the vocabulary (e.g. the form of the "
+            "friction's transition), or a sensor noisier than plant.sensor says (" + out.floor.source +
+            "); to settle it: record more of the regime where the rest concentrates (" + regime +
+            ": e.g. slow reversals and creeping moves for friction at low speed), and measure the sensor at rest for its "
+            "noise");
+      }
     }
     if (!out.floor.from_scenario) out.unexplained.push_back("noise floor: " + out.floor.source);
   }
