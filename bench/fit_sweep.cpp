@@ -2,10 +2,14 @@
 // bench/fit_bench.sh): N seeded records of the independent generator (tests/fit/indepgen: its
 // own RK4 integrator, PID or cascade loop, dwells, reversals and creeping moves, friction forms
 // that differ from the model's, 50-200 nm quantization, jitter, a random nominal mass), covering
-// every effect alone, pairs of effects and effect-free records. One tab-separated line per record:
-//   seed  hidden  named  right  spurious  seconds  parameter_miss  description
-// (right/spurious as tests/fit/indepgen/sweep.hpp counts them); fit_bench.sh sums the lines.
-//   fit_sweep N SEED [SHARD SHARDS] [DURATION_S]
+// every effect alone, pairs of effects and effect-free records (MIX standard), or issue 20's mix
+// (MIX issue20: short-travel ripples, asymmetric friction, one-direction moves, a mass error with a
+// ripple, 4-14 Hz loops; fdgen::issue20_cases). One tab-separated line per record:
+//   seed hidden named right spurious seconds parameter_miss description verdict category
+//   false_all_clear above_floor_all_clear suggestion gap_um gap_floor_um force_N force_floor_N
+//   tentative ties periods nothing_there
+// (as tests/fit/drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
+//   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
 #include <cstdio>
 #include <cstdlib>
 
@@ -18,21 +22,29 @@ int main(int argc, char** argv) {
   const int shard = argc > 3 ? std::atoi(argv[3]) : 0;
   const int shards = argc > 4 ? std::atoi(argv[4]) : 1;
   const double duration = argc > 5 ? std::atof(argv[5]) : 10.0;
-  if (n < 1 || shards < 1 || shard < 0 || shard >= shards || !(duration > 0)) {
-    std::fprintf(stderr, "usage: fit_sweep N SEED [SHARD SHARDS] [DURATION_S]\n");
+  const std::string mix = argc > 6 ? argv[6] : "standard";
+  if (n < 1 || shards < 1 || shard < 0 || shard >= shards || !(duration > 0) || (mix != "standard" && mix != "issue20")) {
+    std::fprintf(stderr, "usage: fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [standard|issue20]\n");
     return 2;
   }
-  std::vector<fdgen::CaseSpec> cases = fdgen::standard_cases(n, seed);
+  std::vector<fdgen::CaseSpec> cases = mix == "issue20" ? fdgen::issue20_cases(n, seed) : fdgen::standard_cases(n, seed);
   for (std::size_t i = 0; i < cases.size(); ++i) {
     if (static_cast<int>(i % static_cast<std::size_t>(shards)) != shard) continue;
     cases[i].duration = duration;
     try {
       const sweep::Outcome o = sweep::run_case(cases[i]);
-      std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\n", static_cast<unsigned long long>(o.spec.seed),
-                  sweep::names(o.hidden).c_str(), sweep::names(o.named).c_str(), o.right ? 1 : 0, o.spurious ? 1 : 0,
-                  o.seconds, o.parameter_miss.empty() ? "-" : o.parameter_miss.c_str(), o.description.c_str());
+      std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\t%s\t%s\t%d\t%d\t%d\t%.4g\t%.4g\t%.4g\t%.4g\t%s\t%s\t%.3g\t%d\n",
+                  static_cast<unsigned long long>(o.spec.seed), sweep::names(o.hidden).c_str(), sweep::names(o.named).c_str(),
+                  o.right ? 1 : 0, o.spurious ? 1 : 0, o.seconds, o.parameter_miss.empty() ? "-" : o.parameter_miss.c_str(),
+                  o.description.c_str(), o.verdict.c_str(), o.category.c_str(), o.false_all_clear ? 1 : 0,
+                  o.above_floor_all_clear ? 1 : 0, o.suggestion ? 1 : 0, o.gap_final * 1e6, o.gap_floor * 1e6, o.force_final,
+                  o.force_floor, sweep::names(o.tentative).c_str(), sweep::names(o.tie_partners).c_str(), o.periods, o.nothing_there ? 1 : 0);
     } catch (const std::exception& e) {
-      std::printf("%llu\t?\terror\t0\t0\t0\t%s\t-\n", static_cast<unsigned long long>(cases[i].seed), e.what());
+      std::string why = e.what();
+      for (char& c : why)
+        if (c == '\t' || c == '\n') c = ' ';
+      std::printf("%llu\t?\terror\t0\t0\t0\t%s\t-\terror\t%s\t0\t0\t0\t0\t0\t0\t0\t-\t-\t0\t0\n",
+                  static_cast<unsigned long long>(cases[i].seed), why.c_str(), cases[i].category.c_str());
     }
     std::fflush(stdout);
   }

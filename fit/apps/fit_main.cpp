@@ -12,6 +12,7 @@
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
+#include "feeddrive/fit/sanity.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/plant/cvode_integrator.hpp"
@@ -63,6 +64,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--reference-column", csv.reference_column, "CSV column with the position reference [m] (optional)")
       ->capture_default_str();
+  std::string separator = ",", units;
+  app.add_option("--separator", separator, "CSV column separator: ',', ';', 'tab' (or a tab character)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({",", ";", "tab", "\t"}));
+  app.add_flag("--decimal-comma", csv.decimal_comma, "numbers are written with a decimal comma (0,25); needs another --separator");
+  app.add_option("--units", units,
+                 "units of the columns, ROLE=UNIT[,...]: t=s|ms|us, x=m|mm|um|nm, xd=..., force=N|kN|mN, u=V|mV, or "
+                 "ROLE=counts:SCALE (SI per count); e.g. t=ms,x=mm,force=kN");
   std::vector<std::string> ask;
   app.add_option("--effects", ask, "also consider these effects where the scenario does not describe them "
                                    "(grinding_force: a grinding process)")
@@ -81,6 +90,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s (see --help)\n", e.what());
     return 2;
   }
+  csv.separator = separator == "tab" ? '\t' : separator[0];
+  if (csv.decimal_comma && csv.separator == ',') {
+    std::fprintf(stderr, "error: --decimal-comma needs another --separator (e.g. --separator ';'): the comma cannot be both\n");
+    return 2;
+  }
   spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
   interrupt::install_handlers();
@@ -91,8 +105,13 @@ int main(int argc, char** argv) {
     const sim::Scenario scenario = sim::load_scenario(scenario_path);
     opt.plausibility.grinding_process =
         scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();
+    if (!units.empty()) csv.units = fit::parse_units(units);
     const fit::MeasuredData data = fit::load_data(data_path, prefix, csv);
+    // sanity before fitting: units, gaps and jumps (fit/sanity.hpp)
+    fit::check_record(data, scenario.plant, scenario.control_period);
     const fit::Record rec = fit::prepare(data, opt.record);
+    fit::check_options(rec, opt);
+    fit::check_force_scale(rec, scenario.plant);
     for (const std::string& n : data.notes) spdlog::warn("{}: {}", data_path, n);
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),
                  scenario_path);
@@ -105,8 +124,13 @@ int main(int argc, char** argv) {
       if (st.accepted)
         std::printf("%-4d %-24s %14.4g %18.4g\n", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
                     st.force_rms_after);
-    std::printf("%s\nresults: %s/{findings.json,model.fitted.yaml,report.md}\n", r.conclusion.c_str(), out_dir.c_str());
-    return 0;
+    std::printf("%s\n", r.conclusion.c_str());
+    for (const auto& [name, caveat] : r.tentative) std::printf("tentative %s: %s\n", name.c_str(), caveat.c_str());
+    for (const std::string& t : r.ties) std::printf("tie: %s\n", t.c_str());
+    for (const std::string& u : r.unexplained) std::printf("  %s\n", u.c_str());
+    std::printf("results: %s/{findings.json,model.fitted.yaml,report.md}\n", out_dir.c_str());
+    // exit codes (docs/fit.md, "Verdicts"): 0 explained or no discrepancy, 3 unexplained, 2 bad input
+    return r.verdict == fit::Verdict::kUnexplained ? fit::kExitUnexplained : 0;
   } catch (const interrupt::Interrupted& e) {  // Ctrl-C in any phase: nothing written
     return interrupt::report(e);
   } catch (const plant::IntegrationError& e) {  // the model cannot be replayed on this record

@@ -35,9 +35,9 @@ void validate(const MeasuredData& d) {
       throw DataError(d.source + ": sample " + std::to_string(k) + ", column " + col + ": " + std::to_string(v) +
                       " is not a finite number");
     };
-    if (!std::isfinite(d.t[k])) bad("t", d.t[k]);
-    if (!std::isfinite(d.x[k])) bad("x", d.x[k]);
-    if (!std::isfinite(d.input[k])) bad(d.input_kind == InputKind::kCommand ? "u" : "force_N", d.input[k]);
+    if (!std::isfinite(d.t[k])) bad(d.time_name.c_str(), d.t[k]);
+    if (!std::isfinite(d.x[k])) bad(d.position_name.c_str(), d.x[k]);
+    if (!std::isfinite(d.input[k])) bad(d.input_name.c_str(), d.input[k]);
     if (!d.xd.empty() && !std::isfinite(d.xd[k])) bad("xd", d.xd[k]);
     if (!d.v.empty() && !std::isfinite(d.v[k])) bad("v", d.v[k]);
     if (k > 0 && !(d.t[k] > d.t[k - 1]))
@@ -46,11 +46,61 @@ void validate(const MeasuredData& d) {
   }
 }
 
+std::string MeasuredData::where(std::size_t k) const {
+  if (k < lines.size()) return source + ":" + std::to_string(lines[k]);
+  return source + ", sample " + std::to_string(k);
+}
+
+Units parse_units(const std::string& spec) {
+  Units u;
+  u.text = spec;
+  std::size_t start = 0;
+  while (start <= spec.size()) {
+    const auto comma = spec.find(',', start);
+    const std::string item = spec.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    start = comma == std::string::npos ? spec.size() + 1 : comma + 1;
+    if (item.empty()) continue;
+    const auto eq = item.find('=');
+    const std::string role = item.substr(0, eq), unit = eq == std::string::npos ? "" : item.substr(eq + 1);
+    const auto bad = [&](const std::string& why) {
+      throw DataError("--units '" + csv::shown(item) + "': " + why +
+                      " (ROLE=UNIT with t: s, ms, us; x, xd: m, mm, um, nm; force: N, kN, mN; u: V, mV; any: counts:SCALE)");
+    };
+    double* target = role == "t" ? &u.t : role == "x" ? &u.x : role == "xd" ? &u.xd : role == "force" ? &u.force
+                   : role == "u" ? &u.u : nullptr;
+    if (!target) bad("unknown role '" + csv::shown(role) + "'");
+    if (unit.empty()) bad("no unit");
+    static const std::map<std::string, std::map<std::string, double>> table{
+        {"t", {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}}},
+        {"x", {{"m", 1.0}, {"mm", 1e-3}, {"um", 1e-6}, {"nm", 1e-9}}},
+        {"xd", {{"m", 1.0}, {"mm", 1e-3}, {"um", 1e-6}, {"nm", 1e-9}}},
+        {"force", {{"N", 1.0}, {"kN", 1e3}, {"mN", 1e-3}}},
+        {"u", {{"V", 1.0}, {"mV", 1e-3}}}};
+    if (unit.rfind("counts:", 0) == 0) {
+      const std::string sc = unit.substr(7);
+      char* end = nullptr;
+      const double v = std::strtod(sc.c_str(), &end);
+      if (sc.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0)) bad("the scale of counts must be a positive number");
+      *target = v;
+      continue;
+    }
+    const auto& units = table.at(role);
+    const auto it = units.find(unit);
+    if (it == units.end()) bad("unknown unit '" + csv::shown(unit) + "' for " + role);
+    *target = it->second;
+  }
+  return u;
+}
+
 namespace {
 
 // The columns of the roles, for the one CSV reader (feeddrive/csv/reader.hpp).
 csv::Options csv_options(const CsvOptions& opt) {
   csv::Options o;
+  o.separator = opt.separator;
+  o.decimal_comma = opt.decimal_comma;
+  o.columns_by_index = true;
+  o.separator_option = "--separator";
   o.columns = {{{opt.time_column}},
                {{opt.position_column}},
                {{opt.command_column, opt.force_column}},
@@ -66,9 +116,28 @@ MeasuredData from_table(csv::Table t, const CsvOptions& opt) {
   d.t = std::move(t.values[0]);
   d.x = std::move(t.values[1]);
   d.input = std::move(t.values[2]);
-  d.input_kind = t.used[2] == opt.command_column ? InputKind::kCommand : InputKind::kForce;
+  // the command column is the first alternative, the force column the second
+  d.input_kind = t.alternative[2] == 0 ? InputKind::kCommand : InputKind::kForce;
   d.xd = std::move(t.values[3]);
   d.v = std::move(t.values[4]);
+  d.lines = std::move(t.lines);
+  d.time_name = t.used[0];
+  d.position_name = t.used[1];
+  d.input_name = t.used[2];
+  const Units& u = opt.units;
+  d.time_factor = u.t;
+  d.position_factor = u.x;
+  d.input_factor = d.input_kind == InputKind::kForce ? u.force : u.u;
+  const auto scale = [](std::vector<double>& v, double f) {
+    if (f != 1.0)
+      for (double& y : v) y *= f;
+  };
+  scale(d.t, d.time_factor);
+  scale(d.x, d.position_factor);
+  scale(d.input, d.input_factor);
+  scale(d.xd, u.xd);
+  scale(d.v, d.position_factor / d.time_factor);
+  if (!u.text.empty()) d.notes.push_back("units " + u.text + " converted to SI on loading");
   validate(d);
   return d;
 }

@@ -2,6 +2,8 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -581,6 +583,60 @@ std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& 
     const JointFit jf = fit_jointly(rec, model, free, &w, 20);
     const Eigen::VectorXd r = force_residual(rec, jf.params);
     for (long a = lo; a < hi; ++a) out[static_cast<std::size_t>(f)] += r[active[a]] * r[active[a]];
+  }
+  return out;
+}
+
+std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec, const plant::PlantParams& fitted,
+                                                                          const std::vector<std::string>& effects) {
+  std::map<std::string, std::map<std::string, double>> out;
+  std::vector<std::pair<std::string, std::string>> keys;
+  std::vector<Effect> named;
+  for (const std::string& name : effects)
+    for (const Effect& e : plant::enabled_effects(fitted.effects))
+      if (e.name == name) {
+        named.push_back(e);
+        for (const auto& [k, v] : e.parameters) keys.emplace_back(name, k);
+      }
+  if (keys.empty()) return out;
+  const Eigen::VectorXd r0 = force_residual(rec, fitted);
+  const long n = rec.active_points();
+  const long k = static_cast<long>(keys.size());
+  Eigen::MatrixXd J(r0.size(), k);
+  for (long c = 0; c < k; ++c) {
+    const auto& [name, key] = keys[static_cast<std::size_t>(c)];
+    Effect e;
+    for (const Effect& x : named)
+      if (x.name == name) e = x;
+    const double v = e.parameters.at(key);
+    // a phase moves by 1e-4 rad; anything else by 1e-5 of itself (or of a typical size)
+    const double h = key.find("phase") != std::string::npos ? 1e-4 : 1e-5 * std::max(std::abs(v), 1e-3);
+    Eigen::VectorXd rp, rm;
+    for (int s : {1, -1}) {
+      Effect moved = e;
+      moved.parameters[key] = v + s * h;
+      plant::PlantParams p = fitted;
+      plant::set_effect(p.effects, moved);
+      (s > 0 ? rp : rm) = force_residual(rec, p);
+    }
+    J.col(c) = (rp - rm) / (2 * h);
+  }
+  force_residual(rec, fitted);  // leaves the cache on the fitted model
+  const double s2 = r0.squaredNorm() / static_cast<double>(std::max(1L, n - k));
+  const Eigen::MatrixXd JtJ = J.transpose() * J;
+  // scaled pseudo-inverse: columns of very different units
+  Eigen::VectorXd d(k);
+  for (long c = 0; c < k; ++c) d[c] = JtJ(c, c) > 0 ? 1.0 / std::sqrt(JtJ(c, c)) : 0.0;
+  const Eigen::MatrixXd S = d.asDiagonal() * JtJ * d.asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  Eigen::VectorXd inv(k);
+  for (long c = 0; c < k; ++c) inv[c] = sv[c] > 1e-10 * sv[0] ? 1.0 / sv[c] : 0.0;
+  const Eigen::MatrixXd P = svd.matrixV() * inv.asDiagonal() * svd.matrixU().transpose();
+  for (long c = 0; c < k; ++c) {
+    const auto& [name, key] = keys[static_cast<std::size_t>(c)];
+    const double var = s2 * d[c] * d[c] * P(c, c);
+    out[name][key] = d[c] > 0 && var > 0 && std::isfinite(var) ? 1.96 * std::sqrt(var) : std::numeric_limits<double>::quiet_NaN();
   }
   return out;
 }

@@ -1,24 +1,16 @@
 #include "feeddrive/fit/plausibility.hpp"
+#include "text.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 namespace feeddrive::fit {
+using text::fmt;
+using text::par;
 namespace {
 
 constexpr double kAsymmetry = kAsymmetryTolerance;
-
-std::string fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
-
-double par(const plant::NamedEffect& e, const char* k) {
-  const auto it = e.parameters.find(k);
-  return it == e.parameters.end() ? 0.0 : it->second;
-}
 
 std::string ripple_pitch(const Envelope& env, double p) {
   if (p > env.max_pitch())

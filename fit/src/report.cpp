@@ -80,17 +80,38 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["force_residual_rms_initial_N"] = r.force_rms_initial;
   j["force_residual_rms_final_N"] = r.force_rms_final;
   j["effects"] = nlohmann::json::array();
-  for (const StepResult& st : r.steps) {
-    if (!st.accepted) continue;
-    Effect final = st.effect;
-    for (const Effect& e : r.effects)
-      if (e.name == st.effect.name) final = e;
-    j["effects"].push_back({{"name", final.name},
-                            {"parameters", params_json(final)},
-                            {"score", st.score},
-                            {"gap_before", st.gap_before},
-                            {"gap_after", st.gap_after}});
+  // the named effects with their final (jointly refitted) parameters, each with the step that
+  // brought it in: the step that added it, or the one whose swap move turned an earlier effect into it
+  for (const Effect& final : r.effects) {
+    const StepResult* from = nullptr;
+    for (const StepResult& st : r.steps) {
+      if (!st.accepted) continue;
+      const std::string into = st.swap.empty() ? "" : st.swap.substr(st.swap.rfind(' ') + 1);
+      if (st.effect.name == final.name || into == final.name) from = &st;
+    }
+    nlohmann::json ci = nlohmann::json::object();
+    if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
+      for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
+    const auto tent = r.tentative.find(final.name);
+    nlohmann::json e = {{"name", final.name},
+                        {"parameters", params_json(final)},
+                        {"ci95", ci},
+                        {"tentative", tent != r.tentative.end()},
+                        {"caveat", tent != r.tentative.end() ? tent->second : std::string()}};
+    if (from) {
+      e["score"] = from->score;
+      e["gap_before"] = from->gap_before;
+      e["gap_after"] = from->gap_after;
+    }
+    j["effects"].push_back(e);
   }
+  j["verdict"] = verdict_name(r.verdict);
+  j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
+  j["noise_floor"] = {{"gap_m", r.floor.gap}, {"force_rms_N", r.floor.force}, {"quantization_m", r.floor.quantization},
+                      {"noise_m", r.floor.noise}, {"position_sigma_m", r.floor.position}, {"factor", kFloorFactor},
+                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source}};
+  j["unexplained"] = r.unexplained;
+  j["ties"] = r.ties;
   j["conclusion"] = r.conclusion;
   j["model_form"] = {{"coulomb_transition_velocity_initial_mps", r.smoothing_initial},
                      {"coulomb_transition_velocity_final_mps", r.smoothing_final},
@@ -105,8 +126,10 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
     for (const CandidateFit& c : st.ranking)
       rk.push_back({{"name", c.effect.name}, {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
                     {"parameters", params_json(c.effect)}, {"k", c.parameters}, {"rss_N2", c.rss},
-                    {"passed_over", c.passed_over}, {"fit_seconds", c.seconds}});
+                    {"passed_over", c.passed_over}, {"tentative", c.tentative}, {"swap", c.swap},
+                    {"fit_seconds", c.seconds}});
     steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk}, {"removed", st.removed},
+                     {"swap", st.swap}, {"caveat", st.caveat}, {"ties", st.ties},
                      {"cross_validation", {{"held_out_sq_residual_without_N2", st.cv_without},
                                            {"held_out_sq_residual_with_N2", st.cv_with}}},
                      {"localisation", {{"summary", st.localisation.summary},
@@ -194,6 +217,8 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
        << " independent force-residual points\n";
     for (const std::string& n : d.notes) md << "- data note: " << n << "\n";
     md << "\n"
+       << "**Verdict: " << verdict_name(r.verdict) << "** (exit code "
+       << (r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0) << ")\n\n"
        << "**" << r.conclusion << "**\n\n"
        << "The gap is the RMS position error of the model replayed from the measured state over windows "
           "(docs/fit.md); the force measure is the RMS of the filtered force residual.\n\n"
@@ -208,9 +233,37 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       md << buf;
     }
     if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
+    std::snprintf(buf, sizeof buf,
+                  "Noise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; %s); \"within\" means at "
+                  "most %.0fx the floor.\n\n",
+                  r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9, r.floor.source.c_str(), kFloorFactor);
+    md << buf;
+    if (!r.unexplained.empty()) {
+      md << "## Unexplained discrepancy\n\n";
+      for (const std::string& u : r.unexplained) md << "- " << u << "\n";
+      md << "\n";
+    }
+    if (!r.ties.empty()) {
+      md << "## Ties\n\n";
+      for (const std::string& t : r.ties) md << "- " << t << "\n";
+      md << "\n";
+    }
     md << "\n## Effects found\n\n";
     if (r.effects.empty()) md << "None: no candidate is significant.\n";
-    for (const Effect& e : r.effects) md << "- `" << e.name << "`: " << params_text(e) << "\n";
+    for (const Effect& e : r.effects) {
+      md << "- `" << e.name << "`" << (r.tentative.count(e.name) ? " (**tentative**)" : "") << ": ";
+      std::string sep;
+      for (const auto& [k, v] : e.parameters) {
+        double w = std::nan("");
+        if (const auto it = r.ci95.find(e.name); it != r.ci95.end() && it->second.count(k)) w = it->second.at(k);
+        std::snprintf(buf, sizeof buf, std::isfinite(w) ? "%s%s = %.6g +- %.2g" : "%s%s = %.6g (interval undetermined)",
+                      sep.c_str(), k.c_str(), v, w);
+        md << buf;
+        sep = ", ";
+      }
+      md << " (95 % intervals)\n";
+      if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
+    }
     if (r.smoothing_fitted) {
       std::snprintf(buf, sizeof buf,
                     "\nModel form (not an effect): the Coulomb transition velocity eps of tanh(v/eps) was refitted, "

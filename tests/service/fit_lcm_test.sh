@@ -31,7 +31,8 @@ set +e
 timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$LOGDIR/run.lcmlog" --out "$TMP/fit" -q --no-plots \
   > "$TMP/fit.out" 2> "$TMP/fit.err"; rc=$?
 set -e
-[ $rc = 0 ] || { cat "$TMP/fit.out" "$TMP/fit.err" >&2; fail "feeddrive-fit on the log: exit $rc"; }
+# 0 or 3 (explained, or an unexplained rest: the verdict is not what this test checks)
+[ $rc = 0 ] || [ $rc = 3 ] || { cat "$TMP/fit.out" "$TMP/fit.err" >&2; fail "feeddrive-fit on the log: exit $rc"; }
 f=$TMP/fit/findings.json
 [ "$(json "$f" '.effects[0].name')" = constant_force ] || { jq . "$f" >&2; fail "first effect is not constant_force"; }
 force=$(json "$f" '.effects[0].parameters.force_N')
@@ -55,7 +56,7 @@ set +e
 timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$TMP/cut.lcmlog" --out "$TMP/cut" -q --no-plots \
   > "$TMP/cut.out" 2> "$TMP/cut.err"; rc=$?
 set -e
-[ $rc = 0 ] || { cat "$TMP/cut.err" >&2; fail "a log cut mid-event: exit $rc, expected 0 (a shorter record)"; }
+[ $rc = 0 ] || [ $rc = 3 ] || { cat "$TMP/cut.err" >&2; fail "a log cut mid-event: exit $rc, expected 0 or 3 (a shorter record)"; }
 notes=$(json "$TMP/cut/findings.json" '.data.notes | join(" | ")')
 printf "%s" "$notes" | grep -q "the log ends inside an event (byte [0-9]*, its last [0-9]* bytes" ||
   fail "findings.json does not note the cut event: $notes"

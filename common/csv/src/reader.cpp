@@ -29,11 +29,11 @@ struct Field {
   std::size_t column;     // 1-based byte column of the field's first byte
 };
 
-void split(std::string_view line, std::vector<Field>& out) {
+void split(std::string_view line, char sep, std::vector<Field>& out) {
   out.clear();
   std::size_t start = 0;
   for (;;) {
-    const auto comma = line.find(',', start);
+    const auto comma = line.find(sep, start);
     const std::string_view raw = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     const auto lead = raw.find_first_not_of(" \t");
     out.push_back({trim(raw), start + 1 + (lead == std::string_view::npos ? 0 : lead)});
@@ -52,6 +52,7 @@ class Parser {
   Parser(std::string origin, const Options& opt) : origin_(std::move(origin)), opt_(opt) {
     table_.source = origin_;
     table_.used.assign(opt.columns.size(), "");
+    table_.alternative.assign(opt.columns.size(), -1);
     table_.values.assign(opt.columns.size(), {});
     index_.assign(opt.columns.size(), -1);
   }
@@ -73,7 +74,7 @@ class Parser {
     }
     const std::string_view t = trim(l);
     if (t.empty() || t.front() == '#') return;
-    split(l, fields_);
+    split(l, opt_.separator, fields_);
     if (!have_header_) {
       header(l);
       return;
@@ -116,14 +117,34 @@ class Parser {
       if (!seen.emplace(name, i).second) fail_line(fields_[i].column + bom_, "duplicate column '" + shown(name) + "' in the header");
       header_.push_back(name);
     }
-    const bool one = fields_.size() == 1 && (l.find(';') != std::string_view::npos || l.find('\t') != std::string_view::npos);
-    const std::string hint = one ? "; columns must be separated by commas" : "";
+    bool one = false;
+    for (const char other : {',', ';', '\t'})
+      one = one || (other != opt_.separator && fields_.size() == 1 && l.find(other) != std::string_view::npos);
+    const std::string sep_name = opt_.separator == ',' ? "commas" : opt_.separator == '\t' ? "tabs" : "'" + std::string(1, opt_.separator) + "'";
+    const std::string hint = one ? "; columns must be separated by " + sep_name +
+                                       (opt_.separator_option.empty() ? "" : " (or give the separator with " + opt_.separator_option + ")")
+                                 : "";
     for (std::size_t c = 0; c < opt_.columns.size(); ++c) {
-      for (const std::string& n : opt_.columns[c].names) {
+      for (std::size_t a = 0; a < opt_.columns[c].names.size(); ++a) {
+        const std::string& n = opt_.columns[c].names[a];
         if (const auto it = seen.find(n); it != seen.end()) {
           index_[c] = static_cast<long>(it->second);
           table_.used[c] = n;
+          table_.alternative[c] = static_cast<int>(a);
           break;
+        }
+      }
+      if (index_[c] < 0 && opt_.columns_by_index) {
+        for (std::size_t a = 0; a < opt_.columns[c].names.size(); ++a) {
+          const std::string& n = opt_.columns[c].names[a];
+          const bool digits = !n.empty() && n.size() < 6 && n.find_first_not_of("0123456789") == std::string::npos;
+          const long k = digits ? std::stol(n) : 0;
+          if (k >= 1 && k <= static_cast<long>(header_.size())) {
+            index_[c] = k - 1;
+            table_.used[c] = header_[static_cast<std::size_t>(k - 1)];
+            table_.alternative[c] = static_cast<int>(a);
+            break;
+          }
         }
       }
       if (index_[c] < 0 && opt_.columns[c].required) {
@@ -158,8 +179,17 @@ class Parser {
     const std::string where = "column '" + name + "': ";
     const std::size_t col = f.column + bom_;
     if (f.text.empty()) fail_line(col, where + "missing value");
-    const char* first = f.text.data();
-    const char* last = first + f.text.size();
+    std::string comma_text;
+    std::string_view text = f.text;
+    if (opt_.decimal_comma) {  // "0,25" is 0.25; a point in such a file is not a number
+      comma_text.assign(text);
+      if (comma_text.find('.') != std::string::npos)
+        fail_line(col, where + "not a number with a decimal comma: '" + shown(f.text) + "'");
+      std::replace(comma_text.begin(), comma_text.end(), ',', '.');
+      text = comma_text;
+    }
+    const char* first = text.data();
+    const char* last = first + text.size();
     if (*first == '+') ++first;
     double v = 0.0;
     const auto res = std::from_chars(first, last, v);

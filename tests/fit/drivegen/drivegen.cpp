@@ -114,6 +114,31 @@ Reference make_reference(Rng& r, double duration, double travel) {
   return ref;
 }
 
+// One direction only: forward moves (trapezoids), creeping and dwells from 0 to `travel`, paced to
+// end near the record's end, never reversing.
+Reference make_forward_reference(Rng& r, double duration, double travel) {
+  Reference ref;
+  double t = 0.0, x = 0.0;
+  const int moves = 6 + static_cast<int>(r.u(0, 7));
+  std::vector<double> share(static_cast<std::size_t>(moves));
+  double sum = 0.0;
+  for (double& s : share) sum += (s = r.u(0.3, 1.0));
+  const double v_need = travel / (0.6 * duration);
+  ref.seg.push_back(dwell(0.0, 0.0, r.u(0.1, 0.3)));
+  t = ref.seg.back().t1;
+  for (int i = 0; i < moves; ++i) {
+    const double d = travel * share[static_cast<std::size_t>(i)] / sum;
+    const double vm = std::max(v_need, r.u(0.005, 0.05)) * (r.coin(0.2) ? 0.05 : 1.0);  // some creeping
+    ref.seg.push_back(move(t, x, d, vm, r.u(0.5, 3.0)));
+    x += d;
+    t = ref.seg.back().t1;
+    ref.seg.push_back(dwell(t, x, r.u(0.05, 0.4)));
+    t = ref.seg.back().t1;
+  }
+  if (t < duration) ref.seg.push_back(dwell(t, x, duration - t + 1.0));
+  return ref;
+}
+
 // ---- the drive ---------------------------------------------------------------------------------
 struct Truth {
   double m{80.0};
@@ -247,7 +272,7 @@ Generated generate(const CaseSpec& spec) {
   // position-dependent effects need travel: at least three ripple pitches, a contact passed often
   const bool positional = hidden("cogging_ripple") || hidden("reluctance_ripple") || hidden("spring_force") ||
                           hidden("grinding_force");
-  const double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
+  double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
   const double Ts = 1.0 / spec.sample_rate;
   T.base_static = hidden("presliding") || r.coin(0.5);
   if (T.base_static) {
@@ -286,12 +311,14 @@ Generated generate(const CaseSpec& spec) {
   }
   if (hidden("cogging_ripple")) {
     T.cp = r.u(0.01, std::min(0.04, travel / 3)), T.ca = r.u(2, 10), T.cphi = r.u(-kPi, kPi);
+    if (spec.ripple_periods > 0) T.cp = travel / spec.ripple_periods;
     T.cb = T.ca * r.u(0, 0.4), T.cphi3 = r.u(-kPi, kPi);
     out.truth.push_back({"cogging_ripple", {{"pitch_m", T.cp}, {"amplitude_N", T.ca}, {"phase_rad", T.cphi},
                                             {"third_harmonic_N", T.cb}, {"third_phase_rad", T.cphi3}}});
   }
   if (hidden("reluctance_ripple")) {
     T.rp = r.u(0.01, std::min(0.04, travel / 3)), T.rA = r.u(0.03, 0.08), T.rphi = r.u(-kPi, kPi);
+    if (spec.ripple_periods > 0) T.rp = travel / spec.ripple_periods;
     out.truth.push_back({"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
   }
   if (hidden("grinding_force")) {
@@ -320,11 +347,14 @@ Generated generate(const CaseSpec& spec) {
   // Bandwidths a 1 kHz loop with a differenced velocity holds without a limit cycle: the PID's
   // triple pole at 15-40 Hz; the cascade's velocity loop at 30-60 Hz (with the one-sample
   // delay: 0.4 and 0.6 of these), its position loop at a quarter of that.
-  const double bw = (pid ? r.u(15, 40) : r.u(30, 60) / 4.0) * (cmd_delay ? (pid ? 0.4 : 0.6) : 1.0), w = 2 * kPi * bw;
+  double bw = (pid ? r.u(15, 40) : r.u(30, 60) / 4.0) * (cmd_delay ? (pid ? 0.4 : 0.6) : 1.0);
+  if (spec.bandwidth_hz > 0) bw = spec.bandwidth_hz;
+  const double w = 2 * kPi * bw;
   const double wv = 4 * w, wp = w;
   const double q = r.u(50e-9, 200e-9), noise = r.u(0.0, 20e-9);
   const double jitter = 0.02 * Ts;
-  const Reference ref = make_reference(r, spec.duration, travel);
+  const Reference ref = spec.one_direction ? make_forward_reference(r, spec.duration, travel)
+                                           : make_reference(r, spec.duration, travel);
   // closed loop
   const long N = static_cast<long>(std::lround(spec.duration * spec.sample_rate)) + 1;
   std::vector<double> t_true(static_cast<std::size_t>(N));
@@ -403,6 +433,8 @@ Generated generate(const CaseSpec& spec) {
   else
     yaml << "  friction: {model: none}\n";
   if (grinding) yaml << "  grinding: {enabled: false}\n";
+  // the encoder is known to its engineer: the fit's noise floor comes from it
+  yaml << "  sensor: {quantization: " << num(q) << ", noise_stddev: " << num(noise) << "}\n";
   yaml << "controller: {type: cascade}\nreference: {type: step}\n";
   out.scenario_yaml = yaml.str();
   long saturated = 0;
@@ -415,9 +447,9 @@ Generated generate(const CaseSpec& spec) {
                {"base_static_friction", T.base_static ? 1.0 : 0.0}};
   char b[512];
   std::snprintf(b, sizeof b,
-                "m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm, %s friction, vt=%.0f um/s, asym %.3f, %.1f %% saturated",
-                m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "", cmd_delay ? " +1-sample delay" : "", q * 1e9,
-                travel * 1e3, T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
+                "%s: m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm%s, %s friction, vt=%.0f um/s, asym %.3f, %.1f %% saturated",
+                spec.category.c_str(), m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "", cmd_delay ? " +1-sample delay" : "",
+                q * 1e9, travel * 1e3, spec.one_direction ? " one direction" : "", T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
                 100.0 * static_cast<double>(saturated) / static_cast<double>(N));
   out.description = b;
   return out;
@@ -430,6 +462,43 @@ std::pair<double, double> integrate_mass(double m, double F, double c, double v0
   double y[4] = {0.0, v0, 0.0, 0.0};
   for (int i = 0; i < steps; ++i) rk4(T, y, F, duration / steps);
   return {y[0], y[1]};
+}
+
+std::vector<CaseSpec> issue20_cases(int n, std::uint64_t seed) {
+  const int special = n - static_cast<int>(std::lround(0.55 * n));
+  std::vector<CaseSpec> out = standard_cases(n - special, seed);
+  Rng r{std::mt19937_64(seed * 6151 + 7)};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (i % 3 == 2) {
+      out[i].bandwidth_hz = r.u(4.0, 14.0);
+      out[i].category = "standard, 4-14 Hz loop";
+    }
+  const int short_n = static_cast<int>(std::lround(special * 15.0 / 45.0));
+  const int asym_n = static_cast<int>(std::lround(special * 10.0 / 45.0));
+  const int one_n = static_cast<int>(std::lround(special * 10.0 / 45.0));
+  const int mass_n = special - short_n - asym_n - one_n;
+  const auto add = [&](std::vector<std::string> hidden, const char* category) {
+    CaseSpec c;
+    c.hidden = std::move(hidden);
+    c.category = category;
+    if (r.coin(0.3)) c.bandwidth_hz = r.u(4.0, 14.0);
+    out.push_back(c);
+    return &out.back();
+  };
+  for (int i = 0; i < short_n; ++i) {
+    std::vector<std::string> h{r.coin(0.6) ? "cogging_ripple" : "reluctance_ripple"};
+    if (r.coin(0.4)) h.push_back("viscous_friction");
+    add(h, "short travel ripple")->ripple_periods = r.u(1.5, 3.0);
+  }
+  for (int i = 0; i < asym_n; ++i) add({"coulomb_friction", "constant_force"}, "asymmetric friction");
+  for (int i = 0; i < one_n; ++i) {
+    std::vector<std::string> h{r.coin(0.5) ? "coulomb_friction" : "constant_force"};
+    if (r.coin(0.3)) h.push_back("viscous_friction");
+    add(h, "one direction")->one_direction = true;
+  }
+  for (int i = 0; i < mass_n; ++i) add({"mass_error", "cogging_ripple"}, "mass error + ripple");
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].seed = seed * 2000003ULL + i;
+  return out;
 }
 
 std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed) {

@@ -43,6 +43,15 @@ struct CaseSpec {
   double sample_rate{1000.0};       ///< [Hz]
   bool grinding_process{false};     ///< the scenario describes a grinding process (forced on with grinding_force)
   bool form_deviation{true};        ///< smoother Coulomb transition, asymmetry, other Stribeck exponent
+  /// > 0: the travel spans this many periods of the hidden ripple (e.g. 1.5-3: near or below the
+  /// two periods the fit needs to resolve a pitch); 0: pitches of 10-40 mm over 60-150 mm.
+  double ripple_periods{0.0};
+  /// Moves in one direction only (forward moves, creeping and dwells, no reversal): a Coulomb
+  /// friction and a constant force are then the same force while moving.
+  bool one_direction{false};
+  /// > 0: the loop's bandwidth [Hz] (PID triple pole, or the cascade's position loop); 0: drawn.
+  double bandwidth_hz{0.0};
+  std::string category{"standard"};  ///< a label for the sweep's table
 };
 
 struct Generated {
@@ -59,6 +68,13 @@ Generated generate(const CaseSpec& spec);
 /// A seeded mix of n cases: about 12 % effect-free, every effect alone at least n/20 times, the
 /// rest pairs of distinct effects (not coulomb + stribeck, which is one Stribeck curve).
 std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed);
+
+/// The mix of issue 20 (n >= 20): about 55 % the standard mix, a third of it with the loop's
+/// bandwidth drawn in 4-14 Hz; 15 % ripples (cogging or reluctance, alone or with viscous
+/// friction) over short travels of 1.5-3 periods; 10 % asymmetric friction (Coulomb friction and
+/// a constant force); 10 % one-direction moves (a Coulomb friction or a constant force, alone or
+/// with viscous friction); 10 % a mass error with a cogging ripple.
+std::vector<CaseSpec> issue20_cases(int n, std::uint64_t seed);
 
 /// The vocabulary, in the order of docs/fit.md.
 const std::vector<std::string>& vocabulary();

@@ -1,6 +1,6 @@
 // fd-drivegen: one record of the independent generator (drivegen.hpp) as files, for manual fits
 // and bench/fit_bench.sh:  DIR/data.csv (t, x, force_N, xd), DIR/model.yaml, DIR/truth.txt.
-//   fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding]
+//   fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] [bw=HZ]
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -11,7 +11,7 @@
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding]\n");
+    std::fprintf(stderr, "usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] [bw=HZ]\n");
     return 2;
   }
   fdgen::CaseSpec spec;
@@ -23,7 +23,14 @@ int main(int argc, char** argv) {
     while (std::getline(ss, e, ','))
       if (!e.empty() && e != "none") spec.hidden.push_back(e);
   }
-  spec.grinding_process = argc > 5 && std::string(argv[5]) == "grinding";
+  for (int a = 5; a < argc; ++a) {
+    const std::string w = argv[a];
+    if (w == "grinding") spec.grinding_process = true;
+    if (w == "noform") spec.form_deviation = false;  // the model's friction form: no transition, asymmetry or exponent change
+    if (w == "onedir") spec.one_direction = true;
+    if (w.rfind("periods=", 0) == 0) spec.ripple_periods = std::atof(w.c_str() + 8);
+    if (w.rfind("bw=", 0) == 0) spec.bandwidth_hz = std::atof(w.c_str() + 3);
+  }
   try {
     const fdgen::Generated g = fdgen::generate(spec);
     std::filesystem::create_directories(argv[2]);

@@ -10,8 +10,21 @@
 // One equivalence: a constant force F and a spring k (x - x_rest) are the spring
 // k (x - (x_rest - F/k)) -- no data can tell them apart -- so that pair is expected as a spring.
 // A spurious effect is a named effect that is not hidden.
+// Issue 20's cases add two readings of "right":
+//   * a tie: on a record that cannot separate two candidates (e.g. a Coulomb friction and a
+//     constant force on moves in one direction), naming one and reporting the tie with the hidden
+//     one is right, and the reported partner is not spurious;
+//   * a ripple over fewer than two of its periods (the fit needs two to resolve a pitch): right
+//     if it is named (tentative or not, pitch within 2 %), or if it is not named, the verdict is
+//     unexplained and the report names a force periodic in position with what would settle it.
+// A false all-clear is a record whose verdict is "explained" or "no discrepancy" while a hidden
+// effect was not named (strict), or while its final gap or force residual is above the noise
+// floor (the issue's wording; the verdict rule excludes it by construction, counted as a check).
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <map>
 #include <set>
@@ -20,6 +33,8 @@
 #include <vector>
 
 #include "feeddrive/fit/data.hpp"
+#include "feeddrive/fit/sanity.hpp"
+#include "feeddrive/fit/verdict.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "drivegen.hpp"
@@ -35,6 +50,15 @@ struct Outcome {
   std::string parameter_miss;   ///< first parameter out of tolerance, if any
   double seconds{0.0};          ///< wall time of the fit
   std::string conclusion;
+  std::string verdict;          ///< explained, no_discrepancy, unexplained
+  std::set<std::string> tentative, tie_partners;
+  bool suggestion{false};       ///< an unexplained verdict says what would settle it
+  bool false_all_clear{false};  ///< explained/no discrepancy with a hidden effect not named (strict)
+  bool nothing_there{false};    ///< "no discrepancy" (or nothing named) on a record with a hidden effect
+  bool above_floor_all_clear{false};  ///< explained/no discrepancy above the floor (never, by the rule)
+  double gap_final{0.0}, gap_floor{0.0}, force_final{0.0}, force_floor{0.0};
+  double periods{0.0};          ///< travelled range / hidden ripple pitch (0: no ripple)
+  std::string category;
 };
 
 /// Main parameters and their relative tolerances, per effect.
@@ -62,6 +86,7 @@ inline MeasuredData measured(const fdgen::Generated& g) {
   d.x = g.x;
   d.input = g.force_N;
   d.input_kind = InputKind::kForce;
+  d.input_name = "force_N";
   d.xd = g.xd;
   validate(d);
   return d;
@@ -83,8 +108,16 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
   const sim::Scenario model = sim::parse_scenario(g.scenario_yaml, ".", "indepgen model");
   opt.plausibility.grinding_process = model.grinding_process;
   const MeasuredData data = measured(g);
+  o.category = spec.category;
   const auto t0 = std::chrono::steady_clock::now();
-  const FitResult r = run_fit(prepare(data), model.plant, opt);
+  check_record(data, model.plant, model.control_period);  // the CLI's sanity checks: no false refusal
+  const Record rec = prepare(data);
+  check_force_scale(rec, model.plant);
+  // FD_SWEEP_VERBOSE=1: the fit's log on stderr (to look at one case)
+  const bool verbose = std::getenv("FD_SWEEP_VERBOSE") != nullptr;
+  const FitResult r = run_fit(rec, model.plant, opt, [verbose](const std::string& s) {
+    if (verbose) std::fprintf(stderr, "  %s\n", s.c_str());
+  });
   o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   o.conclusion = r.conclusion;
   std::map<std::string, std::map<std::string, double>> found;
@@ -94,10 +127,57 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
   }
   for (const auto& n : o.named)
     if (!o.hidden.count(n)) o.spurious = true;
-  o.right = o.named == o.hidden;
+  o.verdict = verdict_name(r.verdict);
+  o.gap_final = r.replay_final.gap;
+  o.force_final = r.force_rms_final;
+  o.gap_floor = r.floor.gap;
+  o.force_floor = r.floor.force;
+  for (const auto& [n, c] : r.tentative) o.tentative.insert(n);
+  for (const auto& t : r.ties) {  // "a or b (scores ...)": b is the partner of the named a
+    const auto sp = t.find(" or "), end = t.find(" (");
+    if (sp != std::string::npos && end != std::string::npos) o.tie_partners.insert(t.substr(sp + 4, end - sp - 4));
+  }
+  for (const auto& u : r.unexplained) o.suggestion = o.suggestion || u.find("to settle it") != std::string::npos ||
+                                                     u.find("--max-effects") != std::string::npos;
+  const double range = *std::max_element(g.x.begin(), g.x.end()) - *std::min_element(g.x.begin(), g.x.end());
+  for (const char* rip : {"cogging_ripple", "reluctance_ripple"})
+    if (truth.count(rip)) o.periods = range / truth[rip]["pitch_m"];
+  // ties: a named effect with the hidden one as its reported partner stands for it
+  std::set<std::string> effective = o.named;
+  for (const auto& n : o.named)
+    if (!o.hidden.count(n))
+      for (const auto& p : o.tie_partners)
+        if (o.hidden.count(p) && !o.named.count(p)) {
+          effective.erase(n);
+          effective.insert(p);
+          found[p] = {};
+          break;
+        }
+  o.spurious = false;
+  for (const auto& n : effective)
+    if (!o.hidden.count(n)) o.spurious = true;
+  o.right = effective == o.hidden;
+  // a ripple over fewer than two periods, honestly left unexplained
+  bool short_ripple_ok = false;
+  if (!o.right && o.periods > 0 && o.periods < 2.0 && o.verdict == "unexplained") {
+    std::set<std::string> rest = o.hidden;
+    rest.erase("cogging_ripple");
+    rest.erase("reluctance_ripple");
+    bool periodic = false;
+    for (const auto& u : r.unexplained) periodic = periodic || u.find("periodic in position") != std::string::npos;
+    short_ripple_ok = periodic && effective == rest;
+  }
+  const bool all_clear = o.verdict != "unexplained";
+  std::set<std::string> missed;
+  for (const auto& h : o.hidden)
+    if (!effective.count(h)) missed.insert(h);
+  o.false_all_clear = all_clear && !missed.empty();
+  o.nothing_there = all_clear && !o.hidden.empty() && o.named.empty();
+  o.above_floor_all_clear = all_clear && !within_floor(r.floor, o.gap_final, o.force_final);
   if (o.right) {
     for (const auto& [n, want] : truth)
       for (const auto& [k, tol] : tolerances().at(n)) {
+        if (found[n].empty()) continue;  // a tie partner stands for it: no parameters of its own
         const double w = want.at(k), got = found[n][k];
         if (!(std::abs(got - w) <= tol * std::abs(w)) && o.parameter_miss.empty()) {
           std::ostringstream s;
@@ -107,6 +187,7 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
       }
     o.right = o.parameter_miss.empty();
   }
+  if (short_ripple_ok) o.right = true;
   return o;
 }
 

@@ -35,6 +35,14 @@ struct MeasuredData {
   std::vector<double> v;            ///< measured velocity [m/s], empty if absent
   double time_offset{0.0};          ///< subtracted from the file's time stamps (t[0] is 0) [s]
   std::vector<std::string> notes;   ///< what the loader did to the record (report.md, findings.json)
+  /// The file line of each sample (CSV; empty for an LCM log), for messages naming a row.
+  std::vector<long> lines;
+  /// The file's names of the time, position and input columns (for messages).
+  std::string time_name{"t"}, position_name{"x"}, input_name{"u"};
+  /// The unit factors applied to them on loading (SI = factor * file value; CsvOptions::units).
+  double time_factor{1.0}, position_factor{1.0}, input_factor{1.0};
+  /// "where sample k is": "FILE:LINE" of a CSV, "FILE, step k" of a log.
+  std::string where(std::size_t k) const;
   std::size_t size() const { return t.size(); }
   /// Median sample period [s].
   double median_period() const;
@@ -43,8 +51,23 @@ struct MeasuredData {
 /// Fewest samples accepted.
 constexpr std::size_t kMinSamples = 50;
 
-/// The CSV columns of each role (a drive's own export names them as it likes).
+/// The unit of each column role, as a factor to SI (docs/fit.md, "Data"): parsed from
+/// "ROLE=UNIT[,ROLE=UNIT...]" with ROLE one of t, x, u, force, xd and UNIT
+///   t: s, ms, us;   x, xd: m, mm, um, nm;   force: N, kN, mN;   u: V, mV;
+///   any role: counts:S (S of the SI unit per count, e.g. x=counts:5e-8 for a 50 nm encoder).
+/// Throws DataError naming the bad entry.
+struct Units {
+  double t{1.0}, x{1.0}, u{1.0}, force{1.0}, xd{1.0};
+  std::string text;  ///< as given, for messages
+};
+Units parse_units(const std::string& spec);
+
+/// The CSV columns of each role (a drive's own export names them as it likes). A column is named
+/// by its header name or, if the header has no such name, by its 1-based index ("2").
 struct CsvOptions {
+  char separator{','};                   ///< column separator (',', ';', '\t')
+  bool decimal_comma{false};             ///< "0,25" means 0.25
+  Units units;                           ///< unit of each role (SI by default)
   std::string time_column{"t"};          ///< time [s]
   std::string position_column{"x"};      ///< the measured position [m]
   std::string command_column{"u"};       ///< the command in the model's unit (thrust = Ka*Kf*u)

@@ -23,6 +23,9 @@ namespace feeddrive::fit {
 /// enabled_effects).
 using Effect = plant::NamedEffect;
 
+/// Why a candidate was not named (for the suggestion of what record would settle it).
+enum class Reason { kNone, kPrerequisite, kImplausible, kBelowThreshold, kNotConfirmed, kNoGapReduction, kInvalid };
+
 struct CandidateFit {
   Effect effect;            ///< as fitted jointly with the effects already added
   int parameters{0};        ///< k of the candidate in the BIC
@@ -33,7 +36,25 @@ struct CandidateFit {
   std::string passed_over;  ///< empty if eligible; else why not (prerequisite, implausible values, ...)
   plant::PlantParams joint; ///< the model plus the candidate, every free parameter jointly refitted
   double seconds{0.0};      ///< wall time of its fits
+  Reason reason{Reason::kNone};  ///< why it was passed over (kNone: eligible)
+  /// Named although it fails a plausibility limit, because the limit lies within the 95 %
+  /// confidence interval of the fitted value (docs/fit.md, "Tentative"): the caveat says which.
+  bool tentative{false};
+  std::string caveat;
+  /// A swap move of its joint fit: an effect already in the model that the refit turned into a
+  /// simpler one, e.g. "stribeck_friction -> coulomb_friction" (docs/fit.md, "Swap moves").
+  std::string swap;
+  std::vector<std::string> free_effects;  ///< the effects its joint fit refitted (with any swap)
 };
+
+/// 95 % confidence half-widths of every parameter of the named `effects` of `fitted`: the
+/// Gauss-Newton covariance s^2 (J^T J)^+ of the least-squares fit (Seber & Wild, Nonlinear
+/// Regression, 1989, sec. 5.1), s^2 = RSS/(n - k) over the n independent filter points, J the
+/// central-difference Jacobian of the filtered residual in the vocabulary's own parameters
+/// (pseudo-inverse: a phase of a vanishing amplitude is undetermined and gets NaN).
+/// Returns {effect: {parameter: 1.96 sigma}}.
+std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec, const plant::PlantParams& fitted,
+                                                                          const std::vector<std::string>& effects);
 
 /// BIC of a residual vector with k parameters over n_active points (0: all of r).
 double bic(const Eigen::VectorXd& r, int k, long n_active = 0);

@@ -14,6 +14,7 @@
 // Pure computation: no files are read or written here.
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "feeddrive/fit/model.hpp"
 #include "feeddrive/fit/plausibility.hpp"
 #include "feeddrive/fit/replay.hpp"
+#include "feeddrive/fit/verdict.hpp"
 
 namespace feeddrive::fit {
 
@@ -46,6 +48,10 @@ struct StepResult {
   /// model without and with it, each refitted on the other blocks.
   std::vector<double> cv_without, cv_with;
   std::vector<std::string> removed;    ///< effects removed by the backward step after the addition
+  std::string swap;                    ///< a swap move of this step, e.g. "stribeck_friction -> coulomb_friction"
+  std::string caveat;                  ///< the winner was named as tentative: why (else empty)
+  /// Candidates the record cannot tell from the winner (docs/fit.md, "Ties"), with their evidence.
+  std::vector<std::string> ties, tie_notes;
   double gap_before{0.0}, gap_after{0.0};              ///< replay gap [m]
   double force_rms_before{0.0}, force_rms_after{0.0};  ///< filtered force residual RMS [N]
   Eigen::VectorXd residual_before, residual_after;     ///< at the filter points [N]
@@ -65,7 +71,22 @@ struct FitResult {
   /// friction level), carried by constant_force in `fitted` but not named as an effect [N].
   double asymmetry_offset{0.0};
   std::string conclusion;
+  NoiseFloor floor;                    ///< the sensor's noise floor (verdict.hpp)
+  Verdict verdict{Verdict::kUnexplained};
+  /// For an unexplained verdict: where the discrepancy is, what it resembles, why each resembling
+  /// candidate was not named and what record would settle it (one sentence each).
+  std::vector<std::string> unexplained;
+  /// 95 % confidence half-widths of every parameter of the named effects (identify.hpp).
+  std::map<std::string, std::map<std::string, double>> ci95;
+  std::map<std::string, std::string> tentative;  ///< named effects that are tentative -> caveat
+  /// Ties of the named effects that no later step resolved: "a or b: the record cannot separate
+  /// them; <what would>".
+  std::vector<std::string> ties;
 };
+
+/// The options against the record (e.g. a replay window of at least 10 sample periods). Throws
+/// DataError. run_fit calls it first; feeddrive-fit calls it before the sanity checks.
+void check_options(const Record& rec, const FitOptions& opt);
 
 using Log = std::function<void(const std::string&)>;
 FitResult run_fit(const Record& rec, const plant::PlantParams& model, const FitOptions& opt, const Log& log = {});

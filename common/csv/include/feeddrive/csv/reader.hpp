@@ -5,7 +5,7 @@
 //
 // Format: UTF-8 text (a byte-order mark is skipped), lines ending in LF or CRLF. Blank lines and
 // lines whose first non-blank character is '#' are skipped. The first other line is the header:
-// comma-separated column names (spaces around them and double quotes are dropped; no name may
+// column names separated by Options::separator (a comma by default) (spaces around them and double quotes are dropped; no name may
 // be empty or appear twice). Every data row has exactly as many fields as the header. The
 // columns asked for are read as numbers by std::from_chars (locale-independent; a leading '+'
 // is accepted) and must be finite; other columns are ignored.
@@ -51,6 +51,7 @@ struct Column {
 struct Table {
   std::string source;                       ///< the file name, for messages
   std::vector<std::string> used;            ///< the name used for each Column ("" if absent)
+  std::vector<int> alternative;             ///< which of the Column's names was used (-1 if absent)
   std::vector<std::vector<double>> values;  ///< values[c][row]; empty for an absent column
   std::vector<long> lines;                  ///< the file line of each row
   std::size_t rows() const { return lines.size(); }
@@ -59,6 +60,16 @@ struct Table {
 
 struct Options {
   std::vector<Column> columns;
+  /// The column separator (',' by default; ';' or '\t' for loggers that write them).
+  char separator{','};
+  /// Numbers written with a decimal comma ("0,25"): the comma is read as the point (the
+  /// separator must then be another character).
+  bool decimal_comma{false};
+  /// A column name that the header lacks and that is a positive integer N names the N-th column
+  /// (1-based), e.g. a logger's unnamed or awkwardly named columns.
+  bool columns_by_index{false};
+  /// Named in the hint when a header seems split by another separator (e.g. "--separator").
+  std::string separator_option;
   /// Index into columns of a column that must increase strictly (time), or -1.
   int increasing{-1};
   Limits limits;

@@ -1,0 +1,61 @@
+#pragma once
+// The verdict of feeddrive-fit (docs/fit.md, "Verdicts"): three outcomes, never confused.
+//   * explained:       effects were named and the final gap and force residual are within the
+//                      noise floor;
+//   * no discrepancy:  nothing was named and the model as given is already within the floor;
+//   * unexplained:     the final gap or force residual stays above the floor (whatever was named);
+//                      the report then says where, what it resembles, why each resembling
+//                      candidate was not named and what record would settle it.
+//
+// The noise floor is the sensor's: a position error of sigma_x = sqrt(sigma_n^2 + q^2/12)
+// (noise sigma_n, quantization q uniform over one step: Widrow & Kollar 2008, ch. 4) per sample.
+//   * gap floor:   sigma_x (the replay compares the simulated position with the measured one);
+//   * force floor: the RMS over the filter points of m * sigma_x * sqrt(sum_k c_ik^2), the exact
+//     propagation of white position noise through the filtered acceleration
+//     A_i = sum_j (x_j+1 - x_j)/dt_j * g_ij,  g_ij = h(tau_i - t_j) - h(tau_i - t_j+1)
+//     (signals.hpp), whose weight on x_k is c_ik = g_i,k-1/dt_k-1 - g_ik/dt_k.
+// Within the floor means at most kFloorFactor times it (model-form error of real friction, time
+// stamp jitter and the integrator take their share; the factor is measured in docs/fit.md).
+// The scenario's plant.sensor gives q and sigma_n; without one, q is the record's smallest
+// position step (its resolution) and sigma_n = 0, and the report says so.
+
+#include <string>
+#include <vector>
+
+#include "feeddrive/fit/identify.hpp"
+#include "feeddrive/fit/model.hpp"
+#include "feeddrive/fit/plausibility.hpp"
+
+namespace feeddrive::fit {
+
+struct NoiseFloor {
+  double quantization{0.0};  ///< q [m]
+  double noise{0.0};         ///< sigma_n [m]
+  double position{0.0};      ///< sigma_x [m]
+  double gap{0.0};           ///< [m]
+  double force{0.0};         ///< [N]
+  bool from_scenario{true};  ///< false: q estimated from the record
+  std::string source;        ///< one line: where q and sigma_n come from
+};
+
+/// "Within the floor": at most this many times the floor.
+constexpr double kFloorFactor = 3.0;
+
+NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model);
+bool within_floor(const NoiseFloor& f, double gap, double force_rms);
+
+enum class Verdict { kExplained, kNoDiscrepancy, kUnexplained };
+/// "explained", "no_discrepancy", "unexplained" (findings.json's `verdict`).
+const char* verdict_name(Verdict v);
+/// feeddrive-fit's exit code of an unexplained verdict (0: explained or no discrepancy; 2: bad input).
+constexpr int kExitUnexplained = 3;
+
+/// One concrete sentence: what record would settle whether `c` is in the drive, e.g. "a force
+/// periodic in position, pitch about 41 mm, seen over 2.0 periods: record a travel of at least 3
+/// periods (125 mm)".
+std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason why);
+
+/// What record would separate two candidates that explain the data equally well.
+std::string what_would_separate(const std::string& a, const std::string& b);
+
+}  // namespace feeddrive::fit

@@ -1,0 +1,187 @@
+#include "feeddrive/fit/sanity.hpp"
+#include "text.hpp"
+
+#include "feeddrive/plant/effects.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+namespace feeddrive::fit {
+using text::fmt;
+using text::par;
+namespace {
+
+// The power of 1000 nearest to r: round(log10(r) / 3).
+int thousands(double r) { return static_cast<int>(std::lround(std::log10(r) / 3.0)); }
+
+std::string hint(const std::string& role, double factor) {
+  const std::string u = unit_name(role, factor);
+  return u.empty() ? std::string() : ": likely in " + u + " (--units " + role + "=" + u + ")";
+}
+
+}  // namespace
+
+std::string unit_name(const std::string& role, double factor) {
+  const auto near = [&](double f) { return std::abs(std::log10(factor / f)) < 0.01; };
+  if (role == "t") return near(1) ? "s" : near(1e-3) ? "ms" : near(1e-6) ? "us" : "";
+  if (role == "x" || role == "xd") return near(1) ? "m" : near(1e-3) ? "mm" : near(1e-6) ? "um" : near(1e-9) ? "nm" : "";
+  if (role == "force") return near(1) ? "N" : near(1e3) ? "kN" : near(1e-3) ? "mN" : "";
+  if (role == "u") return near(1) ? "V" : near(1e-3) ? "mV" : "";
+  return "";
+}
+
+void check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period) {
+  const std::size_t n = d.size();
+  if (n < 3) return;
+  const double T = d.median_period();
+  // 1. gaps and jumps in time: the largest step
+  std::size_t worst = 1;
+  for (std::size_t k = 1; k < n; ++k)
+    if (d.t[k] - d.t[k - 1] > d.t[worst] - d.t[worst - 1]) worst = k;
+  const double gap = d.t[worst] - d.t[worst - 1];
+  if (gap > kMaxGap * T)
+    throw DataError(d.where(worst) + ": column '" + d.time_name + "': the time jumps by " + fmt("%.6g s (%.3g sample periods of %.3g s) from t = %.9g", gap, gap / T, T, d.t[worst - 1] + d.time_offset) +
+                    fmt(" to %.9g s: a gap, or two recordings joined; the fit needs one continuous recording: split the "
+                        "file there and fit each part",
+                        d.t[worst] + d.time_offset));
+  // 2. the time scale against the control period
+  if (control_period > 0 && T > 0) {
+    const int k = thousands(T / control_period);
+    if (k != 0) {
+      const double factor = d.time_factor * std::pow(1000.0, -k);
+      const std::string h = hint("t", factor);
+      if (!h.empty())
+        throw DataError(d.source + ": column '" + d.time_name + "'" +
+                        fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
+    }
+  }
+  // 3. the position scale: travel and speed a feed drive can have
+  // the range between the 0.1th and 99.9th percentiles: an isolated outlier is no unit (it is
+  // named by the jump check below, or by prepare()'s finiteness check)
+  std::vector<double> xs = d.x;
+  std::sort(xs.begin(), xs.end());
+  const double travel = xs[static_cast<std::size_t>(0.999 * static_cast<double>(n - 1))] -
+                        xs[static_cast<std::size_t>(0.001 * static_cast<double>(n - 1))];
+  std::vector<double> speed;
+  speed.reserve(n);
+  for (std::size_t k = 1; k < n; ++k) speed.push_back(std::abs(d.x[k] - d.x[k - 1]) / (d.t[k] - d.t[k - 1]));
+  std::vector<double> sorted = speed;
+  const std::size_t q99 = static_cast<std::size_t>(0.99 * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(q99), sorted.end());
+  const double v99 = sorted[q99];
+  if (travel > kMaxTravel || v99 > kMaxSpeed) {
+    int k = 0;
+    while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
+    const std::string h = hint("x", d.position_factor * std::pow(1e-3, k));
+    throw DataError(d.source + ": column '" + d.position_name + "'" +
+                    fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
+                        "%.3g m, %.3g m/s)",
+                        travel, v99, kMaxTravel, kMaxSpeed) +
+                    (h.empty() ? ": is the position in metres?" : h));
+  }
+  // 4. discontinuities in position: an acceleration no thrust of this drive gives, and beyond the
+  // sensor's own second difference (a quantum and three noise deviations per step, 50-fold)
+  const double mass = plant::effective_params(model).mass;
+  const double gain = d.input_kind == InputKind::kCommand ? model.thrust_gain() : 1.0;
+  double peak = 0.0;
+  for (double u : d.input) peak = std::max(peak, std::abs(gain * u));
+  double q = model.sensor.quantization;
+  if (q == 0.0) {  // the record's own resolution: its smallest position step
+    q = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 1; k < n; ++k)
+      if (d.x[k] != d.x[k - 1]) q = std::min(q, std::abs(d.x[k] - d.x[k - 1]));
+    if (!std::isfinite(q)) q = 0.0;
+  }
+  const double sensor = q + 3.0 * model.sensor.noise_stddev;
+  std::vector<double> acc(n, 0.0);
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    const double h0 = d.t[k] - d.t[k - 1], h1 = d.t[k + 1] - d.t[k];
+    acc[k] = std::abs((d.x[k + 1] - d.x[k]) / h1 - (d.x[k] - d.x[k - 1]) / h0) / (0.5 * (h0 + h1));
+  }
+  // and beyond 20x the record's own 99th percentile (one jump does not move it)
+  std::vector<double> acc_sorted = acc;
+  const std::size_t a99 = static_cast<std::size_t>(0.99 * static_cast<double>(n - 1));
+  std::nth_element(acc_sorted.begin(), acc_sorted.begin() + static_cast<long>(a99), acc_sorted.end());
+  const double typical = acc_sorted[a99];
+  std::size_t jump = 0;
+  double jump_a = 0.0;
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    const double h0 = d.t[k] - d.t[k - 1], h1 = d.t[k + 1] - d.t[k];
+    const double a = acc[k];
+    const double limit = std::max({20.0 * peak / mass, 50.0 * sensor / (h0 * h1), 20.0 * typical});
+    if (a > limit && a / limit > jump_a) {
+      jump = k;
+      jump_a = a / limit;
+    }
+  }
+  if (jump > 0) {
+    // an isolated outlier (a spike: the samples around it agree) rather than a jump
+    for (std::size_t k = std::max<std::size_t>(jump, 1) - 0; k <= jump + 1 && k + 1 < n; ++k) {
+      const double off = std::abs(d.x[k] - 0.5 * (d.x[k - 1] + d.x[k + 1]));
+      if (std::abs(d.x[k + 1] - d.x[k - 1]) < 0.1 * off)
+        throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
+                        fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
+                            "column in metres and free of outliers?",
+                            d.x[k], d.t[k] + d.time_offset, off));
+    }
+    // the step of the jump is the larger of the two around sample `jump`
+    const std::size_t k = std::abs(d.x[jump + 1] - d.x[jump]) > std::abs(d.x[jump] - d.x[jump - 1]) ? jump + 1 : jump;
+    // the step less the motion around it (the mean of the neighbouring steps)
+    const double before = k >= 2 ? d.x[k - 1] - d.x[k - 2] : 0.0, after = k + 1 < n ? d.x[k + 1] - d.x[k] : 0.0;
+    const double size = d.x[k] - d.x[k - 1] - 0.5 * (before + after);
+    throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
+                    fmt(": the position jumps by %.4g mm in one sample (t = %.9g s), an acceleration beyond 20x what "
+                        "the peak thrust of %.4g N gives the %.4g kg mass",
+                        size * 1e3, d.t[k] + d.time_offset, peak, mass) +
+                    ": two recordings joined, or an encoder glitch? The fit needs one continuous recording: split the "
+                    "file there and fit each part");
+  }
+}
+
+void check_force_scale(const Record& rec, const plant::PlantParams& model) {
+  const MeasuredData& d = *rec.data;
+  const long n = static_cast<long>(rec.bank.tau.size());
+  if (n < 8) return;
+  const double mass = plant::effective_params(model).mass;
+  const double gain = thrust_per_input(rec, model);
+  const Eigen::VectorXd thrust = apply(rec.bank, gain * rec.input);
+  const long ni = static_cast<long>(rec.motion.v_mid.size());
+  Eigen::VectorXd sg(ni), v(ni), one = Eigen::VectorXd::Ones(ni);
+  const double v_small = std::max(1e-5, 0.01 * rec.v_max_abs);
+  for (long j = 0; j < ni; ++j) {
+    v[j] = rec.motion.v_mid[static_cast<std::size_t>(j)];
+    sg[j] = std::tanh(v[j] / v_small);
+  }
+  Eigen::MatrixXd A(n, 4);
+  A.col(0) = mass * Eigen::Map<const Eigen::VectorXd>(rec.bank.accel.data(), n);
+  A.col(1) = apply(rec.bank, one);
+  A.col(2) = apply(rec.bank, sg);
+  A.col(3) = apply(rec.bank, v);
+  // scale the columns: the solve must not depend on the units of the others
+  Eigen::VectorXd s(4);
+  for (int c = 0; c < 4; ++c) s[c] = std::max(A.col(c).norm(), 1e-300);
+  const Eigen::MatrixXd As = A * s.cwiseInverse().asDiagonal();
+  const Eigen::VectorXd beta = As.colPivHouseholderQr().solve(thrust).cwiseQuotient(s);
+  const double alpha = beta[0];
+  // only a well-determined ratio: the acceleration column must carry the thrust (R^2 of the fit)
+  const Eigen::VectorXd res = thrust - A * beta;
+  const double r2 = 1.0 - res.squaredNorm() / std::max(thrust.squaredNorm(), 1e-300);
+  if (!(r2 > 0.5) || !(std::abs(alpha) > 0)) return;
+  if (std::abs(alpha) <= kMaxForceRatio && std::abs(alpha) >= 1.0 / kMaxForceRatio) return;
+  const int k = thousands(std::abs(alpha));
+  const bool force = d.input_kind == InputKind::kForce;
+  const std::string role = force ? "force" : "u";
+  const std::string h = hint(role, d.input_factor * std::pow(1000.0, -k));
+  throw DataError(d.source + ": column '" + d.input_name + "'" +
+                  fmt(": the thrust is %.3g times mass x acceleration (%.4g kg; fitted over the record with a constant "
+                      "and a friction)",
+                      alpha, mass) +
+                  (h.empty() ? ": is the input in the model's unit (N for a force, V for a command)?" : h) +
+                  (k > 0 ? std::string(", or the position is in larger units than declared") : std::string()));
+}
+
+}  // namespace feeddrive::fit
