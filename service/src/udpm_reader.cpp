@@ -193,6 +193,14 @@ UdpmReader::~UdpmReader() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+std::string UdpmReader::current_source() const {
+  const auto addr = static_cast<std::uint32_t>(current_ >> 16);  // network byte order, as in sin_addr
+  const auto* b = reinterpret_cast<const unsigned char*>(&addr);
+  const auto port = static_cast<std::uint16_t>(current_ & 0xFFFF);
+  return std::to_string(b[0]) + "." + std::to_string(b[1]) + "." + std::to_string(b[2]) + "." + std::to_string(b[3]) + ":" +
+         std::to_string(ntohs(port));
+}
+
 std::size_t UdpmReader::drain(const MessageSink& sink) {
   std::size_t delivered = 0;
   mmsghdr msgs[kBatch];
@@ -226,6 +234,7 @@ std::size_t UdpmReader::drain(const MessageSink& sink) {
         }
       }
       const std::uint64_t sender = (std::uint64_t{from[i].sin_addr.s_addr} << 16) | from[i].sin_port;
+      current_ = sender;
       if (reassembler_.feed(static_cast<const std::uint8_t*>(iov[i].iov_base), msgs[i].msg_len, sender, utime, sink))
         ++delivered;
     }

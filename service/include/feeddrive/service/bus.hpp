@@ -131,6 +131,9 @@ class Bus {
   /// With a key: messages without a valid mac.
   std::int64_t unauthenticated() const { return unauthenticated_; }
   const std::string& url() const { return url_; }
+  /// Inside a handler: who sent the message being handled, "IP:PORT" of its UDP source (kDirect,
+  /// kBatched), or "" (kEvent: liblcm does not say).
+  std::string current_source() const { return reader_ ? reader_->current_source() : std::string(); }
 
  private:
   struct Raw {

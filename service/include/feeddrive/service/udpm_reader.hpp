@@ -84,6 +84,9 @@ class UdpmReader {
   std::size_t drain(const MessageSink& sink);
 
   std::int64_t malformed() const { return reassembler_.malformed(); }
+  /// While drain() passes a message to its sink: the sender's address and port, "IP:PORT" (the
+  /// UDP source of its last datagram). It names who sent a message (a conflict's two senders).
+  std::string current_source() const;
   /// The socket, for waiting on it (poll/ppoll).
   int fd() const { return fd_; }
   /// The receive buffer the kernel granted [bytes].
@@ -94,6 +97,7 @@ class UdpmReader {
   int granted_{0};
   Reassembler reassembler_;
   std::vector<std::uint8_t> buf_;
+  std::uint64_t current_{0};  ///< the sender of the datagram being passed on (address << 16 | port)
 };
 
 }  // namespace feeddrive::service
