@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/service/cli.hpp"
+#include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/launch.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -36,8 +38,10 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     lo.external.insert(external.begin(), external.end());
     lo.plots = !no_plots;
+    lo.auto_pace = app.count("--max-rate") == 0;
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
     const sim::Scenario s = sim::load_scenario(lo.scenario);  // bad input fails here, before any process starts
+    opt.scenario_hash = service::sha256_hex(text::read_text_file<std::invalid_argument>(lo.scenario, "scenario"));  // run_info_t.scenario_hash
     const auto out = output::check_output_dir(lo.out_dir);  // and this, before any process starts
     output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
     sim::check_run_size(s, lo.out_dir);
@@ -60,9 +64,12 @@ int main(int argc, char** argv) {
     }
     std::ifstream in(lo.out_dir + "/summary.json");
     const auto j = nlohmann::json::parse(in, nullptr, false);
+    // The true-state error where the plant has one, else the measured one (a hardware plant).
+    const bool truth = !j.is_discarded() && j.contains("position_error_max_abs_m") && !j["position_error_max_abs_m"].is_null();
     if (!j.is_discarded() && j.contains("lockstep"))
-      spdlog::info("{} steps, max |e| {} m, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
-                   j["position_error_max_abs_m"].dump(), j["lockstep"].value("resends", 0L),
+      spdlog::info("{} steps, max |e| {} m{}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
+                   j[truth ? "position_error_max_abs_m" : "measured_position_error_max_abs_m"].dump(),
+                   truth ? "" : " (measured: x_d - x_measured)", j["lockstep"].value("resends", 0L),
                    j["lockstep"].value("lost", 0L), j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(),
                    lo.out_dir);
     return 0;

@@ -28,6 +28,11 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
   app.add_option("--linger", opt.linger_s, "seconds to keep answering resend requests after the end")
       ->capture_default_str();
   app.add_flag("--realtime", opt.realtime, "real-time mode: the plant is paced by the wall clock");
+  app.add_option("--max-rate", opt.max_rate,
+                 "lockstep: at most this many steps per second (0: unpaced); the stock lcm-logger records "
+                 "without loss at 1000 (docs/lcm-contract.md)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-bad-commands", opt.max_bad_commands,
                  "real time: missed or invalid commands in a row before the plant goes to zero thrust")
       ->capture_default_str();
@@ -40,6 +45,9 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "identity of the run (nonzero; docs/security.md); default: the plant draws one, the others join "
                  "the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+  app.add_option("--scenario-hash", opt.scenario_hash,
+                 "hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash; feeddrive-launch passes it)")
+      ->type_name("HEX");
   app.add_option("--key", opt.key_file,
                  "authenticate every message with HMAC-SHA256 and this key file (mode 0600; docs/security.md)")
       ->type_name("FILE");

@@ -23,6 +23,14 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
       ++duplicates;
       return;
     }
+    // Lockstep: the plant publishes state k+1 only after command k, so a state beyond the next
+    // unanswered one is the plant's protocol error (a skipped or reordered step number), never a
+    // loss here: named as the plant's, not left to look like the controller's stall. In real time
+    // states go out every period whether answered or not, and a lost one is a gap, not an error.
+    if (!options().realtime && m.seq > next_seq_)
+      throw RunFailure("protocol error of the plant: it published state " + std::to_string(m.seq) + " while step " +
+                       std::to_string(next_seq_) + " has no command yet (a skipped or out-of-order step number; "
+                       "docs/external-plant.md)");
     // Waiting for a reference since the first unanswered state, not the newest: in real-time
     // mode a newer state replaces the pending one every period, and a request timed from the
     // newest would never go out.

@@ -107,6 +107,20 @@ std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint
   return out;
 }
 
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), md, &n, EVP_sha256(), nullptr) != 1 || n != 32)
+    throw std::runtime_error("SHA-256 failed (libcrypto)");
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < n; ++i) {
+    out += hex[md[i] >> 4];
+    out += hex[md[i] & 15];
+  }
+  return out;
+}
+
 std::string read_key_file(const std::string& path) {
   const std::string where = "--key " + path + ": ";
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);

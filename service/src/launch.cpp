@@ -16,6 +16,7 @@
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/service/bus.hpp"
 #include "feeddrive/service/integrity.hpp"
+#include "feeddrive/service/loggers.hpp"
 #include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
@@ -39,7 +40,9 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
                                 "--max-bad-commands", std::to_string(opt.max_bad_commands),
                                 "--spin-us", std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
+  if (opt.max_rate > 0) a.insert(a.end(), {"--max-rate", fmt_double(opt.max_rate)});
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
+  if (!opt.scenario_hash.empty()) a.insert(a.end(), {"--scenario-hash", opt.scenario_hash});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
   if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
   return a;
@@ -147,6 +150,16 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     spdlog::info("run id {}{}", opt.run_id, opt.key_file.empty() ? "" : " (messages authenticated with " + opt.key_file + ")");
   } else if (opt.run_id == 0) {
     spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
+  }
+
+  // A stock lcm-logger started before the run records it only if the run is paced (loggers.hpp).
+  if (lo.auto_pace && !opt.realtime && !lo.external.count("plant")) {
+    const std::vector<StockLogger> loggers = stock_loggers_on(opt.lcm_url);
+    if (!loggers.empty()) {
+      opt.max_rate = kStockLoggerSteps;
+      spdlog::info("{} on the bus: the run is paced to {:g} steps/s, which it records without loss (--max-rate N to "
+                   "choose, --max-rate 0 for none; docs/lcm-contract.md)", describe(loggers), opt.max_rate);
+    }
   }
 
   std::map<pid_t, std::string> running;

@@ -11,6 +11,7 @@
 #include <ctime>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/service/contract.hpp"
 #include <cstdio>
 #include <cstdlib>
 
@@ -51,6 +52,8 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
     : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive), ch_(opt.prefix) {
   if (!opt.key_file.empty()) bus_.set_auth(read_key_file(opt.key_file));
   if (opt.run_id != 0) bus_.set_run_id(opt.run_id);
+  // Under feeddrive-launch the monitor names what the bus drops (one line per event); the others count.
+  if (std::getenv(interrupt::kQuietEnv) != nullptr && role_ != "monitor") bus_.set_reports(false);
   bus_.subscribe<process_status_t>(
       ch_.status,
       [this](const process_status_t& m, std::int64_t recv_us) {
@@ -62,12 +65,13 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
           spdlog::info("{}: joined run {} (taken from the plant's heartbeat)", role_, m.run_id);
         }
         if (m.run_id != bus_.run_id()) {
-          bus_.count_foreign(ch_.status, m.run_id);
+          bus_.count_foreign(ch_.status, m.run_id, m.role);
           return;
         }
         if (m.role == role_) return;
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
+        if (on_peer_status) on_peer_status(m);
       },
       Admit::kAnyRun);
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
@@ -89,6 +93,7 @@ process_status_t Node::status_message(const std::string& state, const std::strin
   m.foreign = bus_.foreign();
   m.conflicts = conflicts;
   m.unauthenticated = bus_.unauthenticated();
+  m.contract_version = kContractVersion;
   return m;
 }
 

@@ -95,6 +95,9 @@ std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint
 /// std::invalid_argument with one line naming the file and what is wrong.
 std::string read_key_file(const std::string& path);
 
+/// Hex SHA-256 of `bytes` (64 lower-case digits): run_info_t.scenario_hash of the scenario file.
+std::string sha256_hex(const std::string& bytes);
+
 /// Signs and verifies messages with one key (see the top of this file). Keeps a keyed OpenSSL
 /// context, so a message costs one HMAC, not a key setup.
 class MessageAuth {
