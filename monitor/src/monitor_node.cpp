@@ -121,7 +121,7 @@ void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, co
   if (who_role == "plant" && plant_seq_seen_ >= 0 && !peer_alive("plant", 0.3)) {
     const std::string why = "the plant restarted: a plant with a new run id " + std::to_string(run_id) +
                             " appeared on " + channel + " after this run's plant (run id " + std::to_string(bus().run_id()) +
-                            ") went silent at step " + std::to_string(plant_seq_seen_) +
+                            ") went silent after state " + std::to_string(rec_.highest_state()) +
                             "; a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
     spdlog::error("{}: {}", role(), why);
     fail_for("plant", why);
@@ -168,7 +168,11 @@ void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t*
 void MonitorNode::check_peer_status(const process_status_t& m) {
   if (m.contract_version != service::kContractVersion) {
     const std::string key = "version " + m.role + " " + std::to_string(m.contract_version);
-    if (named_[key]++ == 0) {
+    if (named_[key]++ == 0 && m.contract_version == 0) {
+      // Built from these types but never set: it decodes, so it may well work; named, not failed.
+      spdlog::warn("{}: the {} sends contract_version 0 in its heartbeat: set it to {} (docs/lcm-contract.md, Versions)",
+                   role(), m.role, service::kContractVersion);
+    } else if (named_[key] == 1) {
       const std::string why = "the " + m.role + " speaks contract version " + std::to_string(m.contract_version) +
                               "; this run speaks " + std::to_string(service::kContractVersion) +
                               ": rebuild it with this feeddrive's lcmtypes/ (docs/lcm-contract.md, Versions)";
