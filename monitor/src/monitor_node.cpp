@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -104,8 +106,9 @@ void MonitorNode::fail_for(const std::string& role, const std::string& why) {
 
 void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, const std::string& sender) {
   const std::string who_role = sender.empty() ? service::publisher_of(channels(), channel) : sender;
-  const std::string key = "foreign " + channel + " " + std::to_string(run_id);
-  if (named_[key]++ > 0) return;  // one line per sender: the count is in the summary
+  // One line per sender (run id 0: per role, whatever the channel): the count is in the summary.
+  const std::string key = run_id == 0 ? "run id 0 " + who_role : "foreign " + channel + " " + std::to_string(run_id);
+  if (named_[key]++ > 0) return;
   const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
   if (run_id == 0) {
     const std::string why = who + " publishes run id 0 on " + channel +
@@ -541,15 +544,19 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
     // An incomplete record (interrupted, failed) never replaces an earlier output: it goes beside
-    // it, to DIR.incomplete-N, and both are kept.
+    // it, to DIR.incomplete-N, and both are kept. An empty folder in DIR's place is no earlier
+    // output: it is removed (rmdir removes only an empty one) and the record takes its place.
+    const std::filesystem::path target = output::normalise(mopt_.out_dir);
+    const bool earlier = output::is_feeddrive_output(target);
+    if (!completed && !earlier) ::rmdir(target.c_str());
     const std::filesystem::path dest = out_->finish(
         sum, mopt_.plots, j.dump(), [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); },
         completed);
-    if (!completed && dest != output::normalise(mopt_.out_dir)) {
+    if (!completed && dest != target) {
       where = dest.string();
       if (!options().quiet)  // an interrupt's one line stays one line with -q
-        spdlog::info("monitor: the run did not complete; the earlier output in {} is kept, this record is in {}",
-                     output::shown(mopt_.out_dir), where);
+        spdlog::info("monitor: the run did not complete; {} in {} is kept, this record is in {}",
+                     earlier ? "the earlier output" : "what was already there", output::shown(mopt_.out_dir), where);
     }
     if (!out_->plot_error().empty() && !interrupt::interrupted())  // an interrupt is reported once, as such
       spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);

@@ -166,9 +166,13 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   for (const auto& role : roles) {
     if (interrupted_by() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}", role, opt.lcm_url, opt.prefix,
-                   opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
-                   opt.key_file.empty() ? "" : " --key " + opt.key_file);
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}; this run is {} (--realtime), "
+                   "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
+                   "(docs/external-{}.md)",
+                   role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
+                   opt.key_file.empty() ? "" : " --key " + opt.key_file, opt.realtime ? "real time" : "lockstep",
+                   seconds_text(opt.start_timeout_s), seconds_text(opt.step_timeout_s), seconds_text(opt.resend_interval_s),
+                   opt.monitor_window, role == "plant" ? "plant" : "controllers");
       continue;
     }
     std::vector<std::string> args = {lo.scenario};
