@@ -497,18 +497,18 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     // records without loss (service::kStockLoggerSteps): the run cannot know what it dropped.
     const double run_rate = wall_time_s > 0 ? static_cast<double>(sum.steps) / wall_time_s : 0.0;
     const double peak = std::max(peak_rate_, run_rate);
-    const bool too_fast = !loggers_.empty() && peak > service::kStockLoggerSteps * 1.02;  // 2 %: the window's clock
+    const bool too_fast = !loggers_.empty() && peak > service::stock_logger_pace(loggers_) * 1.02;  // 2 %: the window's clock
     auto& sl = l["stock_loggers"];
     sl["seen"] = nlohmann::ordered_json::array();
     for (const service::StockLogger& g : loggers_) sl["seen"].push_back({{"name", g.name}, {"pid", g.pid}});
     sl["max_rate"] = options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
     sl["peak_steps_per_second"] = peak;
-    sl["records_without_loss_up_to"] = service::kStockLoggerSteps;
+    sl["records_without_loss_up_to"] = loggers_.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(service::stock_logger_pace(loggers_));
     sl["faster_than_it_records"] = too_fast;
     if (too_fast)
       spdlog::warn("{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
                    "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
-                   role(), peak, service::describe(loggers_), service::kStockLoggerSteps, service::kStockLoggerSteps);
+                   role(), peak, service::describe(loggers_), service::stock_logger_pace(loggers_), service::stock_logger_pace(loggers_));
   }
   const auto hop = [&](const char* name, const stats::StreamingQuantile& v) {
     l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.count()}};

@@ -1,6 +1,7 @@
 #include "feeddrive/service/loggers.hpp"
 
 #include <dirent.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <climits>
@@ -80,7 +81,10 @@ std::vector<StockLogger> stock_loggers_on(const std::string& lcm_url) {
     std::ifstream comm("/proc/" + pid + "/comm");
     std::string name;
     if (!std::getline(comm, name) || name != "lcm-logger") continue;
-    if (has_socket(pid, inodes)) out.push_back({std::atoi(pid.c_str()), name});
+    if (!has_socket(pid, inodes)) continue;
+    const int id = std::atoi(pid.c_str());
+    const int policy = ::sched_getscheduler(id);
+    out.push_back({id, name, policy == SCHED_FIFO || policy == SCHED_RR});
   }
   ::closedir(proc);
   return out;
@@ -88,8 +92,15 @@ std::vector<StockLogger> stock_loggers_on(const std::string& lcm_url) {
 
 std::string describe(const std::vector<StockLogger>& loggers) {
   std::string s;
-  for (const StockLogger& l : loggers) s += (s.empty() ? "" : ", ") + l.name + " (pid " + std::to_string(l.pid) + ")";
+  for (const StockLogger& l : loggers)
+    s += (s.empty() ? "" : ", ") + l.name + " (pid " + std::to_string(l.pid) + (l.realtime ? ", real-time priority)" : ", normal priority)");
   return s;
+}
+
+double stock_logger_pace(const std::vector<StockLogger>& loggers) {
+  for (const StockLogger& l : loggers)
+    if (!l.realtime) return kStockLoggerStepsNormal;
+  return kStockLoggerSteps;
 }
 
 }  // namespace feeddrive::service

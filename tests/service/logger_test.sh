@@ -5,15 +5,18 @@
 # the monitor's own log (feeddrive-launch --lcm-log), which costs the run no extra process.
 # The stock lcm-logger keeps LCM's default 30-message subscription queue and drops silently when
 # it falls behind. Lossless by design: feeddrive-launch sees the logger on the bus and paces the run
-# to what it records without loss (--max-rate 1000, service/loggers.hpp; measured with
-# bench/logger_pace_bench.sh under stress-ng on both cores, docs/lcm-contract.md). So the logger
-# runs here at normal priority and free placement, and the test records once: no retry.
+# to what it records without loss (service/loggers.hpp): 1000 steps/s at real-time priority
+# (chrt -f 20, where permitted, as docs/lcm-contract.md recommends), 500 at normal priority;
+# measured with bench/logger_pace_bench.sh under stress-ng on both cores (20 of 20 runs complete
+# at 1000 with chrt). So the test records once: no retry.
 source "$(dirname "$0")/lib.sh" "$@"
 scen=$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml
-lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
+prio=(chrt -f 20) pace=1000
+"${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority for lcm-logger here; it runs at normal priority (paced to 500 steps/s)"; prio=(); pace=500; }
+"${prio[@]}" lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 300 feeddrive-launch "$scen" --out "$TMP/mon" --no-plots --lcm-url "$URL" 2> "$TMP/launch.err"
-grep -q "lcm-logger (pid [0-9]*) on the bus: the run is paced to 1000 steps/s" "$TMP/launch.err" ||
+grep -q "lcm-logger (pid [0-9]*, [a-z-]* priority) on the bus: the run is paced to $pace steps/s" "$TMP/launch.err" ||
   { cat "$TMP/launch.err"; fail "the launcher did not pace the run for the stock logger"; }
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.seen | length')" -ge 1 ] || fail "the monitor did not see the logger"
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.faster_than_it_records')" = false ] || fail "paced run reported too fast"

@@ -15,16 +15,25 @@
 namespace feeddrive::service {
 
 /// Steps per second the stock lcm-logger records without loss on the development VM with both
-/// cores under a concurrent CPU load (stress-ng), the logger at normal priority. Measured with
-/// bench/logger_pace_bench.sh (docs/lcm-contract.md has the figures).
+/// cores under a concurrent CPU load (stress-ng --cpu 2), measured with bench/logger_pace_bench.sh
+/// (docs/lcm-contract.md has the figures): at real-time priority (chrt -f 20), 1000 (20 of 20
+/// runs complete); at normal priority the scheduler may keep it off a CPU for longer than its
+/// queue lasts at 1000 (2 of 8 runs lost 2-3 steps), so a logger at normal priority gets
+/// kStockLoggerStepsNormal.
 inline constexpr double kStockLoggerSteps = 1000.0;
+inline constexpr double kStockLoggerStepsNormal = 500.0;
 
 /// A process of a known stock logger ("lcm-logger") with a UDP socket bound to the port of
 /// `lcm_url` in this network namespace (it hears the run's group).
 struct StockLogger {
   int pid{0};
   std::string name;
+  bool realtime{false};  ///< scheduled SCHED_FIFO or SCHED_RR
 };
+
+/// The pace at which all of `loggers` record without loss: kStockLoggerSteps when each runs at
+/// real-time priority, else kStockLoggerStepsNormal.
+double stock_logger_pace(const std::vector<StockLogger>& loggers);
 
 /// The stock loggers on the bus of `lcm_url` (udpm:// only; other URLs: none), found through
 /// /proc (net/udp for the port's sockets, fd/ for their owners). Never throws: a /proc that cannot
