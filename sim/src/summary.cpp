@@ -90,15 +90,13 @@ Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator
   if (n_settled_ > 0)
     m.position_error_rms_settled_m =
         n_e_settled_ > 0 ? static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_e_settled_))) : kNone;
-  // rank floor(0.95 n) of the n finite values |e|
-  if (abs_e_.count() > 0) {
-    const auto k = std::min<std::uint64_t>(abs_e_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_e_.count())));
-    m.position_error_p95_abs_m = abs_e_.value_at_rank(k);
-  }
-  if (abs_em_.count() > 0) {
-    const auto k = std::min<std::uint64_t>(abs_em_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_em_.count())));
-    m.measured_position_error_p95_abs_m = abs_em_.value_at_rank(k);
-  }
+  // rank floor(0.95 n) of the n finite values |e| (and |e_m|)
+  const auto p95 = [](const stats::StreamingQuantile& q, double& out) {
+    if (q.count() == 0) return;
+    out = q.value_at_rank(std::min<std::uint64_t>(q.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(q.count()))));
+  };
+  p95(abs_e_, m.position_error_p95_abs_m);
+  p95(abs_em_, m.measured_position_error_p95_abs_m);
   m.measured_position_error_rms_m = n_em_ > 0 ? static_cast<double>(std::sqrt(sem_ / static_cast<long double>(n_em_))) : kNone;
   if (n_em_ == 0) m.measured_position_error_max_abs_m = m.measured_position_error_p95_abs_m = kNone;
   if (n_e_ == 0) m.position_error_max_abs_m = m.position_error_p95_abs_m = kNone;

@@ -18,7 +18,7 @@ namespace feeddrive::service {
 /// cores under a concurrent CPU load (stress-ng --cpu 2), measured with bench/logger_pace_bench.sh
 /// (docs/lcm-contract.md has the figures): at real-time priority (chrt -f 20), 1000 (20 of 20
 /// runs complete); at normal priority the scheduler may keep it off a CPU for longer than its
-/// queue lasts at 1000 (2 of 8 runs lost 2-3 steps), so a logger at normal priority gets
+/// queue lasts at 1000 (2 of 7 runs lost 2-3 steps), so a logger at normal priority gets
 /// kStockLoggerStepsNormal.
 inline constexpr double kStockLoggerSteps = 1000.0;
 inline constexpr double kStockLoggerStepsNormal = 500.0;
