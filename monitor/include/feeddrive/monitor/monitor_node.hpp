@@ -69,8 +69,9 @@ class MonitorNode : public service::Node {
   void on_unauthenticated(const std::string& channel, const std::uint8_t* d, std::size_t n);
   void on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n);
   void check_peer_status(const process_status_t& m);
-  /// Fails the run with `why` when `role` is one of the run's (an observer is only named).
-  void fail_for(const std::string& role, const std::string& why);
+  /// Fails the run with `why` when `role` is one of the run's (an observer is only named) and,
+  /// with unless_role_alive, no admitted process of that role was heard within the last second.
+  void fail_for(const std::string& role, const std::string& why, bool unless_role_alive = true);
   void on_state_timing(const drive_state_t& m, std::int64_t t);
   void on_command_timing(const control_command_t& m, std::int64_t t);
   void prune_timing(std::int64_t seq);
