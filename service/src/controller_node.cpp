@@ -23,11 +23,14 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
       ++duplicates;
       return;
     }
-    // Lockstep: the plant publishes state k+1 only after command k, so a state beyond the next
-    // unanswered one is the plant's protocol error (a skipped or reordered step number), never a
-    // loss here: named as the plant's, not left to look like the controller's stall. In real time
-    // states go out every period whether answered or not, and a lost one is a gap, not an error.
-    if (!options().realtime && m.seq > next_seq_)
+    // Lockstep: the plant publishes state k+1 only after command k, and state k+1 carries what
+    // was applied during step k (previous.seq == k). A state beyond the next unanswered one whose
+    // previous step is not the one before it is the plant's protocol error (a skipped or
+    // reordered step number), never a loss here: named as the plant's, not left to look like the
+    // controller's stall. (previous.seq == k without our command k: another publisher answered
+    // step k; this controller still answers it, and the plant or the monitor names the conflict.)
+    // In real time states go out every period whether answered or not: a lost one is a gap.
+    if (!options().realtime && m.seq > next_seq_ && m.previous.seq != m.seq - 1)
       throw RunFailure("protocol error of the plant: it published state " + std::to_string(m.seq) + " while step " +
                        std::to_string(next_seq_) + " has no command yet (a skipped or out-of-order step number; "
                        "docs/external-plant.md)");
