@@ -363,11 +363,22 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
-    // The record reaches the last step completed before the failure (the batch that failed was
-    // dispatched whole: Bus::poll rethrows after it).
-    try {
-      rec_.flush([this](const sim::Record& r) { out_->add(r); });
-    } catch (const std::exception&) {
+    // The record reaches the last step completed before the failure: the batch that failed was
+    // dispatched whole (Bus::poll rethrows after it), and what is still queued on the socket (a
+    // monitor behind the run when another role's failure arrives) is taken too, up to 100 batches.
+    for (int i = 0; i < 100; ++i) {
+      bool more = false;
+      try {
+        more = bus().poll(std::chrono::microseconds(0));
+      } catch (const std::exception&) {
+        more = true;  // another conflict or failure in this batch: it was dispatched all the same
+      }
+      try {
+        rec_.flush([this](const sim::Record& r) { out_->add(r); });
+      } catch (const std::exception&) {
+        break;
+      }
+      if (!more) break;
     }
   } catch (const interrupt::Interrupted& e) {
     // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
