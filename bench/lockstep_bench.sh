@@ -18,6 +18,9 @@
 # Then the cost of authentication (--key, HMAC-SHA256 on every message; docs/security.md): the
 # same lockstep run without and with a key, alternating, medians, ratio and cost per step.
 # A third argument "auth" runs only that part: bench/lockstep_bench.sh BUILD ROUNDS auth
+# A third argument "speed" runs only the lockstep-against-raw part, on the paper's 50 kHz
+# smc_jerk_limited (50,000 steps of 20 us) and on beyond_jerk_limited (15,000 of 100 us), both
+# placements (issue 21, point 9): bench/lockstep_bench.sh BUILD ROUNDS speed
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -34,7 +37,8 @@ steps_per_s() { jq -r .lockstep.steps_per_second "$1/summary.json"; }
 # bench PLACEMENT: "free" (the scheduler places the processes) or "one-core" (every process
 # pinned to CPU 0: taskset for the ping-pongs, feeddrive-launch --cpus 0).
 bench() {
-  local placement=$1 pin=() cpus=() raw=() bus=() ls=() rate
+  local placement=$1 scen=${2:-$SCEN} pin=() cpus=() raw=() bus=() ls=() rate name
+  name=$(basename "$scen" .yaml)
   if [ "$placement" = one-core ]; then pin=(taskset -c 0); cpus=(--cpus 0); fi
   for r in $(seq "$ROUNDS"); do
     "${pin[@]}" "$BUILD/bin/lcm-pingpong-raw" server "$URL" "RAW$placement$r" & srv=$!
@@ -44,15 +48,15 @@ bench() {
     rate=$("${pin[@]}" "$BUILD/bin/lcm-pingpong" client --count 15000 --lcm-url "$URL" --prefix "BUS$placement$r" |
            awk '/pingpong_rate/ { print $2 }')
     wait $srv; bus+=("$rate")
-    "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/run$placement$r" --no-plots -q \
+    "$BUILD/bin/feeddrive-launch" "$scen" --out "$TMP/run$placement$r" --no-plots -q \
         --lcm-url "$URL" --prefix "LS$placement$r" "${cpus[@]}"
     ls+=("$(steps_per_s "$TMP/run$placement$r")")
-    echo "$placement round $r: raw liblcm ping-pong ${raw[-1]}, Bus ping-pong ${bus[-1]} round trips/s; lockstep ${ls[-1]} steps/s"
+    echo "$name $placement round $r: raw liblcm ping-pong ${raw[-1]}, Bus ping-pong ${bus[-1]} round trips/s; lockstep ${ls[-1]} steps/s"
   done
   local mr mb ml
   mr=$(median "${raw[@]}"); mb=$(median "${bus[@]}"); ml=$(median "${ls[@]}")
-  echo "$placement: medians: raw liblcm ping-pong $mr, Bus ping-pong $mb round trips/s; lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
-  echo "$placement: Bus ping-pong / raw: $(ratio "$mb" "$mr") (target >= 0.95); lockstep / raw: $(ratio "$ml" "$mr") (target >= 0.8)"
+  echo "$name $placement: medians: raw liblcm ping-pong $mr, Bus ping-pong $mb round trips/s; lockstep $ml steps/s (4 processes, CVODE plant, sliding-mode controller)"
+  echo "$name $placement: Bus ping-pong / raw: $(ratio "$mb" "$mr") (target >= 0.95); lockstep / raw: $(ratio "$ml" "$mr") (target >= 0.8)"
   # The Bus ping-pong waits on its own socket (no liblcm receive thread, no pipe): where it beats
   # liblcm, it is the stronger baseline, so the lockstep run is also put against it.
   echo "$placement: lockstep / Bus ping-pong: $(ratio "$ml" "$mb") (a four-process CVODE step against a bare round trip on the same receive path)"
@@ -76,6 +80,13 @@ auth() {
   mp=$(median "${plain[@]}"); mk=$(median "${keyed[@]}")
   awk -v p="$mp" -v k="$mk" 'BEGIN { printf "auth (one core): median %s steps/s without a key, %s with --key: ratio %.3f, cost %.2f us per step (HMAC-SHA256 of every message sent and received)\n", p, k, k / p, 1e6 / k - 1e6 / p }'
 }
+if [ "${3:-all}" = speed ]; then
+  for scen in scenarios/paper/smc_jerk_limited.yaml scenarios/paper/beyond_jerk_limited.yaml; do
+    bench free "$scen"
+    bench one-core "$scen"
+  done
+  exit 0
+fi
 if [ "${3:-all}" = auth ]; then
   auth
   exit 0

@@ -6,29 +6,61 @@
 # and how the plant was scheduled (SCHED_FIFO, or why not). Timing-sensitive: run it on a quiet
 # machine, in a private network namespace:
 #   scripts/netns-run.sh bench/realtime_bench.sh [BUILD_DIR] [ROUNDS] [extra feeddrive-launch options]
+# The machine's own count in the same invocation: right before each run, cyclictest (rt-tests:
+# SCHED_FIFO 80, mlockall, a 100 us interval, 15,000 wake-ups on the run's CPUs) counts the timer
+# wake-ups later than 50 us; the bench prints feeddrive's deadline misses over that count per round
+# and the median ratio (goal: <= 2, the chain has two wake-ups a period: the plant's timer and the
+# controller's receive). CPUS=0 (default) pins the run and cyclictest to CPU 0; CPUS=0,1 gives
+# both cores (cyclictest then runs one thread per core and its count is the sum).
+# ADAPTER=PATH runs that program (examples/c/drive_adapter.c, built as tests/service/hil_test.sh
+# does: liblcm's receive thread and pipe) as the plant, at SCHED_FIFO 80 on CPUS, with the launcher's
+# --external plant, on SCEN (default here scenarios/robustness/robust_smc.yaml: 10 kHz, observers):
+# what a participant that receives with liblcm gets (docs/lcm-contract.md, "Receiving in batches").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 ROUNDS=${2:-5}
 shift $(( $# < 2 ? $# : 2 ))
 URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'
-SCEN=scenarios/paper/beyond_jerk_limited.yaml
+SCEN=${SCEN:-scenarios/paper/beyond_jerk_limited.yaml}
+ADAPTER=${ADAPTER:-}
+if [ -n "$ADAPTER" ] && [ "$SCEN" = scenarios/paper/beyond_jerk_limited.yaml ]; then SCEN=scenarios/robustness/robust_smc.yaml; fi
 TMP=$(mktemp -d)
 trap 'jobs -p | xargs -r kill 2>/dev/null || true; rm -rf "$TMP"' EXIT
 median() { printf '%s\n' "$@" | sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
 # p99 of a histogram (bins of bin_us, then the overflow) as the upper edge of its bin.
 hist_p99='def p99(h; b): (h.samples * 0.99) as $t | reduce range(0; h.counts | length) as $i ({s: 0, v: null};
   .s += h.counts[$i] | if .v == null and .s >= $t then .v = ($i + 1) * b else . end) | (.v // "overflow");'
-misses=(); overruns=()
+CPUS=${CPUS:-0}
+command -v cyclictest > /dev/null || { echo "cyclictest (rt-tests) not installed: scripts/install-deps.sh adds it"; exit 2; }
+# Wake-ups later than 50 us in 15,000 of cyclictest at 100 us on CPUS (histogram bins > 50 plus
+# its overflows).
+machine_late() {
+  local n; n=$(echo "$CPUS" | tr ',' '\n' | wc -l)
+  cyclictest -m -p 80 -i 100 -a "$CPUS" -t "$n" -l 15000 -q -h 1000 2> /dev/null |
+    awk '/^[0-9]+ / { us = $1 + 0; for (i = 2; i <= NF; ++i) if (us > 50) late += $i } /Histogram Overflows/ { for (i = 4; i <= NF; ++i) late += $i } END { print late + 0 }'
+}
+misses=(); overruns=(); lates=(); ratios=()
 for r in $(seq "$ROUNDS"); do
-  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/rt$r" --no-plots --realtime --cpus 0 --lcm-url "$URL" \
+  late=$(machine_late)
+  lates+=("$late")
+  ext=()
+  if [ -n "$ADAPTER" ]; then
+    taskset -c "$CPUS" chrt -f 80 "$ADAPTER" --url "$URL" --prefix "RT$r" 2> "$TMP/adapter$r.err" &
+    ext=(--external plant)
+  fi
+  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/rt$r" --no-plots --realtime --cpus "$CPUS" --lcm-url "$URL" "${ext[@]}" \
       --prefix "RT$r" "$@" 2> "$TMP/rt$r.err" || true
+  [ -n "$ADAPTER" ] && { wait || true; }
   sched=$( (grep -o "plant: real time: [^,]*" "$TMP/rt$r.err" || true) | head -n 1 | sed 's/plant: real time: //')
   sched=${sched:-"SCHED_FIFO granted (no warning from the plant)"}
   j=$TMP/rt$r/summary.json
   [ -f "$j" ] || { tail -3 "$TMP/rt$r.err"; echo "round $r: no summary"; continue; }
   misses+=("$(jq -r .lockstep.deadline_misses "$j")")
   overruns+=("$(jq -r .lockstep.plant_overruns "$j")")
-  echo "round $r: $(jq -r "$hist_p99"' .lockstep as $l | "\($l.deadline_misses) of \($l.steps_expected) deadlines missed, \($l.plant_overruns) plant overruns; state->command p50 \($l.latency_us.state_to_command.p50) us, p99 \($l.latency_us.state_to_command.p99) us; period-start lateness p99 <= \(p99($l.latency_histogram_us.period_start_lateness; $l.latency_histogram_us.bin_us)) us"' "$j"); max |e| $(jq -r .position_error_max_abs_m "$j") m; $sched"
+  ratios+=("$(awk -v m="${misses[-1]}" -v l="$late" 'BEGIN { printf "%.2f", m / (l > 0 ? l : 1) }')")
+  echo "round $r: machine (cyclictest, CPUs $CPUS): $late of 15000 wake-ups later than 50 us; feeddrive misses / machine = ${ratios[-1]}"
+  echo "round $r: $(jq -r "$hist_p99"' .lockstep as $l | "\($l.deadline_misses) of \($l.steps_expected) deadlines missed, \($l.plant_overruns) plant overruns; state->command p50 \($l.latency_us.state_to_command.p50) us, p99 \($l.latency_us.state_to_command.p99) us; period-start lateness p99 <= \(p99($l.latency_histogram_us.period_start_lateness; $l.latency_histogram_us.bin_us)) us"' "$j"); max |e| $(jq -r "(.position_error_max_abs_m // .measured_position_error_max_abs_m)" "$j") m (measured where no true state); $sched"
 done
 echo "median deadline misses: $(median "${misses[@]}") of 15000 (target < 15, 0.1 %); median plant overruns (periods the plant itself started more than its guard late): $(median "${overruns[@]}")"
+echo "machine (cyclictest on CPUs $CPUS): median $(median "${lates[@]}") of 15000 wake-ups later than 50 us; RATIO feeddrive misses / machine's late wake-ups: median $(median "${ratios[@]}") (per round: ${ratios[*]}; goal <= 2)"

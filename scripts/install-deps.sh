@@ -15,7 +15,7 @@ PACKAGES=(
   libbenchmark-dev libceres-dev libssl-dev
   libopenmpi-dev openmpi-bin
   gnuplot-nox jq python3 python3-yaml
-  iproute2 nftables util-linux procps
+  iproute2 nftables util-linux procps rt-tests stress-ng
   lua5.2 liblcm-lua lua-luaossl
 )
 missing=()

@@ -207,6 +207,7 @@ class Node {
     m.state = state;
     m.seq = next_seq_ - 1;
     m.acked_seq = -1;
+    m.contract_version = 3;  // docs/lcm-contract.md, Versions
     m.message = message;
     m.invalid = invalid_;
     lc_.publish(p_ + "_STATUS", &m);

@@ -286,6 +286,7 @@ local function send_status(st, message)
   m.state = st
   m.seq = last_seq
   m.acked_seq = -1
+  m.contract_version = 3  -- docs/lcm-contract.md, Versions
   m.message = message or ''
   m.resends = counters.resends
   m.duplicates = counters.duplicates

@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     mopt.plots = !no_plots;
-    const sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
+    const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    const sim::Scenario& s = rs.scenario;
+    opt.scenario_hash = rs.sha256;  // run_info_t.scenario_hash: of the bytes read here
     output::check_output_dir(mopt.out_dir);  // before the run
     output::check_outside(mopt.lcm_log, "--lcm-log", mopt.out_dir);
     output::check_output_file(mopt.lcm_log, "--lcm-log");

@@ -3,6 +3,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -14,6 +16,8 @@
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 #include "feeddrive/reference_block_t.hpp"
+#include "feeddrive/common/text_file.hpp"
+#include "feeddrive/service/contract.hpp"
 #include "feeddrive/service/translate.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/summary.hpp"
@@ -71,7 +75,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   // second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
   // monitor only listens.
   if (!mopt_.attach) {
-    info_ = service::to_run_info(s_, opt.realtime, 0);  // run_id: stamped by the bus
+    // The scenario's hash as the launcher read it (--scenario-hash), else of the file read here.
+    info_ = service::to_run_info(s_, opt, opt.scenario_hash);  // run_id: stamped by the bus
     on_heartbeat = [this] {
       if (heartbeats_++ % 10 == 0) publish_info();
     };
@@ -79,6 +84,14 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       if (r.channel == channels().info) publish_info();
     };
   }
+  service::BusEvents ev;
+  ev.foreign = [this](const std::string& ch, std::int64_t id, const std::string& r) { on_foreign(ch, id, r); };
+  ev.unauthenticated = [this](const std::string& ch, const std::uint8_t* d, std::size_t n) { on_unauthenticated(ch, d, n); };
+  ev.undecodable = [this](const std::string& ch, const std::uint8_t* d, std::size_t n, const std::string& why) {
+    on_undecodable(ch, d, n, why);
+  };
+  bus().set_events(std::move(ev));
+  on_peer_status = [this](const process_status_t& m) { check_peer_status(m); };
   out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
   out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
@@ -86,7 +99,108 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
 void MonitorNode::publish_info() {
   info_.utime = service::wall_utime();
   info_.run_nonce = run_nonce();
+  info_.current_step = rec_.highest_state() < 0 ? -1 : rec_.next();
   bus().publish(channels().info, info_);
+}
+
+void MonitorNode::fail_for(const std::string& role, const std::string& why, bool unless_role_alive) {
+  // A message the bus drops (unsigned, another run, another contract) from a role whose own,
+  // admitted process is alive is an extra sender on the bus, maybe an attacker: named and counted,
+  // never a reason to end the run (docs/security.md). It fails the run only when it stands in for
+  // a role nobody else fills: then the run could never go on.
+  if (unless_role_alive && peer_alive(role, 1.0)) return;
+  if (service::is_run_role(role) && !mopt_.attach && failure_.empty()) failure_ = why;
+}
+
+void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, const std::string& sender) {
+  const std::string who_role = sender.empty() ? service::publisher_of(channels(), channel) : sender;
+  // One line per sender (run id 0: per role, whatever the channel): the count is in the summary.
+  const std::string key = run_id == 0 ? "run id 0 " + who_role : "foreign " + channel + " " + std::to_string(run_id);
+  if (named_[key]++ > 0) return;
+  const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
+  if (run_id == 0) {
+    const std::string why = who + " publishes run id 0 on " + channel +
+                            ": a client older than run ids (contract version 1)? Stamp run_info_t.run_id (this run: " +
+                            std::to_string(bus().run_id()) + ") on every message; this run speaks contract version " +
+                            std::to_string(service::kContractVersion) + " (docs/lcm-contract.md, Versions)";
+    spdlog::error("{}: {}", role(), why);
+    fail_for(who_role, why);
+    return;
+  }
+  // A plant of another run while this run's plant is silent: the drive restarted (it drew a new
+  // run id). A restarted plant cannot rejoin (docs/external-plant.md, "Restarts").
+  if (who_role == "plant" && plant_seq_seen_ >= 0 && !peer_alive("plant", 0.3)) {
+    const std::string why = "the plant restarted: a plant with a new run id " + std::to_string(run_id) +
+                            " appeared on " + channel + " after this run's plant (run id " + std::to_string(bus().run_id()) +
+                            ") went silent after state " + std::to_string(rec_.highest_state()) +
+                            "; a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
+    spdlog::error("{}: {}", role(), why);
+    fail_for("plant", why, false);  // its own test above: silent for 0.3 s
+    return;
+  }
+  spdlog::warn("{}: {} of another run (run id {}; this run {}) publishes on {}: a second run on this group, a participant "
+               "given the wrong --run-id, or a replayed log; its messages are ignored (give one run another --prefix or "
+               "--lcm-url: docs/security.md)", role(), who, run_id, bus().run_id(), channel);
+}
+
+void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint8_t* d, std::size_t n) {
+  // The mac is the message's tail: mac_size (int16) 0 and no mac bytes means unsigned.
+  const bool unsigned_msg = n >= 2 && d[n - 2] == 0 && d[n - 1] == 0;
+  std::string who_role = service::publisher_of(channels(), channel);
+  if (channel == channels().status) who_role = service::heartbeat_role(d, n);
+  const std::string key = "unauthenticated " + channel + " " + who_role + (unsigned_msg ? " unsigned" : " badmac");
+  const std::int64_t count = ++named_[key];
+  const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
+  const std::string why = who + (unsigned_msg ? " publishes unsigned messages on " : " publishes messages with a mac that does not verify on ") +
+                          channel + ", but this run is authenticated with --key " + options().key_file +
+                          (unsigned_msg ? ": give it the same key" : ": another key, or forged; give it the same key") +
+                          " (docs/security.md)";
+  if (count == 1) spdlog::error("{}: {}", role(), why);
+  // Three in a row from one run role: a participant, not a stray datagram. It can never take
+  // part, so the run fails now instead of at a timeout that would not mention the key.
+  if (count >= 3) fail_for(who_role, why);
+}
+
+void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why_invalid) {
+  if (const auto older = service::older_contract(channels(), channel, d, n)) {
+    const std::string key = "older " + channel + " " + older->role + " " + std::to_string(older->version);
+    if (named_[key]++ > 0) return;
+    const std::string why = service::describe_older(*older, channel);
+    spdlog::error("{}: {}", role(), why);
+    fail_for(older->role, why);
+    return;
+  }
+  const std::string key = "undecodable " + channel;
+  if (named_[key]++ == 0)
+    spdlog::warn("{}: dropped a message on {} that is not valid: {} ({} bytes; counted in invalid_messages, further "
+                 "ones on this channel silently)", role(), channel, why_invalid, n);
+}
+
+void MonitorNode::check_peer_status(const process_status_t& m) {
+  if (m.contract_version != service::kContractVersion) {
+    const std::string key = "version " + m.role + " " + std::to_string(m.contract_version);
+    if (named_[key]++ == 0 && m.contract_version == 0) {
+      // Built from these types but never set: it decodes, so it may well work; named, not failed.
+      spdlog::warn("{}: the {} sends contract_version 0 in its heartbeat: set it to {} (docs/lcm-contract.md, Versions)",
+                   role(), m.role, service::kContractVersion);
+    } else if (named_[key] == 1) {
+      const std::string why = "the " + m.role + " speaks contract version " + std::to_string(m.contract_version) +
+                              "; this run speaks " + std::to_string(service::kContractVersion) +
+                              ": rebuild it with this feeddrive's lcmtypes/ (docs/lcm-contract.md, Versions)";
+      spdlog::error("{}: {}", role(), why);
+      fail_for(m.role, why, false);
+    }
+  }
+  if (m.role != "plant") return;
+  // A plant whose heartbeat goes back (same run id, a new process that starts again at step 0).
+  if (plant_seq_seen_ > 1 && m.seq < plant_seq_seen_ - 1 && m.state != "failed") {
+    const std::string why = "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) +
+                            " to " + std::to_string(m.seq) + " (" + m.state +
+                            "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
+    if (named_["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
+    fail_for("plant", why, false);
+  }
+  plant_seq_seen_ = std::max(plant_seq_seen_, m.seq);
 }
 
 // Latency histograms from the first receive time of each message (one clock: the kernel's
@@ -179,6 +293,21 @@ void MonitorNode::progress(bool force) {
   if (force) std::fprintf(stderr, "\n");
 }
 
+void MonitorNode::watch_rate_and_loggers(std::int64_t now) {
+  if (rate_since_us_ >= 0 && now - rate_since_us_ < 1000000) return;
+  if (rate_since_us_ >= 0)
+    peak_rate_ = std::max(peak_rate_, static_cast<double>(rec_.next() - rate_since_step_) * 1e6 /
+                                          static_cast<double>(now - rate_since_us_));
+  rate_since_us_ = now;
+  rate_since_step_ = rec_.next();
+  for (const service::StockLogger& l : service::stock_loggers_on(options().lcm_url)) {
+    bool known = false;
+    for (const service::StockLogger& k : loggers_) known = known || k.pid == l.pid;
+    if (known) continue;
+    loggers_.push_back(l);  // reported at the end with the peak rate (one line)
+  }
+}
+
 bool MonitorNode::run() {
   set_state("running");
   start_us_ = last_row_us_ = mono_us();
@@ -203,6 +332,8 @@ bool MonitorNode::run() {
         heartbeat();  // "running": the publishers linger after the end while it still records
       }
       progress(false);
+      watch_rate_and_loggers(now);
+      if (!failure_.empty()) throw service::RunFailure(failure_);
       if (!log_error_.empty()) throw service::RunFailure(log_error_);
       if (rec_.complete()) break;
       request_missing();
@@ -235,6 +366,23 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+    // The record reaches the last step completed before the failure: the batch that failed was
+    // dispatched whole (Bus::poll rethrows after it), and what is still queued on the socket (a
+    // monitor behind the run when another role's failure arrives) is taken too, up to 100 batches.
+    for (int i = 0; i < 100; ++i) {
+      bool more = false;
+      try {
+        more = bus().poll(std::chrono::microseconds(0));
+      } catch (const std::exception&) {
+        more = true;  // another conflict or failure in this batch: it was dispatched all the same
+      }
+      try {
+        rec_.flush([this](const sim::Record& r) { out_->add(r); });
+      } catch (const std::exception&) {
+        break;
+      }
+      if (!more) break;
+    }
   } catch (const interrupt::Interrupted& e) {
     // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
     // Ctrl-C stops that too; then the process exits as interrupted (128 + signal).
@@ -367,6 +515,24 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
                           packet(channels().command, control_command_t().getEncodedSize());
   }
   l["safe_state"] = rec_.safe_state();
+  {
+    // Stock loggers on the bus and whether the steps went out faster than the stock lcm-logger
+    // records without loss (service::kStockLoggerSteps): the run cannot know what it dropped.
+    const double run_rate = wall_time_s > 0 ? static_cast<double>(sum.steps) / wall_time_s : 0.0;
+    const double peak = std::max(peak_rate_, run_rate);
+    const bool too_fast = !loggers_.empty() && peak > service::stock_logger_pace(loggers_) * 1.02;  // 2 %: the window's clock
+    auto& sl = l["stock_loggers"];
+    sl["seen"] = nlohmann::ordered_json::array();
+    for (const service::StockLogger& g : loggers_) sl["seen"].push_back({{"name", g.name}, {"pid", g.pid}});
+    sl["max_rate"] = options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
+    sl["peak_steps_per_second"] = peak;
+    sl["records_without_loss_up_to"] = loggers_.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(service::stock_logger_pace(loggers_));
+    sl["faster_than_it_records"] = too_fast;
+    if (too_fast)
+      spdlog::warn("{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
+                   "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
+                   role(), peak, service::describe(loggers_), service::stock_logger_pace(loggers_), service::stock_logger_pace(loggers_));
+  }
   const auto hop = [&](const char* name, const stats::StreamingQuantile& v) {
     l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.count()}};
   };
@@ -401,15 +567,19 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
     // An incomplete record (interrupted, failed) never replaces an earlier output: it goes beside
-    // it, to DIR.incomplete-N, and both are kept.
+    // it, to DIR.incomplete-N, and both are kept. An empty folder in DIR's place is no earlier
+    // output: it is removed (rmdir removes only an empty one) and the record takes its place.
+    const std::filesystem::path target = output::normalise(mopt_.out_dir);
+    const bool earlier = output::is_feeddrive_output(target);
+    if (!completed && !earlier) ::rmdir(target.c_str());
     const std::filesystem::path dest = out_->finish(
         sum, mopt_.plots, j.dump(), [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); },
         completed);
-    if (!completed && dest != output::normalise(mopt_.out_dir)) {
+    if (!completed && dest != target) {
       where = dest.string();
       if (!options().quiet)  // an interrupt's one line stays one line with -q
-        spdlog::info("monitor: the run did not complete; the earlier output in {} is kept, this record is in {}",
-                     output::shown(mopt_.out_dir), where);
+        spdlog::info("monitor: the run did not complete; {} in {} is kept, this record is in {}",
+                     earlier ? "the earlier output" : "what was already there", output::shown(mopt_.out_dir), where);
     }
     if (!out_->plot_error().empty() && !interrupt::interrupted())  // an interrupt is reported once, as such
       spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);

@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/output/folder.hpp"
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/service/cli.hpp"
+#include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/launch.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -36,12 +38,13 @@ int main(int argc, char** argv) {
   return service::run_process(app, argc, argv, opt, [&] {
     lo.external.insert(external.begin(), external.end());
     lo.plots = !no_plots;
+    lo.auto_pace = app.count("--max-rate") == 0;
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
     // Read once, here: bad input fails before any process starts, and every process checks that
     // its copy hashes the same (one run, one scenario).
     const service::RunScenario rs = service::load_run_scenario(lo.scenario, opt);
     const sim::Scenario& s = rs.scenario;
-    opt.scenario_sha256 = rs.sha256;
+    opt.scenario_hash = rs.sha256;  // --scenario-hash, run_info_t.scenario_hash
     const auto out = output::check_output_dir(lo.out_dir);  // and these, before any process starts
     output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
     output::check_output_file(lo.lcm_log, "--lcm-log");
@@ -69,9 +72,12 @@ int main(int argc, char** argv) {
     }
     std::ifstream in(lo.out_dir + "/summary.json");
     const auto j = nlohmann::json::parse(in, nullptr, false);
+    // The true-state error where the plant has one, else the measured one (a hardware plant).
+    const bool truth = !j.is_discarded() && j.contains("position_error_max_abs_m") && !j["position_error_max_abs_m"].is_null();
     if (!j.is_discarded() && j.contains("lockstep"))
-      spdlog::info("{} steps, max |e| {} m, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
-                   j["position_error_max_abs_m"].dump(), j["lockstep"].value("resends", 0L),
+      spdlog::info("{} steps, max |e| {} m{}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
+                   j[truth ? "position_error_max_abs_m" : "measured_position_error_max_abs_m"].dump(),
+                   truth ? "" : " (measured: x_d - x_measured)", j["lockstep"].value("resends", 0L),
                    j["lockstep"].value("lost", 0L), j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(),
                    lo.out_dir);
     return 0;

@@ -1,6 +1,7 @@
 #include "feeddrive/service/bus.hpp"
 
 #include <poll.h>
+#include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -50,12 +51,12 @@ bool Bus::log_due(std::int64_t& last) {
   return true;
 }
 
-void Bus::count_foreign(const std::string& channel, std::int64_t run_id) {
+void Bus::count_foreign(const std::string& channel, std::int64_t run_id, const std::string& role) {
   ++foreign_;
-  if (log_due(last_foreign_log_us_))
-    std::fprintf(stderr, "feeddrive: ignored a message of another run (run id %lld, this run %lld) on %s: %lld so far "
-                 "(a second run on this group, or a replayed log)\n", static_cast<long long>(run_id),
-                 static_cast<long long>(run_id_), channel.c_str(), static_cast<long long>(foreign_));
+  if (events_.foreign) events_.foreign(channel, run_id, role);
+  else if (reports_ && log_due(last_foreign_log_us_))
+    spdlog::warn("ignored a message of another run (run id {}, this run {}) on {}: {} so far (a second run on this "
+                 "group, or a replayed log)", run_id, run_id_, channel, foreign_);
 }
 
 bool Bus::publish_raw(const std::string& channel, const std::uint8_t* data, std::size_t size) {
@@ -66,12 +67,12 @@ bool Bus::publish_raw(const std::string& channel, const std::uint8_t* data, std:
   return true;
 }
 
-void Bus::count_invalid(const std::string& channel, const std::string& why) {
+void Bus::count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why) {
   ++invalid_;
   ++invalid_by_channel_[channel];
-  if (log_due(last_invalid_log_us_))
-    std::fprintf(stderr, "feeddrive: dropped an invalid message on %s: %s (%lld so far)\n", channel.c_str(),
-                 why.c_str(), static_cast<long long>(invalid_));
+  if (events_.undecodable) events_.undecodable(channel, data, size, why);
+  else if (reports_ && log_due(last_invalid_log_us_))
+    spdlog::warn("dropped an invalid message on {}: {} ({} so far)", channel, why, invalid_);
 }
 
 std::map<std::string, std::int64_t> Bus::invalid_by_channel() const {

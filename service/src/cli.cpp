@@ -28,6 +28,11 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
   app.add_option("--linger", opt.linger_s, "seconds to keep answering resend requests after the end")
       ->capture_default_str();
   app.add_flag("--realtime", opt.realtime, "real-time mode: the plant is paced by the wall clock");
+  app.add_option("--max-rate", opt.max_rate,
+                 "lockstep: at most this many steps per second (0: unpaced); the stock lcm-logger records "
+                 "without loss at 1000 (docs/lcm-contract.md)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-bad-commands", opt.max_bad_commands,
                  "real time: missed or invalid commands in a row before the plant goes to zero thrust")
       ->capture_default_str();
@@ -40,6 +45,9 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "identity of the run (nonzero; docs/security.md); default: the plant draws one, the others join "
                  "the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+  app.add_option("--scenario-hash", opt.scenario_hash,
+                 "hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash; feeddrive-launch passes it)")
+      ->type_name("HEX");
   app.add_option("--key", opt.key_file,
                  "authenticate every message with HMAC-SHA256 and this key file (mode 0600; docs/security.md)")
       ->type_name("FILE");
@@ -47,10 +55,6 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "with --key: the run's nonce, which binds the run id on the wire to this run (docs/security.md); "
                  "default: feeddrive-launch draws it, a plant started alone draws it, the others take the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
-  app.add_option("--scenario-sha256", opt.scenario_sha256,
-                 "refuse to start unless the scenario file's SHA-256 is this (feeddrive-launch passes the hash of "
-                 "what it read: one run, one scenario; run_info_t.scenario_sha256 carries it)")
-      ->type_name("HEX");
   app.add_option_function<std::string>(
          "--on-conflict", [&opt](const std::string& v) { opt.on_conflict = parse_conflict_policy(v); },
          "a second, different message for a step: fail (default) or keep-first (count and log it)")
@@ -62,9 +66,9 @@ RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
   std::string text;
   RunScenario r{sim::load_scenario(path, &text), ""};
   r.sha256 = sha256_hex(text);
-  if (!opt.scenario_sha256.empty() && opt.scenario_sha256 != r.sha256)
+  if (!opt.scenario_hash.empty() && opt.scenario_hash != r.sha256)
     throw std::invalid_argument(path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
-                                "..., the launcher read " + opt.scenario_sha256.substr(0, 12) +
+                                "..., the launcher read " + opt.scenario_hash.substr(0, 12) +
                                 "...): the file changed while the run started; one run, one scenario: launch again");
   return r;
 }

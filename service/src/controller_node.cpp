@@ -23,6 +23,18 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
       ++duplicates;
       return;
     }
+    // Lockstep: the plant publishes state k+1 only after a command k. A state beyond the next
+    // unanswered one, when no other publisher's command for that step was seen either (it would
+    // have come first: one socket, in order), is the plant's protocol error (a skipped or
+    // reordered step number), never a loss here: named as the plant's, not left to look like the
+    // controller's stall. With another publisher's command k (forged, or a second controller)
+    // this controller still answers step k, and the plant or the monitor names the conflict.
+    // In real time states go out every period whether answered or not: a lost one is a gap.
+    answered_by_others_.erase(answered_by_others_.begin(), answered_by_others_.lower_bound(next_seq_));
+    if (!options().realtime && m.seq > next_seq_ && !answered_by_others_.count(next_seq_))
+      throw RunFailure("protocol error of the plant: it published state " + std::to_string(m.seq) + " while step " +
+                       std::to_string(next_seq_) + " has no command yet (a skipped or out-of-order step number; "
+                       "docs/external-plant.md)");
     // Waiting for a reference since the first unanswered state, not the newest: in real-time
     // mode a newer state replaces the pending one every period, and a request timed from the
     // newest would never go out.
@@ -40,6 +52,11 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
       refs_[m.seq] = m;
     }
     try_answer();
+  });
+  // Commands for steps not answered here are another publisher's (this controller's own come
+  // back to it with seq < next_seq_). Kept only ahead of next_seq_, at most 1024 steps.
+  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t) {
+    if (m.seq >= next_seq_ && m.seq < next_seq_ + 1024) answered_by_others_.insert(m.seq);
   });
   on_resend_request = [this](const resend_request_t& r) {
     if (r.channel == commands_.channel() && commands_.republish(r.seq)) ++resends;

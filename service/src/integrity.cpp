@@ -3,7 +3,6 @@
 
 #include <fcntl.h>
 #include <openssl/core_names.h>
-#include <openssl/sha.h>
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
@@ -117,23 +116,25 @@ std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce) {
   return static_cast<std::int64_t>(1 + h % m);
 }
 
-std::string sha256_hex(const std::string& bytes) {
-  unsigned char md[SHA256_DIGEST_LENGTH];
-  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), md);
-  static const char* digits = "0123456789abcdef";
-  std::string hex;
-  for (unsigned char c : md) {
-    hex.push_back(digits[c >> 4]);
-    hex.push_back(digits[c & 15]);
-  }
-  return hex;
-}
-
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size) {
   std::array<std::uint8_t, 32> out{};
   unsigned int n = 0;
   if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), data, size, out.data(), &n) == nullptr || n != 32)
     throw std::runtime_error("HMAC-SHA256 failed (libcrypto)");
+  return out;
+}
+
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), md, &n, EVP_sha256(), nullptr) != 1 || n != 32)
+    throw std::runtime_error("SHA-256 failed (libcrypto)");
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < n; ++i) {
+    out += hex[md[i] >> 4];
+    out += hex[md[i] & 15];
+  }
   return out;
 }
 

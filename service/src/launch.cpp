@@ -18,6 +18,7 @@
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/service/bus.hpp"
 #include "feeddrive/service/integrity.hpp"
+#include "feeddrive/service/loggers.hpp"
 #include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
@@ -41,10 +42,11 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
                                 "--max-bad-commands", std::to_string(opt.max_bad_commands),
                                 "--spin-us", std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
+  if (opt.max_rate > 0) a.insert(a.end(), {"--max-rate", fmt_double(opt.max_rate)});
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
+  if (!opt.scenario_hash.empty()) a.insert(a.end(), {"--scenario-hash", opt.scenario_hash});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
   if (!opt.key_file.empty() && opt.run_nonce != 0) a.insert(a.end(), {"--run-nonce", std::to_string(opt.run_nonce)});
-  if (!opt.scenario_sha256.empty()) a.insert(a.end(), {"--scenario-sha256", opt.scenario_sha256});
   if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
   return a;
 }
@@ -161,14 +163,29 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
   }
 
+  // A stock lcm-logger started before the run records it only if the run is paced (loggers.hpp).
+  if (lo.auto_pace && !opt.realtime && !lo.external.count("plant")) {
+    const std::vector<StockLogger> loggers = stock_loggers_on(opt.lcm_url);
+    if (!loggers.empty()) {
+      opt.max_rate = stock_logger_pace(loggers);
+      spdlog::info("{} on the bus: the run is paced to {:g} steps/s, which it records without loss{} (--max-rate N to "
+                   "choose, --max-rate 0 for none; docs/lcm-contract.md)", describe(loggers), opt.max_rate,
+                   opt.max_rate < kStockLoggerSteps ? "; at real-time priority (chrt -f 20) it keeps up with 1000" : "");
+    }
+  }
+
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
     if (interrupted_by() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{}", role, opt.lcm_url, opt.prefix,
-                   opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{}; this run is {} (--realtime), "
+                   "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
+                   "(docs/external-{}.md)",
+                   role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
                    opt.key_file.empty() ? "" : " --key " + opt.key_file,
-                   opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "");
+                   opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
+                   opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s), seconds_text(opt.step_timeout_s),
+                   seconds_text(opt.resend_interval_s), opt.monitor_window, role == "plant" ? "plant" : "controllers");
       continue;
     }
     std::vector<std::string> args = {lo.scenario};
@@ -193,6 +210,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   bool refused = false;  // a process exited 2 (bad input, e.g. a record that cannot fit the disk)
   int forwarded = 0;
   std::int64_t first_failure_us = -1;
+  double grace_s = lo.grace_s;
   bool terminated = false;
   while (!running.empty()) {
     int status = 0;
@@ -213,6 +231,11 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
         if (code == 2) refused = true;
         result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
         if (first_failure_us < 0) first_failure_us = mono_us();
+        // The monitor is the run's record and its judge (it names what the bus drops: an older
+        // contract, an unsigned participant): without it the run is over. The others hear its
+        // failure within 0.1 s; one that never joined a run (it waited for an external plant the
+        // monitor refused) cannot, so it gets 1 s, not the whole grace period.
+        if (role == "monitor") grace_s = std::min(grace_s, 1.0);
       }
       continue;
     }
@@ -223,10 +246,10 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       for (const auto& [p, role] : running) ::kill(p, sig);
     }
     // One failed: the others notice (status or timeout); terminate stragglers after a grace period.
-    if (first_failure_us >= 0 && !terminated && mono_us() - first_failure_us > us(lo.grace_s)) {
+    if (first_failure_us >= 0 && !terminated && mono_us() - first_failure_us > us(grace_s)) {
       terminated = true;
       for (const auto& [p, role] : running) {
-        spdlog::error("{} still running {} s after a failure: terminating it", role, lo.grace_s);
+        spdlog::error("{} still running {} s after a failure: terminating it", role, seconds_text(grace_s));
         ::kill(p, SIGTERM);
       }
     }

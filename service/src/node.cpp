@@ -12,6 +12,7 @@
 #include <ctime>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/service/contract.hpp"
 #include <cstdio>
 #include <cstdlib>
 
@@ -64,6 +65,8 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
   } else if (opt.run_id != 0 && !keyed) {
     bus_.set_run_id(opt.run_id);
   }
+  // Under feeddrive-launch the monitor names what the bus drops (one line per event); the others count.
+  if (std::getenv(interrupt::kQuietEnv) != nullptr && role_ != "monitor") bus_.set_reports(false);
   bus_.subscribe<process_status_t>(
       ch_.status,
       [this, keyed](const process_status_t& m, std::int64_t recv_us) {
@@ -76,7 +79,7 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
           if (keyed && m.run_nonce == 0) {
             if (!warned_no_nonce_)
               spdlog::error("{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
-                            "contract's version 4 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
+                            "contract's version 3 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
                             role_);
             warned_no_nonce_ = true;
             return;
@@ -91,7 +94,7 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
                        keyed ? ", bound to its nonce" : "");
         }
         if (m.run_id != bus_.run_id()) {
-          bus_.count_foreign(ch_.status, m.run_id);
+          bus_.count_foreign(ch_.status, m.run_id, m.role);
           return;
         }
         if (m.role == role_) return;
@@ -114,6 +117,7 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
         }
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
+        if (on_peer_status) on_peer_status(m);
       },
       Admit::kAnyRun);
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
@@ -136,6 +140,7 @@ process_status_t Node::status_message(const std::string& state, const std::strin
   m.foreign = bus_.foreign();
   m.conflicts = conflicts;
   m.unauthenticated = bus_.unauthenticated();
+  m.contract_version = kContractVersion;
   return m;
 }
 

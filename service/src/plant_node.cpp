@@ -111,10 +111,26 @@ void PlantNode::run() {
   }
 }
 
+void PlantNode::wait_for_pace(std::int64_t due_us) {
+  for (std::int64_t now = mono_us(); now < due_us; now = mono_us()) {
+    bus().poll(std::chrono::microseconds(due_us - now));  // resend requests, heartbeats meanwhile
+    check_peers();
+    heartbeat();
+  }
+}
+
 void PlantNode::run_lockstep() {
   const std::int64_t resend_us = us(options().resend_interval_s);
+  // --max-rate: each state at least 1/max_rate after the previous one (no catching up after a
+  // stall: a burst is what a slow recorder cannot take).
+  const std::int64_t pace_us = options().max_rate > 0 ? static_cast<std::int64_t>(1e6 / options().max_rate) : 0;
+  std::int64_t due_us = 0;
   for (std::int64_t k = 0; k < steps_; ++k) {
     wait_for_monitor(k);
+    if (pace_us > 0) {
+      wait_for_pace(due_us);
+      due_us = mono_us() + pace_us;
+    }
     publish_state(k);
     const std::int64_t start = mono_us();
     std::int64_t last_sent = start;

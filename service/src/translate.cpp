@@ -3,6 +3,8 @@
 
 #include <limits>
 
+#include "feeddrive/service/contract.hpp"
+
 namespace feeddrive::service {
 
 reference_t to_message(std::int64_t seq, double t, const trajectory::Sample& s) {
@@ -84,12 +86,27 @@ sim::Record to_record(const drive_state_t& state, const reference_t& ref, const 
   return sim::make_record(state.t, to_sample(ref), st, to_measurement(state), c, applied.u, f);
 }
 
-run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_id) {
+run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std::string& scenario_hash) {
   run_info_t m;
-  m.run_id = run_id;
+  m.run_id = 0;
   m.utime = 0;
   m.scenario = wire::fit(s.name, wire::Check<run_info_t>::kMax_scenario);
-  m.mode = realtime ? "realtime" : "lockstep";
+  m.mode = opt.realtime ? "realtime" : "lockstep";
+  m.contract_version = kContractVersion;
+  m.scenario_hash = scenario_hash;
+  m.start_timeout = opt.start_timeout_s;
+  m.step_timeout = opt.step_timeout_s;
+  m.resend_interval = opt.resend_interval_s;
+  m.monitor_window = opt.monitor_window;
+  m.max_bad_commands = opt.max_bad_commands;
+  m.max_rate = opt.max_rate;
+  m.initial_position = s.plant.initial.position;
+  m.initial_velocity = s.plant.initial.velocity;
+  m.sensor_quantization = s.plant.sensor.quantization;
+  m.sensor_noise_stddev = s.plant.sensor.noise_stddev;
+  // "auto" resolved as plant/sensor.hpp does: the true velocity only from an ideal sensor.
+  m.sensor_velocity = s.plant.sensor.velocity == "auto" ? (s.plant.sensor.ideal() ? "true" : "difference") : s.plant.sensor.velocity;
+  m.current_step = -1;
   m.control_period = s.control_period;
   m.steps = s.steps();
   const plant::PlantParams& p = s.plant;

@@ -28,9 +28,11 @@ std::string size_text(double bytes) {
 
 // The curves of the plots, computed from a record before the reduction (so the reduction keeps
 // the extremes of exactly what is drawn).
-enum Curve { kXd, kX, kE, kEv, kU, kFriction, kRipple, kGrinding, kCurves };
+// x_measured and e_m = xd - x_measured are drawn where the true state is missing (hardware).
+enum Curve { kXd, kX, kE, kEv, kU, kFriction, kRipple, kGrinding, kXm, kEm, kCurves };
 const std::vector<std::string>& curve_names() {
-  static const std::vector<std::string> n = {"xd", "x", "e", "e_v", "u", "f_friction", "f_ripple", "f_grinding"};
+  static const std::vector<std::string> n = {"xd", "x", "e", "e_v", "u", "f_friction", "f_ripple", "f_grinding",
+                                             "x_measured", "e_measured"};
   return n;
 }
 void curve_values(const Record& r, double* y) {
@@ -42,6 +44,8 @@ void curve_values(const Record& r, double* y) {
   y[kFriction] = r.f_friction;
   y[kRipple] = r.f_ripple;
   y[kGrinding] = r.f_grinding;
+  y[kXm] = r.x_measured;
+  y[kEm] = r.xd - r.x_measured;
 }
 
 std::vector<std::size_t> column_indices(const Scenario& s) {
@@ -267,13 +271,18 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   };
   // Fixed data file name, the title through the one escaping rule (feeddrive/output/gnuplot.hpp).
   const std::string t = output::gnuplot_string(title);
+  // The true state where it exists (a simulated plant), else the measurement (hardware).
+  const bool truth = reduced.has_samples(kX);
   std::ostringstream gp;
   gp << "data = 'plot.csv'\nset xlabel 't [s]'\n";
   gp << "set output 'position.png'\nset multiplot layout 2,1 title " << t << "\n"
      << "set ylabel 'position [mm]'\n"
-     << panel({{kXd, "*1e3", "lw 2 ", "x_d"}, {kX, "*1e3", "", "x"}}, "no position recorded")
-     << "set ylabel 'error x_d - x [um]'\n"
-     << panel({{kE, "*1e6", "", "e"}}, "no true position: no error to draw") << "unset multiplot\n";
+     << (truth ? panel({{kXd, "*1e3", "lw 2 ", "x_d"}, {kX, "*1e3", "", "x"}}, "no position recorded")
+               : panel({{kXd, "*1e3", "lw 2 ", "x_d"}, {kXm, "*1e3", "", "x_measured"}}, "no position recorded"))
+     << (truth ? "set ylabel 'error x_d - x [um]'\n" : "set ylabel 'error x_d - x_measured [um]'\n")
+     << (truth ? panel({{kE, "*1e6", "", "e"}}, "no error to draw")
+               : panel({{kEm, "*1e6", "", "e (measured)"}}, "no position recorded: no error to draw"))
+     << "unset multiplot\n";
   gp << "set output 'velocity_error.png'\nset title " << t << "\nset ylabel 'velocity error v_d - v [um/s]'\n"
      << panel({{kEv, "*1e6", "", "e_v"}}, "no true velocity: no error to draw");
   gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n" << panel({{kU, "", "", "u"}}, "no command recorded");

@@ -30,6 +30,13 @@ void SummaryBuilder::add(const Record& q) {
   // The error metrics are over the steps that have a true state (a record from hardware has
   // none: truth.valid = 0 gives NaN): a metric over no such step has no value (null), never 0.
   const bool settled = q.t >= settled_after_;
+  // Against the measured position: every run has one (a record without it, NaN, is skipped).
+  if (const double em = saturated(static_cast<long double>(q.xd) - q.x_measured); std::isfinite(em)) {
+    abs_em_.add(std::abs(em));
+    m.measured_position_error_max_abs_m = std::max(m.measured_position_error_max_abs_m, std::abs(em));
+    sem_ += static_cast<long double>(em) * em;
+    ++n_em_;
+  }
   if (std::isfinite(e)) {
     abs_e_.add(std::abs(e));
     m.position_error_max_abs_m = std::max(m.position_error_max_abs_m, std::abs(e));
@@ -83,11 +90,15 @@ Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator
   if (n_settled_ > 0)
     m.position_error_rms_settled_m =
         n_e_settled_ > 0 ? static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_e_settled_))) : kNone;
-  // rank floor(0.95 n) of the n finite values |e|
-  if (abs_e_.count() > 0) {
-    const auto k = std::min<std::uint64_t>(abs_e_.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(abs_e_.count())));
-    m.position_error_p95_abs_m = abs_e_.value_at_rank(k);
-  }
+  // rank floor(0.95 n) of the n finite values |e| (and |e_m|)
+  const auto p95 = [](const stats::StreamingQuantile& q, double& out) {
+    if (q.count() == 0) return;
+    out = q.value_at_rank(std::min<std::uint64_t>(q.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(q.count()))));
+  };
+  p95(abs_e_, m.position_error_p95_abs_m);
+  p95(abs_em_, m.measured_position_error_p95_abs_m);
+  m.measured_position_error_rms_m = n_em_ > 0 ? static_cast<double>(std::sqrt(sem_ / static_cast<long double>(n_em_))) : kNone;
+  if (n_em_ == 0) m.measured_position_error_max_abs_m = m.measured_position_error_p95_abs_m = kNone;
   if (n_e_ == 0) m.position_error_max_abs_m = m.position_error_p95_abs_m = kNone;
   if (n_e_settled_ == 0) m.position_error_max_abs_settled_m = kNone;
   if (n_ev_ == 0) m.velocity_error_max_abs_mps = kNone;
@@ -121,6 +132,11 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["position_error_max_abs_m"] = val(m.position_error_max_abs_m);
   j["position_error_rms_m"] = val(m.position_error_rms_m);
   j["position_error_p95_abs_m"] = val(m.position_error_p95_abs_m);
+  j["measured_position_error_max_abs_m"] = val(m.measured_position_error_max_abs_m);
+  j["measured_position_error_rms_m"] = val(m.measured_position_error_rms_m);
+  j["measured_position_error_p95_abs_m"] = val(m.measured_position_error_p95_abs_m);
+  // Which error the headline figure is (launcher line, plots): the true state's where it exists.
+  j["error_source"] = m.steps == 0 ? nlohmann::ordered_json() : nlohmann::ordered_json(std::isnan(m.position_error_max_abs_m) ? "measured" : "true_state");
   j["velocity_error_max_abs_mps"] = val(m.velocity_error_max_abs_mps);
   j["velocity_error_max_abs_after_first_mps"] = m.steps > 1 ? nlohmann::ordered_json(m.velocity_error_max_abs_after_first_mps) : nlohmann::ordered_json();
   j["velocity_error_rms_mps"] = val(m.velocity_error_rms_mps);

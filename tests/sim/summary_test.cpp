@@ -125,5 +125,38 @@ TEST(Summary, ARecordWithoutTrueStateHasNoErrorMetricsNotZero) {
   EXPECT_NEAR(m.position_error_rms_m, 1e-3, 1e-18);  // rms of two equal errors
 }
 
+TEST(Summary, MeasuredErrorMetricsInEveryRunAndWhichIsWhich) {
+  // Without a true state the run's tracking error is xd - x_measured: max, RMS and p95 in the
+  // same form. Ten steps with x_measured = xd - e_k, e_k = k * 1 um (k = 0..9): max 9 um,
+  // RMS sqrt(sum k^2 / 10) um = sqrt(28.5) um, p95 = the value of rank floor(0.95 * 10) = 9 of
+  // the sorted |e| (9 um; the histogram keeps it within 2^-11).
+  Scenario s;
+  s.control_period = 1e-4;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const bool truth : {false, true}) {
+    SummaryBuilder b(s);
+    for (long k = 0; k < 10; ++k) {
+      Record r;
+      r.t = k * 1e-4;
+      r.xd = 1e-3;
+      r.x_measured = 1e-3 - k * 1e-6;
+      r.x = truth ? r.x_measured : nan;
+      r.v = truth ? 0.0 : nan;
+      b.add(r);
+    }
+    const auto j = nlohmann::json::parse(summary_json(b.summary(0.0, {}), s));
+    EXPECT_NEAR(j["measured_position_error_max_abs_m"].get<double>(), 9e-6, 1e-15);
+    EXPECT_NEAR(j["measured_position_error_rms_m"].get<double>(), std::sqrt(28.5) * 1e-6, 1e-15);
+    EXPECT_NEAR(j["measured_position_error_p95_abs_m"].get<double>(), 9e-6, 9e-6 * std::ldexp(1.0, -11));
+    EXPECT_EQ(j["error_source"], truth ? "true_state" : "measured");
+    if (truth) {  // an ideal sensor: both the same
+      EXPECT_EQ(j["position_error_max_abs_m"], j["measured_position_error_max_abs_m"]);
+      EXPECT_EQ(j["position_error_rms_m"], j["measured_position_error_rms_m"]);
+    } else {
+      EXPECT_TRUE(j["position_error_max_abs_m"].is_null());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace feeddrive::sim

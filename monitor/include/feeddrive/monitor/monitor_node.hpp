@@ -27,6 +27,7 @@
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/run_info_t.hpp"
 #include "feeddrive/run_summary_t.hpp"
+#include "feeddrive/service/loggers.hpp"
 #include "feeddrive/service/node.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -61,10 +62,23 @@ class MonitorNode : public service::Node {
   /// Returns true when the recording is over.
   bool attached_stalled(std::int64_t now, double limit);
   void publish_info();
+  /// Names the senders of what the bus drops (service::BusEvents), one line per sender and kind,
+  /// and fails the run (failure_, checked in run()) when a run role cannot take part: an older
+  /// contract, run id 0, unsigned in a keyed run, a restarted plant.
+  void on_foreign(const std::string& channel, std::int64_t run_id, const std::string& role);
+  void on_unauthenticated(const std::string& channel, const std::uint8_t* d, std::size_t n);
+  void on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why);
+  void check_peer_status(const process_status_t& m);
+  /// Fails the run with `why` when `role` is one of the run's (an observer is only named) and,
+  /// with unless_role_alive, no admitted process of that role was heard within the last second.
+  void fail_for(const std::string& role, const std::string& why, bool unless_role_alive = true);
   void on_state_timing(const drive_state_t& m, std::int64_t t);
   void on_command_timing(const control_command_t& m, std::int64_t t);
   void prune_timing(std::int64_t seq);
   void progress(bool force);
+  /// Once a second: looks for stock loggers on the bus (service::stock_loggers_on) and measures
+  /// the step rate of the last second (the peak is what a logger had to keep up with).
+  void watch_rate_and_loggers(std::int64_t now);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
   /// latency_histogram.csv (and .png when `plot`; a gnuplot failure is a warning) into the
@@ -98,6 +112,12 @@ class MonitorNode : public service::Node {
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)
   std::int64_t heartbeats_{0};
   Histogram hist_sc_, hist_cs_, hist_late_;
+  std::string failure_;  ///< set by the bus events: the run cannot go on (run() throws it)
+  std::map<std::string, std::int64_t> named_;  ///< what was named already (one line per sender and kind) -> count
+  std::int64_t plant_seq_seen_{-1};  ///< the highest step of the plant's heartbeats
+  std::vector<service::StockLogger> loggers_;  ///< stock loggers seen on the bus during the run
+  std::int64_t rate_since_us_{-1}, rate_since_step_{0};
+  double peak_rate_{0.0};  ///< the most steps per second recorded in one window of >= 1 s
   std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight
   std::int64_t timing_pruned_{-1};                              ///< steps <= this are no longer timed
 };

@@ -13,6 +13,7 @@
 // Nothing here knows about drives: the nodes (plant_node.hpp, ...) hold the protocol logic.
 
 #include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cstdio>
@@ -60,6 +61,18 @@ enum class Receive {
   kEvent,    ///< liblcm's receive thread: two wake-ups per message (receive thread, then pipe)
 };
 
+/// What a bus drops, for a process that names the sender (the monitor: contract.hpp). Each
+/// is called for every such message, after it is counted.
+struct BusEvents {
+  /// With a key: a message without a valid mac (channel, its bytes).
+  std::function<void(const std::string&, const std::uint8_t*, std::size_t)> unauthenticated;
+  /// A message that does not decode as its channel's type or breaks the contract's bounds
+  /// (channel, its bytes, why: "reference_block_t.count = -1 (bound 1..16)").
+  std::function<void(const std::string&, const std::uint8_t*, std::size_t, const std::string&)> undecodable;
+  /// A message of another run (channel, its run id, the sender's role if known, else "").
+  std::function<void(const std::string&, std::int64_t, const std::string&)> foreign;
+};
+
 class Bus {
  public:
   /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kDirect and
@@ -104,7 +117,12 @@ class Bus {
   bool authenticated() const { return auth_ != nullptr; }
   /// Counts (and logs, at most once a second) a message of another run seen by an
   /// Admit::kAnyRun handler.
-  void count_foreign(const std::string& channel, std::int64_t run_id);
+  void count_foreign(const std::string& channel, std::int64_t run_id, const std::string& role = "");
+  /// Names the senders of what it drops (events) instead of the bus's own lines.
+  void set_events(BusEvents e) { events_ = std::move(e); }
+  /// false: the bus only counts foreign, unauthenticated and undecodable messages, it logs no
+  /// line (under feeddrive-launch one process, the monitor, names them: one line per event).
+  void set_reports(bool on) { reports_ = on; }
 
   /// Dispatches the messages that arrive within `timeout` (at least one wait). Returns true if
   /// at least one message was handled. Rethrows the first exception a handler threw.
@@ -124,7 +142,7 @@ class Bus {
   /// invalid() by channel; datagrams without LCM's framing (no channel) under "" .
   std::map<std::string, std::int64_t> invalid_by_channel() const;
   /// Counts (and logs, at most once a second) a message of `channel` that did not decode.
-  void count_invalid(const std::string& channel, const std::string& why);
+  void count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why);
   std::int64_t send_errors() const { return send_errors_; }
   /// Messages of another run (Admit::kRun subscriptions, and count_foreign()).
   std::int64_t foreign() const { return foreign_; }
@@ -167,6 +185,8 @@ class Bus {
   bool run_known_{false};
   bool join_first_{false};
   std::unique_ptr<MessageAuth> auth_;
+  BusEvents events_;
+  bool reports_{true};
   std::vector<std::uint8_t> out_;  ///< publish(): the encoded message
   std::exception_ptr error_;
   /// Logs at most once a second per kind: `last` is that kind's last log time.
@@ -230,9 +250,10 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
     const auto* bytes = static_cast<const std::uint8_t*>(rbuf->data);
     if (auth_ && !auth_->verify(ch, bytes, rbuf->data_size)) {
       ++unauthenticated_;
-      if (log_due(last_unauthenticated_log_us_))
-        std::fprintf(stderr, "feeddrive: rejected a message on %s without a valid mac (%lld so far; forged, or a "
-                     "publisher without the key)\n", ch.c_str(), static_cast<long long>(unauthenticated_));
+      if (events_.unauthenticated) events_.unauthenticated(ch, bytes, rbuf->data_size);
+      else if (reports_ && log_due(last_unauthenticated_log_us_))
+        spdlog::warn("rejected a message on {} without a valid mac ({} so far; forged, or a publisher without the key)",
+                     ch, unauthenticated_);
       return;
     }
     // Every received byte is untrusted: decode_untrusted walks the encoding against the
@@ -241,14 +262,13 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
     const std::int64_t now = mono_us();
     std::string why;
     if (!wire::decode_untrusted(rbuf->data, rbuf->data_size, msg, &why)) {
-      count_invalid(ch, why);
+      count_invalid(ch, bytes, rbuf->data_size, why);
       return;
     }
     if (admit == Admit::kRun) {
       if (!run_known_ && join_first_) {
         set_run_id(msg.run_id);
-        std::fprintf(stderr, "feeddrive: joined run %lld (the first message on %s)\n",
-                     static_cast<long long>(msg.run_id), ch.c_str());
+        spdlog::info("joined run {} (the first message on {})", msg.run_id, ch);
       }
       if (!run_known_) return;  // not joined yet: its own run re-sends what matters
       if (msg.run_id != run_id_) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/controller/controller.hpp"
@@ -34,6 +35,9 @@ class ControllerNode : public Node {
   StepLedger<drive_state_t> state_ledger_;      ///< every state received, for conflicts
   StepLedger<reference_t> reference_ledger_;    ///< every reference received, for conflicts
   std::int64_t next_seq_{0};       ///< first step not answered yet
+  /// Steps >= next_seq_ for which a command of another publisher was seen on the command channel
+  /// (a forged or stray answer: the plant may then move on without this controller's command).
+  std::set<std::int64_t> answered_by_others_;
   std::int64_t last_progress_us_{0};
   bool end_{false};
 };

@@ -95,9 +95,6 @@ std::int64_t draw_run_id();
 /// N = 0 (no nonce: no key) gives R itself.
 std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce);
 
-/// SHA-256 (FIPS 180-4) of `bytes`, as 64 lowercase hex digits (libcrypto).
-std::string sha256_hex(const std::string& bytes);
-
 /// HMAC-SHA256(key, data) (RFC 2104 over FIPS 180-4), for tests and tools.
 std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint8_t* data, std::size_t size);
 
@@ -105,6 +102,9 @@ std::array<std::uint8_t, 32> hmac_sha256(const std::string& key, const std::uint
 /// group or others (mode 0600 or 0400), of 16..4096 bytes; the key is its bytes. Throws
 /// std::invalid_argument with one line naming the file and what is wrong.
 std::string read_key_file(const std::string& path);
+
+/// Hex SHA-256 of `bytes` (64 lower-case digits): run_info_t.scenario_hash of the scenario file.
+std::string sha256_hex(const std::string& bytes);
 
 /// Signs and verifies messages with one key (see the top of this file). Keeps a keyed OpenSSL
 /// context, so a message costs one HMAC, not a key setup.

@@ -41,6 +41,9 @@ struct LaunchOptions {
   double busy_check_s{0.3};
   /// If set: the monitor also writes the run's messages to this LCM log (feeddrive-monitor --lcm-log).
   std::string lcm_log;
+  /// --max-rate not given: when a stock lcm-logger is on the bus at the start (loggers.hpp), a
+  /// lockstep run is paced to what it records without loss (kStockLoggerSteps), and says so.
+  bool auto_pace{true};
 };
 
 /// Parses a CPU list "0" or "0,2" (each an index this process may run on). Throws

@@ -32,6 +32,10 @@ struct NodeOptions {
   long monitor_window{4096};         ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
   double linger_s{10.0};             ///< after the end: keep answering resend requests until the monitor is done
   bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
+  /// Lockstep: the plant publishes at most this many steps per second (each state at least
+  /// 1/max_rate after the previous one, never catching up); 0: as fast as the chain answers. The
+  /// pace at which the stock lcm-logger records without loss is loggers.hpp's kStockLoggerSteps.
+  double max_rate{0.0};
   int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
   /// Real time: busy-wait this long before a period start (after clock_nanosleep). 30 us: a timer
   /// wakes 20-40 us late on the development VM (measured: bench/realtime_bench.sh with 10 us
@@ -41,13 +45,13 @@ struct NodeOptions {
   /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
   /// other process takes it from the plant's first fresh heartbeat.
   std::int64_t run_id{0};
+  /// Hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash); "":
+  /// the monitor hashes the file it read.
+  std::string scenario_hash;
   std::string key_file;              ///< --key: authenticate every message with this key; "": off
   /// --run-nonce, with --key: the run's nonce (feeddrive-launch draws it and gives it to every
   /// process it starts); 0: the plant draws one and the others take it from its fresh heartbeat.
   std::int64_t run_nonce{0};
-  /// --scenario-sha256: the SHA-256 (hex) of the scenario file's bytes as feeddrive-launch read
-  /// them; a process whose file hashes otherwise refuses to start (one run, one scenario). "": no check.
-  std::string scenario_sha256;
   ConflictPolicy on_conflict{ConflictPolicy::kFail};
 };
 
@@ -126,6 +130,8 @@ class Node {
   std::function<void(const resend_request_t&)> on_resend_request;
   /// Called each time the heartbeat goes out (every 100 ms and on changes of state).
   std::function<void()> on_heartbeat;
+  /// Called with every heartbeat of another process of this run.
+  std::function<void(const process_status_t&)> on_peer_status;
 
  private:
   bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);

@@ -54,6 +54,8 @@ class PlantNode : public Node {
   /// Applies u over step k and advances the drive.
   void apply(std::int64_t k, double u);
   void wait_for_monitor(std::int64_t k);
+  /// Lockstep with --max-rate: waits (serving the bus) until monotonic time due_us [us].
+  void wait_for_pace(std::int64_t due_us);
   /// Real time: takes the commands received so far; each newer one switches the input at its
   /// arrival (simulated time clamped to [now, t_end]). Returns true if command k was among them.
   bool take_commands(std::int64_t k, double t_end);

@@ -13,6 +13,7 @@
 #include "feeddrive/reference_t.hpp"
 #include "feeddrive/run_info_t.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/service/node.hpp"
 
 namespace feeddrive::service {
 
@@ -35,8 +36,10 @@ applied_t no_applied();
 sim::Record to_record(const drive_state_t& state, const reference_t& ref, const control_command_t& cmd,
                       const applied_t& applied);
 
-/// The run's self-description (run_info_t) from its scenario: name, mode, period, steps, the
-/// drive's nominal parameters and the command limits (utime and run_id are the sender's).
-run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_id);
+/// The run's self-description (run_info_t) from its scenario and the run's options: name, mode,
+/// period, steps, the drive's nominal parameters, the command limits, the protocol's timeouts,
+/// window and pace, the initial state, the sensor model, the contract version and the scenario's
+/// hash (utime, run_id and current_step are the sender's: current_step -1 here).
+run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std::string& scenario_hash);
 
 }  // namespace feeddrive::service

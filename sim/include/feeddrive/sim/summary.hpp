@@ -1,5 +1,10 @@
 #pragma once
-// Run metrics (summary.json). Errors are true-state errors: e = xd - x, e_v = vd - v.
+// Run metrics (summary.json). position_error_* and velocity_error_* are true-state errors:
+// e = xd - x, e_v = vd - v (null without a true state: a hardware plant). measured_position_error_*
+// are against the measured position, e_m = xd - x_measured (the encoder's, what a controller and a
+// hardware-in-the-loop user have), in every run: max |e_m|, RMS, p95 |e_m| in the same form.
+// error_source names which the headline figure (launcher line, plots) uses: "true_state" or
+// "measured".
 // "settled" metrics are over t >= analysis.settled_after. A metric over an empty window has no
 // value: summary_json writes null, never 0, for the settled metrics when no step reaches
 // settled_after (settled_steps == 0), for the after-first metric with fewer than two steps, and
@@ -25,6 +30,9 @@ struct Summary {
   double position_error_max_abs_m{0.0};
   double position_error_rms_m{0.0};
   double position_error_p95_abs_m{0.0};
+  double measured_position_error_max_abs_m{0.0};  ///< max |xd - x_measured| [m]
+  double measured_position_error_rms_m{0.0};
+  double measured_position_error_p95_abs_m{0.0};
   double velocity_error_max_abs_mps{0.0};
   double velocity_error_max_abs_after_first_mps{0.0};  ///< excludes the first sample
   double velocity_error_rms_mps{0.0};
@@ -64,13 +72,13 @@ class SummaryBuilder {
   Summary m_;
   long n_{0}, n_settled_{0};
   // steps with a finite position / velocity error (all, settled, after the first)
-  long n_e_{0}, n_e_settled_{0}, n_ev_{0}, n_ev_settled_{0}, n_ev_after_first_{0};
+  long n_e_{0}, n_em_{0}, n_e_settled_{0}, n_ev_{0}, n_ev_settled_{0}, n_ev_after_first_{0};
   // Sums of squares and the control's total variation in long double (x86-64: 64-bit mantissa,
   // exponent to 1e4932): no finite record can overflow them, so a run that recorded a finite but
   // absurd value (a corrupt logged state at 1e220 m) still gets finite metrics, never inf/null.
-  long double se_{0.0L}, sev_{0.0L}, se_settled_{0.0L}, total_variation_{0.0L};
+  long double se_{0.0L}, sem_{0.0L}, sev_{0.0L}, se_settled_{0.0L}, total_variation_{0.0L};
   Record last_;
-  stats::StreamingQuantile abs_e_;
+  stats::StreamingQuantile abs_e_, abs_em_;
 };
 
 /// All records in memory at once (SummaryBuilder over r.records).
