@@ -104,7 +104,7 @@ TEST(StudyMillion, StartsAtOnceStaysSmallAndStopsOnCtrlC) {
   // loaded machine.
   EXPECT_LT(stop_s, 5.0);
   // Holding every case (resolved scenario and outcome, ~1.4 kB each) would be 1.4 GB: the cases
-  // in flight, the window of 256 and ~12 bytes per finished case for report.md are a few MB over
+  // in flight, the window of 256 and ~30 bytes per finished case for report.md are a few MB over
   // the process's own 15 MB.
   EXPECT_LT(ru.ru_maxrss, 200L * 1024) << "peak RSS " << ru.ru_maxrss << " kB";
   EXPECT_GT(finished, 10u);
