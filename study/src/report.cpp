@@ -127,7 +127,12 @@ void ResultsWriter::finish() {
 
 ReportData::ReportData(const Study& st)
     : s(st), params(varied_keys(st)), table(st.families.size(), std::vector<Cell>(st.controllers.size())),
-      worst(st.controllers.size()) {}
+      worst(st.controllers.size()) {
+  const auto n = static_cast<std::size_t>(st.total_cases());  // exact: no doubling of the largest vectors
+  controller.reserve(n);
+  shown.reserve(n);
+  x.reserve(n * params.size());
+}
 
 void ReportData::add(std::size_t index, const CaseRecord& c) {
   ++cases;

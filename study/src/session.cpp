@@ -83,6 +83,32 @@ int available_cores() {
 
 namespace {
 
+// Worker threads running cases: the main thread hands each its index and scenario.
+class CasePool {
+ public:
+  explicit CasePool(int jobs) : pool_(jobs, [this](std::size_t i) { return run_case(take(i)); }) {}
+  void push(std::size_t i, std::string yaml) {
+    {
+      std::lock_guard<std::mutex> g(mu_);
+      yaml_[i] = std::move(yaml);
+    }
+    pool_.push(i);
+  }
+  std::size_t in_flight() const { return pool_.in_flight(); }
+  std::optional<std::pair<std::size_t, Outcome>> pop(std::chrono::milliseconds wait) { return pool_.pop(wait); }
+
+ private:
+  std::string take(std::size_t i) {
+    std::lock_guard<std::mutex> g(mu_);
+    std::string text = std::move(yaml_.at(i));
+    yaml_.erase(i);
+    return text;
+  }
+  std::mutex mu_;
+  std::map<std::size_t, std::string> yaml_;  // handed over, not yet taken by a thread
+  Pool pool_;                                // last: its threads stop before the map goes
+};
+
 // Cases resolved before any case runs (probe_cases): about 1 ms each, so the check takes about a
 // second at most, and a 10^6-case study starts its first case within seconds.
 constexpr std::size_t kProbeBudget = 1000;
@@ -251,18 +277,7 @@ int run_study(const Options& o, Transport* t) {
   };
   try {
     results = std::make_unique<ResultsWriter>(study, dir);
-    // The scenarios handed to the threads (slots belongs to this thread alone).
-    std::map<std::size_t, std::string> to_run;
-    std::mutex to_run_mu;
-    Pool pool(jobs, [&to_run, &to_run_mu](std::size_t i) {
-      std::string text;
-      {
-        std::lock_guard<std::mutex> g(to_run_mu);
-        text = std::move(to_run.at(i));
-        to_run.erase(i);
-      }
-      return run_case(text);
-    });
+    CasePool pool(jobs);
     int released = 0;  // ranks told there is no more work
     while (next_row < total || (t && released < t->size() - 1)) {
       if (interrupt::interrupted()) {
@@ -279,11 +294,7 @@ int run_study(const Options& o, Transport* t) {
       while (next_case < total && next_case - next_row < window && ready.size() < want && !interrupt::interrupted())
         prepare_next();
       while (pool.in_flight() < static_cast<std::size_t>(jobs) && !ready.empty()) {
-        {
-          std::lock_guard<std::mutex> g(to_run_mu);
-          to_run[ready.front()] = slots.at(ready.front()).record.resolved.yaml;
-        }
-        pool.push(ready.front());
+        pool.push(ready.front(), slots.at(ready.front()).record.resolved.yaml);
         ready.pop_front();
       }
       while (t && !waiting.empty() && (!ready.empty() || next_case == total)) {
@@ -375,17 +386,7 @@ int serve(Transport& t, int jobs) {
   const int status = t.broadcast(0);
   if (status != 0) return status;
   if (jobs <= 0) jobs = std::max(1, available_cores() / t.local_size());
-  std::map<std::size_t, std::string> yaml;  // the cases this rank holds, filled by the main thread
-  std::mutex yaml_mu;
-  Pool pool(jobs, [&yaml, &yaml_mu](std::size_t i) {
-    std::string text;
-    {
-      std::lock_guard<std::mutex> lock(yaml_mu);
-      text = std::move(yaml.at(i));
-      yaml.erase(i);
-    }
-    return run_case(text);
-  });
+  CasePool pool(jobs);
   bool done = false;
   while (!done || pool.in_flight() > 0) {
     if (!done && pool.in_flight() < static_cast<std::size_t>(jobs)) {
@@ -395,11 +396,7 @@ int serve(Transport& t, int jobs) {
         done = true;
       } else {
         auto [i, text] = unpack(m.payload);
-        {
-          std::lock_guard<std::mutex> lock(yaml_mu);
-          yaml[i] = std::move(text);
-        }
-        pool.push(i);
+        pool.push(i, std::move(text));
       }
       continue;
     }

@@ -53,7 +53,7 @@ std::string csv_field(const std::string& value);
 
 /// What report.md and the plots need of the cases, gathered one case at a time in study order:
 /// per case a few numbers (its controller, the report metric, each varied key as a float for the
-/// plots: 12 + 4 x keys bytes), the worst case of each controller with its parameters, and the
+/// plots: about 20 + 4 x keys bytes), the worst case of each controller with its parameters, and the
 /// first kListedFailures failed cases. Not the cases' scenarios or metrics.
 struct ReportData {
   static constexpr std::size_t kListedFailures = 100;
