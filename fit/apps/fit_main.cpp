@@ -122,8 +122,8 @@ int main(int argc, char** argv) {
     int k = 0;
     for (const auto& st : r.steps)
       if (st.accepted)
-        std::printf("%-4d %-24s %14.4g %18.4g\n", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
-                    st.force_rms_after);
+        std::printf("%-4d %-24s %14.4g %18.4g%s\n", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
+                    st.force_rms_after, st.swap.empty() ? "" : ("   (swap: " + st.swap + ")").c_str());
     std::printf("%s\n", r.conclusion.c_str());
     for (const auto& [name, caveat] : r.tentative) std::printf("tentative %s: %s\n", name.c_str(), caveat.c_str());
     for (const std::string& t : r.ties) std::printf("tie: %s\n", t.c_str());

@@ -654,6 +654,20 @@ Effect canonical(const Effect& e) {
                  {"third_phase_rad", 0.0}}};
 }
 
+double mean_position(const Record& rec) { return x_mean_of(rec); }
+
+std::optional<Effect> simpler_form(const Effect& e, double x_mean) {
+  const auto& q = e.parameters;
+  if (e.name == "stribeck_friction") return Effect{"coulomb_friction", {{"coulomb_N", q.at("coulomb_N")}}};
+  if (e.name == "spring_force")
+    return Effect{"constant_force", {{"force_N", q.at("stiffness_N_per_m") * (x_mean - q.at("rest_position_m"))}}};
+  if (e.name == "cogging_ripple") {
+    const Effect c = canonical(e);
+    if (c.parameters != e.parameters) return c;
+  }
+  return std::nullopt;
+}
+
 std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, const Effect& e) {
   const auto& b = rec.bank;
   const auto& m = rec.motion;

@@ -228,13 +228,15 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     int k = 0;
     for (const StepResult& st : r.steps) {
       if (!st.accepted) continue;
-      std::snprintf(buf, sizeof buf, "| %d | + %s | %.4g | %.4g |\n", ++k, st.effect.name.c_str(), st.gap_after * 1e6,
+      const std::string label = st.effect.name + (st.swap.empty() ? "" : " (swap: " + st.swap + ")") +
+                                (st.caveat.empty() ? "" : " (tentative)");
+      std::snprintf(buf, sizeof buf, "| %d | + %s | %.4g | %.4g |\n", ++k, label.c_str(), st.gap_after * 1e6,
                     st.force_rms_after);
       md << buf;
     }
     if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
     std::snprintf(buf, sizeof buf,
-                  "Noise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; %s); \"within\" means at "
+                  "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; %s); \"within\" means at "
                   "most %.0fx the floor.\n\n",
                   r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9, r.floor.source.c_str(), kFloorFactor);
     md << buf;

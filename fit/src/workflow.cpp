@@ -139,23 +139,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
            fmt("; record a travel of at least 3 periods (%.3g mm) to confirm it", 3e3 * pitch);
   };
   // The simpler effect a refit may turn an effect into (the swap move), if any.
-  const double x_mean = [&] {
-    double sx = 0.0;
-    for (double x : rec.data->x) sx += x;
-    return sx / static_cast<double>(rec.data->size());
-  }();
-  const auto simpler = [&](const Effect& e) -> std::optional<Effect> {
-    const auto& q = e.parameters;
-    if (e.name == "stribeck_friction")  // no hump: Coulomb friction at the same level
-      return Effect{"coulomb_friction", {{"coulomb_N", q.at("coulomb_N")}}};
-    if (e.name == "spring_force")  // no slope: the constant force it exerts over the range
-      return Effect{"constant_force", {{"force_N", q.at("stiffness_N_per_m") * (x_mean - q.at("rest_position_m"))}}};
-    if (e.name == "cogging_ripple") {  // a vanishing fundamental: the ripple of its harmonic
-      const Effect c = canonical(e);
-      if (c.parameters != e.parameters) return c;
-    }
-    return std::nullopt;
-  };
+  const double x_mean = mean_position(rec);
+  const auto simpler = [&](const Effect& e) { return simpler_form(e, x_mean); };
   std::map<std::string, std::string> tentative;  // effect -> caveat, of the effects named as tentative
   int additions = 0;
   for (int it = 0; additions < opt.max_effects && it < 2 * opt.max_effects + 2; ++it) {

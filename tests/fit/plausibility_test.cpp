@@ -99,5 +99,27 @@ TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
   EXPECT_EQ(canonical(both).parameters, both.parameters);
 }
 
+// The swap moves (docs/fit.md, "Swap moves"): what a collapsed effect becomes. The case:
+// a Stribeck curve refitted with a constant force to static = Coulomb = 20.4 N is Coulomb friction
+// at 20.4 N; a spring of 50 N/m resting 0.2 m below the mean position is a constant 10 N; a
+// cogging ripple with a vanishing fundamental is its harmonic; nothing else has a simpler form.
+TEST(SwapMove, ACollapsedEffectBecomesItsSimplerForm) {
+  const auto s = simpler_form({"stribeck_friction", {{"static_N", 20.4}, {"coulomb_N", 20.4}, {"stribeck_velocity_mps", 1e-3}}}, 0.0);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->name, "coulomb_friction");
+  EXPECT_DOUBLE_EQ(s->parameters.at("coulomb_N"), 20.4);
+  const auto k = simpler_form({"spring_force", {{"stiffness_N_per_m", 50.0}, {"rest_position_m", -0.15}}}, 0.05);
+  ASSERT_TRUE(k.has_value());
+  EXPECT_EQ(k->name, "constant_force");
+  EXPECT_NEAR(k->parameters.at("force_N"), 10.0, 1e-12);  // 50 N/m * (0.05 - (-0.15)) m
+  const auto c = simpler_form({"cogging_ripple", {{"pitch_m", 0.1272}, {"amplitude_N", 0.02}, {"phase_rad", 0.5},
+                                                  {"third_harmonic_N", 28.3}, {"third_phase_rad", -0.7}}}, 0.0);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->parameters.at("pitch_m"), 0.0424, 1e-12);
+  EXPECT_FALSE(simpler_form({"cogging_ripple", {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7},
+                                                {"third_harmonic_N", 1.0}, {"third_phase_rad", -0.4}}}, 0.0).has_value());
+  EXPECT_FALSE(simpler_form({"viscous_friction", {{"viscous_Ns_per_m", 200.0}}}, 0.0).has_value());
+}
+
 }  // namespace
 }  // namespace feeddrive::fit

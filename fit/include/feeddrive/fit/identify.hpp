@@ -10,6 +10,7 @@
 // (Schwarz 1978; a score above 10 is "very strong" evidence, Kass & Raftery 1995).
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,15 @@ std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& 
 /// of its third harmonic is the ripple of a third of the pitch (its "third harmonic" is its
 /// fundamental): sin(6 pi x/p + phi3) = sin(2 pi x/(p/3) + phi3).
 Effect canonical(const Effect& e);
+
+/// The simpler effect a joint refit may have turned `e` into (the swap move, docs/fit.md "Swap
+/// moves"), if any: a Stribeck curve (its hump gone) -> coulomb_friction at its Coulomb level; a
+/// spring (its slope gone) -> the constant_force k (x_mean - x_rest) it exerts over the range; a
+/// cogging ripple whose fundamental vanished -> canonical(e), the ripple of its harmonic.
+/// Whether the refit did collapse `e` is for the plausibility rules to say.
+std::optional<Effect> simpler_form(const Effect& e, double x_mean);
+/// The mean measured position of the record [m] (the spring's reference point).
+double mean_position(const Record& rec);
 
 /// The x-axis of the plot of the residual against the effect's own regressor, at filter point
 /// i: e.g. position modulo the pitch for a ripple, velocity for friction. Returns {label, values}.
