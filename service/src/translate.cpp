@@ -119,6 +119,10 @@ run_info_t to_run_info(const sim::Scenario& s, bool realtime, std::int64_t run_i
       m.u_min = s.controller.open_loop.u_min;
       m.u_max = s.controller.open_loop.u_max;
       break;
+    case sim::ControllerType::kPlugin:
+      m.u_min = s.controller.plugin.u_min;
+      m.u_max = s.controller.plugin.u_max;
+      break;
   }
   return m;
 }

@@ -61,7 +61,7 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
     throw ScenarioError("step " + std::to_string(k) + " (t = " + validate::format_number(r.t) + " s): " + what + " = " +
                         validate::format_number(v) + ": " + source);
   };
-  static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop"};
+  static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop", "plugin"};
   const std::string controller =
       std::string("from the controller (controller.type = ") + kControllers[static_cast<int>(s.controller.type)] +
       "; its gains or model make it diverge)";
