@@ -107,7 +107,7 @@ static void die(const char* what, int flag) {
 
 int main(int argc, char** argv) {
   if (argc != 5) {
-    fprintf(stderr, "usage: cvode-floor U_FILE PERIOD plain|deviation REPEATS\n");
+    fprintf(stderr, "usage: cvode-floor U_FILE PERIOD plain|deviation|adams REPEATS\n");
     return 2;
   }
   FILE* f = fopen(argv[1], "r");
@@ -121,9 +121,10 @@ int main(int argc, char** argv) {
     if (++n == cap) u = realloc(u, (cap *= 2) * sizeof *u);
   fclose(f);
   const double T = atof(argv[2]);
-  const int deviation = strcmp(argv[3], "deviation") == 0;
+  const int adams = strcmp(argv[3], "adams") == 0;
+  const int deviation = adams || strcmp(argv[3], "deviation") == 0;
   if (!deviation && strcmp(argv[3], "plain") != 0) {
-    fprintf(stderr, "cvode-floor: FORM %s is not plain or deviation\n", argv[3]);
+    fprintf(stderr, "cvode-floor: FORM %s is not plain, deviation or adams\n", argv[3]);
     return 2;
   }
   const int repeats = atoi(argv[4]);
@@ -141,7 +142,7 @@ int main(int argc, char** argv) {
   ya[0] = ya[1] = ya[2] = 0.0;
   Data data = {0};
   data.deviation = deviation;
-  void* mem = CVodeCreate(CV_BDF, ctx);
+  void* mem = CVodeCreate(adams ? CV_ADAMS : CV_BDF, ctx);
   int flag;
   if ((flag = CVodeInit(mem, rhs, 0.0, y))) die("CVodeInit", flag);
   CVodeSetUserData(mem, &data);
