@@ -8,7 +8,9 @@
 #              and restart at each period (the same work: its steps and rhs counts are printed)
 #   floor-pl   cvode-floor plain: bare CVODE on (x, v, z) itself (looser on position: rtol*|x|)
 #   lsoda      SciPy LSODA (scipy.integrate.ode and odeint, the faster one is the baseline) on the
-#              same system, tolerances, inputs and restarts (bench/lsoda_floor.py)
+#              same system, tolerances, inputs and restarts (bench/lsoda_floor.py); also
+#              solve_ivp(method='LSODA') (the usual interface, slower) and ode at rtol = 1e-11
+#              (tighter, towards feeddrive's position accuracy)
 # Each round runs every program once, in turn; medians over ROUNDS; the ratios are of medians of
 # the same run. Run under the bench lock (the machine is shared):
 #   flock /tmp/feeddrive-bench.lock bash bench/integrator_bench.sh [BUILD_DIR] [ROUNDS]
@@ -49,6 +51,8 @@ for r in $(seq "$ROUNDS"); do
   if [ "$HAVE_SCIPY" = 1 ]; then
     $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 | awk '{print "lsoda-ode", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
     $PY bench/lsoda_floor.py "$TMP/u.txt" $T odeint 1 | awk '{print "lsoda-odeint", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ivp 1 | awk '{print "lsoda-ivp", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 1e-11 | awk '{print "lsoda-ode-tight", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
   fi
 done
 
@@ -62,10 +66,11 @@ for line in open(sys.argv[1]):
 med = {k: statistics.median(float(r[0]) for r in v) for k, v in rows.items()}
 names = {"sim": "feeddrive in-process loop (fd-sim-only)", "plant": "feeddrive plant alone (fd-plant-replay)",
          "floor": "bare CVODE floor, deviation form", "floor-pl": "bare CVODE, plain (x, v, z)",
-         "lsoda-ode": "SciPy LSODA, integrate.ode", "lsoda-odeint": "SciPy LSODA, odeint"}
+         "lsoda-ode": "SciPy LSODA, integrate.ode", "lsoda-odeint": "SciPy LSODA, odeint",
+         "lsoda-ivp": "SciPy LSODA, solve_ivp", "lsoda-ode-tight": "SciPy LSODA, integrate.ode, rtol 1e-11"}
 print(f"{periods} periods, {len(rows['sim'])} rounds; medians")
 print(f"{'':42s} {'s/run':>8s} {'periods/s':>10s} {'us/period':>9s} {'steps/p':>7s} {'rhs/p':>6s}  final x [m], v [m/s]")
-for k in ["sim", "plant", "floor", "floor-pl", "lsoda-ode", "lsoda-odeint"]:
+for k in ["sim", "plant", "floor", "floor-pl", "lsoda-ode", "lsoda-odeint", "lsoda-ivp", "lsoda-ode-tight"]:
     if k not in rows: continue
     r = rows[k][0]
     steps = f"{int(r[1]) / periods:7.2f}" if len(r) > 1 and r[1] != "-" else "      -"
@@ -78,6 +83,8 @@ if have_scipy:
     best = min(med["lsoda-ode"], med["lsoda-odeint"])
     print(f"ratio LSODA (fastest interface) / sim:   {best / med['sim']:.2f}   (goal >= 30)")
     print(f"ratio LSODA (fastest interface) / floor: {best / med['floor']:.2f}")
+    print(f"ratio LSODA solve_ivp / sim:             {med['lsoda-ivp'] / med['sim']:.2f}")
+    print(f"ratio LSODA ode rtol 1e-11 / sim:        {med['lsoda-ode-tight'] / med['sim']:.2f}")
 else:
     print("LSODA rows: SciPy is not installed (apt-get install python3-scipy); no LSODA ratio")
 PYEOF

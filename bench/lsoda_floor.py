@@ -11,9 +11,13 @@ analytic Jacobian; u_k held over [kT, (k+1)T] and the integrator restarted every
 feeddrive and the CVODE floor do. Two interfaces, both LSODA (ODEPACK) underneath:
   ode     scipy.integrate.ode('lsoda'): set_initial_value restarts it each period;
   odeint  scipy.integrate.odeint, one call per period.
+  ivp     scipy.integrate.solve_ivp(method='LSODA'), one call per period: the interface most
+          SciPy users reach for; its per-call Python overhead makes it several times slower.
 The fastest of them is the baseline (its Python right-hand side is the cost SciPy users pay).
+An optional RTOL replaces 1e-8 (the absolute tolerances stay): on the plain variables LSODA's
+position error is rtol*|x|-bound, so matching feeddrive's accuracy needs a tighter rtol.
 
-Usage: lsoda_floor.py U_FILE PERIOD ode|odeint REPEATS
+Usage: lsoda_floor.py U_FILE PERIOD ode|odeint|ivp REPEATS [RTOL]
 Prints one line per repeat: "<interface> seconds S periods N x X v V z Z".
 Needs SciPy: apt-get install python3-scipy (Debian) or pip install scipy.
 """
@@ -22,7 +26,7 @@ import sys
 import time
 
 try:
-    from scipy.integrate import ode, odeint
+    from scipy.integrate import ode, odeint, solve_ivp
 except ImportError:
     sys.exit("lsoda_floor: SciPy is not installed (apt-get install python3-scipy, or pip install scipy)")
 
@@ -74,13 +78,26 @@ def run_odeint(us, T):
     return y
 
 
+def run_ivp(us, T):
+    y = [0.0, 0.0, 0.0]
+    for k, u in enumerate(us):
+        sol = solve_ivp(f, (k * T, (k + 1) * T), y, method="LSODA", args=(u,), jac=jac, rtol=RTOL, atol=ATOL)
+        if not sol.success:
+            sys.exit(f"lsoda_floor: solve_ivp failed in period {k}: {sol.message}")
+        y = sol.y[:, -1]
+    return y
+
+
 def main():
-    if len(sys.argv) != 5 or sys.argv[3] not in ("ode", "odeint"):
-        sys.exit("usage: lsoda_floor.py U_FILE PERIOD ode|odeint REPEATS")
+    global RTOL
+    if len(sys.argv) not in (5, 6) or sys.argv[3] not in ("ode", "odeint", "ivp"):
+        sys.exit("usage: lsoda_floor.py U_FILE PERIOD ode|odeint|ivp REPEATS [RTOL]")
     with open(sys.argv[1]) as fh:
         us = [float(line) for line in fh if line.strip()]
     T, how, repeats = float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
-    run = run_ode if how == "ode" else run_odeint
+    if len(sys.argv) == 6:
+        RTOL = float(sys.argv[5])
+    run = {"ode": run_ode, "odeint": run_odeint, "ivp": run_ivp}[how]
     for _ in range(repeats):
         t0 = time.perf_counter()
         y = run(us, T)
