@@ -12,7 +12,8 @@
 #              solve_ivp(method='LSODA') (the usual interface, slower) and ode at rtol = 1e-11
 #              (tighter, towards feeddrive's position accuracy)
 # Each round runs every program once, in turn; medians over ROUNDS; the ratios are of medians of
-# the same run. Run under the bench lock (the machine is shared):
+# the same run. Each program times its own loop (start-up and loading excluded), as CPU time of
+# the process (the figure quoted: other work on a shared machine barely moves it) and wall time. Run under the bench lock (the machine is shared):
 #   flock /tmp/feeddrive-bench.lock bash bench/integrator_bench.sh [BUILD_DIR] [ROUNDS]
 # Needs SciPy for the LSODA rows (Debian: apt-get install python3-scipy; it uses /usr/bin/python3
 # when that has SciPy, else python3); without it those rows say so and the rest still runs.
@@ -43,16 +44,21 @@ open(sys.argv[3], 'w').write(" ".join(rows[-1][k] for k in ('x', 'v', 'z')) + "\
 PYEOF
 
 : > "$TMP/times"
+# Every program prints "key value" pairs; keep: name, wall s, CPU s, steps, rhs evals, final x, v.
+keep() { awk -v name="$1" '{ for (i = 1; i < NF; i++) kv[$i] = $(i + 1)
+  w = ("seconds" in kv) ? kv["seconds"] : kv["sim_only_seconds"]; c = ("cpu" in kv) ? kv["cpu"] : kv["cpu_seconds"]
+  print name, w, c, ("steps" in kv && name != "sim") ? kv["steps"] : "-", ("rhs" in kv) ? kv["rhs"] : "-",
+        ("x" in kv) ? kv["x"] : "-", ("v" in kv) ? kv["v"] : "-" }' >> "$TMP/times"; }
 for r in $(seq "$ROUNDS"); do
-  "$BUILD/bin/fd-sim-only" "$SCEN" | awk '{print "sim", $2}' >> "$TMP/times"
-  "$BUILD/bin/fd-plant-replay" "$SCEN" "$TMP/u.txt" 1 | awk '{print "plant", $3, $7, $9, $11, $13, $15, $17}' >> "$TMP/times"
-  "$BUILD/bin/cvode-floor" "$TMP/u.txt" $T deviation 1 | awk '{print "floor", $3, $7, $9, $11, $13, $15, $17}' >> "$TMP/times"
-  "$BUILD/bin/cvode-floor" "$TMP/u.txt" $T plain 1 | awk '{print "floor-pl", $3, $7, $9, $11, $13, $15, $17}' >> "$TMP/times"
+  "$BUILD/bin/fd-sim-only" "$SCEN" | keep sim
+  "$BUILD/bin/fd-plant-replay" "$SCEN" "$TMP/u.txt" 1 | keep plant
+  "$BUILD/bin/cvode-floor" "$TMP/u.txt" $T deviation 1 | keep floor
+  "$BUILD/bin/cvode-floor" "$TMP/u.txt" $T plain 1 | keep floor-pl
   if [ "$HAVE_SCIPY" = 1 ]; then
-    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 | awk '{print "lsoda-ode", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
-    $PY bench/lsoda_floor.py "$TMP/u.txt" $T odeint 1 | awk '{print "lsoda-odeint", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
-    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ivp 1 | awk '{print "lsoda-ivp", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
-    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 1e-11 | awk '{print "lsoda-ode-tight", $3, "-", "-", "-", $7, $9, $11}' >> "$TMP/times"
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 | keep lsoda-ode
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T odeint 1 | keep lsoda-odeint
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ivp 1 | keep lsoda-ivp
+    $PY bench/lsoda_floor.py "$TMP/u.txt" $T ode 1 1e-11 | keep lsoda-ode-tight
   fi
 done
 
@@ -63,28 +69,32 @@ rows = {}
 for line in open(sys.argv[1]):
     f = line.split()
     rows.setdefault(f[0], []).append(f[1:])
-med = {k: statistics.median(float(r[0]) for r in v) for k, v in rows.items()}
+wall = {k: statistics.median(float(r[0]) for r in v) for k, v in rows.items()}
+cpu = {k: statistics.median(float(r[1]) for r in v) for k, v in rows.items()}
 names = {"sim": "feeddrive in-process loop (fd-sim-only)", "plant": "feeddrive plant alone (fd-plant-replay)",
          "floor": "bare CVODE floor, deviation form", "floor-pl": "bare CVODE, plain (x, v, z)",
          "lsoda-ode": "SciPy LSODA, integrate.ode", "lsoda-odeint": "SciPy LSODA, odeint",
          "lsoda-ivp": "SciPy LSODA, solve_ivp", "lsoda-ode-tight": "SciPy LSODA, integrate.ode, rtol 1e-11"}
-print(f"{periods} periods, {len(rows['sim'])} rounds; medians")
-print(f"{'':42s} {'s/run':>8s} {'periods/s':>10s} {'us/period':>9s} {'steps/p':>7s} {'rhs/p':>6s}  final x [m], v [m/s]")
-for k in ["sim", "plant", "floor", "floor-pl", "lsoda-ode", "lsoda-odeint", "lsoda-ivp", "lsoda-ode-tight"]:
+print(f"{periods} periods, {len(rows['sim'])} rounds; medians of the CPU time (and wall time) of each loop")
+print(f"{'':40s} {'CPU s':>7s} {'wall s':>7s} {'periods/s':>9s} {'us/per':>7s} {'steps/p':>7s} {'rhs/p':>6s}  final x [m], v [m/s]")
+for k in names:
     if k not in rows: continue
     r = rows[k][0]
-    steps = f"{int(r[1]) / periods:7.2f}" if len(r) > 1 and r[1] != "-" else "      -"
-    rhs = f"{int(r[2]) / periods:6.2f}" if len(r) > 2 and r[2] != "-" else "     -"
-    final = f"{r[4]}, {r[5]}" if len(r) > 5 else ""
-    print(f"{names[k]:42s} {med[k]:8.4f} {periods / med[k]:10.0f} {med[k] / periods * 1e6:9.2f} {steps} {rhs}  {final}")
-print(f"ratio sim / floor:   {med['sim'] / med['floor']:.2f}   (goal <= 1.5)")
-print(f"ratio plant / floor: {med['plant'] / med['floor']:.2f}")
+    steps = f"{int(r[2]) / periods:7.2f}" if r[2] != "-" else "      -"
+    rhs = f"{int(r[3]) / periods:6.2f}" if r[3] != "-" else "     -"
+    final = f"{r[4]}, {r[5]}" if r[4] != "-" else ""
+    print(f"{names[k]:40s} {cpu[k]:7.4f} {wall[k]:7.4f} {periods / cpu[k]:9.0f} {cpu[k] / periods * 1e6:7.2f} {steps} {rhs}  {final}")
+def ratio(label, a, b, goal=""):
+    print(f"{label:42s} CPU {a[0] / b[0]:6.2f}   wall {a[1] / b[1]:6.2f}   {goal}")
+pair = lambda k: (cpu[k], wall[k])
+ratio("ratio sim / floor", pair("sim"), pair("floor"), "(goal <= 1.5)")
+ratio("ratio plant / floor", pair("plant"), pair("floor"))
 if have_scipy:
-    best = min(med["lsoda-ode"], med["lsoda-odeint"])
-    print(f"ratio LSODA (fastest interface) / sim:   {best / med['sim']:.2f}   (goal >= 30)")
-    print(f"ratio LSODA (fastest interface) / floor: {best / med['floor']:.2f}")
-    print(f"ratio LSODA solve_ivp / sim:             {med['lsoda-ivp'] / med['sim']:.2f}")
-    print(f"ratio LSODA ode rtol 1e-11 / sim:        {med['lsoda-ode-tight'] / med['sim']:.2f}")
+    fast = min(("lsoda-ode", "lsoda-odeint"), key=lambda k: cpu[k])
+    ratio(f"ratio LSODA ({fast[6:]}, fastest) / sim", pair(fast), pair("sim"), "(goal >= 30)")
+    ratio(f"ratio LSODA ({fast[6:]}, fastest) / floor", pair(fast), pair("floor"))
+    ratio("ratio LSODA solve_ivp / sim", pair("lsoda-ivp"), pair("sim"))
+    ratio("ratio LSODA ode rtol 1e-11 / sim", pair("lsoda-ode-tight"), pair("sim"))
 else:
     print("LSODA rows: SciPy is not installed (apt-get install python3-scipy); no LSODA ratio")
 PYEOF

@@ -18,7 +18,8 @@ An optional RTOL replaces 1e-8 (the absolute tolerances stay): on the plain vari
 position error is rtol*|x|-bound, so matching feeddrive's accuracy needs a tighter rtol.
 
 Usage: lsoda_floor.py U_FILE PERIOD ode|odeint|ivp REPEATS [RTOL]
-Prints one line per repeat: "<interface> seconds S periods N x X v V z Z".
+Prints one line per repeat: "<interface> seconds S periods N x X v V z Z cpu C" (S wall time, C the
+process's CPU time, of the loop).
 Needs SciPy: apt-get install python3-scipy (Debian) or pip install scipy.
 """
 import math
@@ -99,10 +100,11 @@ def main():
         RTOL = float(sys.argv[5])
     run = {"ode": run_ode, "odeint": run_odeint, "ivp": run_ivp}[how]
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         y = run(us, T)
-        sec = time.perf_counter() - t0
-        print(f"{how} seconds {sec:.6f} periods {len(us)} x {y[0]:.12g} v {y[1]:.12g} z {y[2]:.12g}", flush=True)
+        sec, cpu = time.perf_counter() - t0, time.process_time() - c0
+        print(f"{how} seconds {sec:.6f} periods {len(us)} x {y[0]:.12g} v {y[1]:.12g} z {y[2]:.12g} cpu {cpu:.6f}",
+              flush=True)
 
 
 if __name__ == "__main__":
