@@ -4,8 +4,9 @@
 # sliding-mode law (issue 25, point 5; docs/performance.md): the paper's jerk-limited move at
 # 10 kHz (15,000 periods per case), CASES Monte Carlo plants (mass +-20 %, Fs/Fc and sigma0/sigma1
 # +-30 %, seed 1), all cores. ROUNDS rounds, each runs both studies in turn (alternating which goes
-# first); per study the wall time of the whole feeddrive-study command and the sum of the cases'
-# own times (timing.json). Prints the medians and the ratio plugin / built-in (goal <= 1.10), and
+# first); per study the wall time and the CPU time (user + system, /usr/bin/time) of the whole
+# feeddrive-study command, and the sum of the cases' own times (timing.json). The CPU time is the
+# figure to quote on a shared machine (other work there stretches wall times, not CPU times). Prints the medians and the ratio plugin / built-in (goal <= 1.10), and
 # checks that both studies' results.csv agree in every metric (the same law, bit for bit).
 #   flock /tmp/feeddrive-bench.lock bash bench/plugin_study_bench.sh [BUILD_DIR] [CASES] [ROUNDS]
 set -euo pipefail
@@ -44,9 +45,9 @@ run() {  # NAME ROUND
   rm -rf "$TMP/out_$1"
   local s e
   s=$(date +%s%N)
-  "$BUILD/bin/feeddrive-study" "$TMP/$1.yaml" --out "$TMP/out_$1" --no-plots -q
+  /usr/bin/time -f "%U %S" -o "$TMP/cpu" "$BUILD/bin/feeddrive-study" "$TMP/$1.yaml" --out "$TMP/out_$1" --no-plots -q
   e=$(date +%s%N)
-  echo "$1 $(awk -v a="$s" -v b="$e" 'BEGIN { printf "%.4f", (b - a) / 1e9 }') $(jq -r .case_time_sum_s "$TMP/out_$1/timing.json")" >> "$TMP/times"
+  echo "$1 $(awk -v a="$s" -v b="$e" 'BEGIN { printf "%.4f", (b - a) / 1e9 }') $(jq -r .case_time_sum_s "$TMP/out_$1/timing.json") $(awk '{ print $1 + $2 }' "$TMP/cpu")" >> "$TMP/times"
 }
 for r in $(seq "$ROUNDS"); do
   if [ $((r % 2)) = 1 ]; then run builtin "$r"; run plugin "$r"; else run plugin "$r"; run builtin "$r"; fi
@@ -55,15 +56,15 @@ python3 - "$TMP/times" "$TMP/out_builtin/results.csv" "$TMP/out_plugin/results.c
 import csv, statistics, sys
 t = {}
 for line in open(sys.argv[1]):
-    n, wall, cases = line.split()
-    t.setdefault(n, []).append((float(wall), float(cases)))
+    n, wall, cases, cpu = line.split()
+    t.setdefault(n, []).append((float(wall), float(cases), float(cpu)))
 a, b = list(csv.DictReader(open(sys.argv[2]))), list(csv.DictReader(open(sys.argv[3])))
 diff = [k for ra, rb in zip(a, b) for k in ra if k not in ("hash",) and ra[k] != rb[k]]
 print(f"{sys.argv[4]} cases per study, {len(t['builtin'])} rounds, {sys.argv[5]} cores; results identical: {not diff and len(a) == len(b)}")
-for what, i in (("wall time of feeddrive-study", 0), ("sum of the cases' own times", 1)):
+for what, i in (("CPU time of feeddrive-study", 2), ("wall time of feeddrive-study", 0), ("sum of the cases' own times", 1)):
     mb = statistics.median(x[i] for x in t["builtin"])
     mp = statistics.median(x[i] for x in t["plugin"])
     print(f"{what:30s} built-in {mb:8.3f} s  plugin {mp:8.3f} s  ratio plugin / built-in {mp / mb:.3f} (goal <= 1.10)")
-print(f"per case (wall / cases): built-in {statistics.median(x[0] for x in t['builtin']) / int(sys.argv[4]) * 1e3:.2f} ms, "
-      f"plugin {statistics.median(x[0] for x in t['plugin']) / int(sys.argv[4]) * 1e3:.2f} ms")
+print(f"per case (CPU / cases): built-in {statistics.median(x[2] for x in t['builtin']) / int(sys.argv[4]) * 1e3:.2f} ms, "
+      f"plugin {statistics.median(x[2] for x in t['plugin']) / int(sys.argv[4]) * 1e3:.2f} ms")
 PY
