@@ -115,3 +115,70 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string plugin_scenario(const std::string& controller_extra) {
+  return "duration: 0.01\ncontrol_period: 1e-4\nplant: {friction: {model: lugre}}\n"
+         "controller:\n  type: plugin\n  library: " + module("fd_example_smc_bl") + "\n" + controller_extra +
+         "reference: {type: step, amplitude: 1.0e-6}\n";
+}
+
+std::string load_error(const std::string& yaml) {
+  try {
+    sim::parse_scenario(yaml);
+  } catch (const sim::ScenarioError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The scenario keys: parameters as text (numbers in their shortest exact text), limits, the
+// nominal model defaulting to the plant; bad keys refused with one line naming them.
+TEST(PluginScenario, KeysAreReadAndBadOnesRefused) {
+  const sim::Scenario s = sim::parse_scenario(plugin_scenario(
+      "  parameters: {eta: 5.0, lambda: 5.0e+1, boundary_layer: 0.0005, switching: sat}\n  u_max: 8\n"
+      "  model: {mass: 90}\n"));
+  ASSERT_EQ(s.controller.type, sim::ControllerType::kPlugin);
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {"eta", "5"}, {"lambda", "50"}, {"boundary_layer", "5e-04"}, {"switching", "sat"}};  // std::to_chars shortest
+  EXPECT_EQ(s.controller.plugin.parameters, want);
+  EXPECT_EQ(s.controller.plugin.u_max, 8.0);
+  EXPECT_EQ(s.controller.plugin.u_min, -10.0);
+  EXPECT_EQ(s.controller.plugin.model.mass, 90.0);
+  EXPECT_EQ(s.controller.plugin.model.friction.model, plant::FrictionModel::kLuGre);  // from the plant
+  EXPECT_EQ(s.controller.plugin.period, 1e-4);
+
+  EXPECT_NE(load_error(plugin_scenario("  parameters: {bad-name: 1}\n")).find("controller.parameters.bad-name"),
+            std::string::npos);
+  EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: .nan}\n")).find("controller.parameters.eta"), std::string::npos);
+  EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: [1, 2]}\n")).find("controller.parameters.eta"),
+            std::string::npos);
+  EXPECT_NE(load_error(plugin_scenario("  libary: x.so\n")).find("libary"), std::string::npos);
+  EXPECT_NE(load_error(plugin_scenario("  model: {effects: {constant_force: {force_N: 1}}}\n")).find("controller.model.effects"),
+            std::string::npos);
+  const std::string missing = load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin}\n");
+  EXPECT_NE(missing.find("controller.library"), std::string::npos) << missing;
+  const std::string absent = load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin, library: nowhere.so}\n");
+  EXPECT_NE(absent.find("nowhere.so: no such file"), std::string::npos) << absent;
+  EXPECT_EQ(absent.find('\n'), std::string::npos);
+}
+
+// A study keys and reloads its cases through the resolved keys: a plugin scenario round-trips
+// (library, parameters as numbers or words, the model), and a study can vary a parameter.
+TEST(PluginScenario, ResolvedKeysRoundTrip) {
+  sim::ResolvedKeys first;
+  sim::parse_scenario(plugin_scenario("  parameters: {eta: 5.0, switching: sat}\n"), ".", "scenario", &first);
+  EXPECT_EQ(first.at("controller.parameters.eta").text, "5");
+  EXPECT_FALSE(first.at("controller.parameters.eta").is_string);
+  EXPECT_TRUE(first.at("controller.parameters.switching").is_string);
+  EXPECT_EQ(first.at("controller.library").text, module("fd_example_smc_bl"));
+  EXPECT_TRUE(first.count("controller.model.mass"));
+  const std::string yaml = sim::resolved_yaml(first);
+  sim::ResolvedKeys second;
+  const sim::Scenario s = sim::parse_scenario(yaml, ".", "resolved", &second);
+  EXPECT_EQ(first, second);
+  EXPECT_EQ(s.controller.plugin.parameters.size(), 2u);
+}
+
+}  // namespace
