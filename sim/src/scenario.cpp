@@ -190,6 +190,13 @@ void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
   read_plant(r.child("model"), p.model, true);
 }
 
+// A controller's nominal model by default: the plant itself, without the effects it does not know.
+PlantParams model_of_plant(const PlantParams& plant) {
+  PlantParams m = plant;
+  m.effects = {};
+  return m;
+}
+
 // type plugin (docs/plugins.md): library (resolved against the scenario's folder), parameters
 // (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
 // The library is opened here (file, symbols, ABI version), so a bad one fails at load.
@@ -444,8 +451,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
   if (type == "sliding_mode") {
     s.controller.type = ControllerType::kSlidingMode;
-    s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself,
-    s.controller.sliding_mode.model.effects = {};  // without the effects it does not know
+    s.controller.sliding_mode.model = model_of_plant(s.plant);
     // A model never carries the plant's sensor or initial state; they are not part of it.
     read_sliding_mode(c, s.controller.sliding_mode);
     s.controller.sliding_mode.period = s.control_period;
@@ -461,8 +467,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
   } else if (type == "plugin") {
     s.controller.type = ControllerType::kPlugin;
-    s.controller.plugin.model = s.plant;  // the model defaults to the plant itself, without effects
-    s.controller.plugin.model.effects = {};
+    s.controller.plugin.model = model_of_plant(s.plant);
     read_plugin(c, s.controller.plugin, base_dir);
     s.controller.plugin.period = s.control_period;
     s.controller.plugin.computation_delay = s.controller.computation_delay;
@@ -663,8 +668,7 @@ void use_plugin(Scenario& s, const std::string& library) {
   if (s.controller.type != ControllerType::kPlugin) {
     s.controller.type = ControllerType::kPlugin;
     s.controller.plugin = {};
-    s.controller.plugin.model = s.plant;
-    s.controller.plugin.model.effects = {};
+    s.controller.plugin.model = model_of_plant(s.plant);
     s.controller.plugin.period = s.control_period;
     s.controller.plugin.computation_delay = s.controller.computation_delay;
   }
