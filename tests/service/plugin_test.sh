@@ -73,6 +73,15 @@ for rb, rp in zip(b, p):
 print(f"study: {len(p)} cases per controller, every column equal")
 PY
 pass "feeddrive-study: 5 cases (nominal, mass +-20 %, Fs/Fc +-30 %), plugin = built-in in every metric"
+# A rerun into the same folder keeps every finished case; after the plugin's library changes (the
+# same path, other bytes: a rebuild), the plugin's cases run again and the built-in law's do not.
+timeout 600 feeddrive-study "$TMP/study.yaml" --out "$TMP/study" -j 4 --no-plots -q || fail "study rerun failed"
+[ "$(json "$TMP/study/timing.json" .cases_run)" = 0 ] || fail "rerun: $(json "$TMP/study/timing.json" .cases_run) cases run again"
+printf 'rebuilt' >> "$LIB"  # trailing bytes: still a loadable library, another digest
+timeout 600 feeddrive-study "$TMP/study.yaml" --out "$TMP/study" -j 4 --no-plots -q || fail "study rerun after the rebuild failed"
+[ "$(json "$TMP/study/timing.json" .cases_run)" = 5 ] && [ "$(json "$TMP/study/timing.json" .cases_reused)" = 5 ] ||
+  fail "after the plugin changed: $(json "$TMP/study/timing.json" .cases_run) cases run, $(json "$TMP/study/timing.json" .cases_reused) reused (want 5 and 5)"
+pass "feeddrive-study rerun: nothing run again; after the plugin library changed, its 5 cases run again"
 
 # 3. over LCM: the plugin scenario through feeddrive-launch (feeddrive-controller loads it) ...
 timeout 300 feeddrive-launch "$PLUGIN" --out "$TMP/mp_plugin" --no-plots -q --lcm-url "$URL"
