@@ -13,6 +13,7 @@ set(FEEDDRIVE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/feeddrive)
 set_target_properties(feeddrive_common feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory
   feeddrive_lcmtypes PROPERTIES INSTALL_RPATH "$ORIGIN")
 install(TARGETS feeddrive_common feeddrive_model feeddrive_plant feeddrive_controller feeddrive_trajectory feeddrive_lcmtypes
+  feeddrive_plugin
   EXPORT feeddriveTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -1,5 +1,6 @@
-// feeddrive-controller: the scenario's controller (sliding mode, cascade or open loop) as an LCM
-// process. Wiring only: scenario -> make_controller -> ControllerNode (service/controller_node.hpp).
+// feeddrive-controller: the scenario's controller (sliding mode, cascade, open loop or a plugin) as
+// an LCM process; --plugin PATH hosts the controller plugin at PATH instead (docs/plugins.md).
+// Wiring only: scenario -> make_controller -> ControllerNode (service/controller_node.hpp).
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/service/controller_node.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -10,11 +11,14 @@ int main(int argc, char** argv) {
                "(docs/lcm-contract.md)",
                "feeddrive-controller"};
   std::string scenario_path;
+  std::string plugin;
   service::NodeOptions opt;
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
+  app.add_option("--plugin", plugin, "host the controller plugin (shared library) at PATH (docs/plugins.md)");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
-    const sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
+    sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
+    if (!plugin.empty()) sim::use_plugin(s, plugin);
     service::ControllerNode node(sim::make_controller(s), opt);
     return service::run_node(node);
   });

@@ -137,6 +137,10 @@ run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std
       m.u_min = s.controller.open_loop.u_min;
       m.u_max = s.controller.open_loop.u_max;
       break;
+    case sim::ControllerType::kPlugin:
+      m.u_min = s.controller.plugin.u_min;
+      m.u_max = s.controller.plugin.u_max;
+      break;
   }
   return m;
 }

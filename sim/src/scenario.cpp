@@ -1,6 +1,7 @@
 #include "feeddrive/sim/scenario.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -187,6 +188,36 @@ void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
   read_plant(r.child("model"), p.model, true);
+}
+
+// A controller's nominal model by default: the plant itself, without the effects it does not know.
+PlantParams model_of_plant(const PlantParams& plant) {
+  PlantParams m = plant;
+  m.effects = {};
+  return m;
+}
+
+// type plugin (docs/plugins.md): library (resolved against the scenario's folder), parameters
+// (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
+// The library is opened here (file, symbols, ABI version), so a bad one fails at load.
+void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& base_dir) {
+  p.library = r.required_string("library");
+  if (fs::path(p.library).is_relative()) p.library = (fs::path(base_dir) / p.library).lexically_normal().string();
+  r.record("library", p.library, true);
+  MapReader params = r.child("parameters");
+  for (const std::string& key : params.keys()) {
+    const bool word = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    });
+    if (!word) params.fail(key, ": a parameter name is letters, digits and _ only");
+    std::string value;
+    params.number_or_string(key, value);
+    p.parameters.emplace_back(key, value);
+  }
+  params.finish();
+  r.number("u_min", p.u_min);
+  r.number("u_max", p.u_max);
+  read_plant(r.child("model"), p.model, false);
 }
 
 // tuning: manual (kp, kv, ki as given) or rule (controller/cascade.hpp cascade_tuning(): from the
@@ -420,8 +451,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
   if (type == "sliding_mode") {
     s.controller.type = ControllerType::kSlidingMode;
-    s.controller.sliding_mode.model = s.plant;  // the model defaults to the plant itself,
-    s.controller.sliding_mode.model.effects = {};  // without the effects it does not know
+    s.controller.sliding_mode.model = model_of_plant(s.plant);
     // A model never carries the plant's sensor or initial state; they are not part of it.
     read_sliding_mode(c, s.controller.sliding_mode);
     s.controller.sliding_mode.period = s.control_period;
@@ -435,8 +465,14 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     s.controller.type = ControllerType::kOpenLoop;
     read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
     s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
+  } else if (type == "plugin") {
+    s.controller.type = ControllerType::kPlugin;
+    s.controller.plugin.model = model_of_plant(s.plant);
+    read_plugin(c, s.controller.plugin, base_dir);
+    s.controller.plugin.period = s.control_period;
+    s.controller.plugin.computation_delay = s.controller.computation_delay;
   } else {
-    c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop");
+    c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop, plugin");
   }
   c.finish();
 
@@ -476,6 +512,10 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
       case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
       case ControllerType::kCascade: s.controller.cascade.validate("controller"); break;
       case ControllerType::kOpenLoop: s.controller.open_loop.validate("controller"); break;
+      case ControllerType::kPlugin:
+        s.controller.plugin.validate("controller");
+        controller::PluginLibrary::open(s.controller.plugin.library);
+        break;
     }
     validate_reference(s.reference);
   } catch (const std::invalid_argument& e) {
@@ -619,8 +659,22 @@ std::unique_ptr<controller::Controller> make_controller(const Scenario& s) {
       return std::make_unique<controller::CascadeController>(s.controller.cascade);
     case ControllerType::kOpenLoop:
       return std::make_unique<controller::OpenLoopSource>(s.controller.open_loop);
+    case ControllerType::kPlugin:
+      return std::make_unique<controller::PluginController>(s.controller.plugin);
   }
   return nullptr;
+}
+
+void use_plugin(Scenario& s, const std::string& library) {
+  if (s.controller.type != ControllerType::kPlugin) {
+    s.controller.type = ControllerType::kPlugin;
+    s.controller.plugin = {};
+    s.controller.plugin.model = model_of_plant(s.plant);
+    s.controller.plugin.period = s.control_period;
+    s.controller.plugin.computation_delay = s.controller.computation_delay;
+  }
+  s.controller.plugin.library = library;
+  controller::PluginLibrary::open(library);
 }
 
 }  // namespace feeddrive::sim

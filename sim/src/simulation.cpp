@@ -57,30 +57,39 @@ Record make_record(double t, const trajectory::Sample& ref, const plant::State& 
 }
 
 void check_finite_step(const Scenario& s, long k, const Record& r, double command) {
-  const auto fail = [&](const std::string& what, double v, const std::string& source) {
-    throw ScenarioError("step " + std::to_string(k) + " (t = " + validate::format_number(r.t) + " s): " + what + " = " +
-                        validate::format_number(v) + ": " + source);
+  // The sources are named only when a value fails: building their text (a number formatted, the
+  // plant's time scales) every step cost ~5 % of a period (docs/performance.md).
+  enum class Source { kController, kReference, kSensor, kPlant };
+  const auto source = [&](Source src) -> std::string {
+    static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop", "plugin"};
+    switch (src) {
+      case Source::kController:
+        return std::string("from the controller (controller.type = ") + kControllers[static_cast<int>(s.controller.type)] +
+               "; its gains or model make it diverge)";
+      case Source::kReference: return "from the reference (the reference section)";
+      case Source::kSensor:
+        return "from the sensor (plant.sensor.quantization = " + validate::format_number(s.plant.sensor.quantization) +
+               ", noise_stddev = " + validate::format_number(s.plant.sensor.noise_stddev) + ")";
+      case Source::kPlant: return "from the plant, driven to it (" + s.plant.fastest_time_scales(1) + ")";
+    }
+    return "";
   };
-  static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop"};
-  const std::string controller =
-      std::string("from the controller (controller.type = ") + kControllers[static_cast<int>(s.controller.type)] +
-      "; its gains or model make it diverge)";
-  const std::string reference = "from the reference (the reference section)";
-  const std::string sensor = "from the sensor (plant.sensor.quantization = " + validate::format_number(s.plant.sensor.quantization) +
-                             ", noise_stddev = " + validate::format_number(s.plant.sensor.noise_stddev) + ")";
-  const std::string plant = "from the plant, driven to it (" + s.plant.fastest_time_scales(1) + ")";
-  if (!std::isfinite(command)) fail("the command u", command, controller);
+  const auto fail = [&](const std::string& what, double v, Source src) {
+    throw ScenarioError("step " + std::to_string(k) + " (t = " + validate::format_number(r.t) + " s): " + what + " = " +
+                        validate::format_number(v) + ": " + source(src));
+  };
+  if (!std::isfinite(command)) fail("the command u", command, Source::kController);
   const std::pair<const char*, double> ref[] = {{"xd", r.xd}, {"vd", r.vd}, {"ad", r.ad}, {"jd", r.jd}};
   for (const auto& [what, v] : ref)
-    if (!std::isfinite(v)) fail(what, v, reference);
+    if (!std::isfinite(v)) fail(what, v, Source::kReference);
   const std::pair<const char*, double> meas[] = {{"x_measured", r.x_measured}, {"v_measured", r.v_measured}};
   for (const auto& [what, v] : meas)
-    if (!std::isfinite(v)) fail(what, v, sensor);
+    if (!std::isfinite(v)) fail(what, v, Source::kSensor);
   const std::pair<const char*, double> state[] = {{"x", r.x}, {"v", r.v}, {"z", r.z}, {"fg", r.fg}, {"i", r.i},
                                                   {"f_thrust", r.f_thrust}, {"f_friction", r.f_friction},
                                                   {"f_ripple", r.f_ripple}, {"f_grinding", r.f_grinding}};
   for (const auto& [what, v] : state)
-    if (!std::isfinite(v)) fail(what, v, plant);
+    if (!std::isfinite(v)) fail(what, v, Source::kPlant);
 }
 
 RunStats run(const Scenario& s, const RecordSink& sink) {

@@ -330,6 +330,27 @@ void MapReader::number(const std::string& key, double& out) {
   out = v;
 }
 
+std::vector<std::string> MapReader::keys() const {
+  std::vector<std::string> out;
+  if (!node_.IsMap()) return out;
+  for (const auto& kv : node_) out.push_back(kv.first.IsScalar() ? kv.first.Scalar() : std::string());
+  return out;
+}
+
+void MapReader::number_or_string(const std::string& key, std::string& out) {
+  const YAML::Node n = scalar(key);
+  if (!n.IsDefined()) return;
+  double v = 0.0;
+  if (parse_double(n.Scalar(), v)) {
+    if (!std::isfinite(v)) fail(key, " = " + describe(n) + ": must be finite");
+    out = validate::format_number(v);  // shortest text that reads back to the same double
+    record(key, out, false);
+  } else {
+    out = n.Scalar();
+    record(key, out, true);
+  }
+}
+
 void MapReader::integer(const std::string& key, long& out) {
   const YAML::Node n = scalar(key);
   if (n.IsDefined()) {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <fstream>
+#include <sstream>
 
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -224,6 +226,17 @@ struct Resolver::Impl {
     }
     return keys;
   }
+  // SHA-256 of a plugin library's bytes, once per path per study.
+  std::map<std::string, std::string> digests;
+  const std::string& library_digest(const std::string& path) {
+    auto it = digests.find(path);
+    if (it != digests.end()) return it->second;
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    if (!in) throw StudyError("plugin " + path + ": cannot be read to key the study's cases");
+    return digests.emplace(path, sha256_hex(bytes.str())).first->second;
+  }
   static std::string text_of(const YAML::Node& doc) {
     YAML::Emitter em;
     em << doc;
@@ -318,7 +331,13 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
   }
   ResolvedCase r;
   r.yaml = sim::resolved_yaml(keys);
-  r.hash = sha256_hex(std::string(kCaseFormat) + r.yaml);
+  // A plugin controller's case depends on the library's code too, which the keys (its path) do
+  // not show: its bytes' digest joins the hash, so a rerun after a rebuild of the plugin runs the
+  // cases again instead of keeping results of the old build (docs/plugins.md).
+  std::string code;
+  if (const auto lib = keys.find("controller.library"); lib != keys.end())  // type plugin only
+    code = "plugin library sha256 " + m.library_digest(lib->second.text) + "\n";
+  r.hash = sha256_hex(std::string(kCaseFormat) + code + r.yaml);
   // Every varied key of the study, with its effective value in this case (its nominal value
   // where this case does not vary it), so each row of results.csv places the case on every axis.
   for (const std::string& k : m.varied) {

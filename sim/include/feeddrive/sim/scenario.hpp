@@ -5,7 +5,7 @@
 //   duration: 1.5        [s]
 //   control_period: 1e-4 [s]
 //   plant:      {...}    feeddrive::plant::PlantParams
-//   controller: {type: sliding_mode | cascade | open_loop, ...}
+//   controller: {type: sliding_mode | cascade | open_loop | plugin, ...}
 //   reference:  {type: sine | step | accel_limited | scurve | ramp | waypoints | none, ...}
 //   analysis:   {settled_after: 0.25}   (optional)
 //   output:     {every: 1, columns: [t, xd, x, ...]}   (optional)
@@ -20,6 +20,7 @@
 
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/open_loop.hpp"
+#include "feeddrive/controller/plugin_host.hpp"
 #include "feeddrive/controller/sliding_mode.hpp"
 #include "feeddrive/plant/params.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -32,7 +33,7 @@ class ScenarioError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class ControllerType { kSlidingMode, kCascade, kOpenLoop };
+enum class ControllerType { kSlidingMode, kCascade, kOpenLoop, kPlugin };
 enum class ReferenceType { kNone, kSine, kStep, kAccelLimited, kSCurve, kRamp, kWaypoints };
 
 struct ReferenceConfig {
@@ -55,6 +56,9 @@ struct ControllerConfig {
   controller::CascadeParams cascade;
   controller::OpenLoopParams open_loop;  ///< kind csv: its table read from open_loop_file when loaded
   std::string open_loop_file;            ///< controller.file, resolved against the scenario's folder
+  /// type plugin: controller.library (resolved against the scenario's folder), .parameters,
+  /// .model, .u_min, .u_max (docs/plugins.md).
+  controller::PluginParams plugin;
 };
 
 struct AnalysisConfig {
@@ -125,5 +129,10 @@ void read_open_loop_file(const std::string& path, controller::OpenLoopParams& p)
 
 std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s);
 std::unique_ptr<controller::Controller> make_controller(const Scenario& s);
+
+/// feeddrive-controller --plugin PATH: the scenario's controller becomes the plugin at PATH,
+/// with the scenario's plugin parameters if its controller is a plugin (none otherwise), and the
+/// nominal model, limits and period the scenario gives a plugin. Throws controller::PluginError.
+void use_plugin(Scenario& s, const std::string& library);
 
 }  // namespace feeddrive::sim

@@ -55,6 +55,10 @@ class MapReader {
   /// A list of strings ([a, b] or a block list) if the key is present; a single string is a
   /// list of one.
   void string_list(const std::string& key, std::vector<std::string>& out);
+  /// A number (its shortest round-trip text, recorded as a number) or else a string, as text.
+  void number_or_string(const std::string& key, std::string& out);
+  /// The keys present in the map, in the file's order ("" for a non-scalar key).
+  std::vector<std::string> keys() const;
   /// A required string key.
   std::string required_string(const std::string& key);
   /// A nested map (absent = empty).
