@@ -47,6 +47,7 @@ static char ch_state[80], ch_cmd[80], ch_status[80], ch_resend[80], ch_info[80];
 static unsigned char key[4096];
 static int key_len; /* 0: unsigned run */
 static int64_t run_id;
+static int64_t run_nonce; /* with a key: this run's nonce (docs/security.md, "Replays across runs") */
 static feeddrive_run_info_t info;
 static int have_info;
 static int64_t acked = -1, seq = -1, resends, rejected, missed, invalid, unauthenticated;
@@ -85,12 +86,33 @@ static int admit(const lcm_recv_buf_t *rb, const char *channel) {
   return 1;
 }
 
+/* A random number in 1 .. 2^53 - 1 (exact in a double). */
+static int64_t draw53(void) {
+  FILE *r = fopen("/dev/urandom", "rb");
+  uint64_t b = 0;
+  while (b == 0 && r && fread(&b, sizeof b, 1, r) == 1) b &= (UINT64_C(1) << 53) - 1;
+  if (r) fclose(r);
+  return (int64_t)b;
+}
+
+/* keyed_run_id(R, N) = 1 + (splitmix64(R xor splitmix64(N)) mod (2^53 - 1)) (docs/security.md). */
+static uint64_t splitmix64(uint64_t x) {
+  x += UINT64_C(0x9E3779B97F4A7C15);
+  x = (x ^ (x >> 30)) * UINT64_C(0xBF58476D1CE4E5B9);
+  x = (x ^ (x >> 27)) * UINT64_C(0x94D049BB133111EB);
+  return x ^ (x >> 31);
+}
+static int64_t keyed_run_id(int64_t r, int64_t n) {
+  return (int64_t)(1 + splitmix64((uint64_t)r ^ splitmix64((uint64_t)n)) % ((UINT64_C(1) << 53) - 1));
+}
+
 static void heartbeat(const char *state, const char *message) {
   struct timespec w;
   clock_gettime(CLOCK_REALTIME, &w);
   feeddrive_process_status_t m;
   memset(&m, 0, sizeof m);
   m.utime = (int64_t)w.tv_sec * 1000000 + w.tv_nsec / 1000;
+  m.run_nonce = run_nonce;
   m.role = "plant";
   m.state = (char *)state;
   m.message = (char *)message;
@@ -243,13 +265,12 @@ int main(int argc, char **argv) {
     fclose(f);
     if (key_len < 16) { fprintf(stderr, "drive_adapter: --key %s: fewer than 16 bytes\n", key_file); return 2; }
   }
-  /* Step 1: a run id of its own (the launcher's --run-id if given), 53 bits, never 0. */
-  if (run_id == 0) {
-    FILE *r = fopen("/dev/urandom", "rb");
-    uint64_t b = 0;
-    while (b == 0 && r && fread(&b, sizeof b, 1, r) == 1) b &= (UINT64_C(1) << 53) - 1;
-    if (r) fclose(r);
-    run_id = (int64_t)b;
+  /* Step 1: a run id of its own (the launcher's --run-id if given), 53 bits, never 0. With a
+   * key, a fresh nonce N binds it to this run: the run id on the wire is keyed_run_id(R, N). */
+  if (run_id == 0) run_id = draw53();
+  if (key_file) {
+    run_nonce = draw53();
+    run_id = keyed_run_id(run_id, run_nonce);
   }
   snprintf(ch_state, sizeof ch_state, "%s_STATE", prefix);
   snprintf(ch_cmd, sizeof ch_cmd, "%s_CMD", prefix);

@@ -1,4 +1,5 @@
 #include "feeddrive/wire.hpp"
+#include "feeddrive/service/loggers.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
 
 #include <spdlog/spdlog.h>
@@ -6,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -42,15 +44,44 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
     last_state_us_ = mono_us();
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
+    last_admitted_us_["plant"] = last_state_us_;
+    if (m.previous.seq >= 0) applied_[static_cast<std::uint64_t>(m.previous.seq) % applied_.size()] = {m.previous.seq, m.previous.u};
+    if (command_conflict_ && !command_conflict_->applied_known && m.previous.seq == command_conflict_->step) {
+      command_conflict_->applied_known = true;  // what the plant applied over the conflicted step
+      command_conflict_->applied_u = m.previous.u;
+    }
     rec_.on_state(m, t);
     on_state_timing(m, t);
   });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
+    last_admitted_us_["trajectory"] = mono_us();
     for (const reference_t& m : b.refs)
       if (admit(reference_ledger_, channels().reference, m.seq, m)) rec_.on_reference(m, t);
   });
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
-    if (!admit(command_ledger_, channels().command, m.seq, m)) return;
+    SentCommand& first = first_commands_[static_cast<std::uint64_t>(m.seq) % first_commands_.size()];
+    const SentCommand sent{m.seq, m.u, bus().current_source()};
+    try {
+      if (!admit(command_ledger_, channels().command, m.seq, m)) return;
+    } catch (const service::RunFailure&) {
+      // A forged command raced the controller's (or the reverse): keep both and who sent them;
+      // the step stays in the record (its state k+1 says what the plant applied).
+      if (!command_conflict_ && first.seq == m.seq) {
+        command_conflict_ = CommandConflict{m.seq, first, sent, false, 0.0};
+        const auto& a = applied_[static_cast<std::uint64_t>(m.seq) % applied_.size()];
+        if (a.first == m.seq) command_conflict_->applied_known = true, command_conflict_->applied_u = a.second;
+        for (SentCommand* c : {&command_conflict_->first, &command_conflict_->second}) {
+          // "IP:PORT" of its UDP source, and the local process that owns that port if any.
+          const auto colon = c->sender.rfind(':');
+          if (colon == std::string::npos) continue;
+          const std::string p = service::local_process_on_udp_port(std::atoi(c->sender.c_str() + colon + 1));
+          if (!p.empty()) c->sender += " " + p;
+        }
+      }
+      throw;
+    }
+    if (first.seq != m.seq) first = sent;
+    last_admitted_us_["controller"] = mono_us();
     rec_.on_command(m, t);
     on_command_timing(m, t);
   });
@@ -108,7 +139,11 @@ void MonitorNode::fail_for(const std::string& role, const std::string& why, bool
   // admitted process is alive is an extra sender on the bus, maybe an attacker: named and counted,
   // never a reason to end the run (docs/security.md). It fails the run only when it stands in for
   // a role nobody else fills: then the run could never go on.
-  if (unless_role_alive && peer_alive(role, 1.0)) return;
+  // Filled: its heartbeat within the last second, or its own valid messages (at the start of a
+  // run an attacker's first messages can come before the role's first heartbeat reaches us).
+  const auto admitted = last_admitted_us_.find(role);
+  const bool filled = peer_alive(role, 1.0) || (admitted != last_admitted_us_.end() && mono_us() - admitted->second < 1000000);
+  if (unless_role_alive && filled) return;
   if (service::is_run_role(role) && !mopt_.attach && failure_.empty()) failure_ = why;
 }
 
@@ -366,6 +401,15 @@ bool MonitorNode::run() {
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
+    // A command conflict: wait (at most 0.5 s) for the state that says which command the plant
+    // applied, so that the step is recorded and the summary can name it.
+    for (const std::int64_t until = mono_us() + 500000; command_conflict_ && !command_conflict_->applied_known && mono_us() < until;) {
+      try {
+        bus().poll(std::chrono::microseconds(20000));
+      } catch (const std::exception&) {
+      }
+    }
+    if (const std::string a = applied_command_text(); !a.empty()) failure += "; " + a;
     // The record reaches the last step completed before the failure: the batch that failed was
     // dispatched whole (Bus::poll rethrows after it), and what is still queued on the socket (a
     // monitor behind the run when another role's failure arrives) is taken too, up to 100 batches.
@@ -413,6 +457,21 @@ bool MonitorNode::run() {
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.
   return finish(failure.empty(), failure) && failure.empty();
+}
+
+std::string MonitorNode::applied_command_text() const {
+  if (!command_conflict_) return "";
+  const CommandConflict& c = *command_conflict_;
+  const auto from = [](const SentCommand& s) { return s.sender.empty() ? std::string("an unknown sender") : s.sender; };
+  if (!c.applied_known)
+    return "the plant's state after step " + std::to_string(c.step) + " did not come (it stopped on the conflict before "
+           "applying either command, or that state was lost): u = " + service::seconds_text(c.first.u) + " V from " + from(c.first) + " or u = " +
+           service::seconds_text(c.second.u) + " V from " + from(c.second);
+  const bool first = std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
+  const SentCommand& a = first ? c.first : c.second;
+  const SentCommand& o = first ? c.second : c.first;
+  return "the plant applied u = " + service::seconds_text(a.u) + " V from " + from(a) + " at step " + std::to_string(c.step) +
+         " (the other command, u = " + service::seconds_text(o.u) + " V, came from " + from(o) + "; the step is in the record)";
 }
 
 bool MonitorNode::finish(bool completed, const std::string& failure) {
@@ -491,6 +550,20 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["authenticated"] = bus().authenticated();
   l["foreign_messages"] = foreign;
   l["conflicts"] = conflicts_seen;
+  if (command_conflict_) {
+    // The race of issue 19: which command the plant applied, and who sent each (UDP source).
+    const CommandConflict& c = *command_conflict_;
+    auto& j = l["command_conflict"];
+    j["step"] = c.step;
+    j["first"] = {{"u", c.first.u}, {"sender", c.first.sender}};
+    j["second"] = {{"u", c.second.u}, {"sender", c.second.sender}};
+    if (c.applied_known) {
+      const bool first = std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
+      j["applied"] = {{"u", c.applied_u}, {"sender", (first ? c.first : c.second).sender}, {"which", first ? "first" : "second"}};
+    } else {
+      j["applied"] = nullptr;
+    }
+  }
   l["unauthenticated_messages"] = unauthenticated;
   l["steps_without_command"] = rec_.commandless_rows();
   if (mopt_.attach) {  // an observer records across what it could not get (the run's monitor never does)

@@ -90,6 +90,25 @@ std::vector<StockLogger> stock_loggers_on(const std::string& lcm_url) {
   return out;
 }
 
+std::string local_process_on_udp_port(int port) {
+  const std::set<unsigned long> inodes = socket_inodes_on(port);
+  if (inodes.empty()) return "";
+  DIR* proc = ::opendir("/proc");
+  if (proc == nullptr) return "";
+  std::string found;
+  while (const dirent* e = ::readdir(proc)) {
+    const std::string pid = e->d_name;
+    if (pid.find_first_not_of("0123456789") != std::string::npos || !has_socket(pid, inodes)) continue;
+    std::ifstream comm("/proc/" + pid + "/comm");
+    std::string name;
+    std::getline(comm, name);
+    found = (name.empty() ? "a process" : name) + " (pid " + pid + ")";
+    break;
+  }
+  ::closedir(proc);
+  return found;
+}
+
 std::string describe(const std::vector<StockLogger>& loggers) {
   std::string s;
   for (const StockLogger& l : loggers)

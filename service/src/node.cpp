@@ -102,15 +102,20 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
         // "running" after its own "done" is a forged or replayed heartbeat, not the process. It
         // is a conflict, and the state it claims is ignored, so no heartbeat can hold a run
         // open (docs/security.md, "Heartbeats").
+        // Likewise the monitor's acknowledgement only grows: a heartbeat of the monitor that takes
+        // acked_seq back would stall the plant's flow control (a forged one held a run for as long
+        // as it was sent). Both are ignored and counted as conflicts.
         if (const auto it = peers_.find(m.role); it != peers_.end() && is_run_role(m.role)) {
           const std::string& was = it->second.state;
-          if ((was == "done" || was == "failed") && (m.state == "starting" || m.state == "running")) {
+          const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
+          if (rank(m.state) < rank(was) || (m.role == "monitor" && m.acked_seq < it->second.acked_seq)) {
             ++conflicts;
             const std::int64_t now = mono_us();
             if (now - last_conflict_log_us_ > 1000000) {
               last_conflict_log_us_ = now;
-              spdlog::warn("{}: conflict on {}: a heartbeat of the {} says '{}' after its own '{}' (forged or replayed; "
-                           "ignored, {} conflicts so far)", role_, ch_.status, m.role, m.state, was, conflicts);
+              spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' after its own '{}', acknowledged "
+                           "step {} after {}; forged or replayed; ignored, {} conflicts so far)", role_, ch_.status, m.role,
+                           m.state, was, m.acked_seq, it->second.acked_seq, conflicts);
             }
             return;
           }

@@ -108,6 +108,25 @@ forged() {
   launch "$mode"
   wait $peer_pid || true
   conflict_failure "$mode" "$channel"
+  if [ "$mode" = forge-controller ]; then
+    # The race (issue 19, point 10): the summary names the command the plant applied and its
+    # sender, and the record keeps that step.
+    local step applied sender rows
+    step=$(json "$TMP/$mode/summary.json" .lockstep.command_conflict.step)
+    applied=$(json "$TMP/$mode/summary.json" .lockstep.command_conflict.applied.u)
+    sender=$(json "$TMP/$mode/summary.json" .lockstep.command_conflict.applied.sender)
+    if [ "$applied" = null ]; then  # the plant had both before it integrated: it applied neither
+      json "$TMP/$mode/summary.json" .lockstep.failure | grep -q "did not come (it stopped on the conflict before applying either" ||
+        fail "$mode: neither applied nor said so: $(jq -c .lockstep.command_conflict "$TMP/$mode/summary.json")"
+      echo "  step $step: the plant stopped before applying either: $(jq -c .lockstep.command_conflict "$TMP/$mode/summary.json")"
+    else
+    echo "$sender" | grep -Eq '^[0-9.]+:[0-9]+ [a-z-]+ \(pid [0-9]+\)$' || fail "$mode: no sender of the applied command: $sender"
+    json "$TMP/$mode/summary.json" .lockstep.failure | grep -q "the plant applied u = " || fail "$mode: the failure line does not name the applied command"
+    rows=$(( $(grep -c "" "$TMP/$mode/timeseries.csv") - 1 ))
+    [ "$rows" -gt "$step" ] || fail "$mode: the record ($rows rows) does not keep step $step"
+    echo "  applied at step $step: $(jq -c .lockstep.command_conflict.applied "$TMP/$mode/summary.json"); $rows rows recorded"
+    fi
+  fi
   pass "forged $what without a key: the run failed on the conflict"
   peer "$mode"
   launch "$mode-key" --key "$KEY"

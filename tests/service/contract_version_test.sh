@@ -18,7 +18,7 @@ port=${URL#udpm://*:}; port=${port%%\?*}
 cat > "$TMP/v2.py" <<'PY'
 import socket, struct, sys, time
 port, run_id, role = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-v3 = len(sys.argv) > 4  # version 3: contract_version (int32) before mac_size
+v3 = len(sys.argv) > 4  # version 3: run_nonce (int64) after utime, contract_version (int32) before mac_size
 # lcm-gen's C source holds the type's base hash; the fingerprint on the wire is it rotated left by 1.
 fp3 = (((int(sys.argv[4], 16) << 1) & (2**64 - 1)) | (int(sys.argv[4], 16) >> 63)) if v3 else 0
 def s(x): b = x.encode() + b"\0"; return struct.pack(">i", len(b)) + b
@@ -26,6 +26,7 @@ s_ = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 s_.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
 for n in range(100):
     body = (struct.pack(">Qqq", fp3 if v3 else 0x82c6d4827f2f3fed, run_id, int(time.time() * 1e6))
+            + (struct.pack(">q", 0) if v3 else b"")
             + s(role) + s("running") + struct.pack(">qq", 0, -1) + s("") + struct.pack(">qqqqqq", 0, 0, 0, 0, 0, 0)
             + (struct.pack(">i", 3) if v3 else b"") + struct.pack(">h", 0))
     s_.sendto(b"LC02" + struct.pack(">I", n) + b"FD_STATUS\0" + body, ("239.255.76.67", port))

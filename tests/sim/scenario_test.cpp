@@ -117,7 +117,7 @@ TEST(Scenario, UnreadableFile) {
     load_scenario("/nonexistent/feeddrive.yaml");
     FAIL();
   } catch (const ScenarioError& e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/feeddrive.yaml: cannot read the scenario file");
+    EXPECT_STREQ(e.what(), "/nonexistent/feeddrive.yaml: cannot read the scenario file (No such file or directory)");
   }
 }
 

@@ -15,6 +15,7 @@
 // ends.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <map>
 #include <vector>
@@ -107,6 +108,30 @@ class MonitorNode : public service::Node {
   service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
   service::StepLedger<reference_t> reference_ledger_;
   service::StepLedger<control_command_t> command_ledger_;
+  /// The first command of each recent step and who sent it ("IP:PORT"), to name the two sides of
+  /// a command conflict (a ring indexed by step, like the ledger).
+  struct SentCommand {
+    std::int64_t seq{-1};
+    double u{0.0};
+    std::string sender;
+  };
+  std::vector<SentCommand> first_commands_ = std::vector<SentCommand>(4096);
+  /// A command conflict (two different commands for one step: a forged one raced the
+  /// controller's): both, and the one the plant applied (its state k+1's previous.u), once known.
+  struct CommandConflict {
+    std::int64_t step{-1};
+    SentCommand first, second;
+    bool applied_known{false};
+    double applied_u{0.0};
+  };
+  std::optional<CommandConflict> command_conflict_;
+  /// What the plant applied over each recent step (its next state's `previous`), a ring by step:
+  /// the state can come before the second command of a conflict does.
+  std::vector<std::pair<std::int64_t, double>> applied_ = std::vector<std::pair<std::int64_t, double>>(4096, {-1, 0.0});
+  /// When each role's own (decoded, authenticated, admitted) message last came [mono us].
+  std::map<std::string, std::int64_t> last_admitted_us_;
+  /// "the plant applied u = ... from ..." for the failure line and summary.json, or "".
+  std::string applied_command_text() const;
   run_info_t info_;
   std::unique_ptr<LcmLogWriter> log_;
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)

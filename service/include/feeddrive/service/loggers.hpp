@@ -40,6 +40,11 @@ double stock_logger_pace(const std::vector<StockLogger>& loggers);
 /// be read gives none.
 std::vector<StockLogger> stock_loggers_on(const std::string& lcm_url);
 
+/// The local process that owns the UDP socket bound to `port` in this network namespace, as
+/// "NAME (pid N)", found through /proc as stock_loggers_on does; "" when none is (a sender on
+/// another machine) or /proc cannot say. Names the sender of a message by its UDP source port.
+std::string local_process_on_udp_port(int port);
+
 /// "lcm-logger (pid 123), lcm-logger (pid 456)".
 std::string describe(const std::vector<StockLogger>& loggers);
 
