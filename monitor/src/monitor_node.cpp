@@ -61,6 +61,14 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
     SentCommand& first = first_commands_[static_cast<std::uint64_t>(m.seq) % first_commands_.size()];
     const SentCommand sent{m.seq, m.u, bus().current_source()};
+    // The local process behind each command source, looked up when the source is first heard (a
+    // process that has exited by the time a conflict is judged can no longer be found): at most
+    // 16 sources, one /proc scan each.
+    if (!source_process_.count(sent.sender) && source_process_.size() < 16) {
+      const auto colon = sent.sender.rfind(':');
+      source_process_[sent.sender] =
+          colon == std::string::npos ? "" : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
+    }
     try {
       if (!admit(command_ledger_, channels().command, m.seq, m)) return;
     } catch (const service::RunFailure&) {
@@ -72,10 +80,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
         if (a.first == m.seq) command_conflict_->applied_known = true, command_conflict_->applied_u = a.second;
         for (SentCommand* c : {&command_conflict_->first, &command_conflict_->second}) {
           // "IP:PORT" of its UDP source, and the local process that owns that port if any.
-          const auto colon = c->sender.rfind(':');
-          if (colon == std::string::npos) continue;
-          const std::string p = service::local_process_on_udp_port(std::atoi(c->sender.c_str() + colon + 1));
-          if (!p.empty()) c->sender += " " + p;
+          const auto known = source_process_.find(c->sender);
+          if (known != source_process_.end() && !known->second.empty()) c->sender += " " + known->second;
         }
       }
       throw;
@@ -123,6 +129,9 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   };
   bus().set_events(std::move(ev));
   on_peer_status = [this](const process_status_t& m) { check_peer_status(m); };
+  on_peer_status_back = [this](const process_status_t& m) {  // "starting" after "running": a restart?
+    if (m.role == "plant" && m.state != "failed") plant_went_back(m);
+  };
   out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
   out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
@@ -227,15 +236,50 @@ void MonitorNode::check_peer_status(const process_status_t& m) {
     }
   }
   if (m.role != "plant") return;
-  // A plant whose heartbeat goes back (same run id, a new process that starts again at step 0).
+  // A heartbeat step far beyond every state recorded (more than the flow-control window and
+  // 100 steps in flight) is not the plant's: forged. It is not taken as the plant's progress,
+  // so it cannot make the real heartbeats look as if they went back.
+  if (m.seq > rec_.highest_state() + std::max<std::int64_t>(options().monitor_window, 0) + 100) {
+    if (named_["implausible plant heartbeat"]++ == 0)
+      spdlog::warn("{}: a heartbeat of the plant claims step {}, beyond every state recorded ({}): forged; ignored",
+                   role(), m.seq, rec_.highest_state());
+    return;
+  }
   if (plant_seq_seen_ > 1 && m.seq < plant_seq_seen_ - 1 && m.state != "failed") {
-    const std::string why = "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) +
-                            " to " + std::to_string(m.seq) + " (" + m.state +
-                            "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
-    if (named_["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
-    fail_for("plant", why, false);
+    plant_went_back(m);
+    return;
   }
   plant_seq_seen_ = std::max(plant_seq_seen_, m.seq);
+}
+
+// A plant whose heartbeat goes back (its step, or "starting" after "running"): a new process
+// with the same run id that starts again (docs/external-plant.md, "Restarts").
+// - With --key that cannot be: a restarted plant draws a new nonce, so its run id on the wire
+//   is another (on_foreign names it). A heartbeat of this run that goes back is a replay of
+//   the run's own signed heartbeats: named once and ignored (docs/security.md, "Heartbeats").
+// - Without a key a restart and a forged heartbeat look the same, and anyone on the bus can
+//   send either, as they can send a forged command (docs/security.md: detected, not
+//   prevented). A record that joins two drives' motions must not pass as complete, so the run
+//   fails, and the line says both.
+void MonitorNode::plant_went_back(const process_status_t& m) {
+  if (plant_seq_seen_ < 0) return;  // no plant of this run heard yet: nothing to restart
+  // After the plant's own "done" or "failed" nothing restarts the run (and the Node ignored the
+  // heartbeat); a step beyond every state recorded is forged (check_peer_status).
+  if (const process_status_t* p = peer("plant"); p != nullptr && (p->state == "done" || p->state == "failed")) return;
+  if (m.seq > rec_.highest_state() + std::max<std::int64_t>(options().monitor_window, 0) + 100) return;
+  if (!options().key_file.empty()) {
+    if (named_["plant heartbeat back"]++ == 0)
+      spdlog::warn("{}: a signed heartbeat of the plant went back (step {} '{}' after step {}): a replay of this run's "
+                   "own heartbeats (a restarted plant would have drawn a new nonce); ignored",
+                   role(), m.seq, m.state, plant_seq_seen_);
+    return;
+  }
+  const std::string why = "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) +
+                          " to " + std::to_string(m.seq) + " (" + m.state +
+                          "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts). "
+                          "Without --key a forged heartbeat looks the same (docs/security.md)";
+  if (named_["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
+  fail_for("plant", why, false);
 }
 
 // Latency histograms from the first receive time of each message (one clock: the kernel's

@@ -65,11 +65,32 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
 RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
   std::string text;
   RunScenario r{sim::load_scenario(path, &text), ""};
+  // The run's scenario is the file and the tables it names (waypoints, an open-loop force
+  // table), as parsed here: a table swapped while the run starts changes the hash as the file
+  // does. A scenario that names no file hashes as its text alone.
+  const auto add_table = [&text](const std::string& what, const std::string& file, const std::vector<double>& a,
+                                 const std::vector<double>& b) {
+    if (file.empty()) return;
+    text += "\n# feeddrive table " + what + "\n";  // its content, not its path (relative or not)
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const double v[2] = {a[i], i < b.size() ? b[i] : 0.0};
+      text.append(reinterpret_cast<const char*>(v), sizeof v);
+    }
+  };
+  std::vector<double> wt, wx;
+  for (const auto& w : r.scenario.reference.waypoints) {
+    wt.push_back(w.t);
+    wx.push_back(w.x);
+  }
+  if (r.scenario.reference.type == sim::ReferenceType::kWaypoints) add_table("waypoints", r.scenario.reference.waypoints_file, wt, wx);
+  if (r.scenario.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
+    add_table("open_loop", r.scenario.controller.open_loop_file, r.scenario.controller.open_loop.table_t,
+              r.scenario.controller.open_loop.table_value);
   r.sha256 = sha256_hex(text);
   if (!opt.scenario_hash.empty() && opt.scenario_hash != r.sha256)
     throw std::invalid_argument(path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
                                 "..., the launcher read " + opt.scenario_hash.substr(0, 12) +
-                                "...): the file changed while the run started; one run, one scenario: launch again");
+                                "...): the file, or a table it names, changed while the run started; one run, one scenario: launch again");
   return r;
 }
 

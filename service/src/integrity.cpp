@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <stdexcept>
 
@@ -139,8 +140,16 @@ std::string sha256_hex(const std::string& bytes) {
 }
 
 std::string read_key_file(const std::string& path) {
-  const std::string where = "--key " + path + ": ";
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);  // a FIFO must not block
+  // A symlink is followed (a Kubernetes or Docker secret is one): every check below is on the
+  // file it leads to, as opened (fstat), so swapping the link after the check changes nothing.
+  std::string where = "--key " + path + ": ";
+  struct stat lst {};
+  if (::lstat(path.c_str(), &lst) == 0 && S_ISLNK(lst.st_mode)) {
+    std::error_code ec;
+    const auto target = std::filesystem::canonical(path, ec);
+    where = "--key " + path + " (a link to " + (ec ? std::string("a missing file") : target.string()) + "): ";
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);  // a FIFO must not block
   if (fd < 0) throw std::invalid_argument(where + "cannot open it (" + std::strerror(errno) + ")");
   struct stat st {};
   std::string key;

@@ -102,23 +102,42 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
         // "running" after its own "done" is a forged or replayed heartbeat, not the process. It
         // is a conflict, and the state it claims is ignored, so no heartbeat can hold a run
         // open (docs/security.md, "Heartbeats").
-        // Likewise the monitor's acknowledgement only grows: a heartbeat of the monitor that takes
-        // acked_seq back would stall the plant's flow control (a forged one held a run for as long
-        // as it was sent). Both are ignored and counted as conflicts.
-        if (const auto it = peers_.find(m.role); it != peers_.end() && is_run_role(m.role)) {
-          const std::string& was = it->second.state;
-          const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
-          if (rank(m.state) < rank(was) || (m.role == "monitor" && m.acked_seq < it->second.acked_seq)) {
+        // Likewise, at the plant (whose flow control reads it), the monitor's acknowledgement only
+        // grows: a heartbeat that takes acked_seq back would stall the plant (a forged one held a
+        // run for as long as it was sent). And it cannot pass the plant's own step + 2 (the monitor
+        // cannot have recorded a state the plant has not sent), so a forged "acked_seq 10^9"
+        // neither raises the bar that real heartbeats must clear nor releases the flow control.
+        // All are ignored and counted as conflicts.
+        const bool a_monitor = role_ == "plant" && (m.role == "monitor" || m.role == kAttachedMonitorRole);
+        const bool implausible = a_monitor && m.acked_seq > seq_ + 2;
+        const auto it = peers_.find(m.role);
+        const bool tracked = it != peers_.end() && (is_run_role(m.role) || m.role == kAttachedMonitorRole);
+        const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
+        if (implausible || (tracked && (rank(m.state) < rank(it->second.state) ||
+                                        (a_monitor && m.acked_seq < it->second.acked_seq)))) {
+          const std::string was = tracked ? it->second.state : std::string("-");
+          const std::int64_t was_acked = tracked ? it->second.acked_seq : -1;
+          {
             ++conflicts;
             const std::int64_t now = mono_us();
             if (now - last_conflict_log_us_ > 1000000) {
               last_conflict_log_us_ = now;
-              spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' after its own '{}', acknowledged "
-                           "step {} after {}; forged or replayed; ignored, {} conflicts so far)", role_, ch_.status, m.role,
-                           m.state, was, m.acked_seq, it->second.acked_seq, conflicts);
+              if (implausible)
+                spdlog::warn("{}: conflict on {}: a heartbeat of the {} acknowledges step {}, beyond this {}'s step {}; "
+                             "forged or replayed; ignored, {} conflicts so far", role_, ch_.status, m.role, m.acked_seq,
+                             role_, seq_, conflicts);
+              else
+                spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' after its own '{}', acknowledged "
+                             "step {} after {}; forged or replayed; ignored, {} conflicts so far)", role_, ch_.status,
+                             m.role, m.state, was, m.acked_seq, was_acked, conflicts);
             }
+            if (!implausible && on_peer_status_back) on_peer_status_back(m);
             return;
           }
+        }
+        if (m.role == kAttachedMonitorRole && m.acked_seq != attached_acked_) {
+          attached_acked_ = m.acked_seq;
+          attached_progress_us_ = recv_us;
         }
         peers_[m.role] = m;
         peer_seen_us_[m.role] = recv_us;
@@ -239,11 +258,17 @@ void Node::linger(const std::function<void()>& every_100ms) {
   set_state("done");
   const std::int64_t start = mono_us();
   std::int64_t last_sent = start;
-  // An attached monitor still recording (heard within the last second) may yet ask for what it
-  // missed: wait for it too, within the same limit.
-  const auto recording = [this] {
+  // An attached monitor still recording may yet ask for what it missed: wait for it too, but
+  // only while its acknowledgement moves (it advanced within the last second) and for at most
+  // kAttachedHoldS after the run's monitor is done. A heartbeat saying "running" alone (a
+  // forged one, or an attached monitor that hangs) holds nobody (docs/security.md, "Heartbeats").
+  std::int64_t monitor_done_us = -1;
+  const auto recording = [&] {
     const process_status_t* a = peer(kAttachedMonitorRole);
-    return a != nullptr && a->state == "running" && peer_alive(kAttachedMonitorRole, 1.0);
+    const std::int64_t now = mono_us();
+    if (monitor_done_us < 0) monitor_done_us = now;
+    return a != nullptr && a->state == "running" && peer_alive(kAttachedMonitorRole, 1.0) &&
+           now - attached_progress_us_ <= us(1.0) && now - monitor_done_us <= us(kAttachedHoldS);
   };
   while ((!monitor_done() || recording()) && mono_us() - start < us(opt_.linger_s)) {
     if (every_100ms && mono_us() - last_sent > 100000) {

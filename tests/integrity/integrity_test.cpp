@@ -15,6 +15,7 @@
 
 #include "../../examples/c/fd_sign.h"
 #include "feeddrive/service/bus.hpp"
+#include "feeddrive/service/cli.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/node.hpp"
 
@@ -307,6 +308,72 @@ TEST(KeyFile, OnlyTheOwnersAndOfAKeysLength) {
   { std::ofstream(path) << "short"; }
   EXPECT_THROW(read_key_file(path), std::invalid_argument);
   EXPECT_THROW(read_key_file((dir / "missing").string()), std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
+
+// A key behind a symlink (as Kubernetes and Docker mount secrets: key -> ..data/key) is read,
+// and the checks are the target's: a link to a group-readable file is refused, naming the target.
+TEST(KeyFile, ASymlinkIsFollowedAndItsTargetChecked) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd-key-link-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "..data");
+  const std::string target = (dir / "..data" / "key").string();
+  { std::ofstream(target) << "0123456789abcdef0123456789abcdef"; }
+  ::chmod(target.c_str(), 0600);
+  const std::string link = (dir / "key").string();
+  std::filesystem::create_symlink("..data/key", link);
+  EXPECT_EQ(read_key_file(link), "0123456789abcdef0123456789abcdef");
+  ::chmod(target.c_str(), 0644);
+  try {
+    read_key_file(link);
+    FAIL() << "a link to a world-readable key was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("a link to " + std::filesystem::canonical(target).string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("mode 0644"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(target);
+  try {
+    read_key_file(link);
+    FAIL() << "a dangling link was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("a link to a missing file"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace feeddrive::service
+
+namespace feeddrive::service {
+namespace {
+
+// The run's scenario hash (run_info_t.scenario_hash, --scenario-hash) covers the tables the file
+// names: a waypoints CSV swapped while the run starts is refused as the file itself would be
+// (issue 19's review). A scenario without tables keeps its plain SHA-256 (the launcher's hash of
+// older runs is unchanged).
+TEST(ScenarioHash, CoversTheTablesItNames) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd-hash-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string yaml = "name: h\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
+                           "reference: {type: waypoints, file: w.csv}\n";
+  { std::ofstream(dir / "s.yaml") << yaml; }
+  { std::ofstream(dir / "w.csv") << "t,x\n0,0\n0.005,1e-4\n0.01,1e-4\n"; }
+  const std::string path = (dir / "s.yaml").string();
+  NodeOptions opt;
+  const std::string h1 = load_run_scenario(path, opt).sha256;
+  EXPECT_NE(h1, sha256_hex(yaml)) << "the table is part of the hash";
+  EXPECT_EQ(load_run_scenario(path, opt).sha256, h1) << "the same files, the same hash";
+  { std::ofstream(dir / "w.csv") << "t,x\n0,0\n0.005,2e-4\n0.01,2e-4\n"; }
+  opt.scenario_hash = h1;
+  try {
+    load_run_scenario(path, opt);
+    FAIL() << "a swapped waypoints table passed the launcher's hash";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("a table it names, changed"), std::string::npos) << e.what();
+  }
+  const std::string plain = "name: p\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
+                            "reference: {type: step, amplitude: 1.0e-4}\n";
+  { std::ofstream(dir / "plain.yaml") << plain; }
+  EXPECT_EQ(load_run_scenario((dir / "plain.yaml").string(), NodeOptions{}).sha256, sha256_hex(plain));
   std::filesystem::remove_all(dir);
 }
 

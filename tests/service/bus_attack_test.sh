@@ -17,6 +17,12 @@
 #      sent every 5 ms through a whole run: counted invalid per channel, the run identical.
 #   6. a forged monitor heartbeat saying "running" every 10 ms: it does not hold the others open
 #      after the real monitor is done (with --linger 60, the launch ends long before 60 s).
+#   7. forged heartbeats (issue 19's review): the monitor acknowledging step 10^9, the plant at
+#      step 10^9, an attached monitor "running" that seems to progress; no key, --linger 60: the
+#      run completes identical, nothing says "restarted", the launch ends in seconds. (Without a
+#      key a plant heartbeat that goes back is a restart and fails the run: hil_test case 7b.)
+#   8. with --key, the run's own signed heartbeats of its first 0.3 s replayed through the rest
+#      of it (the plant's go back): the run completes identical.
 #   4. concurrent runs with the default settings: the second launch refuses at once, in one
 #      line, naming the run that holds the group and how to choose another (exit 2); with
 #      another --prefix both complete identical. Two launches started at the same instant
@@ -74,6 +80,14 @@ completed_identical() {
   [ "$rc" = 0 ] || { tail -5 "$TMP/$1.log" >&2; fail "$1: launch exited $rc"; }
   [ "$(json "$TMP/$1/summary.json" .lockstep.completed)" = true ] || fail "$1: not completed"
   [ "$(json "$TMP/$1/summary.json" .lockstep.conflicts)" = 0 ] || fail "$1: conflicts in a completed run"
+  same_csv "$TMP/sim/timeseries.csv" "$TMP/$1/timeseries.csv"
+}
+
+# completed_identical_despite NAME: the run completed, its record is feeddrive-sim's, and the
+# forgeries it ignored were counted as conflicts (a heartbeat that goes back is one).
+completed_identical_despite() {
+  [ "$rc" = 0 ] || { tail -5 "$TMP/$1.log" >&2; fail "$1: launch exited $rc"; }
+  [ "$(json "$TMP/$1/summary.json" .lockstep.completed)" = true ] || fail "$1: not completed"
   same_csv "$TMP/sim/timeseries.csv" "$TMP/$1/timeseries.csv"
 }
 
@@ -211,6 +225,32 @@ wait $peer_pid 2> /dev/null || true
 # 30 s: the run itself takes a few seconds even on a loaded machine; a held linger takes 60 s.
 [ "$took" -lt 30 ] || fail "fake_monitor: the launch took $took s with --linger 60: the forged heartbeat held the run open"
 pass "a forged 'running' heartbeat of the monitor: the run ended in $took s (--linger 60)"
+
+# 7. Forged heartbeats that go back, claim the future, or seem to progress.
+timeout 300 "$BUILD/tests/fd-test-peer" fake-heartbeats --seconds 120 --lcm-url "$URL" > "$TMP/peer.log" 2>&1 & peer_pid=$!
+wait_on_bus $peer_pid
+start=$(date +%s)
+launch fake_heartbeats --linger 60
+took=$(( $(date +%s) - start ))
+kill $peer_pid 2> /dev/null || true
+wait $peer_pid 2> /dev/null || true
+[ "$rc" = 0 ] || { tail -5 "$TMP/fake_heartbeats.log" >&2; fail "fake_heartbeats: launch exited $rc"; }
+completed_identical_despite fake_heartbeats
+! grep -q "restarted" "$TMP/fake_heartbeats.log" || fail "fake_heartbeats: a forged heartbeat was taken for a restart"
+# 30 s: as in case 6; an attached monitor may hold the linger 2 s at most (node.hpp kAttachedHoldS).
+[ "$took" -lt 30 ] || fail "fake_heartbeats: the launch took $took s with --linger 60: a forged heartbeat held the run open"
+pass "forged heartbeats (acked 10^9, plant at 10^9, an attached monitor 'running'): identical, $(json "$TMP/fake_heartbeats/summary.json" .lockstep.conflicts) conflicts ignored, ended in $took s"
+
+# 8. The run's own signed heartbeats, replayed through the run.
+timeout 300 "$BUILD/tests/fd-test-peer" replay-status --seconds 120 --lcm-url "$URL" > "$TMP/peer.log" 2>&1 & peer_pid=$!
+wait_on_bus $peer_pid
+launch replay_status --key "$KEY"
+kill $peer_pid 2> /dev/null || true
+wait $peer_pid 2> /dev/null || true
+grep -q "replayed" "$TMP/peer.log" || fail "replay_status: the peer replayed nothing ($(cat "$TMP/peer.log"))"
+[ "$rc" = 0 ] || { tail -5 "$TMP/replay_status.log" >&2; fail "replay_status: launch exited $rc"; }
+completed_identical_despite replay_status
+pass "the run's own signed heartbeats replayed with --key: identical ($(tail -n 1 "$TMP/peer.log"))"
 
 # 4. Concurrent runs.
 timeout 300 feeddrive-launch "$scen" --out "$TMP/first" --no-plots -q --lcm-url "$URL" > "$TMP/first.log" 2>&1 & first=$!

@@ -37,6 +37,9 @@ refused fifo_log "lcm-log fifo: is a FIFO" s.yaml --out o --no-plots -q --lcm-ur
 refused fifo_scenario "fifo: the scenario file is a FIFO" fifo --out o --no-plots -q --lcm-url "$URL"
 refused dir_log "lcm-log $TMP: is a folder" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log "$TMP"
 refused missing_parent "its folder $TMP/nowhere does not exist" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log "$TMP/nowhere/run.lcmlog"
+# /proc takes no new file, although root may write in it (access() says yes): the launcher
+# creates the file and removes it again before anything starts (issue 19's review).
+refused proc_log "lcm-log /proc/fd-run.lcmlog: cannot be created" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log /proc/fd-run.lcmlog
 [ -e o ] && fail "a refused launch left an output folder"
 
 # 2. A scenario other than the launcher's.

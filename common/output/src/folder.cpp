@@ -259,6 +259,11 @@ void check_output_file(const std::string& file, const std::string& option) {
     if (S_ISFIFO(st.st_mode)) refuse(option, file, "is a FIFO (a writer would block on it); name a regular file");
     if (!S_ISREG(st.st_mode)) refuse(option, file, "is a device or socket, not a regular file");
     if (::access(file.c_str(), W_OK) != 0) refuse(option, file, "exists and is not writable (" + error_text(errno) + ")");
+    // Opened for writing, without truncating it: what root's access() does not see (a read-only
+    // mount, a pseudo file system) shows here.
+    const int fd = ::open(file.c_str(), O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) refuse(option, file, "cannot be opened for writing (" + error_text(errno) + ")");
+    ::close(fd);
     return;
   }
   if (errno != ENOENT) refuse(option, file, "cannot be examined (" + error_text(errno) + ")");
@@ -267,6 +272,12 @@ void check_output_file(const std::string& file, const std::string& option) {
   if (!S_ISDIR(st.st_mode)) refuse(option, file, parent.string() + " is not a folder");
   if (::access(parent.c_str(), W_OK | X_OK) != 0)
     refuse(option, file, "its folder " + parent.string() + " is not writable (" + error_text(errno) + ")");
+  // Created and removed again: /proc, /sys or a read-only mount pass the checks above for root but
+  // take no new file.
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) refuse(option, file, "cannot be created (" + error_text(errno) + ")");
+  ::close(fd);
+  ::unlink(file.c_str());
 }
 
 void replace_folder(const fs::path& fresh, const fs::path& target) {

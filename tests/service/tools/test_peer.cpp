@@ -17,6 +17,14 @@
 //                   drive_state_t with mac_size -1. Each must be counted invalid and dropped.
 //   fake-monitor    a forged heartbeat of the run's monitor saying "running", every 10 ms for
 //                   --seconds: after the real monitor's "done" it must not hold the run open.
+//   fake-heartbeats forged heartbeats every 10 ms for --seconds (issue 19's review): the monitor
+//                   "running" acknowledging step 10^9, the plant "running" at step 10^9, an
+//                   attached monitor "running" whose acknowledgement moves each time. No one may
+//                   end the run, stall the plant, or hold the linger open. (A plant heartbeat
+//                   that goes back, without a key, is a restart: hil_test case 7b.)
+//   replay-status   records the run's own heartbeats (signed, under --key) during its first
+//                   0.3 s and sends them again, every 10 ms, until --seconds: the plant's go
+//                   back; they must not end the run as a "restart".
 // Every peer joins the run of the first message it hears (or --run-id).
 #include <CLI/CLI.hpp>
 
@@ -26,6 +34,8 @@
 #include <vector>
 #include <random>
 #include <thread>
+
+#include <lcm/lcm-cpp.hpp>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
@@ -46,7 +56,8 @@ int main(int argc, char** argv) {
   app.add_option("mode", mode)
       ->required()
       ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
-                             "forge-reference", "malformed", "fake-monitor"}));
+                             "forge-reference", "malformed", "fake-monitor", "fake-heartbeats",
+                             "replay-status"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -62,7 +73,40 @@ int main(int argc, char** argv) {
     bus.join_first_seen();
   }
   const Channels ch(prefix);
-  if (mode == "malformed" || mode == "fake-monitor") {
+  if (mode == "replay-status") {
+    // The raw datagrams, as the run's processes signed them: a replay needs no key.
+    lcm::LCM raw(url);
+    if (!raw.good()) return 1;
+    struct Capture {
+      std::vector<std::vector<std::uint8_t>> kept;
+      std::int64_t first_us{-1};
+      void on(const lcm::ReceiveBuffer* rb, const std::string&) {
+        const std::int64_t now = mono_us();
+        if (first_us < 0) first_us = now;
+        if (now - first_us < 300000 && kept.size() < 200)
+          kept.emplace_back(static_cast<const std::uint8_t*>(rb->data), static_cast<const std::uint8_t*>(rb->data) + rb->data_size);
+      }
+    } cap;
+    raw.subscribe(ch.status, &Capture::on, &cap);
+    const auto give_up = mono_us() + 60000000;
+    while ((cap.first_us < 0 || mono_us() - cap.first_us < 300000) && mono_us() < give_up) raw.handleTimeout(10);
+    if (cap.kept.empty()) {
+      std::printf("%s: heard no heartbeat\n", mode.c_str());
+      return 1;
+    }
+    std::printf("%s: replaying %zu heartbeats of the run's first 0.3 s\n", mode.c_str(), cap.kept.size());
+    std::fflush(stdout);
+    const auto end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    long n = 0;
+    while (mono_us() < end) {
+      for (const auto& b : cap.kept) raw.publish(ch.status, b.data(), static_cast<unsigned>(b.size()));
+      ++n;
+      raw.handleTimeout(10);
+    }
+    std::printf("%s: replayed %zu heartbeats %ld times\n", mode.c_str(), cap.kept.size(), n);
+    return 0;
+  }
+  if (mode == "malformed" || mode == "fake-monitor" || mode == "fake-heartbeats") {
     bus.subscribe<drive_state_t>(ch.state, [](const drive_state_t&, std::int64_t) {});
     const auto give_up = mono_us() + 60000000;
     while (!bus.run_known() && mono_us() < give_up) bus.poll(std::chrono::milliseconds(10));
@@ -120,6 +164,20 @@ int main(int argc, char** argv) {
       if (mode == "fake-monitor") {
         st.utime = wall_utime();
         bus.publish(ch.status, st);
+      } else if (mode == "fake-heartbeats") {
+        process_status_t f = st;
+        f.utime = wall_utime();
+        f.role = "monitor";
+        f.acked_seq = 1000000000;
+        bus.publish(ch.status, f);
+        f.role = "plant";
+        f.seq = 1000000000;
+        f.acked_seq = 0;
+        bus.publish(ch.status, f);
+        f.role = "monitor-attached";
+        f.seq = 0;
+        f.acked_seq = n;
+        bus.publish(ch.status, f);
       } else {
         for (const auto& b : status_bad) bus.publish_raw(ch.status, b.data(), b.size());
         for (const auto& b : ref_bad) bus.publish_raw(ch.reference, b.data(), b.size());
@@ -127,7 +185,10 @@ int main(int argc, char** argv) {
         for (const auto& b : state_bad) bus.publish_raw(ch.state, b.data(), b.size());
       }
       ++n;
-      bus.poll(std::chrono::milliseconds(mode == "fake-monitor" ? 10 : 5));
+      // Paced by the clock, not by what it hears (a poll returns at the first datagram, and the
+      // run sends tens of thousands a second): this peer forges, it does not flood.
+      const auto tick = mono_us() + (mode == "malformed" ? 5000 : 10000);
+      for (std::int64_t now = mono_us(); now < tick; now = mono_us()) bus.poll(std::chrono::microseconds(tick - now));
     }
     std::printf("%s: %ld rounds in run %lld\n", mode.c_str(), n, static_cast<long long>(run));
     return 0;

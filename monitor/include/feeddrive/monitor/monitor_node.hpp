@@ -70,6 +70,7 @@ class MonitorNode : public service::Node {
   void on_unauthenticated(const std::string& channel, const std::uint8_t* d, std::size_t n);
   void on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why);
   void check_peer_status(const process_status_t& m);
+  void plant_went_back(const process_status_t& m);
   /// Fails the run with `why` when `role` is one of the run's (an observer is only named) and,
   /// with unless_role_alive, no admitted process of that role was heard within the last second.
   void fail_for(const std::string& role, const std::string& why, bool unless_role_alive = true);
@@ -140,6 +141,7 @@ class MonitorNode : public service::Node {
   std::string failure_;  ///< set by the bus events: the run cannot go on (run() throws it)
   std::map<std::string, std::int64_t> named_;  ///< what was named already (one line per sender and kind) -> count
   std::int64_t plant_seq_seen_{-1};  ///< the highest step of the plant's heartbeats
+  std::map<std::string, std::string> source_process_;  ///< command source "IP:PORT" -> local process
   std::vector<service::StockLogger> loggers_;  ///< stock loggers seen on the bus during the run
   std::int64_t rate_since_us_{-1}, rate_since_step_{0};
   double peak_rate_{0.0};  ///< the most steps per second recorded in one window of >= 1 s

@@ -132,6 +132,9 @@ class Node {
   std::function<void()> on_heartbeat;
   /// Called with every heartbeat of another process of this run.
   std::function<void(const process_status_t&)> on_peer_status;
+  /// A heartbeat of this run that went back (ignored as a conflict): the monitor tells a
+  /// restarted plant from a replay by it (docs/security.md, "Heartbeats").
+  std::function<void(const process_status_t&)> on_peer_status_back;
 
  private:
   bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);
@@ -149,6 +152,9 @@ class Node {
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
   std::int64_t last_conflict_log_us_{-1};
+  std::int64_t attached_acked_{-2};        ///< the attached monitor's last acknowledgement
+  std::int64_t attached_progress_us_{-1};  ///< when it last moved (mono_us)
+  static constexpr double kAttachedHoldS = 2.0;  ///< longest an attached monitor holds the linger
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;
 };
