@@ -247,7 +247,7 @@ wait_on_bus $peer_pid
 launch replay_status --key "$KEY"
 kill $peer_pid 2> /dev/null || true
 wait $peer_pid 2> /dev/null || true
-grep -q "replayed" "$TMP/peer.log" || fail "replay_status: the peer replayed nothing ($(cat "$TMP/peer.log"))"
+grep -q "replaying" "$TMP/peer.log" || fail "replay_status: the peer replayed nothing ($(cat "$TMP/peer.log"))"
 [ "$rc" = 0 ] || { tail -5 "$TMP/replay_status.log" >&2; fail "replay_status: launch exited $rc"; }
 completed_identical_despite replay_status
 pass "the run's own signed heartbeats replayed with --key: identical ($(tail -n 1 "$TMP/peer.log"))"

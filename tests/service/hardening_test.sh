@@ -79,7 +79,12 @@ feeddrive-launch s.yaml --out mon --no-plots --lcm-url "$URL" --step-timeout 2 >
 for _ in $(seq 200); do [ "$(running_children $launcher)" = 4 ] && break; sleep 0.05; done
 monitor=$(pgrep -P $launcher -f "feeddrive-monitor " || true)
 [ -n "$monitor" ] || fail "no monitor under the launcher"
-sleep 1
+# Mid-run: once the monitor's staging record holds 64 kB of rows (past any write buffer), not
+# after a fixed sleep (a loaded machine may not have started the run by then).
+for _ in $(seq 400); do
+  [ -n "$(find . -maxdepth 2 -path "./.mon.partial-$monitor-*/timeseries.csv" -size +64k 2> /dev/null)" ] && break
+  sleep 0.05
+done
 kill -KILL "$monitor"
 wait $launcher || rc=$?
 [ "$rc" = 1 ] || { tail -5 mon.log >&2; fail "monitor killed: launch exited $rc, expected 1"; }
