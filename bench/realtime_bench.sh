@@ -16,6 +16,11 @@
 # does: liblcm's receive thread and pipe) as the plant, at SCHED_FIFO 80 on CPUS, with the launcher's
 # --external plant, on SCEN (default here scenarios/robustness/robust_smc.yaml: 10 kHz, observers):
 # what a participant that receives with liblcm gets (docs/lcm-contract.md, "Receiving in batches").
+# ISOLATE=1 (root, cgroup v1 cpuset) moves every other task of the machine off CPUS for the
+# bench's duration (a cpuset "feeddrive-others" on the remaining CPUs; kernel threads bound to
+# a CPU stay), and puts them back at the end: what an isolated core gives the same chain
+# (docs/lcm-contract.md, "An isolated core"). OFF_PATH_CPUS=LIST passes --off-path-cpus LIST: the
+# monitor and the trajectory there, the plant and controller on CPUS.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -40,6 +45,36 @@ machine_late() {
   cyclictest -m -p 80 -i 100 -a "$CPUS" -t "$n" -l 15000 -q -h 1000 2> /dev/null |
     awk '/^[0-9]+ / { us = $1 + 0; for (i = 2; i <= NF; ++i) if (us > 50) late += $i } /Histogram Overflows/ { for (i = 4; i <= NF; ++i) late += $i } END { print late + 0 }'
 }
+ISOLATE=${ISOLATE:-}
+CPUSET=/sys/fs/cgroup/cpuset
+if [ -n "$ISOLATE" ]; then
+  ALL=$(cat "$CPUSET/cpuset.cpus")
+  REST=$(python3 -c "
+import sys
+def parse(s):
+    out = set()
+    for part in s.split(','):
+        a, _, b = part.partition('-')
+        out.update(range(int(a), int(b or a) + 1))
+    return out
+rest = sorted(parse(sys.argv[1]) - parse(sys.argv[2]))
+print(','.join(map(str, rest)))" "$ALL" "$CPUS")
+  [ -n "$REST" ] || { echo "ISOLATE: CPUS=$CPUS leaves no CPU for the rest of the machine ($ALL)"; exit 2; }
+  [ -w "$CPUSET/tasks" ] || { echo "ISOLATE: needs root and a cgroup v1 cpuset at $CPUSET"; exit 2; }
+  OTHERS=$CPUSET/feeddrive-others
+  mkdir -p "$OTHERS"
+  echo "$REST" > "$OTHERS/cpuset.cpus"
+  cat "$CPUSET/cpuset.mems" > "$OTHERS/cpuset.mems"
+  restore() {
+    while read -r t; do echo "$t" > "$CPUSET/tasks" 2> /dev/null || true; done < "$OTHERS/tasks"
+    rmdir "$OTHERS" 2> /dev/null || true
+  }
+  trap 'restore; jobs -p | xargs -r kill 2>/dev/null || true; rm -rf "$TMP"' EXIT
+  moved=0
+  while read -r t; do echo "$t" > "$OTHERS/tasks" 2> /dev/null && moved=$((moved + 1)) || true; done < "$CPUSET/tasks"
+  echo $$ > "$CPUSET/tasks"  # this bench (and what it starts) stays where it can reach CPUS
+  echo "ISOLATE: $moved tasks moved to CPUs $REST for the bench; CPUs $CPUS keep the run, cyclictest and per-CPU kernel threads"
+fi
 misses=(); overruns=(); lates=(); ratios=()
 for r in $(seq "$ROUNDS"); do
   late=$(machine_late)
@@ -49,7 +84,9 @@ for r in $(seq "$ROUNDS"); do
     taskset -c "$CPUS" chrt -f 80 "$ADAPTER" --url "$URL" --prefix "RT$r" 2> "$TMP/adapter$r.err" &
     ext=(--external plant)
   fi
-  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/rt$r" --no-plots --realtime --cpus "$CPUS" --lcm-url "$URL" "${ext[@]}" \
+  off=()
+  [ -n "${OFF_PATH_CPUS:-}" ] && off=(--off-path-cpus "$OFF_PATH_CPUS")
+  "$BUILD/bin/feeddrive-launch" "$SCEN" --out "$TMP/rt$r" --no-plots --realtime --cpus "$CPUS" "${off[@]}" --lcm-url "$URL" "${ext[@]}" \
       --prefix "RT$r" "$@" 2> "$TMP/rt$r.err" || true
   [ -n "$ADAPTER" ] && { wait || true; }
   sched=$( (grep -o "plant: real time: [^,]*" "$TMP/rt$r.err" || true) | head -n 1 | sed 's/plant: real time: //')

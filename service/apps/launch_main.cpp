@@ -34,12 +34,18 @@ int main(int argc, char** argv) {
   std::string cpus;
   app.add_option("--cpus", cpus, "pin every process to these CPUs, e.g. 0 or 0,1 (a lockstep chain runs fastest on one core where cross-core wake-ups are slow)")
       ->type_name("LIST");
+  std::string off_path_cpus;
+  app.add_option("--off-path-cpus", off_path_cpus,
+                 "pin the monitor and the trajectory (off the step's critical path) to these CPUs instead; "
+                 "with --realtime, keeps --cpus for the plant and controller (docs/lcm-contract.md, An isolated core)")
+      ->type_name("LIST");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     lo.external.insert(external.begin(), external.end());
     lo.plots = !no_plots;
     lo.auto_pace = app.count("--max-rate") == 0;
     if (!cpus.empty()) lo.cpus = service::parse_cpu_list(cpus);
+    if (!off_path_cpus.empty()) lo.off_path_cpus = service::parse_cpu_list(off_path_cpus, "--off-path-cpus");
     // Read once, here: bad input fails before any process starts, and every process checks that
     // its copy hashes the same (one run, one scenario).
     const service::RunScenario rs = service::load_run_scenario(lo.scenario, opt);

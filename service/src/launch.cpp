@@ -96,7 +96,7 @@ std::string executable_dir() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
 }
 
-std::vector<int> parse_cpu_list(const std::string& text) {
+std::vector<int> parse_cpu_list(const std::string& text, const std::string& option) {
   cpu_set_t allowed;
   CPU_ZERO(&allowed);
   if (::sched_getaffinity(0, sizeof allowed, &allowed) != 0) throw std::runtime_error("sched_getaffinity failed");
@@ -108,7 +108,7 @@ std::vector<int> parse_cpu_list(const std::string& text) {
     char* stop = nullptr;
     const long c = std::strtol(item.c_str(), &stop, 10);
     if (item.empty() || *stop != '\0' || c < 0 || c >= CPU_SETSIZE || !CPU_ISSET(static_cast<int>(c), &allowed))
-      throw std::invalid_argument("--cpus " + text + ": '" + item + "' is not a CPU this process may use");
+      throw std::invalid_argument(option + " " + text + ": '" + item + "' is not a CPU this process may use");
     out.push_back(static_cast<int>(c));
     start = end + 1;
   }
@@ -203,7 +203,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     // plant); how much they yield to it depends on the mode (launch.hpp).
     const bool off_path = role == "monitor" || role == "trajectory";
     const int niceness = off_path ? (opt.realtime ? lo.realtime_off_path_niceness : lo.off_path_niceness) : 0;
-    running[spawn(exe, args, niceness, lo.cpus)] = role;
+    running[spawn(exe, args, niceness, off_path && !lo.off_path_cpus.empty() ? lo.off_path_cpus : lo.cpus)] = role;
   }
 
   LaunchResult result;

@@ -35,6 +35,10 @@ struct LaunchOptions {
   /// once, and on machines where waking a process on another core is slow (virtual machines)
   /// one core is fastest (bench/lockstep_bench.sh measures it).
   std::vector<int> cpus;
+  /// CPUs for the processes off the step's critical path (monitor, trajectory); empty: `cpus`.
+  /// A real-time run keeps its core for the plant and controller and sends these elsewhere
+  /// (docs/lcm-contract.md, "An isolated core").
+  std::vector<int> off_path_cpus;
   /// Before starting, listen this long for another run's plant on the group and prefix (its
   /// heartbeat comes every 100 ms); if one is there, refuse in one line (docs/security.md).
   /// 0: no check.
@@ -48,7 +52,7 @@ struct LaunchOptions {
 
 /// Parses a CPU list "0" or "0,2" (each an index this process may run on). Throws
 /// std::invalid_argument naming the bad entry.
-std::vector<int> parse_cpu_list(const std::string& text);
+std::vector<int> parse_cpu_list(const std::string& text, const std::string& option = "--cpus");
 
 struct LaunchResult {
   int exit_code{0};             ///< 0 if every started process exited 0
