@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "feeddrive/monitor/log_reader.hpp"
+#include "feeddrive/record/log_reader.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/sim/output.hpp"
@@ -43,12 +43,12 @@ int main(int argc, char** argv) {
     sim::check_run_size(s, out_dir, log_steps);
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
     out.set_expected_steps(std::min(static_cast<double>(s.steps()), log_steps));
-    const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
-    const monitor::Recorder& rec = c.recorder;
+    const record::LogConversion c = record::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
+    const record::Recorder& rec = c.recorder;
     if (out.steps() == 0)
       throw std::invalid_argument(log_path + ": no complete step on channels " + opt.prefix + "_STATE/_REF/_CMD (" +
                                   std::to_string(c.events) + " events read; " +
-                                  (c.cut_bytes > 0 ? monitor::describe_cut(c) : std::string("wrong --prefix?")) + ")");
+                                  (c.cut_bytes > 0 ? record::describe_cut(c) : std::string("wrong --prefix?")) + ")");
     nlohmann::ordered_json j;
     auto& l = j["log"];
     l["events"] = c.events;
@@ -68,9 +68,9 @@ int main(int argc, char** argv) {
     spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
                  log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
                  out_dir);
-    if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, monitor::describe_cut(c));
+    if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, record::describe_cut(c));
     if (!rec.gaps().empty())
-      spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, monitor::describe_gaps(rec.gaps()),
+      spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, record::describe_gaps(rec.gaps()),
                    rec.steps(), out.steps(), out_dir);
     return 0;
   });

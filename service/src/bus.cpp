@@ -12,15 +12,6 @@ namespace feeddrive::service {
 
 std::string default_lcm_url() { return "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"; }
 
-Channels::Channels(const std::string& prefix)
-    : state(prefix + "_STATE"),
-      command(prefix + "_CMD"),
-      reference(prefix + "_REF"),
-      status(prefix + "_STATUS"),
-      resend(prefix + "_RESEND"),
-      summary(prefix + "_SUMMARY"),
-      info(prefix + "_INFO") {}
-
 std::int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())

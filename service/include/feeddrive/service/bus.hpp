@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "feeddrive/record/channels.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/udpm_reader.hpp"
 #include "feeddrive/wire.hpp"
@@ -39,11 +40,8 @@ namespace feeddrive::service {
 /// under bursts).
 std::string default_lcm_url();
 
-/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY, _INFO.
-struct Channels {
-  explicit Channels(const std::string& prefix);
-  std::string state, command, reference, status, resend, summary, info;
-};
+/// The channel names of one run (feeddrive/record/channels.hpp: no transport needed to name them).
+using record::Channels;
 
 /// Microseconds since the Unix epoch (process_status_t.utime) and a monotonic clock [us].
 std::int64_t wall_utime();
