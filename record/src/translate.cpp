@@ -15,9 +15,7 @@ reference_t to_message(std::int64_t seq, double t, const trajectory::Sample& s) 
   return m;
 }
 
-trajectory::Sample to_sample(const reference_t& m) {
-  return {m.position, m.velocity, m.acceleration, m.jerk};
-}
+trajectory::Sample to_sample(const reference_t& m) { return {m.position, m.velocity, m.acceleration, m.jerk}; }
 
 control_command_t to_message(std::int64_t seq, double t, const controller::Command& c) {
   control_command_t m;
@@ -71,8 +69,9 @@ sim::Record to_record(const drive_state_t& state, const reference_t& ref, const 
                       const applied_t& applied) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const bool truth = state.truth.valid;
-  const plant::State st = truth ? plant::State{state.truth.x, state.truth.v, state.truth.z, state.truth.fg, state.truth.i}
-                                : plant::State{nan, nan, nan, nan, nan};
+  const plant::State st = truth
+                              ? plant::State{state.truth.x, state.truth.v, state.truth.z, state.truth.fg, state.truth.i}
+                              : plant::State{nan, nan, nan, nan, nan};
   controller::Command c;
   c.u = cmd.u;
   c.u_unsaturated = cmd.u_unsaturated;
