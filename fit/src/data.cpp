@@ -144,14 +144,6 @@ MeasuredData from_table(csv::Table t, const CsvOptions& opt) {
 
 }  // namespace
 
-MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt) {
-  try {
-    return from_table(csv::parse(text, origin, csv_options(opt)), opt);
-  } catch (const csv::CsvError& e) {
-    throw DataError(e.what());
-  }
-}
-
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
   try {
     return from_table(csv::read_file(path, csv_options(opt)), opt);

@@ -84,7 +84,7 @@ int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, co
   logger->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
   spdlog::set_default_logger(logger);
   spdlog::set_level(opt.quiet ? spdlog::level::warn : spdlog::level::info);
-  install_signal_handlers();
+  interrupt::install_handlers();
   try {
     return body();
   } catch (const interrupt::Interrupted& e) {

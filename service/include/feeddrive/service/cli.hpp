@@ -13,8 +13,9 @@
 
 namespace feeddrive::service {
 
-/// --lcm-url, --prefix, --start-timeout, --step-timeout, --resend-interval, --monitor-window,
-/// --linger, --realtime, --max-bad-commands, --quiet.
+/// Adds the options every run process shares (the protocol's timeouts and pace, real time, the
+/// run's identity and --key, --quiet): their list is docs/cli.md, "Options of every run process",
+/// checked against --help by tests/docs/cli_docs_test.py.
 void add_node_options(CLI::App& app, NodeOptions& opt);
 
 /// Parses the arguments and runs body(). body returns the exit code; std::invalid_argument
