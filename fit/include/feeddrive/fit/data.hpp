@@ -13,11 +13,13 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/errors.hpp"
+
 namespace feeddrive::fit {
 
-class DataError : public std::runtime_error {
+class DataError : public BadInput {
  public:
-  using std::runtime_error::runtime_error;
+  using BadInput::BadInput;
 };
 
 enum class InputKind {
