@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # feeddrive-fit speed and detection rate on data it was not built against (not a timed test):
-#   1. speed: a 25 s record at 1 kHz of the independent generator (tests/fit/drivegen: static
+#   1. speed: a 25 s record at 1 kHz of the independent generator (drivegen/: static
 #      base friction, a grinding process described, a hidden constant force and cogging ripple),
 #      fitted with the whole vocabulary (all 11 candidates eligible) by the feeddrive-fit
 #      executable pinned to one core, RUNS times (0: skip); prints the median wall time (target < 30 s);

@@ -8,7 +8,7 @@
 //   seed hidden named right spurious seconds parameter_miss description verdict category
 //   false_all_clear above_floor_all_clear suggestion gap_um gap_floor_um force_N force_floor_N
 //   tentative ties periods nothing_there
-// (as tests/fit/drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
+// (as drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
 //   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
 #include <cstdio>
 #include <cstdlib>

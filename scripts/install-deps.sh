@@ -14,7 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libbenchmark-dev libceres-dev libssl-dev
   libopenmpi-dev openmpi-bin
-  gnuplot-nox jq python3 python3-yaml
+  gnuplot-nox jq python3 python3-yaml clang-format
   iproute2 nftables util-linux procps rt-tests stress-ng
   lua5.2 liblcm-lua lua-luaossl
 )

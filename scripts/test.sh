@@ -2,6 +2,7 @@
 # Installs, builds and runs every test (ctest). The README's test command; .ci/run calls it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+# CI builds with -Werror (FEEDDRIVE_WERROR; off by default for packagers with newer compilers).
+bash scripts/build.sh -DFEEDDRIVE_WERROR=ON
 BUILD_DIR=${BUILD_DIR:-build}
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 1200

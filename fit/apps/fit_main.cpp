@@ -1,6 +1,5 @@
 // feeddrive-fit: finds where a model and measured data disagree, names the missing effect, adds
 // it, and shows the gap shrink (docs/fit.md). Wiring only: load -> run_fit -> write_outputs.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -8,16 +7,15 @@
 #include <cstdlib>
 #include <cstdio>
 
-#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/report.hpp"
 #include "feeddrive/fit/sanity.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/output/folder.hpp"
-#include "feeddrive/plant/cvode_integrator.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/tool/main.hpp"
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
@@ -82,25 +80,13 @@ int main(int argc, char** argv) {
   app.add_flag("--no-form-fit", [&](std::int64_t) { opt.fit_form = false; }, "keep the model's Coulomb transition velocity");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only the result table and errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {  // one line, as for every bad input
-    std::fprintf(stderr, "error: %s (see --help)\n", e.what());
-    return 2;
-  }
-  csv.separator = separator == "tab" ? '\t' : separator[0];
-  if (csv.decimal_comma && csv.separator == ',') {
-    std::fprintf(stderr, "error: --decimal-comma needs another --separator (e.g. --separator ';'): the comma cannot be both\n");
-    return 2;
-  }
-  spdlog::set_pattern("[%H:%M:%S.%e] [feeddrive-fit] [%l] %v");
-  if (quiet) spdlog::set_level(spdlog::level::warn);
-  interrupt::install_handlers();
-  try {
-    // Bad input (scenario, data, too short a record, an --out that must not be replaced) is a
-    // DataError / ScenarioError / std::invalid_argument: exit 2, before any work is done.
+  // Bad input (scenario, data, too short a record, an --out that must not be replaced, a model
+  // that cannot be replayed on this record) is a BadInput or std::invalid_argument: exit 2 with one
+  // line (tool::report), before any work is done. Ctrl-C in any phase: nothing written.
+  return tool::run(app, argc, argv, {"feeddrive-fit", &quiet, {}}, [&]() -> int {
+    csv.separator = separator == "tab" ? '\t' : separator[0];
+    if (csv.decimal_comma && csv.separator == ',')
+      throw BadInput("--decimal-comma needs another --separator (e.g. --separator ';'): the comma cannot be both");
     output::check_output_dir(out_dir);
     const sim::Scenario scenario = sim::load_scenario(scenario_path);
     opt.plausibility.grinding_process =
@@ -131,22 +117,5 @@ int main(int argc, char** argv) {
     std::printf("results: %s/{findings.json,model.fitted.yaml,report.md}\n", out_dir.c_str());
     // exit codes (docs/fit.md, "Verdicts"): 0 explained or no discrepancy, 3 unexplained, 2 bad input
     return r.verdict == fit::Verdict::kUnexplained ? fit::kExitUnexplained : 0;
-  } catch (const interrupt::Interrupted& e) {  // Ctrl-C in any phase: nothing written
-    return interrupt::report(e);
-  } catch (const plant::IntegrationError& e) {  // the model cannot be replayed on this record
-    std::fprintf(stderr, "error: %s: %s\n", scenario_path.c_str(), e.what());
-    return 2;
-  } catch (const sim::ScenarioError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const fit::DataError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {  // e.g. --out names an unrelated folder
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

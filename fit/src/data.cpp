@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "feeddrive/csv/reader.hpp"
-#include "feeddrive/monitor/log_reader.hpp"
+#include "feeddrive/record/log_reader.hpp"
 
 namespace feeddrive::fit {
 double MeasuredData::median_period() const {
@@ -144,14 +144,6 @@ MeasuredData from_table(csv::Table t, const CsvOptions& opt) {
 
 }  // namespace
 
-MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt) {
-  try {
-    return from_table(csv::parse(text, origin, csv_options(opt)), opt);
-  } catch (const csv::CsvError& e) {
-    throw DataError(e.what());
-  }
-}
-
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
   try {
     return from_table(csv::read_file(path, csv_options(opt)), opt);
@@ -161,18 +153,18 @@ MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
 }
 
 MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
-  monitor::LogConversion c;
+  record::LogConversion c;
   std::vector<sim::Record> rows;
   std::string notes_tail;
   try {
-    c = monitor::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false);
+    c = record::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false);
   } catch (const std::exception& e) {
     throw DataError(e.what());
   }
   if (rows.empty())
     throw DataError(path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +
                     std::to_string(c.events) + " events read; " +
-                    (c.cut_bytes > 0 ? monitor::describe_cut(c) : std::string("wrong --prefix?")) + ")");
+                    (c.cut_bytes > 0 ? record::describe_cut(c) : std::string("wrong --prefix?")) + ")");
   // A gap that runs to the end (the log stops early: the logger was stopped, or its last event
   // was cut short) only shortens the record; a gap inside it cannot be replayed.
   auto gaps = c.recorder.gaps();
@@ -182,7 +174,7 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
     gaps.pop_back();
   }
   if (!gaps.empty())
-    throw DataError(path + ": " + monitor::describe_gaps(gaps) + " of " +
+    throw DataError(path + ": " + record::describe_gaps(gaps) + " of " +
                     std::to_string(c.recorder.steps()) + "; the fit needs every state (position and applied input); " +
                     "feeddrive-log2csv writes the complete steps");
   MeasuredData d;
@@ -205,7 +197,7 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
     d.notes.push_back(std::to_string(n) + " of " + std::to_string(rows.size()) +
                       " steps have no command in the log: their input is the one the plant applied (from its next state)");
   if (c.non_finite > 0) d.notes.push_back(std::to_string(c.non_finite) + " messages with a non-finite value were dropped");
-  if (c.cut_bytes > 0) d.notes.push_back(monitor::describe_cut(c));
+  if (c.cut_bytes > 0) d.notes.push_back(record::describe_cut(c));
   if (!notes_tail.empty()) d.notes.push_back(notes_tail);
   validate(d);
   return d;

@@ -4,35 +4,34 @@
 // are missing are reported in one warning line and in summary.json ("log": missing_steps, gaps).
 // Exit 2 (one line) for a log that cannot be read, is corrupt (the event's byte offset), or holds
 // no complete step.
-#include <spdlog/spdlog.h>
-#include <algorithm>
-#include <limits>
-#include <filesystem>
-
-#include <cstdio>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
-#include "feeddrive/monitor/log_reader.hpp"
+#include <algorithm>
+#include <filesystem>
+#include <limits>
+
 #include "feeddrive/output/folder.hpp"
-#include "feeddrive/service/cli.hpp"
+#include "feeddrive/record/log_reader.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/summary.hpp"
+#include "feeddrive/tool/main.hpp"
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
   CLI::App app{"feeddrive-log2csv: converts an lcm-logger log of a run into timeseries.csv and summary.json",
                "feeddrive-log2csv"};
   std::string log_path, scenario_path, out_dir;
-  bool plots = false;
-  service::NodeOptions opt;  // only --prefix and --quiet matter here
+  std::string prefix = "FD";
+  bool plots = false, quiet = false;
   app.add_option("log", log_path, "LCM log file written by lcm-logger")->required();
   app.add_option("--scenario,-s", scenario_path, "the run's scenario YAML (control period, name)")->required();
   app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
-  app.add_option("--prefix", opt.prefix, "channel prefix of the run")->capture_default_str();
+  app.add_option("--prefix", prefix, "channel prefix of the run")->capture_default_str();
   app.add_flag("--plots", plots, "also draw the PNG plots");
-  app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
-  return service::run_process(app, argc, argv, opt, [&] {
+  app.add_flag("--quiet,-q", quiet, "log only warnings and errors");
+  return tool::run(app, argc, argv, {"feeddrive-log2csv", &quiet, {}}, [&] {
     const sim::Scenario s = sim::load_scenario(scenario_path);
     output::check_output_dir(out_dir);
     // A step of a log is at least a state and a command event, each over 40 bytes (the 28-byte
@@ -43,12 +42,12 @@ int main(int argc, char** argv) {
     sim::check_run_size(s, out_dir, log_steps);
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
     out.set_expected_steps(std::min(static_cast<double>(s.steps()), log_steps));
-    const monitor::LogConversion c = monitor::read_log(log_path, opt.prefix, [&](const sim::Record& r) { out.add(r); });
-    const monitor::Recorder& rec = c.recorder;
+    const record::LogConversion c = record::read_log(log_path, prefix, [&](const sim::Record& r) { out.add(r); });
+    const record::Recorder& rec = c.recorder;
     if (out.steps() == 0)
-      throw std::invalid_argument(log_path + ": no complete step on channels " + opt.prefix + "_STATE/_REF/_CMD (" +
+      throw std::invalid_argument(log_path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +
                                   std::to_string(c.events) + " events read; " +
-                                  (c.cut_bytes > 0 ? monitor::describe_cut(c) : std::string("wrong --prefix?")) + ")");
+                                  (c.cut_bytes > 0 ? record::describe_cut(c) : std::string("wrong --prefix?")) + ")");
     nlohmann::ordered_json j;
     auto& l = j["log"];
     l["events"] = c.events;
@@ -68,9 +67,9 @@ int main(int argc, char** argv) {
     spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
                  log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
                  out_dir);
-    if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, monitor::describe_cut(c));
+    if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, record::describe_cut(c));
     if (!rec.gaps().empty())
-      spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, monitor::describe_gaps(rec.gaps()),
+      spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, record::describe_gaps(rec.gaps()),
                    rec.steps(), out.steps(), out_dir);
     return 0;
   });

@@ -96,7 +96,7 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
                                   opt.lcm_url);
     output::check_outside(mopt_.lcm_log, "--lcm-log", mopt_.out_dir);
-    log_ = std::make_unique<LcmLogWriter>(mopt_.lcm_log);
+    log_ = std::make_unique<record::LcmLogWriter>(mopt_.lcm_log);
     const std::string run_channels = opt.prefix + "_";
     bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
       if (ch.compare(0, run_channels.size(), run_channels) != 0 || !log_error_.empty()) return;
@@ -329,7 +329,7 @@ void MonitorNode::request_missing() {
   // there yet. A monitor far behind (an attached one whose socket overflowed) asks for up to
   // kPerRound messages of each kind a round, not one.
   constexpr std::size_t kPerRound = 64;
-  for (const Missing& m : rec_.missing_until(rec_.highest_state(), kPerRound)) {
+  for (const record::Missing& m : rec_.missing_until(rec_.highest_state(), kPerRound)) {
     const std::string& channel = m.what == "state" ? channels().state : m.what == "reference" ? channels().reference : channels().command;
     request_resend(channel, m.seq);
     ++lost_;
@@ -352,7 +352,7 @@ bool MonitorNode::attached_stalled(std::int64_t now, double limit) {
     const std::size_t gaps = rec_.gaps().size();
     if (rec_.skip_lost(sink) > 0 || rec_.gaps().size() != gaps) last_row_us_ = now;
     if (rec_.gaps().size() != gaps && !options().quiet)
-      spdlog::warn("{}: {} (not re-sent after {} requests)", role(), describe_gaps({rec_.gaps().back()}), asking_requests_);
+      spdlog::warn("{}: {} (not re-sent after {} requests)", role(), record::describe_gaps({rec_.gaps().back()}), asking_requests_);
   }
   return rec_.complete();
 }
@@ -428,12 +428,12 @@ bool MonitorNode::run() {
         // A role whose heartbeat still comes is waiting on another and runs its own timeout: it
         // will name the culprit (check_peers above), as the trajectory and the controller do. So
         // wait for it (at most three timeouts), then name only the roles that went silent.
-        const std::vector<Missing> missing = rec_.missing();
+        const std::vector<record::Missing> missing = rec_.missing();
         bool someone_waits = false;
-        for (const Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
+        for (const record::Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
         if (someone_waits && now - last_row_us_ <= 3 * us(limit)) continue;
         std::string silent, all;
-        for (const Missing& m : missing) {
+        for (const record::Missing& m : missing) {
           const std::string what = m.what + " " + std::to_string(m.seq) + " from the " + m.role;
           all += (all.empty() ? "" : ", ") + what;
           if (!peer_alive(m.role, 0.5)) silent += (silent.empty() ? "" : ", ") + what;
@@ -613,7 +613,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   if (mopt_.attach) {  // an observer records across what it could not get (the run's monitor never does)
     l["missing_steps"] = rec_.missing_steps();
     l["gaps"] = nlohmann::ordered_json::array();
-    for (const Gap& g : rec_.gaps()) l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
+    for (const record::Gap& g : rec_.gaps()) l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
   }
   l["steps_per_second"] = rec_.steps_per_second();
   {
@@ -715,7 +715,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     announce_failure(why);
   }
   if (!rec_.gaps().empty())
-    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), describe_gaps(rec_.gaps()), sum.steps, where);
+    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), record::describe_gaps(rec_.gaps()), sum.steps, where);
   if (!options().quiet)
     spdlog::info("monitor: {} steps recorded{} -> {}", sum.steps,
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")", where);

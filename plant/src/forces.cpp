@@ -130,8 +130,6 @@ double contact_fraction_dx(const GrindingParams& p, double x) {
              : 0.0;
 }
 
-bool in_contact(const GrindingParams& p, double x) { return x > p.contact_position; }
-
 double grinding_rate(const GrindingParams& p, double x, double v, double fg) {
   if (!p.enabled) return 0.0;
   return contact_fraction(p, x) * p.stiffness * v - p.stiffness / p.damping() * fg;

@@ -12,15 +12,6 @@ namespace feeddrive::service {
 
 std::string default_lcm_url() { return "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"; }
 
-Channels::Channels(const std::string& prefix)
-    : state(prefix + "_STATE"),
-      command(prefix + "_CMD"),
-      reference(prefix + "_REF"),
-      status(prefix + "_STATUS"),
-      resend(prefix + "_RESEND"),
-      summary(prefix + "_SUMMARY"),
-      info(prefix + "_INFO") {}
-
 std::int64_t wall_utime() {
   return std::chrono::duration_cast<std::chrono::microseconds>(
              std::chrono::system_clock::now().time_since_epoch())
@@ -60,11 +51,15 @@ void Bus::count_foreign(const std::string& channel, std::int64_t run_id, const s
 }
 
 bool Bus::publish_raw(const std::string& channel, const std::uint8_t* data, std::size_t size) {
-  if (lcm_.publish(channel, data, static_cast<unsigned int>(size)) != 0) {
-    ++send_errors_;
-    return false;
-  }
-  return true;
+  return sent(lcm_.publish(channel, data, static_cast<unsigned int>(size)), channel);
+}
+
+bool Bus::sent(int rc, const std::string& channel) {
+  if (rc == 0) return true;
+  ++send_errors_;
+  if (log_due(last_send_error_log_us_))
+    spdlog::warn("cannot send on {}: LCM publish failed ({} send errors so far)", channel, send_errors_);
+  return false;
 }
 
 void Bus::count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why) {

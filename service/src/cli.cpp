@@ -1,13 +1,12 @@
 #include "feeddrive/service/cli.hpp"
 
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 #include <limits>
 
 #include "feeddrive/common/interrupt.hpp"
-#include "feeddrive/plant/cvode_integrator.hpp"
+#include "feeddrive/tool/main.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
@@ -95,37 +94,8 @@ RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
 }
 
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  auto logger = spdlog::stderr_color_mt(app.get_name());
-  logger->set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
-  spdlog::set_default_logger(logger);
-  spdlog::set_level(opt.quiet ? spdlog::level::warn : spdlog::level::info);
-  install_signal_handlers();
-  try {
-    return body();
-  } catch (const interrupt::Interrupted& e) {
-    return interrupt::report(e);
-  } catch (const plant::IntegrationError& e) {  // the scenario's keys make it unintegrable
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const sim::ScenarioError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
-  } catch (const RunFailure& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  // RunFailure is a std::runtime_error: exit 1; the mapping is tool::report's, as in every tool.
+  return tool::run(app, argc, argv, {app.get_name(), &opt.quiet, {}}, body);
 }
 
 }  // namespace feeddrive::service

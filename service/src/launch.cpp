@@ -176,7 +176,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
 
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
-    if (interrupted_by() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
+    if (interrupt::signal_number() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
       spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{}; this run is {} (--realtime), "
                    "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
@@ -240,7 +240,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       continue;
     }
     // Forward Ctrl-C / SIGTERM to every child once.
-    const int sig = interrupted_by();
+    const int sig = interrupt::signal_number();
     if (sig != 0 && forwarded != sig) {
       forwarded = sig;
       for (const auto& [p, role] : running) ::kill(p, sig);

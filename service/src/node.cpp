@@ -17,10 +17,6 @@
 #include <cstdlib>
 
 namespace feeddrive::service {
-void install_signal_handlers() { interrupt::install_handlers(); }
-
-int interrupted_by() { return interrupt::signal_number(); }
-
 std::string enter_realtime(int priority) {
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;

@@ -291,11 +291,4 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   dir.plot(gp.str());
 }
 
-void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots, const std::string& extra_json, const std::string& tool) {
-  RunWriter w(out_dir, s, tool);
-  for (const Record& q : r.records) w.add(q);
-  w.finish(sum, plots, extra_json);
-}
-
 }  // namespace feeddrive::sim

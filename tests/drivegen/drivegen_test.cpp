@@ -1,4 +1,4 @@
-// The independent generator itself (tests/fit/drivegen): its integrator against analytic
+// The independent generator itself (drivegen/): its integrator against analytic
 // solutions, its sensor and clock, its determinism and its case mix.
 #include <gtest/gtest.h>
 

@@ -2,7 +2,11 @@
 // commas and columns by index, on hand-made CSV text (pure logic, no fit).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "feeddrive/fit/data.hpp"
@@ -41,6 +45,20 @@ TEST(FitUnits, EveryUnitIsAFactorToSI) {
   EXPECT_EQ(unit_name("force", 1e6), "");
 }
 
+// `text` as the file logger.csv in a fresh folder, read by load_csv (the fit reads files only);
+// the folder is removed afterwards, also when load_csv throws.
+MeasuredData load_text(const std::string& text, const CsvOptions& o) {
+  namespace fs = std::filesystem;
+  struct Folder {
+    fs::path dir = fs::temp_directory_path() / ("fd_fit_data_test_" + std::to_string(::getpid()));
+    Folder() { fs::create_directories(dir); }
+    ~Folder() { fs::remove_all(dir); }
+  } folder;
+  const std::string path = (folder.dir / "logger.csv").string();
+  std::ofstream(path) << text;
+  return load_csv(path, o);
+}
+
 // 60 rows of "time_ms;pos_mm;force_N" with decimal commas: t = k ms, x = 0.5 k mm, F = 1.5 N.
 std::string logger_text(const std::string& header = "time_ms;pos_mm;force_N") {
   std::string s = header + "\n";
@@ -55,7 +73,7 @@ TEST(FitCsv, SemicolonsDecimalCommasUnitsAndColumnIndex) {
   o.units = parse_units("t=ms,x=mm");
   o.time_column = "time_ms";
   o.position_column = "pos_mm";
-  const MeasuredData d = parse_csv(logger_text(), "logger.csv", o);
+  const MeasuredData d = load_text(logger_text(), o);
   ASSERT_EQ(d.size(), 60u);
   EXPECT_EQ(d.input_kind, InputKind::kForce);
   EXPECT_DOUBLE_EQ(d.t[7], 7e-3);
@@ -66,7 +84,7 @@ TEST(FitCsv, SemicolonsDecimalCommasUnitsAndColumnIndex) {
   o.time_column = "1";
   o.position_column = "2";
   o.force_column = "3";
-  const MeasuredData e = parse_csv(logger_text("a;b;c"), "logger.csv", o);
+  const MeasuredData e = load_text(logger_text("a;b;c"), o);
   EXPECT_DOUBLE_EQ(e.t[7], 7e-3);
   EXPECT_EQ(e.position_name, "b");
   EXPECT_EQ(e.input_kind, InputKind::kForce);
@@ -77,10 +95,10 @@ TEST(FitCsv, SemicolonsDecimalCommasUnitsAndColumnIndex) {
   std::string bad = logger_text();
   bad.replace(bad.find("1,5"), 3, "1.5");
   try {
-    parse_csv(bad, "logger.csv", o);
+    load_text(bad, o);
     ADD_FAILURE() << "a decimal point was accepted";
   } catch (const DataError& err) {
-    EXPECT_NE(std::string(err.what()).find("logger.csv:2:"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("/logger.csv:2:"), std::string::npos) << err.what();
     EXPECT_NE(std::string(err.what()).find("not a number with a decimal comma"), std::string::npos) << err.what();
   }
 }

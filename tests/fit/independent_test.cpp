@@ -1,5 +1,5 @@
 // feeddrive-fit on records it was not built against: a seeded subset of the independent
-// generator's case mix (tests/fit/drivegen: its own RK4 integrator, PID or cascade loop, dwells,
+// generator's case mix (drivegen/: its own RK4 integrator, PID or cascade loop, dwells,
 // reversals and creeping moves, smoother and asymmetric friction, 50-200 nm quantization,
 // jitter, a random nominal mass). The full sweep of 100+ records is bench/fit_bench.sh, with its
 // figures in docs/fit.md; this subset runs on every CI.

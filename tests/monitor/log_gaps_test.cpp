@@ -17,10 +17,10 @@
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
-#include "feeddrive/monitor/log_reader.hpp"
+#include "feeddrive/record/log_reader.hpp"
 #include "feeddrive/reference_block_t.hpp"
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 namespace {
 namespace fs = std::filesystem;
 
@@ -329,4 +329,4 @@ TEST(LogGaps, CorruptEventNamesItsByteOffset) {
 }
 
 }  // namespace
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

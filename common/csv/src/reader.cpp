@@ -95,7 +95,6 @@ class Parser {
     return std::move(table_);
   }
 
-  [[noreturn]] void fail_file(const std::string& why) const { throw CsvError(origin_ + ": " + why); }
   [[noreturn]] void fail_line(std::size_t col, const std::string& why) const {
     throw CsvError(origin_ + ":" + std::to_string(line_no_) + (col ? ":" + std::to_string(col) : "") + ": " + why);
   }

@@ -13,11 +13,13 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/errors.hpp"
+
 namespace feeddrive::fit {
 
-class DataError : public std::runtime_error {
+class DataError : public BadInput {
  public:
-  using std::runtime_error::runtime_error;
+  using BadInput::BadInput;
 };
 
 enum class InputKind {
@@ -77,8 +79,6 @@ struct CsvOptions {
 
 /// Reads a CSV file (see above). Throws DataError.
 MeasuredData load_csv(const std::string& path, const CsvOptions& opt = {});
-/// Parses CSV text; `origin` names it in messages.
-MeasuredData parse_csv(const std::string& text, const std::string& origin, const CsvOptions& opt = {});
 /// Reads an LCM log written by lcm-logger (channels <prefix>_STATE/_REF/_CMD). Every step needs
 /// its state and the next one (position, and the input applied during the step); a step whose
 /// command was lost (the stock logger drops messages) uses the applied input the plant reports

@@ -20,10 +20,10 @@
 #include <map>
 #include <vector>
 
-#include "feeddrive/monitor/lcm_log.hpp"
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/monitor/histogram.hpp"
-#include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/record/recorder.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/run_info_t.hpp"
@@ -91,7 +91,7 @@ class MonitorNode : public service::Node {
   sim::Scenario s_;
   MonitorOptions mopt_;
   bool too_big_{false};
-  Recorder rec_;
+  record::Recorder rec_;
   std::unique_ptr<sim::RunWriter> out_;
   std::string open_error_;  // why out_ could not be opened
   std::int64_t start_us_{0};
@@ -134,7 +134,7 @@ class MonitorNode : public service::Node {
   /// "the plant applied u = ... from ..." for the failure line and summary.json, or "".
   std::string applied_command_text() const;
   run_info_t info_;
-  std::unique_ptr<LcmLogWriter> log_;
+  std::unique_ptr<record::LcmLogWriter> log_;
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)
   std::int64_t heartbeats_{0};
   Histogram hist_sc_, hist_cs_, hist_late_;

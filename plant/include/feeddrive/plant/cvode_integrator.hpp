@@ -19,6 +19,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "feeddrive/common/errors.hpp"
 #include "feeddrive/plant/dynamics.hpp"
 
 namespace feeddrive::plant {
@@ -26,9 +27,9 @@ namespace feeddrive::plant {
 /// CVODE could not integrate a control period (too stiff, too fast, or a state that runs away):
 /// a property of the scenario's keys, which the message names (PlantParams::fastest_time_scales).
 /// The tools report it as bad input (exit 2).
-class IntegrationError : public std::runtime_error {
+class IntegrationError : public BadInput {  // the scenario's keys make the model unintegrable: exit 2
  public:
-  using std::runtime_error::runtime_error;
+  using BadInput::BadInput;
 };
 
 class CvodeIntegrator {

@@ -54,8 +54,6 @@ double ripple_force(const RippleParams& p, double x, double desired_force);
 double contact_fraction(const GrindingParams& p, double x);
 /// ds/dx (0 outside the engagement band).
 double contact_fraction_dx(const GrindingParams& p, double x);
-/// True when the wheel touches the work: s(x) > 0, i.e. x > contact_position.
-bool in_contact(const GrindingParams& p, double x);
 /// Hahn-Lindsay normal force rate (Xie & Liang eq. 13 as an ODE, V_r = v):
 ///   dFg/dt = s(x)*ke*v - (ke/C)*Fg,   C = c*pi*dw*bs
 /// (in full contact eq. 13; out of contact the deflection relaxes: dFg/dt = -(ke/C)*Fg).

@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "feeddrive/record/channels.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/udpm_reader.hpp"
 #include "feeddrive/wire.hpp"
@@ -39,11 +40,8 @@ namespace feeddrive::service {
 /// under bursts).
 std::string default_lcm_url();
 
-/// Channel names of one run: <prefix>_STATE, _CMD, _REF, _STATUS, _RESEND, _SUMMARY, _INFO.
-struct Channels {
-  explicit Channels(const std::string& prefix);
-  std::string state, command, reference, status, resend, summary, info;
-};
+/// The channel names of one run (feeddrive/record/channels.hpp: no transport needed to name them).
+using record::Channels;
 
 /// Microseconds since the Unix epoch (process_status_t.utime) and a monotonic clock [us].
 std::int64_t wall_utime();
@@ -143,7 +141,6 @@ class Bus {
   std::map<std::string, std::int64_t> invalid_by_channel() const;
   /// Counts (and logs, at most once a second) a message of `channel` that did not decode.
   void count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why);
-  std::int64_t send_errors() const { return send_errors_; }
   /// Messages of another run (Admit::kRun subscriptions, and count_foreign()).
   std::int64_t foreign() const { return foreign_; }
   /// With a key: messages without a valid mac.
@@ -176,6 +173,7 @@ class Bus {
   std::int64_t invalid_{0};
   std::map<std::string, std::int64_t> invalid_by_channel_;
   std::int64_t send_errors_{0};
+  std::int64_t last_send_error_log_us_{-1};
   std::int64_t last_invalid_log_us_{-1};
   std::int64_t foreign_{0};
   std::int64_t last_foreign_log_us_{-1};
@@ -191,6 +189,9 @@ class Bus {
   std::exception_ptr error_;
   /// Logs at most once a second per kind: `last` is that kind's last log time.
   static bool log_due(std::int64_t& last);
+  /// liblcm's publish result `rc` on `channel`: 0 is true; a failure (the socket's buffer full,
+  /// no route) is counted and logged, at most once a second, and false.
+  bool sent(int rc, const std::string& channel);
 };
 
 /// Remembers the last `capacity` messages published on one channel, by step number, and
@@ -308,11 +309,7 @@ bool Bus::publish(const std::string& channel, const Msg& m) {
   if (out_.size() < size) out_.resize(size);
   if (msg.encode(out_.data(), 0, n) != n) throw std::logic_error(std::string("cannot encode a ") + Msg::getTypeName());
   if (auth_) auth_->sign(channel, out_.data(), size);  // mac_size 0 -> 32, then the mac
-  if (lcm_.publish(channel, out_.data(), static_cast<unsigned int>(size)) != 0) {
-    ++send_errors_;
-    return false;
-  }
-  return true;
+  return sent(lcm_.publish(channel, out_.data(), static_cast<unsigned int>(size)), channel);
 }
 
 }  // namespace feeddrive::service

@@ -13,13 +13,14 @@
 
 namespace feeddrive::service {
 
-/// --lcm-url, --prefix, --start-timeout, --step-timeout, --resend-interval, --monitor-window,
-/// --linger, --realtime, --max-bad-commands, --quiet.
+/// Adds the options every run process shares (the protocol's timeouts and pace, real time, the
+/// run's identity and --key, --quiet): their list is docs/cli.md, "Options of every run process",
+/// checked against --help by tests/docs/cli_docs_test.py.
 void add_node_options(CLI::App& app, NodeOptions& opt);
 
-/// Parses the arguments and runs body(). body returns the exit code; std::invalid_argument
-/// (bad input) gives 2, RunFailure and other exceptions 1, interrupt::Interrupted 130 (SIGINT) or
-/// 143 (SIGTERM), each as one line on stderr.
+/// Parses the arguments and runs body() with tool::run (feeddrive/tool/main.hpp): body returns
+/// the exit code; what it throws gets the one mapping of every tool (bad input 2, RunFailure and
+/// other failures 1, interrupt::Interrupted 128 + signal), each as one line on stderr.
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body);
 
 /// The scenario of a run process: loaded once, its bytes hashed (SHA-256, FIPS 180-4, by

@@ -159,11 +159,6 @@ class Node {
   std::map<std::string, std::int64_t> peer_seen_us_;
 };
 
-/// Installs SIGINT/SIGTERM handlers that make every wait end with RunFailure("interrupted").
-void install_signal_handlers();
-/// The signal that interrupted the process, or 0.
-int interrupted_by();
-
 /// Real-time setup of a process on a real-time run's critical path (plant, controller), as
 /// real-time Linux practice has it: mlockall(MCL_CURRENT | MCL_FUTURE) (no page fault in a
 /// period), SCHED_FIFO at `priority` where permitted, and a 1 ns timer slack (the default 50 us

@@ -1,40 +1,25 @@
 #pragma once
-// Translators between the LCM message contract (lcmtypes/) and the domain structs of the
-// libraries. No logic beyond copying fields lives here.
+// Translators between the LCM message contract (lcmtypes/) and the service's structs: the run's
+// self-description here; the field copies of the step's messages in feeddrive/record/translate.hpp.
+// No logic beyond copying fields lives here.
 
-#include "feeddrive/controller/controller.hpp"
-#include "feeddrive/plant/dynamics.hpp"
-#include "feeddrive/plant/sensor.hpp"
-#include "feeddrive/sim/simulation.hpp"
-#include "feeddrive/trajectory/trajectory.hpp"
-#include "feeddrive/applied_t.hpp"
-#include "feeddrive/control_command_t.hpp"
-#include "feeddrive/drive_state_t.hpp"
-#include "feeddrive/reference_t.hpp"
+#include "feeddrive/record/translate.hpp"
 #include "feeddrive/run_info_t.hpp"
-#include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/service/node.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::service {
 
-reference_t to_message(std::int64_t seq, double t, const trajectory::Sample& s);
-trajectory::Sample to_sample(const reference_t& m);
-
-control_command_t to_message(std::int64_t seq, double t, const controller::Command& c);
-
-plant::Measurement to_measurement(const drive_state_t& m);
-/// The truth fields a simulated plant sends (valid = true).
-drive_truth_t to_truth_message(const plant::State& s);
-/// What the controller may use of the truth (nullopt-like: valid == false -> no truth).
-controller::Truth to_truth(const drive_truth_t& m);
-
-applied_t to_applied(std::int64_t seq, double u, const plant::Forces& f);
-applied_t no_applied();
-
-/// Assembles one row of timeseries.csv from the messages of step k: its state, reference and
-/// command, and what the plant applied during it (carried by the state of step k+1).
-sim::Record to_record(const drive_state_t& state, const reference_t& ref, const control_command_t& cmd,
-                      const applied_t& applied);
+// The field copies between messages and domain structs need no transport: they live in
+// feeddrive::record (feeddrive/record/translate.hpp), shared with the offline tools.
+using record::no_applied;
+using record::to_applied;
+using record::to_measurement;
+using record::to_message;
+using record::to_record;
+using record::to_sample;
+using record::to_truth;
+using record::to_truth_message;
 
 /// The run's self-description (run_info_t) from its scenario and the run's options: name, mode,
 /// period, steps, the drive's nominal parameters, the command limits, the protocol's timeouts,

@@ -132,8 +132,4 @@ class RunWriter {
 /// `title` is any text (it goes through output::gnuplot_string). Throws on failure.
 void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title);
 
-/// All records at once (RunWriter over r.records); log2csv and tests.
-void write_results(const std::string& out_dir, const RunResult& r, const Summary& sum, const Scenario& s,
-                   bool plots = true, const std::string& extra_json = "", const std::string& tool = "feeddrive-sim");
-
 }  // namespace feeddrive::sim

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/errors.hpp"
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/open_loop.hpp"
 #include "feeddrive/controller/plugin_host.hpp"
@@ -28,9 +29,9 @@
 
 namespace feeddrive::sim {
 
-class ScenarioError : public std::runtime_error {
+class ScenarioError : public BadInput {
  public:
-  using std::runtime_error::runtime_error;
+  using BadInput::BadInput;
 };
 
 enum class ControllerType { kSlidingMode, kCascade, kOpenLoop, kPlugin };

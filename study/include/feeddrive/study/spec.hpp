@@ -37,11 +37,13 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/errors.hpp"
+
 namespace feeddrive::study {
 
-class StudyError : public std::runtime_error {
+class StudyError : public BadInput {
  public:
-  using std::runtime_error::runtime_error;
+  using BadInput::BadInput;
 };
 
 /// One scenario key (dotted path) set to a YAML scalar (its text).

@@ -1,12 +1,12 @@
-#include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/record/recorder.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "feeddrive/service/translate.hpp"
+#include "feeddrive/record/translate.hpp"
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 
 void Recorder::on_state(const drive_state_t& m, std::int64_t recv_us) {
   if (m.steps > 0) {
@@ -120,7 +120,7 @@ void Recorder::add_row(const Seen<drive_state_t>& s, const reference_t* r, const
     no_ref.position = no_ref.velocity = no_ref.acceleration = no_ref.jerk = nan;
     r = &no_ref;
   }
-  sink(service::to_record(s.msg, *r, *c, s1.previous));
+  sink(to_record(s.msg, *r, *c, s1.previous));
 }
 
 std::size_t Recorder::flush_final(const sim::RecordSink& sink, bool need_reference) {
@@ -252,4 +252,4 @@ double Recorder::steps_per_second() const {
   return static_cast<double>(highest_state_ - first_state_seq_) / (static_cast<double>(last_state_us_ - first_state_us_) * 1e-6);
 }
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 
 constexpr std::uint32_t kLcmLogSync = 0xEDA1DA01u;
 constexpr std::size_t kLcmLogHeaderSize = 28;
@@ -55,4 +55,4 @@ class LcmLogWriter {
   bool failed_{false};
 };
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

@@ -1,10 +1,10 @@
-#include "feeddrive/monitor/lcm_log.hpp"
+#include "feeddrive/record/lcm_log.hpp"
 
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 namespace {
 
 std::uint64_t get_be(const std::uint8_t* p, int n) {
@@ -78,4 +78,4 @@ void LcmLogWriter::close() {
     throw std::runtime_error(path_ + ": writing the LCM log failed: " + std::strerror(err));
 }
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

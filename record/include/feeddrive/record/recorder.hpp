@@ -21,7 +21,7 @@
 #include "feeddrive/reference_t.hpp"
 #include "feeddrive/sim/simulation.hpp"
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 
 /// One message a row is waiting for.
 struct Missing {
@@ -153,4 +153,4 @@ class Recorder {
   stats::StreamingQuantile lat_sc_, lat_cs_, lead_;
 };
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

@@ -1,4 +1,4 @@
-#include "feeddrive/monitor/log_reader.hpp"
+#include "feeddrive/record/log_reader.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,12 +9,12 @@
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/text_file.hpp"
-#include "feeddrive/monitor/lcm_log.hpp"
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
-#include "feeddrive/service/bus.hpp"
+#include "feeddrive/record/channels.hpp"
 #include "feeddrive/wire.hpp"
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 namespace {
 
 // One event of an LCM log file (the format: lcm_log.hpp). We parse it ourselves rather than with lcm::LogFile
@@ -146,7 +146,7 @@ bool finite_reference(const reference_t& m) {
 LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
                        bool need_reference) {
   LogParser log(path);
-  const service::Channels ch(prefix);
+  const Channels ch(prefix);
   LogConversion out;
   Event ev;
   while (log.next(ev, out.events)) {
@@ -188,4 +188,4 @@ std::string describe_cut(const LogConversion& c) {
          std::to_string(c.cut_bytes) + " bytes; the logger stopped mid-write?): that event is ignored";
 }
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

@@ -4,9 +4,9 @@
 
 #include <string>
 
-#include "feeddrive/monitor/recorder.hpp"
+#include "feeddrive/record/recorder.hpp"
 
-namespace feeddrive::monitor {
+namespace feeddrive::record {
 
 struct LogConversion {
   Recorder recorder{true, true};        ///< rows found (attach mode: from the first state logged)
@@ -31,4 +31,4 @@ std::string describe_cut(const LogConversion& c);
 LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
                        bool need_reference = true);
 
-}  // namespace feeddrive::monitor
+}  // namespace feeddrive::record

@@ -1,0 +1,61 @@
+#pragma once
+// The one main() of every feeddrive tool: command-line parsing, one logging style, the interrupt
+// handlers, and the one mapping from what the work threw to an exit code and a one-line message
+// (feeddrive/common/errors.hpp for the codes). A tool's main only declares its options and wires
+// its body; no tool writes its own catch ladder.
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/interrupt.hpp"
+
+namespace feeddrive::tool {
+
+/// The exit code and the one line on stderr for an exception a tool's work threw:
+///   interrupt::Interrupted          128 + signal  "error: interrupted by SIGINT<interrupt_detail>"
+///                                                 (no line under feeddrive-launch: it reports once)
+///   BadInput, std::invalid_argument 2             "error: <what>"
+///   any other std::exception        1             "error: <what>"
+int report(std::exception_ptr e, const std::string& interrupt_detail = "");
+
+/// Parses the command line. nullopt: go on; else the exit code: 0 after --help, 2 after a parse
+/// error, reported in one line "error: <what> (see --help)".
+std::optional<int> parse(CLI::App& app, int argc, char** argv);
+
+/// The one logging style: spdlog on stderr, "[HH:MM:SS.mmm] [name] [level] message"; quiet:
+/// warnings and errors only.
+void setup_logging(const std::string& name, bool quiet);
+
+/// What run() needs besides the body.
+struct Options {
+  std::string name;              ///< the logger's name: the tool ("feeddrive-sim")
+  const bool* quiet{nullptr};    ///< the tool's --quiet flag, read after parsing
+  /// Appended to the interrupt's line, computed after parsing ("; nothing written to DIR").
+  std::function<std::string()> interrupt_detail;
+};
+
+/// Runs f(), a step that only reads and checks the input before any work: whatever it throws,
+/// but an interrupt, is the input's fault (BadInput: exit 2).
+template <typename F>
+auto input_step(F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const interrupt::Interrupted&) {
+    throw;
+  } catch (const BadInput&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw BadInput(e.what());
+  }
+}
+
+/// parse(), setup_logging(), interrupt::install_handlers(), then body(): its return value, or
+/// report() of what it threw.
+int run(CLI::App& app, int argc, char** argv, const Options& opt, const std::function<int()>& body);
+
+}  // namespace feeddrive::tool

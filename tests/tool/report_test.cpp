@@ -1,0 +1,66 @@
+// The one mapping from errors to exit codes of every tool (common/tool/main.hpp): pure logic.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/tool/main.hpp"
+
+namespace feeddrive::tool {
+namespace {
+
+template <typename E>
+int code_of(const E& e) {
+  return report(std::make_exception_ptr(e));
+}
+
+TEST(ToolReport, EachErrorKindHasItsExitCodeAndOneLine) {
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(code_of(BadInput("plant.mass = -1: must be > 0")), kExitBadInput);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: plant.mass = -1: must be > 0\n");
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(code_of(std::invalid_argument("--out: not a feeddrive output")), kExitBadInput);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: --out: not a feeddrive output\n");
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(code_of(std::runtime_error("step timeout")), kExitFailed);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: step timeout\n");
+  // 128 + signal, one line unless started by feeddrive-launch (it reports the interrupt once).
+  ::unsetenv(interrupt::kQuietEnv);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(report(std::make_exception_ptr(interrupt::Interrupted(SIGINT)), "; nothing written"), 128 + SIGINT);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: interrupted by SIGINT; nothing written\n");
+  ::setenv(interrupt::kQuietEnv, "1", 1);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(code_of(interrupt::Interrupted(SIGTERM)), 128 + SIGTERM);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "");
+  ::unsetenv(interrupt::kQuietEnv);
+}
+
+TEST(ToolReport, InputStepMakesEveryErrorButAnInterruptBadInput) {
+  EXPECT_THROW(input_step([]() -> int { throw std::runtime_error("yaml: bad indentation"); }), BadInput);
+  EXPECT_THROW(input_step([]() -> int { throw interrupt::Interrupted(SIGINT); }), interrupt::Interrupted);
+  EXPECT_EQ(input_step([] { return 7; }), 7);
+}
+
+TEST(ToolParse, HelpIsZeroAndAParseErrorIsTwoInOneLine) {
+  CLI::App app{"t", "t"};
+  std::string out;
+  app.add_option("--out", out)->required();
+  char name[] = "t", bad[] = "--nope", help[] = "--help";
+  char* bad_argv[] = {name, bad};
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(parse(app, 2, bad_argv), kExitBadInput);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err.rfind("error: ", 0), 0u) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << err;  // one line
+  char* help_argv[] = {name, help};
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(parse(app, 2, help_argv), 0);
+  testing::internal::GetCapturedStdout();
+}
+
+}  // namespace
+}  // namespace feeddrive::tool
