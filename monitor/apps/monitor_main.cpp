@@ -1,5 +1,6 @@
 // feeddrive-monitor: records a run from its LCM channels into DIR/{timeseries.csv, summary.json,
 // *.png} (feeddrive-sim's format plus lockstep statistics). Wiring only: scenario -> MonitorNode.
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/common/interrupt.hpp"
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
     opt.scenario_hash = rs.sha256;  // run_info_t.scenario_hash: of the bytes read here
     output::check_output_dir(mopt.out_dir);  // before the run
     output::check_outside(mopt.lcm_log, "--lcm-log", mopt.out_dir);
-    output::check_output_file(mopt.lcm_log, "--lcm-log");
+    output::check_output_file(mopt.lcm_log, "--lcm-log", record::kLcmLogMagic);
     sim::check_run_size(s, mopt.out_dir);
     monitor::MonitorNode node(s, opt, mopt);
     const bool ok = node.run();

@@ -194,15 +194,29 @@ void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint
   if (channel == channels().status) who_role = service::heartbeat_role(d, n);
   const std::string key = "unauthenticated " + channel + " " + who_role + (unsigned_msg ? " unsigned" : " badmac");
   const std::int64_t count = ++named_[key];
+  const std::int64_t now = mono_us();
+  const std::int64_t first = first_unauthenticated_us_.emplace(key, now).first->second;
   const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
   const std::string why = who + (unsigned_msg ? " publishes unsigned messages on " : " publishes messages with a mac that does not verify on ") +
                           channel + ", but this run is authenticated with --key " + options().key_file +
                           (unsigned_msg ? ": give it the same key" : ": another key, or forged; give it the same key") +
                           " (docs/security.md)";
+  // This monitor's own role is never someone else's to fill: such a message is forged. Named
+  // once, counted, never a reason to end the run.
+  if (who_role == role()) {
+    if (count == 1)
+      spdlog::warn("{}: {} message on {} in this monitor's own role: forged; ignored (counted as unauthenticated)",
+                   role(), unsigned_msg ? "an unsigned" : "a wrongly signed", channel);
+    return;
+  }
   if (count == 1) spdlog::error("{}: {}", role(), why);
-  // Three in a row from one run role: a participant, not a stray datagram. It can never take
-  // part, so the run fails now instead of at a timeout that would not mention the key.
-  if (count >= 3) fail_for(who_role, why);
+  // A participant, not stray or forged datagrams: its own heartbeats (on the status channel, in
+  // its role), three of them over at least a second, while no process of this run fills the
+  // role (fail_for: the real process, once up, fills it and the sender is only named). Unsigned
+  // data messages alone (junk on a channel) are counted and named, never a reason to end the
+  // run. An unsigned participant can never take part, so the run fails now instead of at a
+  // timeout that would not mention the key.
+  if (channel == channels().status && count >= 3 && now - first >= 1000000) fail_for(who_role, why);
 }
 
 void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why_invalid) {
@@ -399,6 +413,12 @@ bool MonitorNode::run() {
       const std::size_t added = rec_.flush([this](const sim::Record& r) { out_->add(r); });
       const std::int64_t now = mono_us();
       if (added > 0) last_row_us_ = now;
+      // Every second the rows so far go to the staged file: a SIGKILLed monitor loses at most
+      // the last second (the launcher moves the staged folder beside --out).
+      if (now - last_file_flush_us_ >= 1000000) {
+        out_->flush();
+        last_file_flush_us_ = now;
+      }
       if (!mopt_.attach) {
         acked_seq = rec_.next();
         set_seq(rec_.next());

@@ -17,7 +17,9 @@ int main(int argc, char** argv) {
   app.add_option("--plugin", plugin, "host the controller plugin (shared library) at PATH (docs/plugins.md)");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
-    sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
+    const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    opt.scenario_hash = rs.sha256;  // checked against the monitor's run_info_t
+    sim::Scenario s = rs.scenario;
     if (!plugin.empty()) sim::use_plugin(s, plugin);
     service::ControllerNode node(sim::make_controller(s), opt);
     return service::run_node(node);

@@ -3,9 +3,11 @@
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/service/cli.hpp"
@@ -53,7 +55,7 @@ int main(int argc, char** argv) {
     opt.scenario_hash = rs.sha256;  // --scenario-hash, run_info_t.scenario_hash
     const auto out = output::check_output_dir(lo.out_dir);  // and these, before any process starts
     output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
-    output::check_output_file(lo.lcm_log, "--lcm-log");
+    output::check_output_file(lo.lcm_log, "--lcm-log", record::kLcmLogMagic);
     if (!opt.key_file.empty()) service::read_key_file(opt.key_file);
     sim::check_run_size(s, lo.out_dir);
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);
@@ -64,10 +66,14 @@ int main(int argc, char** argv) {
     };
     const ino_t before = marker_id();
     const service::LaunchResult r = service::launch(lo, opt);
-    for (const auto& f : r.failed) spdlog::error("failed: {}", f);
+    // A refusal (bad input, exit 2) is the run's one line, printed once however many processes
+    // gave it; the others were stopped for it and say nothing.
+    for (const auto& line : r.refusals) std::fprintf(stderr, "%s\n", line.c_str());
+    if (r.refusals.empty())
+      for (const auto& f : r.failed) spdlog::error("failed: {}", f);
     if (!r.partial_record.empty())
-      spdlog::error("the monitor was killed: its record up to then (not flushed at the kill: the last rows may be "
-                    "missing) is in {}", r.partial_record);
+      spdlog::error("the monitor was killed: its record up to then (it goes to the file every second: the last "
+                    "second's rows may be missing; no summary.json) is in {}", r.partial_record);
     // A failed run's record is where the monitor said (DIR, or DIR.incomplete-N beside an
     // earlier output): DIR's summary may be the earlier run's, so it is not shown as this one's.
     if (r.exit_code != 0) return r.exit_code;

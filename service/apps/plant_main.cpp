@@ -14,7 +14,9 @@ int main(int argc, char** argv) {
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
-    const sim::Scenario s = service::load_run_scenario(scenario_path, opt).scenario;  // the launcher's scenario, or exit 2
+    const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    opt.scenario_hash = rs.sha256;  // checked against the monitor's run_info_t
+    const sim::Scenario s = rs.scenario;
     service::PlantNode node(s, opt);
     return service::run_node(node);
   });

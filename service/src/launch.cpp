@@ -1,6 +1,8 @@
 #include "feeddrive/service/launch.hpp"
 
 #include <sched.h>
+#include <algorithm>
+#include <fcntl.h>
 #include <sys/prctl.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
@@ -51,7 +53,46 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   return a;
 }
 
-pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int niceness, const std::vector<int>& cpus) {
+// The children's refusals (interrupt::kRefusalFdEnv): a pipe whose write end they inherit. Read
+// when they have all exited; each different line once, in order.
+class RefusalPipe {
+ public:
+  RefusalPipe() {
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC | O_NONBLOCK) != 0) return;  // none: the children print to stderr
+    read_ = fds[0];
+    // The write end is inherited by the children (no close-on-exec there): dup'ed without it.
+    write_ = ::fcntl(fds[1], F_DUPFD, 3);
+    ::close(fds[1]);
+  }
+  ~RefusalPipe() {
+    if (read_ >= 0) ::close(read_);
+    if (write_ >= 0) ::close(write_);
+  }
+  RefusalPipe(const RefusalPipe&) = delete;
+  RefusalPipe& operator=(const RefusalPipe&) = delete;
+  int write_fd() const { return write_; }
+  std::vector<std::string> lines() {
+    std::string text;
+    char buf[4096];
+    for (ssize_t n; read_ >= 0 && (n = ::read(read_, buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
+    std::vector<std::string> out;
+    std::size_t start = 0;
+    while (start < text.size()) {
+      const std::size_t end = std::min(text.find('\n', start), text.size());
+      const std::string line = text.substr(start, end - start);
+      if (!line.empty() && std::find(out.begin(), out.end(), line) == out.end()) out.push_back(line);
+      start = end + 1;
+    }
+    return out;
+  }
+
+ private:
+  int read_{-1}, write_{-1};
+};
+
+pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int niceness, const std::vector<int>& cpus,
+            int refusal_fd) {
   std::vector<char*> argv;
   argv.push_back(const_cast<char*>(exe.c_str()));
   for (const auto& s : args) argv.push_back(const_cast<char*>(s.c_str()));
@@ -83,6 +124,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
       if (::sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "warning: sched_setaffinity failed\n");
     }
     ::setenv(interrupt::kQuietEnv, "1", 1);  // an interrupt is reported once, by the launcher
+    if (refusal_fd >= 0) ::setenv(interrupt::kRefusalFdEnv, std::to_string(refusal_fd).c_str(), 1);  // and a refusal
     ::execv(exe.c_str(), argv.data());
     std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
     ::_exit(127);
@@ -174,17 +216,19 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     }
   }
 
+  RefusalPipe refusal_pipe;
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
     if (interrupt::signal_number() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{}; this run is {} (--realtime), "
+      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
+                   "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
                    "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
                    "(docs/external-{}.md)",
                    role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
                    opt.key_file.empty() ? "" : " --key " + opt.key_file,
                    opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
-                   opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s), seconds_text(opt.step_timeout_s),
+                   opt.scenario_hash, opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s), seconds_text(opt.step_timeout_s),
                    seconds_text(opt.resend_interval_s), opt.monitor_window, role == "plant" ? "plant" : "controllers");
       continue;
     }
@@ -203,7 +247,8 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     // plant); how much they yield to it depends on the mode (launch.hpp).
     const bool off_path = role == "monitor" || role == "trajectory";
     const int niceness = off_path ? (opt.realtime ? lo.realtime_off_path_niceness : lo.off_path_niceness) : 0;
-    running[spawn(exe, args, niceness, off_path && !lo.off_path_cpus.empty() ? lo.off_path_cpus : lo.cpus)] = role;
+    running[spawn(exe, args, niceness, off_path && !lo.off_path_cpus.empty() ? lo.off_path_cpus : lo.cpus,
+                  refusal_pipe.write_fd())] = role;
   }
 
   LaunchResult result;
@@ -228,7 +273,13 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
         }
       }
       if (code != 0) {
-        if (code == 2) refused = true;
+        if (code == 2 && !refused) {
+          // Bad input: nothing to run. The others are stopped at once, quietly (they would only
+          // fail for want of this one); the refusal is the launcher's one line.
+          refused = true;
+          for (const auto& [p, other] : running) ::kill(p, SIGTERM);
+          terminated = true;
+        }
         result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
         if (first_failure_us < 0) first_failure_us = mono_us();
         // The monitor is the run's record and its judge (it names what the bus drops: an older
@@ -255,6 +306,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     }
     ::usleep(20000);
   }
+  result.refusals = refusal_pipe.lines();
   // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
   interrupt::check();
   result.exit_code = result.failed.empty() ? 0 : refused ? 2 : 1;

@@ -10,8 +10,10 @@
 #include <csignal>
 #include <cstring>
 #include <ctime>
+#include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/run_info_t.hpp"
 #include "feeddrive/service/contract.hpp"
 #include <cstdio>
 #include <cstdlib>
@@ -109,8 +111,14 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
         const auto it = peers_.find(m.role);
         const bool tracked = it != peers_.end() && (is_run_role(m.role) || m.role == kAttachedMonitorRole);
         const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
-        if (implausible || (tracked && (rank(m.state) < rank(it->second.state) ||
-                                        (a_monitor && m.acked_seq < it->second.acked_seq)))) {
+        // With --key, a run role's own step only grows within a state too: a signed "running"
+        // heartbeat at an earlier step is a replay (the trajectory paces itself by the plant's
+        // step, so a replayed one held the references back for seconds). Signed heartbeats
+        // cannot claim a future step, so the rule cannot be poisoned; without a key anyone can
+        // forge any step (docs/security.md: detected, not prevented), and the newest one wins.
+        const bool seq_back = keyed && tracked && m.state == it->second.state && m.seq < it->second.seq;
+        if (implausible || seq_back ||
+            (tracked && (rank(m.state) < rank(it->second.state) || (a_monitor && m.acked_seq < it->second.acked_seq)))) {
           const std::string was = tracked ? it->second.state : std::string("-");
           const std::int64_t was_acked = tracked ? it->second.acked_seq : -1;
           {
@@ -123,9 +131,10 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
                              "forged or replayed; ignored, {} conflicts so far", role_, ch_.status, m.role, m.acked_seq,
                              role_, seq_, conflicts);
               else
-                spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' after its own '{}', acknowledged "
-                             "step {} after {}; forged or replayed; ignored, {} conflicts so far)", role_, ch_.status,
-                             m.role, m.state, was, m.acked_seq, was_acked, conflicts);
+                spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' at step {} after its own '{}' at "
+                             "step {}, acknowledged step {} after {}; forged or replayed; ignored, {} conflicts so far)",
+                             role_, ch_.status, m.role, m.state, m.seq, was, tracked ? it->second.seq : -1, m.acked_seq,
+                             was_acked, conflicts);
             }
             if (!implausible && on_peer_status_back) on_peer_status_back(m);
             return;
@@ -140,6 +149,18 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive)
         if (on_peer_status) on_peer_status(m);
       },
       Admit::kAnyRun);
+  // One run, one scenario: a participant started by hand (an external controller, a drive
+  // adapter's companion) with another scenario file than the run's is refused with exit 2 as
+  // soon as the monitor's run_info_t names the run's scenario hash (docs/lcm-contract.md).
+  if (role_ == "plant" || role_ == "controller" || role_ == "trajectory")
+    bus_.subscribe<run_info_t>(ch_.info, [this](const run_info_t& m, std::int64_t) {
+      if (opt_.scenario_hash.empty() || m.scenario_hash.empty() || m.scenario_hash == opt_.scenario_hash ||
+          !scenario_mismatch_.empty())
+        return;
+      scenario_mismatch_ = "this " + role_ + "'s scenario (sha256 " + opt_.scenario_hash.substr(0, 12) +
+                           "...) is not the run's (" + m.scenario + ", sha256 " + m.scenario_hash.substr(0, 12) +
+                           "... in run_info_t): start it with the run's scenario file; one run, one scenario";
+    });
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
     if (on_resend_request) on_resend_request(m);
   });
@@ -222,6 +243,7 @@ bool is_run_role(const std::string& role) {
 
 void Node::check_peers() const {
   interrupt::check();
+  if (!scenario_mismatch_.empty()) throw std::invalid_argument(scenario_mismatch_);
   for (const auto& [role, st] : peers_) {
     if (st.state != "failed" || !is_run_role(role)) continue;
     // Under feeddrive-launch a Ctrl-C reaches every process, but not at the same instant: a

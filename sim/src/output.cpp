@@ -134,17 +134,43 @@ void RunWriter::submit() {
   cv_.notify_all();
 }
 
+void RunWriter::flush() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (error_) std::rethrow_exception(error_);
+    flush_pending_ = true;
+  }
+  if (!block_.empty()) submit();
+  cv_.notify_all();
+}
+
 void RunWriter::drain() {
   submit();
   std::unique_lock<std::mutex> lock(m_);
-  cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || error_; });
+  cv_.wait(lock, [this] { return (queue_.empty() && !busy_ && !flush_pending_) || error_; });
   if (error_) std::rethrow_exception(error_);
 }
 
 void RunWriter::work() {
   std::unique_lock<std::mutex> lock(m_);
   for (;;) {
-    cv_.wait(lock, [this] { return !queue_.empty() || stop_; });
+    cv_.wait(lock, [this] { return !queue_.empty() || stop_ || flush_pending_; });
+    if (queue_.empty() && flush_pending_) {  // flush(): the rows written so far go to the file
+      flush_pending_ = false;
+      busy_ = true;
+      lock.unlock();
+      std::exception_ptr err;
+      try {
+        csv_->flush();
+      } catch (...) {
+        err = std::current_exception();
+      }
+      lock.lock();
+      busy_ = false;
+      if (err && !error_) error_ = err;
+      cv_.notify_all();
+      continue;
+    }
     if (queue_.empty()) return;  // stop_
     std::vector<Record> rows = std::move(queue_.front());
     queue_.pop_front();

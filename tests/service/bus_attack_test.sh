@@ -23,6 +23,10 @@
 #      key a plant heartbeat that goes back is a restart and fails the run: hil_test case 7b.)
 #   8. with --key, the run's own signed heartbeats of its first 0.3 s replayed through the rest
 #      of it (the plant's go back): the run completes identical.
+#   9. with --key, the same unsigned forgeries (case 7's heartbeats, and junk on the command
+#      and state channels from before the start): counted unauthenticated, never a reason to end
+#      the run, since each role is filled by its own process (issue 19's review: three unsigned
+#      "monitor" heartbeats ended a keyed run).
 #   4. concurrent runs with the default settings: the second launch refuses at once, in one
 #      line, naming the run that holds the group and how to choose another (exit 2); with
 #      another --prefix both complete identical. Two launches started at the same instant
@@ -251,6 +255,19 @@ grep -q "replaying" "$TMP/peer.log" || fail "replay_status: the peer replayed no
 [ "$rc" = 0 ] || { tail -5 "$TMP/replay_status.log" >&2; fail "replay_status: launch exited $rc"; }
 completed_identical_despite replay_status
 pass "the run's own signed heartbeats replayed with --key: identical ($(tail -n 1 "$TMP/peer.log"))"
+
+# 9. Unsigned forgeries in a keyed run.
+for mode in fake-heartbeats junk; do
+  timeout 300 "$BUILD/tests/fd-test-peer" $mode --seconds 120 --lcm-url "$URL" > "$TMP/peer.log" 2>&1 & peer_pid=$!
+  wait_on_bus $peer_pid
+  launch "keyed_$mode" --key "$KEY"
+  kill $peer_pid 2> /dev/null || true
+  wait $peer_pid 2> /dev/null || true
+  completed_identical_despite "keyed_$mode"
+  n=$(json "$TMP/keyed_$mode/summary.json" .lockstep.unauthenticated_messages)
+  [ "$n" -gt 0 ] || fail "keyed_$mode: no unauthenticated message counted"
+  pass "unsigned $mode in a keyed run: $n unauthenticated messages dropped; identical"
+done
 
 # 4. Concurrent runs.
 timeout 300 feeddrive-launch "$scen" --out "$TMP/first" --no-plots -q --lcm-url "$URL" > "$TMP/first.log" 2>&1 & first=$!

@@ -40,6 +40,11 @@ refused missing_parent "its folder $TMP/nowhere does not exist" s.yaml --out o -
 # /proc takes no new file, although root may write in it (access() says yes): the launcher
 # creates the file and removes it again before anything starts (issue 19's review).
 refused proc_log "lcm-log /proc/fd-run.lcmlog: cannot be created" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log /proc/fd-run.lcmlog
+refused proc_file_log "lcm-log /proc/version: is a kernel pseudo file" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log /proc/version
+# A file that is not an LCM log (here the run's own scenario) is never overwritten by --lcm-log.
+cp s.yaml s_before.yaml
+refused clobber_log "lcm-log s.yaml: exists and is not a file this option writes" s.yaml --out o --no-plots -q --lcm-url "$URL" --lcm-log s.yaml
+cmp -s s.yaml s_before.yaml || fail "--lcm-log s.yaml changed the scenario"
 [ -e o ] && fail "a refused launch left an output folder"
 
 # 2. A scenario other than the launcher's.
@@ -73,24 +78,46 @@ done
 [ "$left" = 0 ] || fail "$left of the launcher's processes still running 5 s after it was killed"
 pass "SIGKILL of feeddrive-launch: its four processes stopped with it"
 
-# 4. SIGKILL of the monitor.
+# 4. SIGKILL of the monitor, mid-run, paced at 500 steps/s: the staged record goes beside --out
+# and holds every step up to the last second (the monitor hands its rows to the file every
+# second; issue 19's review found 0 bytes after 3,000 steps).
 rc=0
-feeddrive-launch s.yaml --out mon --no-plots --lcm-url "$URL" --step-timeout 2 > mon.log 2>&1 & launcher=$!
+feeddrive-launch s.yaml --out mon --no-plots --lcm-url "$URL" --step-timeout 2 --max-rate 500 > mon.log 2>&1 & launcher=$!
 for _ in $(seq 200); do [ "$(running_children $launcher)" = 4 ] && break; sleep 0.05; done
 monitor=$(pgrep -P $launcher -f "feeddrive-monitor " || true)
 [ -n "$monitor" ] || fail "no monitor under the launcher"
-# Mid-run: once the monitor's staging record holds 64 kB of rows (past any write buffer), not
-# after a fixed sleep (a loaded machine may not have started the run by then).
-for _ in $(seq 400); do
-  [ -n "$(find . -maxdepth 2 -path "./.mon.partial-$monitor-*/timeseries.csv" -size +64k 2> /dev/null)" ] && break
+# Killed once its progress line says step 1500 (3 s of steps), whatever the machine's load.
+at=0
+for _ in $(seq 600); do
+  at=$(tr '\r' '\n' < mon.log | grep -o "step [0-9]*" | tail -n 1 | cut -d' ' -f2 || true)
+  [ "${at:-0}" -ge 1500 ] && break
   sleep 0.05
 done
+[ "${at:-0}" -ge 1500 ] || fail "the monitor did not reach step 1500 within 30 s"
 kill -KILL "$monitor"
 wait $launcher || rc=$?
 [ "$rc" = 1 ] || { tail -5 mon.log >&2; fail "monitor killed: launch exited $rc, expected 1"; }
 tail -n 1 mon.log | grep -q "the monitor was killed: its record up to then .* is in $TMP/mon.incomplete-1" ||
   { tail -5 mon.log >&2; fail "the launcher's last line does not name the monitor's partial record"; }
 [ -d mon.incomplete-1 ] || fail "no mon.incomplete-1"
-rows=$(grep -c "" mon.incomplete-1/timeseries.csv || true)
-[ "$rows" -gt 1 ] || fail "the partial record has no rows"
-pass "SIGKILL of the monitor: $(tail -n 1 mon.log | sed 's/.*\] //') ($rows lines)"
+rows=$(( $(grep -c "" mon.incomplete-1/timeseries.csv || true) - 1 ))
+# At most one second (500 steps) lost, and 100 more for the progress line's own lag.
+[ "$rows" -ge $(( at - 600 )) ] || fail "the partial record has $rows rows; the monitor had passed step $at"
+pass "SIGKILL of the monitor at step $at: $(tail -n 1 mon.log | sed 's/.*\] //') ($rows rows kept)"
+
+# 5. An external controller started by hand with another scenario file (issue 19's review: it
+# ran, and the run passed with the record of the other file): refused with exit 2 and one line
+# naming both hashes once the monitor's run_info_t names the run's scenario; the run fails.
+sed 's/^name:.*/name: another/' s.yaml > another.yaml
+rc=0
+timeout 60 feeddrive-launch s.yaml --out ext --no-plots -q --lcm-url "$URL" --external controller --run-id 4711 \
+  --start-timeout 5 > ext.log 2>&1 & launcher=$!
+crc=0
+timeout 30 feeddrive-controller another.yaml --lcm-url "$URL" --run-id 4711 -q > ctl.log 2>&1 || crc=$?
+wait $launcher || rc=$?
+[ "$crc" = 2 ] || { cat ctl.log >&2; fail "a controller with another scenario: exit $crc, expected 2"; }
+[ "$(grep -c "" ctl.log)" = 1 ] || { cat ctl.log >&2; fail "a controller with another scenario: not one line"; }
+grep -q "this controller's scenario (sha256 .*) is not the run's" ctl.log || { cat ctl.log >&2; fail "the refusal does not name the scenarios"; }
+[ "$rc" != 0 ] || fail "the run passed with a controller of another scenario"
+[ -f ext/summary.json ] && [ "$(jq -r .lockstep.completed ext/summary.json)" = true ] && fail "ext: completed"
+pass "an external controller with another scenario: $(cat ctl.log | sed 's/.*\] //') (the launch exited $rc)"

@@ -1,3 +1,4 @@
+#include <unistd.h>
 // The one mapping from errors to exit codes of every tool (common/tool/main.hpp): pure logic.
 #include <gtest/gtest.h>
 
@@ -37,6 +38,25 @@ TEST(ToolReport, EachErrorKindHasItsExitCodeAndOneLine) {
   EXPECT_EQ(code_of(interrupt::Interrupted(SIGTERM)), 128 + SIGTERM);
   EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "");
   ::unsetenv(interrupt::kQuietEnv);
+}
+
+// Under feeddrive-launch a refusal goes to the launcher's pipe (interrupt::kRefusalFdEnv), which
+// prints each different line once; a failure (exit 1) still goes to stderr.
+TEST(ToolReport, UnderTheLauncherARefusalGoesToItsPipe) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ::setenv(interrupt::kRefusalFdEnv, std::to_string(fds[1]).c_str(), 1);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(code_of(std::invalid_argument("s.yaml: the scenario file is a FIFO")), kExitBadInput);
+  EXPECT_EQ(code_of(std::runtime_error("step timeout")), kExitFailed);
+  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: step timeout\n");
+  ::unsetenv(interrupt::kRefusalFdEnv);
+  ::close(fds[1]);
+  char buf[256];
+  const ssize_t n = ::read(fds[0], buf, sizeof buf);
+  ::close(fds[0]);
+  ASSERT_GT(n, 0);
+  EXPECT_EQ(std::string(buf, static_cast<std::size_t>(n)), "error: s.yaml: the scenario file is a FIFO\n");
 }
 
 TEST(ToolReport, InputStepMakesEveryErrorButAnInterruptBadInput) {

@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <fcntl.h>
+#include <sys/statfs.h>
 #include <stdio.h>  // renameat2, RENAME_EXCHANGE (_GNU_SOURCE)
 #include <sys/stat.h>
 #include <unistd.h>
@@ -251,7 +252,7 @@ void check_outside(const std::string& file, const std::string& file_option, cons
                                 ", which is replaced when the run ends (the file would be lost); put it next to the folder");
 }
 
-void check_output_file(const std::string& file, const std::string& option) {
+void check_output_file(const std::string& file, const std::string& option, const std::string& magic) {
   if (file.empty()) return;
   struct stat st {};
   if (::stat(file.c_str(), &st) == 0) {
@@ -261,9 +262,18 @@ void check_output_file(const std::string& file, const std::string& option) {
     if (::access(file.c_str(), W_OK) != 0) refuse(option, file, "exists and is not writable (" + error_text(errno) + ")");
     // Opened for writing, without truncating it: what root's access() does not see (a read-only
     // mount, a pseudo file system) shows here.
-    const int fd = ::open(file.c_str(), O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    // /proc and /sys files pass every check above for root and take no log.
+    struct statfs fs {};
+    if (::statfs(file.c_str(), &fs) == 0 && (fs.f_type == 0x9fa0 /* PROC_SUPER_MAGIC */ || fs.f_type == 0x62656572 /* SYSFS_MAGIC */))
+      refuse(option, file, "is a kernel pseudo file (/proc, /sys), not a file to write a log to");
+    const int fd = ::open(file.c_str(), O_RDWR | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) refuse(option, file, "cannot be opened for writing (" + error_text(errno) + ")");
+    std::string head(magic.size(), '\0');
+    const ssize_t got = magic.empty() || st.st_size == 0 ? 0 : ::read(fd, head.data(), head.size());
     ::close(fd);
+    if (!magic.empty() && st.st_size > 0 && (got != static_cast<ssize_t>(magic.size()) || head != magic))
+      refuse(option, file, "exists and is not a file this option writes (" + std::to_string(st.st_size) +
+                               " bytes); it is not replaced: name a new file, or remove it first");
     return;
   }
   if (errno != ENOENT) refuse(option, file, "cannot be examined (" + error_text(errno) + ")");

@@ -3,12 +3,32 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 #include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::tool {
+
+namespace {
+
+// A refusal's one line: to the launcher's pipe when started by feeddrive-launch (it prints each
+// different line once), else to stderr. One write(2) of under PIPE_BUF bytes: never interleaved.
+int refuse(const char* what) {
+  const std::string line = std::string("error: ") + what + "\n";
+  if (const char* fd = std::getenv(interrupt::kRefusalFdEnv); fd != nullptr && *fd != '\0') {
+    const std::string cut = line.size() < 4000 ? line : line.substr(0, 3999) + "\n";
+    if (::write(std::atoi(fd), cut.data(), cut.size()) == static_cast<ssize_t>(cut.size())) return kExitBadInput;
+  }
+  std::fputs(line.c_str(), stderr);
+  return kExitBadInput;
+}
+
+}  // namespace
 
 int report(std::exception_ptr e, const std::string& interrupt_detail) {
   try {
@@ -16,11 +36,9 @@ int report(std::exception_ptr e, const std::string& interrupt_detail) {
   } catch (const interrupt::Interrupted& i) {
     return interrupt::report(i, interrupt_detail);
   } catch (const BadInput& b) {
-    std::fprintf(stderr, "error: %s\n", b.what());
-    return kExitBadInput;
+    return refuse(b.what());
   } catch (const std::invalid_argument& b) {
-    std::fprintf(stderr, "error: %s\n", b.what());
-    return kExitBadInput;
+    return refuse(b.what());
   } catch (const std::exception& f) {
     std::fprintf(stderr, "error: %s\n", f.what());
     return kExitFailed;

@@ -76,6 +76,11 @@ inline void clear() { detail::g_signal = 0; }
 /// Set (to "1") by feeddrive-launch for the processes it starts: the launcher reports the
 /// interrupt once, its children stay silent about it.
 inline constexpr const char* kQuietEnv = "FEEDDRIVE_INTERRUPT_QUIET";
+/// Set by feeddrive-launch for the processes it starts: the number of a file descriptor (a
+/// pipe's write end). A refusal (bad input, exit 2) is written there as its one line instead of
+/// to stderr, and the launcher prints each different one once (four processes refusing one
+/// swapped scenario make one line, not four).
+inline constexpr const char* kRefusalFdEnv = "FEEDDRIVE_REFUSAL_FD";
 
 /// The end of an interrupted tool (docs/scenario.md, "Exit codes and Ctrl-C"): prints the one
 /// line "error: interrupted by SIGINT<detail>" (unless started by feeddrive-launch) and returns

@@ -142,6 +142,8 @@ class MonitorNode : public service::Node {
   std::map<std::string, std::int64_t> named_;  ///< what was named already (one line per sender and kind) -> count
   std::int64_t plant_seq_seen_{-1};  ///< the highest step of the plant's heartbeats
   std::map<std::string, std::string> source_process_;  ///< command source "IP:PORT" -> local process
+  std::map<std::string, std::int64_t> first_unauthenticated_us_;  ///< per channel and role (mono_us)
+  std::int64_t last_file_flush_us_{0};  ///< when the record last went to its file (mono_us)
   std::vector<service::StockLogger> loggers_;  ///< stock loggers seen on the bus during the run
   std::int64_t rate_since_us_{-1}, rate_since_step_{0};
   double peak_rate_{0.0};  ///< the most steps per second recorded in one window of >= 1 s

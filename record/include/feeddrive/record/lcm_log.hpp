@@ -18,6 +18,9 @@ namespace feeddrive::record {
 
 constexpr std::uint32_t kLcmLogSync = 0xEDA1DA01u;
 constexpr std::size_t kLcmLogHeaderSize = 28;
+/// The first four bytes of every LCM log file (the sync word, big-endian): an existing file that
+/// does not start with them is not an LCM log and is never overwritten by --lcm-log.
+inline const std::string kLcmLogMagic{"\xED\xA1\xDA\x01", 4};
 
 struct LcmLogHeader {
   std::uint32_t sync{kLcmLogSync};

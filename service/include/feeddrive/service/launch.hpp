@@ -60,6 +60,9 @@ struct LaunchResult {
   /// The monitor was killed (no unwinding, e.g. SIGKILL): where its record so far was moved
   /// (DIR.incomplete-N, output::rescue_staging); "" otherwise.
   std::string partial_record;
+  /// The different one-line refusals of the processes that exited 2 (bad input), each once; the
+  /// launcher prints these instead of a line per process (the others were stopped at once).
+  std::vector<std::string> refusals;
 };
 
 /// Throws std::invalid_argument (one line: who holds it, how to choose another) if another

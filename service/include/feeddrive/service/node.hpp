@@ -152,6 +152,7 @@ class Node {
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
   std::int64_t last_conflict_log_us_{-1};
+  std::string scenario_mismatch_;  ///< set when run_info_t names another scenario hash than ours
   std::int64_t attached_acked_{-2};        ///< the attached monitor's last acknowledgement
   std::int64_t attached_progress_us_{-1};  ///< when it last moved (mono_us)
   static constexpr double kAttachedHoldS = 2.0;  ///< longest an attached monitor holds the linger

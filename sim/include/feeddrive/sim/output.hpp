@@ -70,6 +70,10 @@ class RunWriter {
   void keep_data_on_interrupt(bool keep) { keep_on_interrupt_ = keep; }
   /// How many steps the record will have (a log's own bound where it is shorter than the scenario).
   void set_expected_steps(double steps) { expected_steps_ = steps; }
+  /// Has every row added so far written to timeseries.csv's file now (not only when a block of
+  /// kBlockRows fills): the monitor calls it every second, so a SIGKILL loses at most a second
+  /// of its record (the launcher rescues the staged folder). Rethrows a write error.
+  void flush();
   long steps() const { return added_; }
   /// The most recent record (undefined before the first add).
   const Record& last() const { return last_; }
@@ -122,7 +126,7 @@ class RunWriter {
   std::condition_variable cv_;
   std::deque<std::vector<Record>> queue_;
   std::vector<std::vector<Record>> spare_;  // emptied blocks, reused
-  bool busy_{false}, stop_{false};
+  bool busy_{false}, stop_{false}, flush_pending_{false};
   std::exception_ptr error_;
   std::thread worker_;
 };

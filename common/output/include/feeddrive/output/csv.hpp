@@ -38,12 +38,14 @@ class CsvWriter {
   void row(const std::vector<double>& values) { row(values.data(), values.size()); }
   /// Flushes and closes; throws std::runtime_error on any write error.
   void close();
+  /// Hands the buffered rows to the file (the kernel's page cache: a process killed after this
+  /// loses none of them); throws std::runtime_error on a write error.
+  void flush();
   std::uint64_t rows() const { return rows_; }
   /// Bytes of text so far, header included (written to the file or still in the buffer).
   std::uint64_t bytes() const { return bytes_ + used_; }
 
  private:
-  void flush();
   std::filesystem::path path_;
   int fd_{-1};
   std::vector<char> buf_;

@@ -75,7 +75,10 @@ void check_outside(const std::string& file, const std::string& file_option, cons
 /// exists and is writable, and the file, if it exists, is a regular file this user can write
 /// (not a FIFO, which would block the writer's open(), a device or a folder). Throws
 /// std::invalid_argument, one line naming the option, the value and what is wrong. "" passes.
-void check_output_file(const std::string& file, const std::string& option);
+/// An existing, non-empty file is replaced only if it starts with `magic` (e.g. an LCM log's
+/// first four bytes): a user's scenario, key or other file is never overwritten. Empty `magic`:
+/// any file may be replaced.
+void check_output_file(const std::string& file, const std::string& option, const std::string& magic = "");
 
 /// After the process `pid` that wrote `out` died unfinished (SIGKILL: no unwinding), moves the
 /// staging folder it left (its record so far) to the first free OUT.incomplete-N beside `out`
