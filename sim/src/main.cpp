@@ -56,9 +56,8 @@ int main(int argc, char** argv) {
       spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), feeddrive::output::shown(out_dir));
     else if (!no_plots)
       spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
-    spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",
-                 summary.position_error_max_abs_m, summary.position_error_rms_m, summary.control_min,
-                 summary.control_max, summary.wall_time_s, out_dir);
+    spdlog::info("{}, wall {:.3f} s -> {}", feeddrive::sim::summary_headline(feeddrive::sim::summary_json(summary, scenario)),
+                 summary.wall_time_s, out_dir);
   } catch (const feeddrive::interrupt::Interrupted& e) {
     std::fprintf(stderr, "error: %s; nothing written to %s\n", e.what(), feeddrive::output::shown(out_dir).c_str());
     return e.exit_code();

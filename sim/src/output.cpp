@@ -208,7 +208,7 @@ void RunWriter::check_projected_size() const {
   }
 }
 
-Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) {
+Summary RunWriter::summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) {
   drain();
   return summary_.summary(wall_time_s, integrator);
 }
