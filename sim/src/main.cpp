@@ -3,6 +3,9 @@
 //   scenario.yaml --> load_scenario --> run (reference -> controller -> CVODE plant) --> RunWriter
 //                                        each record streamed to timeseries.csv, summary, plots
 //
+// --frequency-response: instead of the scenario's run, the closed loop's frequency response by
+// stepped sines (analysis/frequency_response.hpp, docs/analysis.md) into DIR.
+//
 // Exit codes: 0 ok, 2 bad input (scenario, arguments, a run too large), 1 runtime failure,
 // 128 + signal after Ctrl-C / SIGTERM (the staged output folder is removed).
 #include <CLI/CLI.hpp>
@@ -10,6 +13,7 @@
 
 #include <cstdio>
 
+#include "feeddrive/analysis/frequency_response.hpp"
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
@@ -25,6 +29,19 @@ int main(int argc, char** argv) {
   app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only errors");
+  bool frequency_response = false;
+  feeddrive::analysis::FrequencyResponseOptions fr;
+  app.add_flag("--frequency-response", frequency_response, "measure the closed loop's frequency response (docs/analysis.md)");
+  app.add_option("--fr-frequencies", fr.frequencies, "frequencies [Hz] (default: --fr-points log-spaced)")->delimiter(',');
+  app.add_option("--fr-from", fr.f_min, "lowest frequency [Hz]")->capture_default_str();
+  app.add_option("--fr-to", fr.f_max, "highest frequency [Hz] (0: 0.2/control_period)")->capture_default_str();
+  app.add_option("--fr-points", fr.points, "number of frequencies")->capture_default_str();
+  app.add_option("--fr-amplitude", fr.reference_amplitude, "reference sine amplitude [m] (0: no reference run)")->capture_default_str();
+  app.add_option("--fr-acceleration", fr.acceleration_limit, "reference acceleration limit [m/s^2] (0: a quarter of the force range / mass)")->capture_default_str();
+  app.add_option("--fr-force", fr.force_amplitude, "disturbance force amplitude [N] (0: no disturbance run)")->capture_default_str();
+  app.add_option("--fr-velocity", fr.feed_velocity, "constant feed velocity under the excitation [m/s]")->capture_default_str();
+  app.add_option("--fr-settle", fr.settle_time, "least settling time dropped per frequency [s]")->capture_default_str();
+  app.add_option("--jobs,-j", fr.jobs, "frequencies measured in parallel")->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -38,12 +55,21 @@ int main(int argc, char** argv) {
   try {
     scenario = feeddrive::sim::load_scenario(scenario_path);
     feeddrive::output::check_output_dir(out_dir);  // before any work
-    feeddrive::sim::check_run_size(scenario, out_dir);
+    if (frequency_response) fr.validate(scenario);
+    else feeddrive::sim::check_run_size(scenario, out_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
   }
   try {
+    if (frequency_response) {
+      const auto r = feeddrive::analysis::measure_frequency_response(scenario, fr);
+      if (!quiet) std::fputs(feeddrive::analysis::frequency_response_table(scenario, r).c_str(), stdout);
+      const std::string plot_error = feeddrive::analysis::write_frequency_response(out_dir, scenario, r, !no_plots);
+      if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, feeddrive::output::shown(out_dir));
+      spdlog::info("{} frequencies in {:.1f} s -> {}", r.points.size(), r.wall_time_s, out_dir);
+      return 0;
+    }
     spdlog::info("{}: {} steps of {} s", scenario.name, scenario.steps(), scenario.control_period);
     if (scenario.controller.type == feeddrive::sim::ControllerType::kCascade)
       spdlog::info("cascade gains: kp = {:.6g} 1/s, kv = {:.6g} 1/s, ki = {:.6g} 1/s^2", scenario.controller.cascade.kp,
