@@ -219,6 +219,21 @@ FrequencyResponse measure_frequency_response(const sim::Scenario& s, const Frequ
   return r;
 }
 
+std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>& h, bool negative_start) {
+  std::vector<double> phase(h.size(), 0.0);
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    double a = std::arg(h[i]) * 180.0 / kPi;
+    if (i == 0) {
+      if (negative_start && a > 0.0) a -= 360.0;
+    } else {
+      while (a - phase[i - 1] > 180.0) a -= 360.0;
+      while (a - phase[i - 1] < -180.0) a += 360.0;
+    }
+    phase[i] = a;
+  }
+  return phase;
+}
+
 void compute_figures(FrequencyResponse& r) {
   const auto& p = r.points;
   const double kBw = -20.0 * std::log10(std::sqrt(2.0));  // -3.01 dB
@@ -236,17 +251,9 @@ void compute_figures(FrequencyResponse& r) {
     }
   }
   // phase of L unwrapped from the lowest frequency, started in (-360, 0]
-  std::vector<double> phase(p.size(), 0.0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    double a = std::arg(p[i].loop) * 180.0 / kPi;
-    if (i == 0) {
-      if (a > 0.0) a -= 360.0;
-    } else {
-      while (a - phase[i - 1] > 180.0) a -= 360.0;
-      while (a - phase[i - 1] < -180.0) a += 360.0;
-    }
-    phase[i] = a;
-  }
+  std::vector<cd> loop;
+  for (const FrequencyPoint& q : p) loop.push_back(q.loop);
+  const std::vector<double> phase = unwrapped_phase_deg(loop, true);
   std::size_t ic = p.size();
   for (std::size_t i = 1; i < p.size(); ++i) {
     if (!p[i].has_disturbance) break;

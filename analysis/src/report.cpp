@@ -81,11 +81,19 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
                            "stiffness_N_per_um", "L_dB", "L_deg", "S_dB", "S_deg", "T_drift", "T_nonfundamental",
                            "disturbance_drift", "disturbance_nonfundamental", "saturated_steps"});
     const double nan = std::nan("");
+    // phases unwrapped along the frequency axis (the loop's from (-360, 0], as the margins take it)
+    std::vector<std::complex<double>> t, gd, l, si;
     for (const FrequencyPoint& p : r.points) {
+      t.push_back(p.closed_loop), gd.push_back(p.compliance), l.push_back(p.loop), si.push_back(p.sensitivity);
+    }
+    const auto t_deg = unwrapped_phase_deg(t), gd_deg = unwrapped_phase_deg(gd), l_deg = unwrapped_phase_deg(l, true),
+               s_deg = unwrapped_phase_deg(si);
+    for (std::size_t i = 0; i < r.points.size(); ++i) {
+      const FrequencyPoint& p = r.points[i];
       const bool a = p.has_reference, d = p.has_disturbance;
-      csv.row({p.frequency_hz, p.reference_amplitude_m, a ? db(p.closed_loop) : nan, a ? deg(p.closed_loop) : nan,
-               d ? std::abs(p.compliance) : nan, d ? deg(p.compliance) : nan, d ? p.stiffness_N_per_um() : nan,
-               d ? db(p.loop) : nan, d ? deg(p.loop) : nan, d ? db(p.sensitivity) : nan, d ? deg(p.sensitivity) : nan,
+      csv.row({p.frequency_hz, p.reference_amplitude_m, a ? db(p.closed_loop) : nan, a ? t_deg[i] : nan,
+               d ? std::abs(p.compliance) : nan, d ? gd_deg[i] : nan, d ? p.stiffness_N_per_um() : nan,
+               d ? db(p.loop) : nan, d ? l_deg[i] : nan, d ? db(p.sensitivity) : nan, d ? s_deg[i] : nan,
                a ? p.closed_loop_drift : nan, a ? p.closed_loop_nonfundamental : nan, d ? p.disturbance_drift : nan,
                d ? p.disturbance_nonfundamental : nan, static_cast<double>(p.saturated_steps)});
     }

@@ -87,6 +87,9 @@ struct FrequencyResponse {
 FrequencyResponse measure_frequency_response(const sim::Scenario& s, const FrequencyResponseOptions& o);
 /// The summary figures from the points (measure_frequency_response calls it).
 void compute_figures(FrequencyResponse& r);
+/// The phases of h [deg], unwrapped (no step of more than 180 deg between neighbours), the first
+/// in (-180, 180], or in (-360, 0] with `negative_start` (an open loop's phase).
+std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>& h, bool negative_start = false);
 
 /// The table printed by the tool (one row per frequency, the amplitudes and the summary figures).
 std::string frequency_response_table(const sim::Scenario& s, const FrequencyResponse& r);
