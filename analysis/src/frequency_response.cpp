@@ -183,7 +183,7 @@ FrequencyResponse measure_frequency_response(const sim::Scenario& s, const Frequ
   r.options = o;
   std::vector<double> fs = o.frequencies;
   if (fs.empty()) {
-    const double f_max = o.f_max > 0.0 ? o.f_max : std::min(0.2 / s.control_period, 0.49 / s.control_period);
+    const double f_max = o.f_max > 0.0 ? o.f_max : 0.4 / s.control_period;
     for (int i = 0; i < o.points; ++i)
       fs.push_back(o.points == 1 ? o.f_min : o.f_min * std::pow(f_max / o.f_min, static_cast<double>(i) / (o.points - 1)));
   }

@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_flag("--frequency-response", frequency_response, "measure the closed loop's frequency response (docs/analysis.md)");
   app.add_option("--fr-frequencies", fr.frequencies, "frequencies [Hz] (default: --fr-points log-spaced)")->delimiter(',');
   app.add_option("--fr-from", fr.f_min, "lowest frequency [Hz]")->capture_default_str();
-  app.add_option("--fr-to", fr.f_max, "highest frequency [Hz] (0: 0.2/control_period)")->capture_default_str();
+  app.add_option("--fr-to", fr.f_max, "highest frequency [Hz] (0: 0.4/control_period)")->capture_default_str();
   app.add_option("--fr-points", fr.points, "number of frequencies")->capture_default_str();
   app.add_option("--fr-amplitude", fr.reference_amplitude, "reference sine amplitude [m] (0: no reference run)")->capture_default_str();
   app.add_option("--fr-acceleration", fr.acceleration_limit, "reference acceleration limit [m/s^2] (0: a quarter of the force range / mass)")->capture_default_str();

@@ -42,7 +42,7 @@ namespace feeddrive::analysis {
 struct FrequencyResponseOptions {
   std::vector<double> frequencies;  ///< [Hz]; empty: `points` log-spaced over [f_min, f_max]
   double f_min{5.0};                ///< [Hz]
-  double f_max{0.0};                ///< [Hz]; 0: 0.2/T (2 kHz at T = 0.1 ms), below Nyquist 0.5/T
+  double f_max{0.0};                ///< [Hz]; 0: 0.4/T (4 kHz at T = 0.1 ms), below Nyquist 0.5/T
   int points{20};
   double reference_amplitude{1e-5};   ///< A [m]; 0: no reference run
   double acceleration_limit{0.0};     ///< a_lim [m/s^2]; 0: a quarter of the controller's force range / mass
