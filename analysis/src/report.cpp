@@ -41,6 +41,16 @@ std::string bandwidth_text(const FrequencyResponse& r) {
   return "above the highest frequency measured (|T| >= -3 dB throughout)";
 }
 
+// The frequencies whose response is mostly not at the excitation's frequency, or drifts.
+std::string doubtful_points(const FrequencyResponse& r) {
+  std::string out;
+  for (const FrequencyPoint& p : r.points)
+    if (std::max(p.closed_loop_nonfundamental, p.disturbance_nonfundamental) > 0.5 * std::sqrt(2.0) ||
+        std::max(p.closed_loop_drift, p.disturbance_drift) > 0.1)
+      out += (out.empty() ? "" : ", ") + g(p.frequency_hz);
+  return out;
+}
+
 }  // namespace
 
 std::string frequency_response_table(const sim::Scenario& s, const FrequencyResponse& r) {
@@ -68,6 +78,12 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
   t << "peak sensitivity Ms " << g(r.sensitivity_peak, "%.3f") << " (" << g(20 * std::log10(r.sensitivity_peak), "%.2f") << " dB) at "
     << g(r.sensitivity_peak_hz) << " Hz; phase margin " << g(r.phase_margin_deg, "%.1f") << " deg at " << g(r.crossover_hz)
     << " Hz; gain margin " << g(r.gain_margin_db, "%.1f") << " dB at " << g(r.phase_crossover_hz) << " Hz\n";
+  const std::string doubtful = doubtful_points(r);
+  if (!doubtful.empty())
+    t << "WARNING: at " << doubtful << " Hz more than half of the power of the position's response is at other frequencies (nonfund > 0.71) or the two "
+      << "blocks differ by more than 10 %: the ratio there is not a frequency response (chatter, stick-slip, a response that "
+      << "wanders), and the figures above that use those points are doubtful. A larger amplitude, a boundary layer or "
+      << "--fr-settle would settle it.\n";
   t << "least dynamic stiffness " << g(r.min_stiffness_N_per_um) << " N/um at " << g(r.min_stiffness_hz) << " Hz (force amplitude "
     << g(o.force_amplitude) << " N)\n";
   return t.str();
@@ -129,6 +145,8 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
   j["phase_crossover_hz"] = num(r.phase_crossover_hz);
   j["min_dynamic_stiffness_N_per_um"] = num(r.min_stiffness_N_per_um);
   j["min_dynamic_stiffness_hz"] = num(r.min_stiffness_hz);
+  const std::string doubtful = doubtful_points(r);
+  j["doubtful_frequencies_hz"] = doubtful.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(doubtful);
   j["wall_time_s"] = r.wall_time_s;
   folder.write_text("frequency_response.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::string plot_error;

@@ -24,6 +24,9 @@
 //   drift         |H_1 - H_2|/|H| of the two blocks (a transient left, or a response that wanders)
 //   nonfundamental sqrt(P_other/(P_fund + P_other)) of the position: the share of the response at
 //                 other frequencies (harmonics from friction, stick-slip, chatter, noise)
+// A point where nonfundamental > 1/sqrt(2) (more of the power elsewhere than at f) or drift > 0.1
+// is named as doubtful in the table and in frequency_response.json (doubtful_frequencies_hz): its
+// ratio is not a frequency response, and neither is a figure interpolated from it.
 // Friction makes the result depend on the amplitude: A(f), F and v_feed are in every output.
 //
 // Summary figures (FrequencyResponse): closed-loop bandwidth (the first -3 dB crossing of |T|,
