@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 namespace feeddrive::sim {
@@ -47,6 +48,20 @@ namespace {
 // A difference of two finite doubles can exceed the largest double (1e308 - -1e308): the metrics
 // saturate there instead of becoming infinite (NaN, a run without truth, stays NaN).
 constexpr double kLargest = std::numeric_limits<double>::max();
+// The move metrics' keys in summary.json, in order (null where they do not apply).
+const std::pair<const char*, double Summary::*> kMoveFields[] = {
+    {"move_start_s", &Summary::move_start_s},
+    {"move_end_s", &Summary::move_end_s},
+    {"move_distance_m", &Summary::move_distance_m},
+    {"rise_time_s", &Summary::rise_time_s},
+    {"overshoot_m", &Summary::overshoot_m},
+    {"overshoot_percent", &Summary::overshoot_percent},
+    {"settling_band_m", &Summary::settling_band_m},
+    {"settling_time_s", &Summary::settling_time_s},
+    {"settle_after_move_s", &Summary::settle_after_move_s},
+    {"position_error_max_abs_during_move_m", &Summary::position_error_max_abs_during_move_m},
+    {"position_error_rms_during_move_m", &Summary::position_error_rms_during_move_m},
+    {"position_error_max_abs_after_move_m", &Summary::position_error_max_abs_after_move_m}};
 double saturated(long double v) { return v > kLargest ? kLargest : v < -kLargest ? -kLargest : static_cast<double>(v); }
 }  // namespace
 
@@ -292,18 +307,7 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["integrator_error_test_fails"] = counted(m.integrator_error_test_fails);
   // Move and step metrics (summary.hpp): null where they do not apply.
   const auto opt = [&](double v) { return m.steps > 0 && std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
-  j["move_start_s"] = opt(m.move_start_s);
-  j["move_end_s"] = opt(m.move_end_s);
-  j["move_distance_m"] = opt(m.move_distance_m);
-  j["rise_time_s"] = opt(m.rise_time_s);
-  j["overshoot_m"] = opt(m.overshoot_m);
-  j["overshoot_percent"] = opt(m.overshoot_percent);
-  j["settling_band_m"] = opt(m.settling_band_m);
-  j["settling_time_s"] = opt(m.settling_time_s);
-  j["settle_after_move_s"] = opt(m.settle_after_move_s);
-  j["position_error_max_abs_during_move_m"] = opt(m.position_error_max_abs_during_move_m);
-  j["position_error_rms_during_move_m"] = opt(m.position_error_rms_during_move_m);
-  j["position_error_max_abs_after_move_m"] = opt(m.position_error_max_abs_after_move_m);
+  for (const auto& [key, field] : kMoveFields) j[key] = opt(m.*field);
   // Chatter (summary.hpp): reversals of the command's steps larger than the threshold.
   j["control_chatter_threshold_V"] = m.control_chatter_threshold_V;
   j["control_reversals_per_s"] = val(m.control_reversals_per_s);
@@ -331,10 +335,7 @@ std::vector<std::string> summary_metric_names() {
   m.steps = 2;
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
-  for (double* v : {&m.move_start_s, &m.move_end_s, &m.move_distance_m, &m.rise_time_s, &m.overshoot_m, &m.overshoot_percent,
-                    &m.settling_band_m, &m.settling_time_s, &m.settle_after_move_s, &m.position_error_max_abs_during_move_m,
-                    &m.position_error_rms_during_move_m, &m.position_error_max_abs_after_move_m})
-    *v = 0.0;  // a move's metrics are numbers for a move
+  for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
   std::vector<std::string> names;
   for (auto it = j.begin(); it != j.end(); ++it)
