@@ -75,15 +75,19 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
   }
   t << "closed-loop bandwidth (-3 dB): " << bandwidth_text(r) << "; peak |T| " << g(r.peak_db, "%.2f") << " dB at " << g(r.peak_hz)
     << " Hz\n";
+  const std::string top = r.points.empty() ? "n/a" : g(r.points.back().frequency_hz);
   t << "peak sensitivity Ms " << g(r.sensitivity_peak, "%.3f") << " (" << g(20 * std::log10(r.sensitivity_peak), "%.2f") << " dB) at "
-    << g(r.sensitivity_peak_hz) << " Hz; phase margin " << g(r.phase_margin_deg, "%.1f") << " deg at " << g(r.crossover_hz)
-    << " Hz; gain margin " << g(r.gain_margin_db, "%.1f") << " dB at " << g(r.phase_crossover_hz) << " Hz\n";
+    << g(r.sensitivity_peak_hz) << " Hz; ";
+  if (std::isnan(r.phase_margin_deg)) t << "phase margin: none found (|L| does not cross 0 dB downward up to " << top << " Hz)";
+  else t << "phase margin " << g(r.phase_margin_deg, "%.1f") << " deg at " << g(r.crossover_hz) << " Hz";
+  if (std::isnan(r.gain_margin_db)) t << "; gain margin: none found (arg L does not cross -180 deg above the crossover up to " << top << " Hz)\n";
+  else t << "; gain margin " << g(r.gain_margin_db, "%.1f") << " dB at " << g(r.phase_crossover_hz) << " Hz\n";
   const std::string doubtful = doubtful_points(r);
   if (!doubtful.empty())
     t << "WARNING: at " << doubtful << " Hz more than half of the power of the position's response is at other frequencies (nonfund > 0.71) or the two "
       << "blocks differ by more than 10 %: the ratio there is not a frequency response (chatter, stick-slip, a response that "
-      << "wanders), and the figures above that use those points are doubtful. A larger amplitude, a boundary layer or "
-      << "--fr-settle would settle it.\n";
+      << "wanders), and the figures above that use those points are doubtful. What may help: an amplitude well above the "
+      << "chatter's, a longer --fr-settle (a transient), a smooth switching law.\n";
   t << "least dynamic stiffness " << g(r.min_stiffness_N_per_um) << " N/um at " << g(r.min_stiffness_hz) << " Hz (force amplitude "
     << g(o.force_amplitude) << " N)\n";
   return t.str();
