@@ -254,7 +254,9 @@ std::string summary_headline(const std::string& text) {
   line += ", u in [" + num("control_min") + ", " + num("control_max") + "] V";
   if (j.contains("settling_time_s") && j["settling_time_s"].is_number())
     line += ", settles to " + num("settling_band_m") + " m in " + num("settling_time_s") + " s";
-  else if (j.contains("move_start_s") && j["move_start_s"].is_number() && j.contains("settling_band_m") && j["settling_band_m"].is_number())
+  else if (j.contains("move_start_s") && j["move_start_s"].is_number() && j.contains("settling_band_m") &&
+           j["settling_band_m"].is_number() && j.contains("move_end_s") && j["move_end_s"].is_number() &&
+           j["move_end_s"].get<double>() <= j.value("sim_time_s", 0.0))  // a move that ended within the run
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
   if (j.value("control_chattering", false))
     line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
