@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/record/lcm_log.hpp"
@@ -83,15 +84,15 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::ifstream in(lo.out_dir + "/summary.json");
-    const auto j = nlohmann::json::parse(in, nullptr, false);
-    // The true-state error where the plant has one, else the measured one (a hardware plant).
-    const bool truth = !j.is_discarded() && j.contains("position_error_max_abs_m") && !j["position_error_max_abs_m"].is_null();
-    if (!j.is_discarded() && j.contains("lockstep"))
-      spdlog::info("{} steps, max |e| {} m{}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
-                   j[truth ? "position_error_max_abs_m" : "measured_position_error_max_abs_m"].dump(),
-                   truth ? "" : " (measured: x_d - x_measured)", j["lockstep"].value("resends", 0L),
-                   j["lockstep"].value("lost", 0L), j["lockstep"]["latency_us"]["state_to_command"]["p50"].dump(),
-                   lo.out_dir);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto j = nlohmann::json::parse(text, nullptr, false);
+    // The headline as feeddrive-sim prints it (sim/summary.hpp), then the lockstep figures.
+    if (!j.is_discarded() && j.contains("lockstep")) {
+      const auto p50 = j["lockstep"]["latency_us"]["state_to_command"].value("p50", nlohmann::json());
+      spdlog::info("{} steps, {}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
+                   sim::summary_headline(text), j["lockstep"].value("resends", 0L), j["lockstep"].value("lost", 0L),
+                   p50.is_number() ? fmt::format("{:.4g}", p50.get<double>()) : std::string("n/a"), lo.out_dir);
+    }
     return 0;
   });
 }

@@ -3,10 +3,16 @@
 //   scenario.yaml --> load_scenario --> run (reference -> controller -> CVODE plant) --> RunWriter
 //                                        each record streamed to timeseries.csv, summary, plots
 //
+// --frequency-response: instead of the scenario's run, the closed loop's frequency response by
+// stepped sines (analysis/frequency_response.hpp, docs/analysis.md) into DIR.
+//
 // Exit codes: 0 ok, 2 bad input (scenario, arguments, a run too large), 1 runtime failure,
 // 128 + signal after Ctrl-C / SIGTERM (the staged output folder is removed).
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
+
+#include "feeddrive/analysis/frequency_response.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -23,14 +29,38 @@ int main(int argc, char** argv) {
   app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--quiet,-q", quiet, "print only errors");
+  bool frequency_response = false;
+  analysis::FrequencyResponseOptions fr;
+  app.add_flag("--frequency-response", frequency_response, "measure the closed loop's frequency response (docs/analysis.md)");
+  app.add_option("--fr-frequencies", fr.frequencies, "frequencies [Hz] (default: --fr-points log-spaced)")->delimiter(',');
+  app.add_option("--fr-from", fr.f_min, "lowest frequency [Hz]")->capture_default_str();
+  app.add_option("--fr-to", fr.f_max, "highest frequency [Hz] (0: 0.4/control_period)")->capture_default_str();
+  app.add_option("--fr-points", fr.points, "number of frequencies")->capture_default_str();
+  app.add_option("--fr-amplitude", fr.reference_amplitude, "reference sine amplitude [m] (0: no reference run)")->capture_default_str();
+  app.add_option("--fr-acceleration", fr.acceleration_limit, "reference acceleration limit [m/s^2] (0: a quarter of the force range / mass)")->capture_default_str();
+  app.add_option("--fr-force", fr.force_amplitude, "disturbance force amplitude [N] (0: no disturbance run)")->capture_default_str();
+  app.add_option("--fr-velocity", fr.feed_velocity, "constant feed velocity under the excitation [m/s]")->capture_default_str();
+  app.add_option("--fr-settle", fr.settle_time, "least settling time dropped per frequency [s]")->capture_default_str();
+  app.add_option("--jobs,-j", fr.jobs, "frequencies measured in parallel")->capture_default_str();
   tool::Options opt{"feeddrive-sim", &quiet, [&] { return "; nothing written to " + output::shown(out_dir); }};
   return tool::run(app, argc, argv, opt, [&] {
     const sim::Scenario scenario = tool::input_step([&] {
       sim::Scenario s = sim::load_scenario(scenario_path);
       output::check_output_dir(out_dir);  // before any work
-      sim::check_run_size(s, out_dir);
+      if (frequency_response)
+        fr.validate(s);
+      else
+        sim::check_run_size(s, out_dir);
       return s;
     });
+    if (frequency_response) {
+      const auto r = analysis::measure_frequency_response(scenario, fr);
+      if (!quiet) std::fputs(analysis::frequency_response_table(scenario, r).c_str(), stdout);
+      const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, !no_plots);
+      if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
+      spdlog::info("{} frequencies in {:.1f} s -> {}", r.points.size(), r.wall_time_s, out_dir);
+      return kExitOk;
+    }
     spdlog::info("{}: {} steps of {} s", scenario.name, scenario.steps(), scenario.control_period);
     if (scenario.controller.type == sim::ControllerType::kCascade)
       spdlog::info("cascade gains: kp = {:.6g} 1/s, kv = {:.6g} 1/s, ki = {:.6g} 1/s^2", scenario.controller.cascade.kp,
@@ -46,9 +76,8 @@ int main(int argc, char** argv) {
       spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
     else if (!no_plots)
       spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
-    spdlog::info("max |e| = {:.4g} m, rms e = {:.4g} m, u in [{:.4g}, {:.4g}], wall {:.3f} s -> {}",
-                 summary.position_error_max_abs_m, summary.position_error_rms_m, summary.control_min,
-                 summary.control_max, summary.wall_time_s, out_dir);
+    spdlog::info("{}, wall {:.3f} s -> {}", sim::summary_headline(sim::summary_json(summary, scenario)),
+                 summary.wall_time_s, out_dir);
     return kExitOk;
   });
 }

@@ -234,7 +234,7 @@ void RunWriter::check_projected_size() const {
   }
 }
 
-Summary RunWriter::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) {
+Summary RunWriter::summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) {
   drain();
   return summary_.summary(wall_time_s, integrator);
 }
@@ -283,11 +283,20 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
     const char* style;
     const char* title;
   };
-  auto panel = [&](const std::vector<Line>& lines, const char* none) {
+  // A force that is 0 throughout (ripple or grinding switched off) is not drawn: a flat line at 0
+  // titled "grinding" reads as a grinding force that happens to be 0.
+  const auto zero_throughout = [&](Curve c) {
+    for (std::size_t b = 0; b < reduced.buckets(); ++b) {
+      const output::MinMaxReducer::Extremes& e = reduced.at(b, c);
+      if (e.n > 0 && (e.y_min != 0.0 || e.y_max != 0.0)) return false;
+    }
+    return true;
+  };
+  auto panel = [&](const std::vector<Line>& lines, const char* none, bool skip_zero = false) {
     std::ostringstream p;
     bool first = true;
     for (const Line& l : lines) {
-      if (!reduced.has_samples(l.c)) continue;
+      if (!reduced.has_samples(l.c) || (skip_zero && zero_throughout(l.c))) continue;
       p << (first ? "plot data" : ", ''") << " every ::1 using " << 2 * l.c + 1 << ":($" << 2 * l.c + 2 << l.scale
         << ") with lines " << l.style << "title '" << l.title << "'";
       first = false;
@@ -313,7 +322,8 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
      << panel({{kEv, "*1e6", "", "e_v"}}, "no true velocity: no error to draw");
   gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n" << panel({{kU, "", "", "u"}}, "no command recorded");
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
-     << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}}, "no forces recorded");
+     << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}},
+              "no friction, ripple or grinding force in this run", true);
   dir.plot(gp.str());
 }
 

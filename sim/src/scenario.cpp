@@ -474,6 +474,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   } else {
     c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop, plugin");
   }
+  s.controller.model_given = c.has("model");
   c.finish();
 
   read_reference(top.child("reference"), s.reference, base_dir);
@@ -498,9 +499,11 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   }
   MapReader a = top.child("analysis");
   a.number("settled_after", s.analysis.settled_after);
+  a.number("settling_band", s.analysis.settling_band);
   a.finish();
   top.finish();
   if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
+  if (s.analysis.settling_band < 0.0) a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) + ": must be >= 0 (0: 2 % of the move's distance)");
 
   // Component validation: each validate() names its key and value; tables come from the files.
   try {

@@ -92,11 +92,14 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
     if (!std::isfinite(v)) fail(what, v, Source::kPlant);
 }
 
-RunStats run(const Scenario& s, const RecordSink& sink) {
+RunStats run(const Scenario& s, const RecordSink& sink) { return run(s, sink, Excitation{}); }
 
+RunStats run(const Scenario& s, const RecordSink& sink, const Excitation& excitation) {
   const auto wall_start = std::chrono::steady_clock::now();
   plant::Plant drive(s.drive(), s.control_period);
-  const auto reference = make_reference(s);
+  const auto own_reference = excitation.reference ? nullptr : make_reference(s);
+  const trajectory::Trajectory* reference = excitation.reference ? excitation.reference : own_reference.get();
+  const double thrust_gain = s.plant.thrust_gain();
   const auto controller = make_controller(s);
   const long n = s.steps();
 
@@ -109,11 +112,13 @@ RunStats run(const Scenario& s, const RecordSink& sink) {
     const controller::Truth truth{st.z, st.fg};
     const controller::Command cmd = controller->update(ref, meas, &truth);
     const double u = plant::admit_command(cmd.u, s.plant.input_limit).u;
-    const plant::Forces f = drive.forces(u);
+    // the drive's input: the command plus the excitation's force at the amplifier input
+    const double u_drive = excitation.input_force ? u + excitation.input_force(t) / thrust_gain : u;
+    const plant::Forces f = drive.forces(u_drive);
     const Record r = make_record(t, ref, st, meas, cmd, u, f);
     check_finite_step(s, k, r, cmd.u);
     sink(r);
-    drive.advance(u, s.time_of(k + 1));
+    drive.advance(u_drive, s.time_of(k + 1));
   }
   RunStats stats;
   stats.steps = n;

@@ -2,20 +2,66 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <utility>
 #include <nlohmann/json.hpp>
 
 namespace feeddrive::sim {
 
+double controller_output_range(const Scenario& s) {
+  switch (s.controller.type) {
+    case ControllerType::kSlidingMode: return s.controller.sliding_mode.u_max - s.controller.sliding_mode.u_min;
+    case ControllerType::kCascade: return s.controller.cascade.u_max - s.controller.cascade.u_min;
+    case ControllerType::kOpenLoop: return s.controller.open_loop.u_max - s.controller.open_loop.u_min;
+    case ControllerType::kPlugin: return s.controller.plugin.u_max - s.controller.plugin.u_min;
+  }
+  return 0.0;
+}
+
+std::string controller_model_source(const Scenario& s) {
+  if (s.controller.type == ControllerType::kOpenLoop) return "";
+  if (s.controller.model_given) return "own";
+  return s.plant.effects.any() ? "plant_without_effects" : "plant";
+}
+
 SummaryBuilder::SummaryBuilder(const Scenario& s)
     : settled_after_(s.analysis.settled_after), control_period_(s.control_period) {
   m_.settled_after_s = settled_after_;
+  // A rest-to-rest move: a reference with a finite end (summary.hpp, "Move metrics").
+  const ReferenceType type = s.reference.type;
+  if (type == ReferenceType::kStep || type == ReferenceType::kAccelLimited || type == ReferenceType::kSCurve ||
+      type == ReferenceType::kWaypoints) {
+    const auto ref = make_reference(s);
+    move_end_ = ref->end_time();
+    is_move_ = std::isfinite(move_end_);
+    x0_ = ref->sample(0.0).position;
+    target_ = ref->sample(is_move_ ? move_end_ : 0.0).position;
+    distance_ = target_ - x0_;
+    band_ = s.analysis.settling_band > 0.0 ? s.analysis.settling_band : 0.02 * std::abs(distance_);
+  }
+  chatter_delta_ = 0.01 * controller_output_range(s);
+  m_.control_chatter_threshold_V = chatter_delta_;
 }
 
 namespace {
 // A difference of two finite doubles can exceed the largest double (1e308 - -1e308): the metrics
 // saturate there instead of becoming infinite (NaN, a run without truth, stays NaN).
 constexpr double kLargest = std::numeric_limits<double>::max();
+// The move metrics' keys in summary.json, in order (null where they do not apply).
+const std::pair<const char*, double Summary::*> kMoveFields[] = {
+    {"move_start_s", &Summary::move_start_s},
+    {"move_end_s", &Summary::move_end_s},
+    {"move_distance_m", &Summary::move_distance_m},
+    {"rise_time_s", &Summary::rise_time_s},
+    {"overshoot_m", &Summary::overshoot_m},
+    {"overshoot_percent", &Summary::overshoot_percent},
+    {"settling_band_m", &Summary::settling_band_m},
+    {"settling_time_s", &Summary::settling_time_s},
+    {"settle_after_move_s", &Summary::settle_after_move_s},
+    {"position_error_max_abs_during_move_m", &Summary::position_error_max_abs_during_move_m},
+    {"position_error_rms_during_move_m", &Summary::position_error_rms_during_move_m},
+    {"position_error_max_abs_after_move_m", &Summary::position_error_max_abs_after_move_m}};
 double saturated(long double v) { return v > kLargest ? kLargest : v < -kLargest ? -kLargest : static_cast<double>(v); }
 }  // namespace
 
@@ -62,6 +108,16 @@ void SummaryBuilder::add(const Record& q) {
     }
   }
   if (settled) ++n_settled_;
+  if (is_move_) add_move(q);
+  if (n_ > 0) {  // chatter: opposite signs of two successive command steps, both >= delta
+    const double du = q.u - last_.u;
+    if (std::abs(du) >= chatter_delta_ && chatter_delta_ > 0.0) {
+      if (du * du_prev_ < 0.0) ++reversals_;
+      du_prev_ = du;
+    } else {
+      du_prev_ = 0.0;
+    }
+  }
   m.control_min = std::min(m.control_min, q.u);
   m.control_max = std::max(m.control_max, q.u);
   if (n_ > 0) total_variation_ += std::abs(static_cast<long double>(q.u) - last_.u);
@@ -72,17 +128,81 @@ void SummaryBuilder::add(const Record& q) {
   ++n_;
 }
 
-Summary SummaryBuilder::summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) const {
+void SummaryBuilder::add_move(const Record& q) {
+  const double y = std::isfinite(q.x) ? q.x : q.x_measured;
+  if (!std::isfinite(y)) return;
+  if (std::isnan(move_start_)) {
+    if (q.xd == x0_) return;  // not started
+    move_start_ = q.t;
+  }
+  const double sign = distance_ >= 0.0 ? 1.0 : -1.0;
+  if (distance_ != 0.0) {
+    const double progress = (y - x0_) / distance_;  // 0 at the start, 1 at the target
+    if (std::isnan(t10_) && progress >= 0.1) t10_ = q.t;
+    if (std::isnan(t90_) && progress >= 0.9) t90_ = q.t;
+    overshoot_ = std::max(overshoot_, sign * (y - target_));
+  }
+  // t_in: the first in-band step after the last out-of-band one (the move start if none was out)
+  if (std::abs(y - target_) > band_) {
+    last_out_ = true;
+  } else if (last_out_ || std::isnan(t_in_)) {
+    t_in_ = last_out_ ? q.t : move_start_;
+    last_out_ = false;
+  }
+  const double e = std::abs(q.xd - y);
+  if (q.t <= move_end_) {
+    max_during_ = std::max(max_during_, e);
+    se_during_ += static_cast<long double>(e) * e;
+    ++n_during_;
+  } else {
+    max_after_ = std::max(max_after_, e);
+    ++n_after_;
+  }
+}
+
+void SummaryBuilder::finish_move(Summary& m) const {
+  if (!is_move_) return;
+  m.move_end_s = move_end_;
+  m.move_distance_m = distance_;
+  if (std::isnan(move_start_)) return;  // the reference has not moved yet
+  m.move_start_s = move_start_;
+  if (distance_ != 0.0) {
+    if (!std::isnan(t10_) && !std::isnan(t90_)) m.rise_time_s = t90_ - t10_;
+    m.overshoot_m = overshoot_;
+    m.overshoot_percent = 100.0 * overshoot_ / std::abs(distance_);
+  }
+  if (band_ > 0.0) {
+    m.settling_band_m = band_;
+    const bool ended = last_.t >= move_end_;  // the reference has stopped within the run
+    if (ended && !last_out_ && !std::isnan(t_in_)) {
+      m.settling_time_s = t_in_ - move_start_;
+      m.settle_after_move_s = std::max(0.0, t_in_ - move_end_);
+    }
+  }
+  if (n_during_ > 0) {
+    m.position_error_max_abs_during_move_m = max_during_;
+    m.position_error_rms_during_move_m = static_cast<double>(std::sqrt(se_during_ / static_cast<long double>(n_during_)));
+  }
+  if (n_after_ > 0) m.position_error_max_abs_after_move_m = max_after_;
+}
+
+Summary SummaryBuilder::summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) const {
   Summary m = m_;
   m.steps = n_;
   m.sim_time_s = static_cast<double>(n_) * control_period_;
   m.wall_time_s = wall_time_s;
   m.settled_steps = n_settled_;
-  m.integrator_steps = integrator.steps;
-  m.integrator_rhs_evals = integrator.rhs_evals;
-  m.integrator_jac_evals = integrator.jac_evals;
-  m.integrator_error_test_fails = integrator.error_test_fails;
+  m.integrator_known = integrator.has_value();
+  if (integrator) {
+    m.integrator_steps = integrator->steps;
+    m.integrator_rhs_evals = integrator->rhs_evals;
+    m.integrator_jac_evals = integrator->jac_evals;
+    m.integrator_error_test_fails = integrator->error_test_fails;
+  }
   if (n_ == 0) return m;
+  finish_move(m);
+  m.control_reversals_per_s = m.sim_time_s > 0.0 ? static_cast<double>(reversals_) / m.sim_time_s : 0.0;
+  m.control_chattering = m.control_reversals_per_s >= 0.05 / control_period_;
   constexpr double kNone = std::numeric_limits<double>::quiet_NaN();  // written as null
   m.position_error_rms_m = n_e_ > 0 ? static_cast<double>(std::sqrt(se_ / static_cast<long double>(n_e_))) : kNone;
   m.velocity_error_rms_mps = n_ev_ > 0 ? static_cast<double>(std::sqrt(sev_ / static_cast<long double>(n_ev_))) : kNone;
@@ -115,6 +235,33 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   SummaryBuilder b(s);
   for (const Record& q : r.records) b.add(q);
   return b.summary(r.wall_time_s, r.integrator);
+}
+
+std::string summary_headline(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return "no summary";
+  const auto num = [&](const char* key) -> std::string {
+    if (!j.contains(key) || !j[key].is_number()) return "n/a";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", j[key].get<double>());
+    return buf;
+  };
+  // The true-state error where the plant has one, else the measured one (a hardware plant).
+  const bool truth = j.contains("position_error_max_abs_m") && j["position_error_max_abs_m"].is_number();
+  std::string line = truth ? "max |e| = " + num("position_error_max_abs_m") + " m, rms e = " + num("position_error_rms_m") + " m"
+                           : "max |e_m| = " + num("measured_position_error_max_abs_m") + " m, rms e_m = " +
+                                 num("measured_position_error_rms_m") + " m (measured: x_d - x_measured)";
+  line += ", u in [" + num("control_min") + ", " + num("control_max") + "] V";
+  if (j.contains("settling_time_s") && j["settling_time_s"].is_number())
+    line += ", settles to " + num("settling_band_m") + " m in " + num("settling_time_s") + " s";
+  else if (j.contains("move_start_s") && j["move_start_s"].is_number() && j.contains("settling_band_m") &&
+           j["settling_band_m"].is_number() && j.contains("move_end_s") && j["move_end_s"].is_number() &&
+           j["move_end_s"].get<double>() <= j.value("sim_time_s", 0.0))  // a move that ended within the run
+    line += ", NOT SETTLED to " + num("settling_band_m") + " m";
+  if (j.value("control_chattering", false))
+    line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
+  if (j.contains("controller_model") && j["controller_model"] == "plant") line += ", model = plant";
+  return line;
 }
 
 std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
@@ -154,10 +301,23 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["final_friction_N"] = val(m.final_friction_N);
   j["max_position_m"] = val(m.max_position_m);
   j["min_position_m"] = val(m.min_position_m);
-  j["integrator_steps"] = m.integrator_steps;
-  j["integrator_rhs_evals"] = m.integrator_rhs_evals;
-  j["integrator_jac_evals"] = m.integrator_jac_evals;
-  j["integrator_error_test_fails"] = m.integrator_error_test_fails;
+  // The plant's CVODE counts where it ran in this process; null where it ran elsewhere (never 0).
+  const auto counted = [&](long v) { return m.integrator_known ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  j["integrator_steps"] = counted(m.integrator_steps);
+  j["integrator_rhs_evals"] = counted(m.integrator_rhs_evals);
+  j["integrator_jac_evals"] = counted(m.integrator_jac_evals);
+  j["integrator_error_test_fails"] = counted(m.integrator_error_test_fails);
+  // Move and step metrics (summary.hpp): null where they do not apply.
+  const auto opt = [&](double v) { return m.steps > 0 && std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  for (const auto& [key, field] : kMoveFields) j[key] = opt(m.*field);
+  // Chatter (summary.hpp): reversals of the command's steps larger than the threshold.
+  j["control_chatter_threshold_V"] = m.control_chatter_threshold_V;
+  j["control_reversals_per_s"] = val(m.control_reversals_per_s);
+  j["control_chattering"] = m.steps > 0 ? nlohmann::ordered_json(m.control_chattering) : nlohmann::ordered_json();
+  // Whose parameters the controller's model holds: "plant" means every result is a
+  // perfect-model result (docs/scenario.md).
+  const std::string model = controller_model_source(s);
+  j["controller_model"] = model.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(model);
   // The gains a cascade runs with (tuning: rule chooses them: docs/controllers.md).
   if (s.controller.type == ControllerType::kCascade)
     j["cascade_gains"] = {{"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
@@ -176,6 +336,8 @@ std::vector<std::string> summary_metric_names() {
   Summary m;
   m.steps = 2;
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
+  m.integrator_known = true;
+  for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
   std::vector<std::string> names;
   for (auto it = j.begin(); it != j.end(); ++it)

@@ -49,6 +49,13 @@ NULLABLE_SUMMARY = {
     "position_error_max_abs_settled_m",
     "position_error_rms_settled_m",
     "velocity_error_max_abs_settled_mps",
+    # move metrics: null for a reference that is no move, a move not finished or not settled
+    "move_start_s", "move_end_s", "move_distance_m", "rise_time_s", "overshoot_m", "overshoot_percent",
+    "settling_band_m", "settling_time_s", "settle_after_move_s", "position_error_max_abs_during_move_m",
+    "position_error_rms_during_move_m", "position_error_max_abs_after_move_m",
+    "controller_model",  # open_loop has no model
+    # the plant's CVODE counts are null where it ran in another process (a log, the monitor)
+    "integrator_steps", "integrator_rhs_evals", "integrator_jac_evals", "integrator_error_test_fails",
 }
 # timeseries.csv columns that must be finite in every row (the diagnostic columns
 # u_unsaturated, sliding, z_estimate are NaN where a controller has none).

@@ -430,3 +430,30 @@ TEST(Cli, AStagingFolderLeftByAKilledRunIsRemovedByTheNextRun) {
   EXPECT_TRUE(fs::exists(foreign / "notes.txt"));
   fs::remove_all(foreign);
 }
+
+namespace {
+
+TEST(Cli, FrequencyResponseWritesTableDataAndBodePlots) {
+  // feeddrive-sim --frequency-response (docs/analysis.md): two frequencies of the linear drive;
+  // the numbers are tested in tests/analysis, here the tool: files, the stated amplitude, exit codes.
+  const fs::path scn = write_file("fr.yaml",
+                                  "name: fr\nduration: 1.0\ncontrol_period: 1.0e-4\nplant: {friction: {model: none}}\n"
+                                  "controller: {type: cascade, tuning: rule}\n");
+  const fs::path out = scratch() / "fr_out";
+  const ProcResult ok = run_sim(scn.string() + " --out " + out.string() + " --frequency-response --fr-frequencies 50,500 --fr-force 20");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  for (const char* f : {"frequency_response.csv", "frequency_response.json", "bode_reference.png", "bode_compliance.png", "bode_loop.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto j = nlohmann::json::parse(slurp(out / "frequency_response.json"));
+  EXPECT_EQ(j["excitation"]["force_amplitude_N"], 20.0);
+  EXPECT_EQ(j["excitation"]["reference_amplitude_m"], 1e-5);
+  EXPECT_TRUE(j["min_dynamic_stiffness_N_per_um"].is_number());
+  // one line naming the option and the value, exit 2, nothing written
+  const fs::path bad = scratch() / "fr_bad";
+  const ProcResult e = run_sim(scn.string() + " --out " + bad.string() + " --frequency-response --fr-frequencies 7000");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_EQ(e.err, "error: --fr-frequencies 7000: must be > 0 and below Nyquist 5000 Hz\n");
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+}  // namespace

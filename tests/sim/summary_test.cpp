@@ -160,3 +160,89 @@ TEST(Summary, MeasuredErrorMetricsInEveryRunAndWhichIsWhich) {
 
 }  // namespace
 }  // namespace feeddrive::sim
+
+namespace feeddrive::sim {
+namespace {
+
+// Step and move metrics (summary.hpp, "Move metrics") on records of a known response: a step of
+// D = 1 mm at t0 = 0.1 s followed by the underdamped second-order response
+//   y(t') = D (1 - e^{-zeta wn t'} (cos wd t' + zeta/sqrt(1 - zeta^2) sin wd t')),  t' = t - t0,
+// whose overshoot is exp(-pi zeta/sqrt(1 - zeta^2)) of D (at t' = pi/wd) and whose 10-90 % rise
+// time and settling time to a 2 % band have no closed form: they are found here by bisection on
+// the continuous y and compared with the sampled metrics within one sample period T (the
+// summary sees y only at the steps; a crossing is reported at the first step past it).
+TEST(Summary, StepMetricsOfASecondOrderResponse) {
+  Scenario s;
+  s.control_period = 1e-4;
+  s.duration = 1.0;
+  s.reference.type = ReferenceType::kStep;
+  s.reference.step = {1e-3, 0.1, 0.0};
+  const double D = 1e-3, t0 = 0.1, zeta = 0.3, wn = 60.0, wd = wn * std::sqrt(1 - zeta * zeta), T = 1e-4;
+  const auto y = [&](double tp) {
+    return tp < 0 ? 0.0 : D * (1 - std::exp(-zeta * wn * tp) * (std::cos(wd * tp) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * tp)));
+  };
+  SummaryBuilder b(s);
+  for (long k = 0; k < 10000; ++k) {
+    Record r;
+    r.t = k * T;
+    r.xd = r.t >= t0 ? D : 0.0;
+    r.x = r.x_measured = y(r.t - t0);
+    r.u = (k % 2) ? 1.0 : -1.0;  // a +-1 V command reversing every period: chatter
+    b.add(r);
+  }
+  const Summary m = b.summary(1.0, plant::CvodeIntegrator::Stats{});
+  // first t' with y(t') >= level, by bisection on [0, first peak] where y is increasing
+  const auto first_at = [&](double level) {
+    double lo = 0.0, hi = M_PI / wd;
+    for (int i = 0; i < 200; ++i) ((y(0.5 * (lo + hi)) >= level) ? hi : lo) = 0.5 * (lo + hi);
+    return hi;
+  };
+  EXPECT_NEAR(m.move_start_s, t0, 1e-12);
+  EXPECT_NEAR(m.rise_time_s, first_at(0.9 * D) - first_at(0.1 * D), T);
+  EXPECT_NEAR(m.overshoot_percent, 100.0 * std::exp(-M_PI * zeta / std::sqrt(1 - zeta * zeta)), 1e-3);
+  EXPECT_DOUBLE_EQ(m.settling_band_m, 0.02 * D);
+  // settling: the last t' where |y - D| > 2 % D, scanned finely (the envelope decays monotonically)
+  double last_out = 0.0;
+  for (double tp = 0.0; tp < 0.9; tp += 1e-6)
+    if (std::abs(y(tp) - D) > 0.02 * D) last_out = tp;
+  EXPECT_NEAR(m.settling_time_s, last_out, T);
+  EXPECT_NEAR(m.settle_after_move_s, m.settling_time_s, 1e-12);  // a step ends where it starts
+  EXPECT_NEAR(m.position_error_max_abs_during_move_m, D, 1e-15);  // the jump itself
+  // after the move: the largest |D - y| after t0, the first undershoot below D: at t' = 0+ ~ D
+  EXPECT_LE(m.position_error_max_abs_after_move_m, D);
+  // +-1 V every period: every step of 2 V reverses the previous one (9998 reversals in 1 s)
+  EXPECT_NEAR(m.control_reversals_per_s, 9998.0, 1e-9);
+  EXPECT_TRUE(m.control_chattering);
+  const auto j = nlohmann::json::parse(summary_json(m, s));
+  EXPECT_TRUE(j["integrator_steps"].is_number());
+  EXPECT_EQ(j["controller_model"], "plant");  // no controller.model: the plant's own parameters
+  // The plant ran elsewhere (a monitor's record): its integrator counts are unknown, null.
+  const auto jm = nlohmann::json::parse(summary_json(b.summary(1.0, {}), s));
+  for (const char* key : {"integrator_steps", "integrator_rhs_evals", "integrator_jac_evals", "integrator_error_test_fails"})
+    EXPECT_TRUE(jm[key].is_null()) << key;
+}
+
+TEST(Summary, MoveMetricsApplyOnlyToMoves) {
+  // A sine reference is no move: every move metric null. A smooth command never chatters.
+  Scenario s;
+  s.control_period = 1e-4;
+  s.reference.type = ReferenceType::kSine;
+  SummaryBuilder b(s);
+  for (long k = 0; k < 1000; ++k) {
+    Record r;
+    r.t = k * 1e-4;
+    r.xd = std::sin(r.t);
+    r.x = r.x_measured = r.xd;
+    r.u = std::sin(10 * r.t);
+    b.add(r);
+  }
+  const auto j = nlohmann::json::parse(summary_json(b.summary(0.1, {}), s));
+  for (const char* key : {"move_start_s", "move_end_s", "rise_time_s", "overshoot_m", "settling_time_s",
+                          "settling_band_m", "position_error_max_abs_during_move_m", "position_error_max_abs_after_move_m"})
+    EXPECT_TRUE(j[key].is_null()) << key;
+  EXPECT_EQ(j["control_reversals_per_s"], 0.0);
+  EXPECT_EQ(j["control_chattering"], false);
+}
+
+}  // namespace
+}  // namespace feeddrive::sim

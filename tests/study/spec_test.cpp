@@ -42,7 +42,7 @@ TEST(StudySpec, AMisspeltReportMetricIsRefusedWithTheNearestName) {
       << e;
   EXPECT_NE(study_error(study_text("report: {metric: wall_time_s}\n")).find("report.metric = 'wall_time_s': not a metric"),
             std::string::npos);  // a wall-clock metric is not in results.csv
-  EXPECT_NE(study_error(study_text("report: {metric: overshoot}\n")).find("; one of control_period_s, steps, sim_time_s, position_error_max_abs_m, "),
+  EXPECT_NE(study_error(study_text("report: {metric: wobble}\n")).find("; one of control_period_s, steps, sim_time_s, position_error_max_abs_m, "),
             std::string::npos);  // nothing close: the list
   EXPECT_NO_THROW(parse_study(study_text("report: {metric: control_total_variation}\n"), ".", "s.yaml"));
 }

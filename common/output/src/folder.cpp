@@ -422,7 +422,7 @@ void StagedFolder::write_text(const std::string& name, const std::string& text) 
 void StagedFolder::plot(const std::string& script) const {
   run_gnuplot(staging_,
               "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\n"
-              "set grid\nset key outside top center horizontal\n" +
+              "set grid\nset key outside right top vertical\n" +
                   script);
 }
 

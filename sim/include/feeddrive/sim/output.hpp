@@ -24,6 +24,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -78,7 +79,8 @@ class RunWriter {
   /// The most recent record (undefined before the first add).
   const Record& last() const { return last_; }
   /// The summary of every record added so far (waits until the writer thread has them all).
-  Summary summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator);
+  /// `integrator`: none ({}) where the plant ran in another process (its counts are then null).
+  Summary summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator);
 
   /// Closes timeseries.csv, writes summary.json (`sum` plus the keys of the JSON object
   /// extra_json) and the plots (when asked and there is at least one record), and swaps the

@@ -60,11 +60,17 @@ struct ControllerConfig {
   /// type plugin: controller.library (resolved against the scenario's folder), .parameters,
   /// .model, .u_min, .u_max (docs/plugins.md).
   controller::PluginParams plugin;
+  /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
+  /// plant's own parameters without its effects; summary.json says so as controller_model).
+  bool model_given{false};
 };
 
 struct AnalysisConfig {
   /// Start [s] of the "settled" window over which the *_settled error metrics are computed.
   double settled_after{0.25};
+  /// Half-width [m] of the band the move's settling time is measured to (summary.hpp, "Move
+  /// metrics"); 0 (default): 2 % of the move's distance (MATLAB stepinfo's SettlingTimeThreshold).
+  double settling_band{0.0};
 };
 
 /// What timeseries.csv records (the summary and the plots always cover every step).

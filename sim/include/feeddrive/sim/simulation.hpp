@@ -62,6 +62,18 @@ struct RunStats {
 /// interrupt::Interrupted after Ctrl-C or SIGTERM.
 RunStats run(const Scenario& s, const RecordSink& sink);
 
+/// An excitation of the closed loop (the frequency response, analysis/frequency_response.hpp):
+///  * reference: replaces the scenario's reference (nullptr: the scenario's);
+///  * input_force: F_d(t_k) [N], added at the amplifier input as u + F_d/(Ka*Kf) and held over the
+///    period like the command (a drive's set-point injection: without the electrical option a
+///    force on the carriage; with it, the set-point of the current loop). The controller does not
+///    see it; the record's u stays the controller's command, f_thrust includes F_d.
+struct Excitation {
+  const trajectory::Trajectory* reference{nullptr};
+  std::function<double(double t)> input_force;
+};
+RunStats run(const Scenario& s, const RecordSink& sink, const Excitation& excitation);
+
 /// All records in memory (tests, short runs).
 struct RunResult {
   std::vector<Record> records;

@@ -14,7 +14,31 @@
 // of steps): maxima, minima, sums of squares (RMS), the total variation and the end state are
 // exact; position_error_p95_abs_m is the rank-floor(0.95 n) order statistic of |e| from a
 // bounded histogram (feeddrive/common/quantile.hpp), within 2^-11 (0.05 %) of the exact value.
+//
+// Move metrics (docs/scenario.md, "Move and step metrics"): for a reference that is a rest-to-rest
+// move (step, accel_limited, scurve, waypoints: a finite end_time() t_e within the run), with
+// x0 = xd(0), target xT = xd(t_e), distance D = xT - x0, the position y = x (x_measured in a run
+// without a true state), the move start t_s = the first step whose xd differs from x0:
+//   rise time      t(y first >= x0 + 0.9 D) - t(y first >= x0 + 0.1 D)   (in the direction of D;
+//                  MATLAB stepinfo's RiseTimeLimits [0.1 0.9])
+//   overshoot      max over t >= t_s of sgn(D)*(y - xT)  (>= 0), also in % of |D|
+//   band b         analysis.settling_band, or 2 % of |D| when 0 (stepinfo's default)
+//   settling time  t_in - t_s, t_in = the step after the last t >= t_s with |y - xT| > b
+//                  (t_s if none); null if |y - xT| > b at the last step (not settled)
+//   settle after the move  max(0, t_in - t_e): the in-position time after the reference stopped
+//   error during / after the move  max |xd - y| over t_s <= t <= t_e / over t > t_e (RMS during)
+// A reference that is not a move (sine, ramp, none), a move with D = 0 (rise, overshoot; and the
+// band unless settling_band is given) or a move that ends after the run has null for what does
+// not apply.
+//
+// Chatter: a reversal is a step k where du_k = u_k - u_{k-1} and du_{k-1} have opposite signs and
+// both |du| >= delta = 1 % of the controller's output range (u_max - u_min; 0.2 V for +-10 V).
+// control_reversals_per_s = reversals / sim_time; the control chatters (control_chattering) when
+// that rate is at least 5 % of the control rate (0.05/T: 500 /s at T = 0.1 ms). A sgn switching
+// law in a band reverses every period (rate 1/T); a smooth law tracking a smooth reference never.
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,11 +75,37 @@ struct Summary {
   double final_friction_N{0.0};
   double max_position_m{0.0};
   double min_position_m{0.0};
+  /// The integrator ran in this process (false: a monitor's record of a separate plant, or a
+  /// log; summary_json writes its counts as null).
+  bool integrator_known{false};
   long integrator_steps{0};
   long integrator_rhs_evals{0};
   long integrator_jac_evals{0};
   long integrator_error_test_fails{0};
+  // Move metrics (above); NaN = does not apply (written as null).
+  double move_start_s{kNaN}, move_end_s{kNaN}, move_distance_m{kNaN};
+  double rise_time_s{kNaN}, overshoot_m{kNaN}, overshoot_percent{kNaN};
+  double settling_band_m{kNaN}, settling_time_s{kNaN}, settle_after_move_s{kNaN};
+  double position_error_max_abs_during_move_m{kNaN}, position_error_rms_during_move_m{kNaN};
+  double position_error_max_abs_after_move_m{kNaN};
+  // Chatter (above)
+  double control_chatter_threshold_V{0.0};
+  double control_reversals_per_s{0.0};
+  bool control_chattering{false};
+
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// The controller's output range u_max - u_min [V] of a scenario (chatter threshold).
+double controller_output_range(const Scenario& s);
+/// summary.json's controller_model: "plant" (the controller's model is the plant's own
+/// parameters: no controller.model key), "plant_without_effects" (the same, the plant having
+/// effects the model lacks), "own" (controller.model given), "" (open_loop: no model).
+std::string controller_model_source(const Scenario& s);
+/// The headline of a run for a tool's final line, from summary.json's text: "max |e| = 1.367e-06
+/// m, rms e = ..., u in [..., ...] V" (the measured error where the run has no true state), and
+/// ", CONTROL CHATTERS (n reversals/s)" when control_chattering. feeddrive-sim and -launch print it.
+std::string summary_headline(const std::string& summary_json_text);
 
 /// The metrics of a stream of records.
 class SummaryBuilder {
@@ -65,9 +115,13 @@ class SummaryBuilder {
   long steps() const { return n_; }
   const Record& last() const { return last_; }
   /// The summary of every record added so far.
-  Summary summary(double wall_time_s, const plant::CvodeIntegrator::Stats& integrator) const;
+  /// `integrator`: the CVODE counts of the plant run in this process; none (`{}`) where the
+  /// plant ran elsewhere (the monitor, a log): the counts are then null.
+  Summary summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) const;
 
  private:
+  void add_move(const Record& q);
+  void finish_move(Summary& m) const;
   double settled_after_, control_period_;
   Summary m_;
   long n_{0}, n_settled_{0};
@@ -79,6 +133,20 @@ class SummaryBuilder {
   long double se_{0.0L}, sem_{0.0L}, sev_{0.0L}, se_settled_{0.0L}, total_variation_{0.0L};
   Record last_;
   stats::StreamingQuantile abs_e_, abs_em_;
+  // move metrics
+  bool is_move_{false};
+  double x0_{0.0}, target_{0.0}, distance_{0.0}, move_end_{0.0}, band_{0.0};
+  double move_start_{Summary::kNaN}, t10_{Summary::kNaN}, t90_{Summary::kNaN}, overshoot_{0.0};
+  double t_in_{Summary::kNaN};  // first step after the last out-of-band one (NaN: none out yet)
+  bool last_out_{false};
+  long n_during_{0};
+  long double se_during_{0.0L};
+  double max_during_{0.0}, max_after_{0.0};
+  long n_after_{0};
+  // chatter
+  double chatter_delta_{0.0};
+  double du_prev_{0.0};
+  long reversals_{0};
 };
 
 /// All records in memory at once (SummaryBuilder over r.records).

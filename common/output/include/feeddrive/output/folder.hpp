@@ -103,7 +103,8 @@ class StagedFolder {
   /// Writes dir()/name; throws std::runtime_error naming the file.
   void write_text(const std::string& name, const std::string& text) const;
   /// Runs a gnuplot script in dir() (run_gnuplot) after the preamble every feeddrive plot shares:
-  /// UTF-8, comma-separated data, 1000x700 PNG (cairo, no enhanced text), grid, key on top.
+  /// UTF-8, comma-separated data, 1000x700 PNG (cairo, no enhanced text), grid, key to the right of the plot
+  /// (clear of the title above it).
   void plot(const std::string& script) const;
   /// The final folder (absolute, normalised).
   const std::filesystem::path& target() const { return target_; }
