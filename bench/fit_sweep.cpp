@@ -10,8 +10,12 @@
 //   tentative ties periods nothing_there
 // (as tests/fit/drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
 //   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
+// FD_SWEEP_ONLY=i,j,...: only the cases of these indices in the mix (to look at a few records).
 #include <cstdio>
 #include <cstdlib>
+#include <set>
+#include <sstream>
+#include <string>
 
 #include "sweep.hpp"
 
@@ -28,7 +32,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::vector<fdgen::CaseSpec> cases = mix == "issue20" ? fdgen::issue20_cases(n, seed) : fdgen::standard_cases(n, seed);
+  std::set<std::size_t> only;
+  if (const char* o = std::getenv("FD_SWEEP_ONLY")) {
+    std::stringstream ss(o);
+    std::string item;
+    while (std::getline(ss, item, ','))
+      if (!item.empty()) only.insert(static_cast<std::size_t>(std::stoul(item)));
+  }
   for (std::size_t i = 0; i < cases.size(); ++i) {
+    if (!only.empty() && !only.count(i)) continue;
     if (static_cast<int>(i % static_cast<std::size_t>(shards)) != shard) continue;
     cases[i].duration = duration;
     try {

@@ -35,7 +35,7 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
   const long n = static_cast<long>(t.size());
   const double L = rec.bank.half_width;
   const double mass = plant::effective_params(model).mass;
-  double sum = 0.0;
+  double noise_sum = 0.0, bias_sum = 0.0;
   long count = 0;
   std::vector<double> c;
   for (std::size_t i = 0; i < rec.bank.tau.size(); ++i) {
@@ -52,10 +52,20 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
     }
     double s = 0.0;
     for (double v : c) s += v * v;
-    sum += s;
+    // the filter's own discretisation (header): b_i = m sum_j a_j h''(tau_i - t_mid,j) dt_j^3 / 12
+    double b = 0.0;
+    for (long j = j0; j < j1; ++j) {
+      const double dt = t[j + 1] - t[j], a_mid = 0.5 * (rec.motion.a[j] + rec.motion.a[j + 1]);
+      b += a_mid * kernel_dd(tau - 0.5 * (t[j] + t[j + 1]), L) * dt * dt * dt / 12.0;
+    }
+    noise_sum += s;
+    bias_sum += mass * mass * b * b;
     ++count;
   }
-  f.force = count ? mass * f.position * std::sqrt(sum / static_cast<double>(count)) : 0.0;
+  const double nc = std::max(1.0, static_cast<double>(count));
+  f.force_noise = count ? mass * f.position * std::sqrt(noise_sum / nc) : 0.0;
+  f.force_discretisation = count ? std::sqrt(bias_sum / nc) : 0.0;
+  f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
   return f;
 }
 

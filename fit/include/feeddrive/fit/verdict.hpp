@@ -13,7 +13,17 @@
 //   * force floor: the RMS over the filter points of m * sigma_x * sqrt(sum_k c_ik^2), the exact
 //     propagation of white position noise through the filtered acceleration
 //     A_i = sum_j (x_j+1 - x_j)/dt_j * g_ij,  g_ij = h(tau_i - t_j) - h(tau_i - t_j+1)
-//     (signals.hpp), whose weight on x_k is c_ik = g_i,k-1/dt_k-1 - g_ik/dt_k.
+//     (signals.hpp), whose weight on x_k is c_ik = g_i,k-1/dt_k-1 - g_ik/dt_k;
+//     plus, in quadrature, what the filter's discretisation leaves on a perfect model: A_i
+//     integrates h'' against the positions joined by straight lines, while a drive under a thrust
+//     held over each interval moves on a parabola there (x' linear, not constant). The difference
+//     is, to leading order in dt (Taylor expansion of h' about the interval midpoint),
+//         A_true,i - A_i = - sum_j a_j h''(tau_i - t_mid,j) dt_j^3 / 12,
+//     i.e. (dt^2/12) times the filtered second derivative of the acceleration: a deterministic
+//     residual of m times that at the thrust's jumps (0.1-0.3 N at 1 kHz, L = 10 ms, a few m/s^2).
+//     The acceleration a_j is the record's own estimate (local cubic, signals.hpp), so the term
+//     depends on the record only, not on the model. Over the filter points:
+//         force floor = sqrt( mean_i ( m^2 sigma_x^2 sum_k c_ik^2 + b_i^2 ) ),  b_i = m |A_true,i - A_i|.
 // Within the floor means at most kFloorFactor times it (model-form error of real friction, time
 // stamp jitter and the integrator take their share; the factor is measured in docs/fit.md).
 // The scenario's plant.sensor gives q and sigma_n; without one, q is the record's smallest
@@ -33,7 +43,9 @@ struct NoiseFloor {
   double noise{0.0};         ///< sigma_n [m]
   double position{0.0};      ///< sigma_x [m]
   double gap{0.0};           ///< [m]
-  double force{0.0};         ///< [N]
+  double force{0.0};         ///< [N]: sqrt(force_noise^2 + force_discretisation^2)
+  double force_noise{0.0};   ///< of the sensor's noise through the filter [N]
+  double force_discretisation{0.0};  ///< of the filter's discretisation on this record [N]
   bool from_scenario{true};  ///< false: q estimated from the record
   std::string source;        ///< one line: where q and sigma_n come from
 };
