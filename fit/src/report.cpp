@@ -109,7 +109,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
   j["noise_floor"] = {{"gap_m", r.floor.gap}, {"force_rms_N", r.floor.force}, {"quantization_m", r.floor.quantization},
                       {"noise_m", r.floor.noise}, {"position_sigma_m", r.floor.position}, {"factor", kFloorFactor},
-                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source}};
+                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source},
+                      {"force_noise_N", r.floor.force_noise}, {"force_discretisation_N", r.floor.force_discretisation},
+                      {"stamp_error_s", r.floor.stamp_error}};
   j["unexplained"] = r.unexplained;
   j["ties"] = r.ties;
   j["conclusion"] = r.conclusion;

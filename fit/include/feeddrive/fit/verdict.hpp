@@ -32,8 +32,9 @@
 // dF_k d_k (t - t_k)/m, of which the window's least-squares line takes the part in span{1, t}.
 // In the force residual the same impulse enters the filtered thrust as dF_k d_k h(tau_i - t_k).
 // Both add in quadrature to the sensor's terms (per sample variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2).
-// Within the floor means at most kFloorFactor times it (model-form error of real friction, time
-// stamp jitter and the integrator take their share; the factor is measured in docs/fit.md).
+// Within the floor means at most kFloorFactor times it (the integrator, the first-order terms
+// above and a stamp error not given take their share; a model exact but for these sits at
+// 1.0-1.15x: docs/fit.md). A friction whose form differs from the model's is a discrepancy, not noise.
 // The scenario's plant.sensor gives q and sigma_n; without one, q is the record's smallest
 // position step (its resolution) and sigma_n = 0, and the report says so.
 
