@@ -237,11 +237,16 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       md << buf;
     }
     if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
-    std::snprintf(buf, sizeof buf,
-                  "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; %s); \"within\" means at "
-                  "most %.0fx the floor.\n\n",
-                  r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9, r.floor.source.c_str(), kFloorFactor);
-    md << buf;
+    {
+      char a[160], b[200];
+      std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ", r.floor.gap * 1e6,
+                    r.floor.force, r.floor.position * 1e9);
+      std::snprintf(b, sizeof b,
+                    "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
+                    "most %.0fx the floor.\n\n",
+                    r.floor.force_noise, r.floor.force_discretisation, kFloorFactor);
+      md << a << r.floor.source << b;
+    }
     if (!r.unexplained.empty()) {
       md << "## Unexplained discrepancy\n\n";
       for (const std::string& u : r.unexplained) md << "- " << u << "\n";
