@@ -11,6 +11,8 @@
 // (as tests/fit/drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
 //   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
 // FD_SWEEP_ONLY=i,j,...: only the cases of these indices in the mix (to look at a few records).
+// FD_SWEEP_NOFORM=1: the same cases with the model's friction form (no smoother transition,
+// asymmetry or other Stribeck exponent), to tell a miss caused by the form from one that is not.
 #include <cstdio>
 #include <cstdlib>
 #include <set>
@@ -43,6 +45,7 @@ int main(int argc, char** argv) {
     if (!only.empty() && !only.count(i)) continue;
     if (static_cast<int>(i % static_cast<std::size_t>(shards)) != shard) continue;
     cases[i].duration = duration;
+    if (std::getenv("FD_SWEEP_NOFORM")) cases[i].form_deviation = false;
     try {
       const sweep::Outcome o = sweep::run_case(cases[i]);
       std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\t%s\t%s\t%d\t%d\t%d\t%.4g\t%.4g\t%.4g\t%.4g\t%s\t%s\t%.3g\t%d\n",
