@@ -10,8 +10,14 @@
 //   tentative ties periods nothing_there
 // (as drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
 //   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
+// FD_SWEEP_ONLY=i,j,...: only the cases of these indices in the mix (to look at a few records).
+// FD_SWEEP_NOFORM=1: the same cases with the model's friction form (no smoother transition,
+// asymmetry or other Stribeck exponent), to tell a miss caused by the form from one that is not.
 #include <cstdio>
 #include <cstdlib>
+#include <set>
+#include <sstream>
+#include <string>
 
 #include "sweep.hpp"
 
@@ -28,9 +34,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::vector<fdgen::CaseSpec> cases = mix == "issue20" ? fdgen::issue20_cases(n, seed) : fdgen::standard_cases(n, seed);
+  std::set<std::size_t> only;
+  if (const char* o = std::getenv("FD_SWEEP_ONLY")) {
+    std::stringstream ss(o);
+    std::string item;
+    while (std::getline(ss, item, ','))
+      if (!item.empty()) only.insert(static_cast<std::size_t>(std::stoul(item)));
+  }
   for (std::size_t i = 0; i < cases.size(); ++i) {
+    if (!only.empty() && !only.count(i)) continue;
     if (static_cast<int>(i % static_cast<std::size_t>(shards)) != shard) continue;
     cases[i].duration = duration;
+    if (std::getenv("FD_SWEEP_NOFORM")) cases[i].form_deviation = false;
     try {
       const sweep::Outcome o = sweep::run_case(cases[i]);
       std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\t%s\t%s\t%d\t%d\t%d\t%.4g\t%.4g\t%.4g\t%.4g\t%s\t%s\t%.3g\t%d\n",

@@ -13,6 +13,8 @@ namespace fdgen {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// The time stamps are recorded with an error uniform in +-kStampError [s] (1 sigma: kStampError/sqrt(3)).
+constexpr double kStampError = 1e-6;
 
 struct Rng {
   std::mt19937_64 g;
@@ -398,7 +400,7 @@ Generated generate(const CaseSpec& spec) {
       pending = F;
     }
     applied[k] = act;
-    out.t.push_back(tk + (k > 0 && k + 1 < N ? r.u(-1e-6, 1e-6) : 0.0));
+    out.t.push_back(tk + (k > 0 && k + 1 < N ? r.u(-kStampError, kStampError) : 0.0));
     out.x.push_back(xm);
     out.force_N.push_back(act);
     out.xd.push_back(xd);
@@ -443,6 +445,7 @@ Generated generate(const CaseSpec& spec) {
                {"mass_nominal_kg", m_nom},    {"travel_m", travel},          {"controller", pid ? 0.0 : 1.0},
                {"bandwidth_hz", bw},          {"feedforward", ff ? 1.0 : 0.0}, {"command_delay_samples", cmd_delay},
                {"quantization_m", q},         {"noise_m", noise},            {"jitter_s", jitter},
+               {"stamp_error_s", kStampError / std::sqrt(3.0)},
                {"coulomb_transition_mps", T.vt}, {"asymmetry", T.asym},      {"stribeck_exponent", T.delta},
                {"base_static_friction", T.base_static ? 1.0 : 0.0}};
   char b[512];

@@ -1,5 +1,6 @@
 // fd-drivegen: one record of the independent generator (drivegen.hpp) as files, for manual fits
-// and bench/fit_bench.sh:  DIR/data.csv (t, x, force_N, xd), DIR/model.yaml, DIR/truth.txt.
+// and bench/fit_bench.sh:  DIR/data.csv (t, x, force_N, xd), DIR/model.yaml, DIR/truth.txt and
+// DIR/knobs.txt (everything else drawn, e.g. stamp_error_s for feeddrive-fit --time-stamp-error).
 //   fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] [bw=HZ]
 #include <cstdio>
 #include <cstdlib>
@@ -43,6 +44,9 @@ int main(int argc, char** argv) {
       for (const auto& [k, v] : e.parameters) t << ' ' << k << '=' << v;
       t << '\n';
     }
+    std::ofstream k(dir + "/knobs.txt");
+    k.precision(10);
+    for (const auto& [n, v] : g.knobs) k << n << ' ' << v << '\n';
     std::printf("%s\n", g.description.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

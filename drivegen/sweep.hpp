@@ -107,6 +107,8 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
   for (const auto& [n, p] : truth) o.hidden.insert(n);
   const sim::Scenario model = sim::parse_scenario(g.scenario_yaml, ".", "indepgen model");
   opt.plausibility.grinding_process = model.grinding_process;
+  // the logger's time-stamp error is known to the engineer, as the encoder is (plant.sensor)
+  opt.stamp_error = g.knobs.at("stamp_error_s");
   const MeasuredData data = measured(g);
   o.category = spec.category;
   const auto t0 = std::chrono::steady_clock::now();

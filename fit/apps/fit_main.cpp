@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   app.add_option("--filter-half-width", opt.record.filter_half_width, "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
       ->capture_default_str()
       ->check(within(1e-5, 10.0, true));
+  app.add_option("--time-stamp-error", opt.stamp_error,
+                 "standard deviation of the record's time stamps [s], for the noise floor (0: not known, not in the floor)")
+      ->capture_default_str()
+      ->check(within(1e-12, 1e-2, true));
   app.add_option("--prefix", prefix, "channel prefix of an LCM log (ignored for CSV)")->capture_default_str();
   app.add_option("--time-column", csv.time_column, "CSV column with the time [s]")->capture_default_str();
   app.add_option("--position-column", csv.position_column, "CSV column with the measured position [m]")->capture_default_str();

@@ -109,7 +109,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
   j["noise_floor"] = {{"gap_m", r.floor.gap}, {"force_rms_N", r.floor.force}, {"quantization_m", r.floor.quantization},
                       {"noise_m", r.floor.noise}, {"position_sigma_m", r.floor.position}, {"factor", kFloorFactor},
-                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source}};
+                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source},
+                      {"force_noise_N", r.floor.force_noise}, {"force_discretisation_N", r.floor.force_discretisation},
+                      {"stamp_error_s", r.floor.stamp_error}};
   j["unexplained"] = r.unexplained;
   j["ties"] = r.ties;
   j["conclusion"] = r.conclusion;
@@ -235,11 +237,16 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       md << buf;
     }
     if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
-    std::snprintf(buf, sizeof buf,
-                  "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; %s); \"within\" means at "
-                  "most %.0fx the floor.\n\n",
-                  r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9, r.floor.source.c_str(), kFloorFactor);
-    md << buf;
+    {
+      char a[160], b[200];
+      std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ", r.floor.gap * 1e6,
+                    r.floor.force, r.floor.position * 1e9);
+      std::snprintf(b, sizeof b,
+                    "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
+                    "most %.0fx the floor.\n\n",
+                    r.floor.force_noise, r.floor.force_discretisation, kFloorFactor);
+      md << a << r.floor.source << b;
+    }
     if (!r.unexplained.empty()) {
       md << "## Unexplained discrepancy\n\n";
       for (const std::string& u : r.unexplained) md << "- " << u << "\n";

@@ -11,11 +11,12 @@
 namespace feeddrive::fit {
 using text::fmt;
 using text::par;
-NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
+NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt) {
   const MeasuredData& d = *rec.data;
   NoiseFloor f;
   f.quantization = model.sensor.quantization;
   f.noise = model.sensor.noise_stddev;
+  f.stamp_error = opt.stamp_error;
   if (model.sensor.ideal()) {
     f.from_scenario = false;
     double q = std::numeric_limits<double>::infinity();
@@ -28,14 +29,76 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
   } else {
     f.source = fmt("plant.sensor: quantization %.3g nm, noise %.3g nm", f.quantization * 1e9, f.noise * 1e9);
   }
+  f.source += f.stamp_error > 0 ? fmt("; time stamps: %.3g us (1 sigma)", f.stamp_error * 1e6)
+                                : std::string("; time-stamp error not given (--time-stamp-error): taken as 0");
   f.position = std::sqrt(f.noise * f.noise + f.quantization * f.quantization / 12.0);
-  f.gap = f.position;
-  // force floor: white position noise through the filtered acceleration (header)
   const auto& t = d.t;
   const long n = static_cast<long>(t.size());
-  const double L = rec.bank.half_width;
   const double mass = plant::effective_params(model).mass;
-  double sum = 0.0;
+  const double st2 = f.stamp_error * f.stamp_error;
+  // per-sample position variance: the sensor's, plus v_k^2 sigma_t^2 of a stamp error (header)
+  std::vector<double> var_x(static_cast<std::size_t>(n), f.position * f.position);
+  // thrust jumps at the samples: dF_k = F_k - F_k-1 (the thrust held over [t_k, t_k+1))
+  std::vector<double> dF(static_cast<std::size_t>(n), 0.0);
+  if (st2 > 0) {
+    const double gain = thrust_per_input(rec, model);
+    for (long k = 0; k < n; ++k) var_x[static_cast<std::size_t>(k)] += rec.motion.v[k] * rec.motion.v[k] * st2;
+    for (long k = 1; k + 1 < n; ++k) dF[static_cast<std::size_t>(k)] = gain * (rec.input[k] - rec.input[k - 1]);
+  }
+  // gap floor: over the replay's windows (replay.hpp), the expected mean square of
+  //   sensor noise and stamp error of each sample, plus the drift of a thrust switched dt_k early
+  //   or late: a ramp dF_k dt_k (t - t_k)/m after t_k, less its least-squares line (the window's
+  //   start correction), ||P ramp_k||^2 summed over the window's samples.
+  {
+    const double W = opt.replay_window > 0 ? opt.replay_window : std::max(0.1, 20.0 * rec.period);
+    double sum = 0.0;
+    long count = 0;
+    long s = 0;
+    std::vector<double> tau;
+    while (s + 1 < n) {
+      long e = s;
+      while (e + 1 < n && t[e + 1] - t[s] <= W + 1e-12) ++e;
+      if (e == s) e = s + 1;
+      for (long k = s + 1; k <= e; ++k) sum += var_x[static_cast<std::size_t>(k)];
+      count += e - s;
+      if (st2 > 0) {
+        tau.assign(static_cast<std::size_t>(e - s + 1), 0.0);
+        double S0 = 0, S1 = 0, S2 = 0;
+        for (long l = s; l <= e; ++l) {
+          const double x = t[l] - t[s];
+          tau[static_cast<std::size_t>(l - s)] = x;
+          S0 += 1;
+          S1 += x;
+          S2 += x * x;
+        }
+        const double det = S0 * S2 - S1 * S1;
+        for (long k = s + 1; k < e; ++k) {
+          const double g = dF[static_cast<std::size_t>(k)];
+          if (g == 0.0 || !(det > 0)) continue;
+          const double tk = t[k] - t[s];
+          double E0 = 0, E1 = 0;
+          for (const double x : tau) {
+            const double y = std::max(0.0, x - tk);
+            E0 += y;
+            E1 += y * x;
+          }
+          const double a = (S2 * E0 - S1 * E1) / det, b = (S0 * E1 - S1 * E0) / det;
+          double ss = 0.0;
+          for (std::size_t l = 1; l < tau.size(); ++l) {
+            const double y = std::max(0.0, tau[l] - tk) - a - b * tau[l];
+            ss += y * y;
+          }
+          sum += st2 * g * g / (mass * mass) * ss;
+        }
+      }
+      s = e;
+    }
+    f.gap = count ? std::sqrt(sum / static_cast<double>(count)) : f.position;
+  }
+  // force floor: sensor noise and stamp errors through the filtered acceleration, a thrust switched
+  // early or late through the filtered thrust, and the filter's discretisation (header)
+  const double L = rec.bank.half_width;
+  double noise_sum = 0.0, bias_sum = 0.0;
   long count = 0;
   std::vector<double> c;
   for (std::size_t i = 0; i < rec.bank.tau.size(); ++i) {
@@ -51,11 +114,28 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model) {
       c[static_cast<std::size_t>(j - j0)] -= g;
     }
     double s = 0.0;
-    for (double v : c) s += v * v;
-    sum += s;
+    for (long k = j0; k <= j1; ++k) {
+      const double ck = c[static_cast<std::size_t>(k - j0)];
+      s += mass * mass * ck * ck * var_x[static_cast<std::size_t>(k)];
+      if (st2 > 0) {
+        const double h = kernel(tau - t[k], L) * dF[static_cast<std::size_t>(k)];
+        s += st2 * h * h;
+      }
+    }
+    // the filter's own discretisation (header): b_i = m sum_j a_j h''(tau_i - t_mid,j) dt_j^3 / 12
+    double b = 0.0;
+    for (long j = j0; j < j1; ++j) {
+      const double dt = t[j + 1] - t[j], a_mid = 0.5 * (rec.motion.a[j] + rec.motion.a[j + 1]);
+      b += a_mid * kernel_dd(tau - 0.5 * (t[j] + t[j + 1]), L) * dt * dt * dt / 12.0;
+    }
+    noise_sum += s;
+    bias_sum += mass * mass * b * b;
     ++count;
   }
-  f.force = count ? mass * f.position * std::sqrt(sum / static_cast<double>(count)) : 0.0;
+  const double nc = std::max(1.0, static_cast<double>(count));
+  f.force_noise = count ? std::sqrt(noise_sum / nc) : 0.0;
+  f.force_discretisation = count ? std::sqrt(bias_sum / nc) : 0.0;
+  f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
   return f;
 }
 

@@ -504,7 +504,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     }
   }
   // The verdict against the sensor's noise floor (verdict.hpp).
-  out.floor = noise_floor(rec, model);
+  out.floor = noise_floor(rec, model, FloorOptions{opt.stamp_error, opt.replay_window});
   const double gap_final = rp.gap, force_final = out.force_rms_final;
   const bool final_within = within_floor(out.floor, gap_final, force_final);
   const std::string floor_text = fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.0fx)",

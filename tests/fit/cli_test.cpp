@@ -180,6 +180,8 @@ TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
       {"--score-threshold nan", "--score-threshold: 'nan' is not a finite number"},
       {"--min-gap-reduction -5", "--min-gap-reduction: '-5' is outside [0, 0.99]"},
       {"--filter-half-width inf", "--filter-half-width: 'inf' is not a finite number"},
+      {"--time-stamp-error -1e-6", "--time-stamp-error: '-1e-6' is outside ["},
+      {"--time-stamp-error nan", "--time-stamp-error: 'nan' is not a finite number"},
   };
   for (const auto& [option, message] : bad) {
     const ProcResult r = run_fit("--scenario x.yaml --data y.csv --out z " + option);
@@ -572,6 +574,39 @@ TEST(FitVerdict, UnexplainedSaysWhatWouldSettleItAndExitsThree) {
   EXPECT_NE(all.find("record a travel of at least 3 periods"), std::string::npos) << all;
   EXPECT_EQ(j["conclusion"].get<std::string>().find("within its noise"), std::string::npos);
   EXPECT_NE(slurp(g.out / "report.md").find("## Unexplained discrepancy"), std::string::npos);
+}
+
+// The noise floor's terms (fit/verdict.hpp): the same record with its time stamps' error given
+// (the generator's +-1 us, uniform: 0.577 us, DIR/knobs.txt) gets a higher floor -- v d_k per
+// sample and the thrust's jumps switched early or late -- which findings.json carries with the
+// force floor's parts; and the ripple's 23 um gap, ~400x the floor either way, stays unexplained.
+TEST(FitVerdict, StampErrorRaisesTheFloorAndHidesNoEffect) {
+  using namespace issue20;
+  const GeneratedFit plain = generate_and_fit("verdict_stamps_plain", "5 10 cogging_ripple,mass_error periods=1.6");
+  const fs::path dir = scratch() / "gen_verdict_stamps_plain";
+  ASSERT_NE(slurp(dir / "knobs.txt").find("stamp_error_s 5.77350269"), std::string::npos);
+  const fs::path out = scratch() / "verdict_stamps";
+  const ProcResult r = run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
+                               " --out " + out.string() + " --no-plots -q --time-stamp-error 5.7735e-7");
+  ASSERT_EQ(r.code, 3) << r.err << r.out;
+  ASSERT_EQ(plain.run.code, 3) << plain.run.err;
+  const auto j = findings(out);
+  const auto& f0 = plain.findings["noise_floor"];
+  const auto& f1 = j["noise_floor"];
+  EXPECT_DOUBLE_EQ(f1["stamp_error_s"].get<double>(), 5.7735e-7);
+  EXPECT_EQ(f0["stamp_error_s"].get<double>(), 0.0);
+  EXPECT_NE(f0["source"].get<std::string>().find("time-stamp error not given"), std::string::npos);
+  // the stamps add to the floor, never take away (variances add)
+  EXPECT_GT(f1["gap_m"].get<double>(), f0["gap_m"].get<double>());
+  EXPECT_GT(f1["force_rms_N"].get<double>(), f0["force_rms_N"].get<double>());
+  // the force floor = sensor/stamps and discretisation in quadrature; the discretisation does not
+  // depend on the stamps' error
+  EXPECT_GT(f1["force_discretisation_N"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(f1["force_discretisation_N"].get<double>(), f0["force_discretisation_N"].get<double>());
+  EXPECT_NEAR(std::hypot(f1["force_noise_N"].get<double>(), f1["force_discretisation_N"].get<double>()),
+              f1["force_rms_N"].get<double>(), 1e-9 * f1["force_rms_N"].get<double>());
+  EXPECT_EQ(j["verdict"], "unexplained");
+  EXPECT_GT(j["gap_final"].get<double>(), 100.0 * f1["gap_m"].get<double>());
 }
 
 // The issue's first case: a 40.2 mm ripple over 78.7 mm (pitch 2.2 % above travel/2) and a

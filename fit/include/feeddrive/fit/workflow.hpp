@@ -34,6 +34,7 @@ struct FitOptions {
   double score_threshold{10.0};     ///< least BIC score of a significant effect
   double min_gap_reduction{0.05};   ///< the replay gap must shrink by at least this fraction
   double replay_window{0.0};        ///< W [s] of the replay (0: default)
+  double stamp_error{0.0};          ///< sigma_t [s] of the record's time stamps, for the noise floor (verdict.hpp)
   RecordOptions record;
 };
 
