@@ -16,6 +16,13 @@ double kernel(double s, double L) {
 }
 
 // Hc = 1/2 + 315/256 * P(u),  P(u) = u - 4u^3/3 + 6u^5/5 - 4u^7/7 + u^9/9  (P(1) = 128/315).
+double kernel_dd(double s, double L) {
+  const double u = s / L;
+  if (u <= -1.0 || u >= 1.0) return 0.0;
+  const double w = 1.0 - u * u;
+  return -8.0 * 315.0 / (256.0 * L) * w * w * (1.0 - 7.0 * u * u) / (L * L);
+}
+
 double kernel_cdf(double s, double L) {
   const double u = s / L;
   if (u <= -1.0) return 0.0;

@@ -20,8 +20,10 @@
 
 namespace feeddrive::fit {
 
-/// h(s) and Hc(s) = Int_{-inf}^{s} h of the kernel above, half-width L [s].
+/// h(s), h''(s) and Hc(s) = Int_{-inf}^{s} h of the kernel above, half-width L [s] (h'' gives
+/// the noise floor's discretisation term, verdict.cpp).
 double kernel(double s, double L);
+double kernel_dd(double s, double L);
 double kernel_cdf(double s, double L);
 
 /// x^, v^, a^ at every sample and at the midpoint of every interval (size n-1).
