@@ -33,8 +33,8 @@ void setup_logging(const std::string& name, bool quiet);
 
 /// What run() needs besides the body.
 struct Options {
-  std::string name;              ///< the logger's name: the tool ("feeddrive-sim")
-  const bool* quiet{nullptr};    ///< the tool's --quiet flag, read after parsing
+  std::string name;            ///< the logger's name: the tool ("feeddrive-sim")
+  const bool* quiet{nullptr};  ///< the tool's --quiet flag, read after parsing
   /// Appended to the interrupt's line, computed after parsing ("; nothing written to DIR").
   std::function<std::string()> interrupt_detail;
 };
