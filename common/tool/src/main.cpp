@@ -3,18 +3,47 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <pthread.h>
+#include <signal.h>
+
 #include <cstdio>
+#include <cstdlib>
 
 #include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::tool {
+namespace {
+extern "C" void on_signal(int sig) { interrupt::detail::g_signal = sig; }
+}  // namespace
+
+void install_interrupt_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking call returns EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGXFSZ, SIG_IGN);
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+}
+
+int report_interrupt(const interrupt::Interrupted& e, const std::string& detail) {
+  const char* quiet = std::getenv(interrupt::kQuietEnv);
+  if (quiet == nullptr || std::string(quiet) != "1") std::fprintf(stderr, "error: %s%s\n", e.what(), detail.c_str());
+  return e.exit_code();
+}
+
 
 int report(std::exception_ptr e, const std::string& interrupt_detail) {
   try {
     std::rethrow_exception(e);
   } catch (const interrupt::Interrupted& i) {
-    return interrupt::report(i, interrupt_detail);
+    return report_interrupt(i, interrupt_detail);
   } catch (const BadInput& b) {
     std::fprintf(stderr, "error: %s\n", b.what());
     return kExitBadInput;
@@ -52,7 +81,7 @@ void setup_logging(const std::string& name, bool quiet) {
 int run(CLI::App& app, int argc, char** argv, const Options& opt, const std::function<int()>& body) {
   if (const std::optional<int> rc = parse(app, argc, argv)) return *rc;
   setup_logging(opt.name, opt.quiet != nullptr && *opt.quiet);
-  interrupt::install_handlers();
+  install_interrupt_handlers();
   try {
     return body();
   } catch (...) {
