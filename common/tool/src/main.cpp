@@ -51,7 +51,9 @@ int report(std::exception_ptr e, const std::string& interrupt_detail) {
     std::fprintf(stderr, "error: %s\n", b.what());
     return kExitBadInput;
   } catch (const std::exception& f) {
-    std::fprintf(stderr, "error: %s\n", f.what());
+    // A failure of the run, logged with the process's name: under feeddrive-launch the lines of
+    // four processes meet on one terminal, and each must say whose it is.
+    spdlog::error("{}", f.what());
     return kExitFailed;
   }
 }

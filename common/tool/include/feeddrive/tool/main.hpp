@@ -34,7 +34,7 @@ int report_interrupt(const interrupt::Interrupted& e, const std::string& detail 
 ///   interrupt::Interrupted          128 + signal  "error: interrupted by SIGINT<interrupt_detail>"
 ///                                                 (no line under feeddrive-launch: it reports once)
 ///   BadInput, std::invalid_argument 2             "error: <what>"
-///   any other std::exception        1             "error: <what>"
+///   any other std::exception        1             spdlog::error("<what>"): "[time] [tool] [error] <what>"
 int report(std::exception_ptr e, const std::string& interrupt_detail = "");
 
 /// Parses the command line. nullopt: go on; else the exit code: 0 after --help, 2 after a parse
