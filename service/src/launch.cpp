@@ -98,7 +98,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   for (const auto& s : args) argv.push_back(const_cast<char*>(s.c_str()));
   argv.push_back(nullptr);
   // SIGINT and SIGTERM stay blocked from before the fork until the new program has installed its
-  // handlers (interrupt::install_handlers unblocks them): a Ctrl-C that reaches the child between
+  // handlers (tool::install_interrupt_handlers unblocks them): a Ctrl-C that reaches the child between
   // fork and exec stays pending instead of being lost with the launcher's handler at exec (the
   // child then ran on to its 10 s start timeout).
   const pid_t launcher = ::getpid();

@@ -14,6 +14,7 @@
 #include "feeddrive/study/session.hpp"
 #include "feeddrive/study/spec.hpp"
 #include "feeddrive/study/transport.hpp"
+#include "feeddrive/tool/main.hpp"
 
 int main(int argc, char** argv) {
   std::string command = "feeddrive-study";
@@ -49,7 +50,7 @@ int main(int argc, char** argv) {
   }
   o.plots = !no_plots;
   // Ctrl-C / SIGTERM: the running cases stop, the finished ones stay in DIR/cases.
-  feeddrive::interrupt::install_handlers();
+  feeddrive::tool::install_interrupt_handlers();
   o.command = command;
   if (transport && transport->rank() != 0) return feeddrive::study::serve(*transport, o.jobs);
   return feeddrive::study::run_study(o, transport.get());

@@ -19,6 +19,7 @@ int code_of(const E& e) {
 }
 
 TEST(ToolReport, EachErrorKindHasItsExitCodeAndOneLine) {
+  setup_logging("test_tool", false);
   testing::internal::CaptureStderr();
   EXPECT_EQ(code_of(BadInput("plant.mass = -1: must be > 0")), kExitBadInput);
   EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: plant.mass = -1: must be > 0\n");
@@ -27,7 +28,10 @@ TEST(ToolReport, EachErrorKindHasItsExitCodeAndOneLine) {
   EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: --out: not a feeddrive output\n");
   testing::internal::CaptureStderr();
   EXPECT_EQ(code_of(std::runtime_error("step timeout")), kExitFailed);
-  EXPECT_EQ(std::string(testing::internal::GetCapturedStderr()), "error: step timeout\n");
+  // a failure of the run: one log line naming the process (setup_logging's logger)
+  const std::string failed = testing::internal::GetCapturedStderr();
+  EXPECT_NE(failed.find("] [test_tool] [error] step timeout"), std::string::npos) << failed;
+  EXPECT_EQ(failed.find('\n'), failed.size() - 1) << failed;
   // 128 + signal, one line unless started by feeddrive-launch (it reports the interrupt once).
   ::unsetenv(interrupt::kQuietEnv);
   testing::internal::CaptureStderr();

@@ -3,6 +3,8 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -13,6 +15,31 @@
 #include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::tool {
+namespace {
+extern "C" void on_signal(int sig) { interrupt::detail::g_signal = sig; }
+}  // namespace
+
+void install_interrupt_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking call returns EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGXFSZ, SIG_IGN);
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+}
+
+int report_interrupt(const interrupt::Interrupted& e, const std::string& detail) {
+  const char* quiet = std::getenv(interrupt::kQuietEnv);
+  if (quiet == nullptr || std::string(quiet) != "1") std::fprintf(stderr, "error: %s%s\n", e.what(), detail.c_str());
+  return e.exit_code();
+}
+
 
 namespace {
 
@@ -34,13 +61,15 @@ int report(std::exception_ptr e, const std::string& interrupt_detail) {
   try {
     std::rethrow_exception(e);
   } catch (const interrupt::Interrupted& i) {
-    return interrupt::report(i, interrupt_detail);
+    return report_interrupt(i, interrupt_detail);
   } catch (const BadInput& b) {
     return refuse(b.what());
   } catch (const std::invalid_argument& b) {
     return refuse(b.what());
   } catch (const std::exception& f) {
-    std::fprintf(stderr, "error: %s\n", f.what());
+    // A failure of the run, logged with the process's name: under feeddrive-launch the lines of
+    // four processes meet on one terminal, and each must say whose it is.
+    spdlog::error("{}", f.what());
     return kExitFailed;
   }
 }
@@ -70,7 +99,7 @@ void setup_logging(const std::string& name, bool quiet) {
 int run(CLI::App& app, int argc, char** argv, const Options& opt, const std::function<int()>& body) {
   if (const std::optional<int> rc = parse(app, argc, argv)) return *rc;
   setup_logging(opt.name, opt.quiet != nullptr && *opt.quiet);
-  interrupt::install_handlers();
+  install_interrupt_handlers();
   try {
     return body();
   } catch (...) {

@@ -16,11 +16,25 @@
 
 namespace feeddrive::tool {
 
+/// Installs the process's SIGINT/SIGTERM handlers, which set the interrupt flag the libraries
+/// poll (feeddrive/common/interrupt.hpp); idempotent. No SA_RESTART: a blocking system call (poll,
+/// nanosleep, waitpid) returns EINTR at once and the caller sees the flag. SIGXFSZ is ignored: a
+/// file grown past the file-size limit (ulimit -f) is then a write error (EFBIG) reported as
+/// such, with the staging folder removed, not a process killed mid-write. The two signals are
+/// unblocked (feeddrive-launch starts its processes with them blocked, so that a Ctrl-C during
+/// their start is kept pending, not lost).
+void install_interrupt_handlers();
+
+/// The end of an interrupted tool (docs/scenario.md, "Exit codes and Ctrl-C"): prints the one
+/// line "error: interrupted by SIGINT<detail>" (unless started by feeddrive-launch:
+/// interrupt::kQuietEnv) and returns the exit code 128 + signal.
+int report_interrupt(const interrupt::Interrupted& e, const std::string& detail = "");
+
 /// The exit code and the one line on stderr for an exception a tool's work threw:
 ///   interrupt::Interrupted          128 + signal  "error: interrupted by SIGINT<interrupt_detail>"
 ///                                                 (no line under feeddrive-launch: it reports once)
 ///   BadInput, std::invalid_argument 2             "error: <what>"
-///   any other std::exception        1             "error: <what>"
+///   any other std::exception        1             spdlog::error("<what>"): "[time] [tool] [error] <what>"
 int report(std::exception_ptr e, const std::string& interrupt_detail = "");
 
 /// Parses the command line. nullopt: go on; else the exit code: 0 after --help, 2 after a parse
@@ -33,8 +47,8 @@ void setup_logging(const std::string& name, bool quiet);
 
 /// What run() needs besides the body.
 struct Options {
-  std::string name;              ///< the logger's name: the tool ("feeddrive-sim")
-  const bool* quiet{nullptr};    ///< the tool's --quiet flag, read after parsing
+  std::string name;            ///< the logger's name: the tool ("feeddrive-sim")
+  const bool* quiet{nullptr};  ///< the tool's --quiet flag, read after parsing
   /// Appended to the interrupt's line, computed after parsing ("; nothing written to DIR").
   std::function<std::string()> interrupt_detail;
 };
@@ -54,7 +68,7 @@ auto input_step(F&& f) -> decltype(f()) {
   }
 }
 
-/// parse(), setup_logging(), interrupt::install_handlers(), then body(): its return value, or
+/// parse(), setup_logging(), install_interrupt_handlers(), then body(): its return value, or
 /// report() of what it threw.
 int run(CLI::App& app, int argc, char** argv, const Options& opt, const std::function<int()>& body);
 
