@@ -18,7 +18,9 @@ int main(int argc, char** argv) {
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
-    opt.scenario_hash = rs.sha256;  // checked against the monitor's run_info_t
+    // Checked against the monitor's run_info_t, except for a --plugin host: its scenario gives the
+    // plugin's parameters and may be another file than the run's (docs/plugins.md).
+    if (plugin.empty()) opt.scenario_hash = rs.sha256;
     sim::Scenario s = rs.scenario;
     if (!plugin.empty()) sim::use_plugin(s, plugin);
     service::ControllerNode node(sim::make_controller(s), opt);
