@@ -253,7 +253,7 @@ void MonitorNode::check_peer_status(const process_status_t& m) {
   // A heartbeat step far beyond every state recorded (more than the flow-control window and
   // 100 steps in flight) is not the plant's: forged. It is not taken as the plant's progress,
   // so it cannot make the real heartbeats look as if they went back.
-  if (m.seq > rec_.highest_state() + std::max<std::int64_t>(options().monitor_window, 0) + 100) {
+  if (plant_step_implausible(m.seq)) {
     if (named_["implausible plant heartbeat"]++ == 0)
       spdlog::warn("{}: a heartbeat of the plant claims step {}, beyond every state recorded ({}): forged; ignored",
                    role(), m.seq, rec_.highest_state());
@@ -264,6 +264,12 @@ void MonitorNode::check_peer_status(const process_status_t& m) {
     return;
   }
   plant_seq_seen_ = std::max(plant_seq_seen_, m.seq);
+}
+
+// A plant step beyond every state recorded by more than the flow-control window and 100 steps
+// in flight is not the plant's: forged.
+bool MonitorNode::plant_step_implausible(std::int64_t seq) const {
+  return seq > rec_.highest_state() + std::max<std::int64_t>(options().monitor_window, 0) + 100;
 }
 
 // A plant whose heartbeat goes back (its step, or "starting" after "running"): a new process
@@ -280,7 +286,7 @@ void MonitorNode::plant_went_back(const process_status_t& m) {
   // After the plant's own "done" or "failed" nothing restarts the run (and the Node ignored the
   // heartbeat); a step beyond every state recorded is forged (check_peer_status).
   if (const process_status_t* p = peer("plant"); p != nullptr && (p->state == "done" || p->state == "failed")) return;
-  if (m.seq > rec_.highest_state() + std::max<std::int64_t>(options().monitor_window, 0) + 100) return;
+  if (plant_step_implausible(m.seq)) return;
   if (!options().key_file.empty()) {
     if (named_["plant heartbeat back"]++ == 0)
       spdlog::warn("{}: a signed heartbeat of the plant went back (step {} '{}' after step {}): a replay of this run's "

@@ -125,40 +125,33 @@ pass "skipped step: exit 1, the plant named, 499 steps recorded"
 # 7. A restarted drive: the adapter dies at step 3000 and a new one starts (a new run id). The
 # monitor says the plant restarted within 1 s of the new one's first heartbeat (2.5 s with the
 # adapter's start and the launcher's exit).
-timeout 60 "$TMP/adapter" --url "$URL" --exit-at 3000 2> /dev/null & a=$!
-timeout 60 feeddrive-launch "$hil" --out "$TMP/restart" --no-plots -q --lcm-url "$URL" --external plant 2> "$TMP/restart.err" & l=$!
-wait $a || true
-sleep 0.5
-start=$(date +%s.%N)
-timeout 60 "$TMP/adapter" --url "$URL" 2> /dev/null & a2=$!
-set +e
-wait $l; rc=$?
-set -e
-took=$(echo "$(date +%s.%N) - $start" | bc)
-kill $a2 2>/dev/null || true
-[ $rc = 1 ] || { cat "$TMP/restart.err"; fail "restart: exit $rc"; }
-[ "$(grep -c "monitor: the plant restarted" "$TMP/restart.err")" = 1 ] || { cat "$TMP/restart.err"; fail "restart: no single line saying the plant restarted"; }
-awk -v t="$took" 'BEGIN { exit !(t < 2.5) }' || { cat "$TMP/restart.err"; fail "restart: took $took s"; }
-pass "restarted adapter: exit 1 after $took s: $(grep -m1 "the plant restarted" "$TMP/restart.err" | cut -c1-160)..."
+# restart NAME WHAT [ADAPTER/LAUNCH OPTIONS...]: the adapter dies at step 3000, a new one starts
+# 0.5 s later; the run fails with exit 1 and one line saying the plant restarted, within 2.5 s.
+restart() {
+  local name=$1 what=$2 a a2 l rc start took
+  shift 2
+  timeout 60 "$TMP/adapter" --url "$URL" "$@" --exit-at 3000 2> /dev/null & a=$!
+  timeout 60 feeddrive-launch "$hil" --out "$TMP/$name" --no-plots -q --lcm-url "$URL" --external plant "$@" 2> "$TMP/$name.err" & l=$!
+  wait $a || true
+  sleep 0.5
+  start=$(date +%s.%N)
+  timeout 60 "$TMP/adapter" --url "$URL" "$@" 2> /dev/null & a2=$!
+  set +e
+  wait $l; rc=$?
+  set -e
+  took=$(echo "$(date +%s.%N) - $start" | bc)
+  kill $a2 2>/dev/null || true
+  [ $rc = 1 ] || { cat "$TMP/$name.err"; fail "$what: exit $rc"; }
+  [ "$(grep -c "monitor: the plant restarted" "$TMP/$name.err")" = 1 ] ||
+    { cat "$TMP/$name.err"; fail "$what: no single line saying the plant restarted"; }
+  awk -v t="$took" 'BEGIN { exit !(t < 2.5) }' || { cat "$TMP/$name.err"; fail "$what: took $took s"; }
+  pass "$what: exit 1 after $took s: $(grep -m1 "the plant restarted" "$TMP/$name.err" | cut -c1-160)..."
+}
+restart restart "restarted adapter"
 
 # 7b. The same, with one run id given to both (docs/deployment.md's fixed --run-id, no key):
 # the new adapter's heartbeat goes back ("starting" at step -1 after "running"): a restart,
 # named as such within the same bound, although the new adapter would resume at the run's
 # current step (a record joining two drives' motions must not pass as complete). With --key a
 # heartbeat that goes back is a replay, ignored: service.bus_attack_test case 8.
-timeout 60 "$TMP/adapter" --url "$URL" --run-id 777 --exit-at 3000 2> /dev/null & a=$!
-timeout 60 feeddrive-launch "$hil" --out "$TMP/restart_same" --no-plots -q --lcm-url "$URL" --external plant --run-id 777 2> "$TMP/restart_same.err" & l=$!
-wait $a || true
-sleep 0.5
-start=$(date +%s.%N)
-timeout 60 "$TMP/adapter" --url "$URL" --run-id 777 2> /dev/null & a2=$!
-set +e
-wait $l; rc=$?
-set -e
-took=$(echo "$(date +%s.%N) - $start" | bc)
-kill $a2 2>/dev/null || true
-[ $rc = 1 ] || { cat "$TMP/restart_same.err"; fail "restart with the same run id: exit $rc"; }
-[ "$(grep -c "monitor: the plant restarted" "$TMP/restart_same.err")" = 1 ] ||
-  { cat "$TMP/restart_same.err"; fail "restart with the same run id: no single line saying the plant restarted"; }
-awk -v t="$took" 'BEGIN { exit !(t < 2.5) }' || { cat "$TMP/restart_same.err"; fail "restart with the same run id: took $took s"; }
-pass "restarted adapter, same run id: exit 1 after $took s: $(grep -m1 "the plant restarted" "$TMP/restart_same.err" | cut -c1-160)..."
+restart restart_same "restarted adapter, same run id" --run-id 777

@@ -71,6 +71,7 @@ class MonitorNode : public service::Node {
   void on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why);
   void check_peer_status(const process_status_t& m);
   void plant_went_back(const process_status_t& m);
+  bool plant_step_implausible(std::int64_t seq) const;
   /// Fails the run with `why` when `role` is one of the run's (an observer is only named) and,
   /// with unless_role_alive, no admitted process of that role was heard within the last second.
   void fail_for(const std::string& role, const std::string& why, bool unless_role_alive = true);
