@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
       spdlog::error("--out {}: the monitor wrote no results", output::shown(lo.out_dir));
       return 1;
     }
+    for (const std::string& w : s.warnings) spdlog::warn("{}", w);  // after the run, as feeddrive-sim does
     std::ifstream in(lo.out_dir + "/summary.json");
     const auto j = nlohmann::json::parse(in, nullptr, false);
     // The true-state error where the plant has one, else the measured one (a hardware plant).

@@ -13,6 +13,8 @@
 namespace feeddrive::service {
 
 void add_node_options(CLI::App& app, NodeOptions& opt) {
+  app.add_option("--set", opt.sets, "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
+      ->type_name("KEY=VALUE");
   app.add_option("--lcm-url", opt.lcm_url, "LCM URL (default: multicast, ttl=0, 4 MB receive buffer)")
       ->capture_default_str();
   app.add_option("--prefix", opt.prefix, "channel prefix: <prefix>_STATE, _CMD, _REF, ...")->capture_default_str();
@@ -64,7 +66,9 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
 
 RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
   std::string text;
-  RunScenario r{sim::load_scenario(path, &text), ""};
+  std::vector<sim::KeySetting> sets;
+  for (const std::string& k : opt.sets) sets.push_back(sim::parse_key_setting(k));
+  RunScenario r{sim::load_scenario(path, sets, &text), ""};
   r.sha256 = sha256_hex(text);
   if (!opt.scenario_hash.empty() && opt.scenario_hash != r.sha256)
     throw std::invalid_argument(path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
