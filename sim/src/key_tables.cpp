@@ -31,7 +31,7 @@ std::string valid_text(const Meta& m) {
     case Check::kPositive: s = "> 0"; break;
     case Check::kNonNegative: s = "≥ 0"; break;
     case Check::kNotPlusInf: s = "finite or -.inf"; break;
-    case Check::kNone: s = "see meaning"; break;
+    case Check::kNone: s = "its own rule (Meaning)"; break;
   }
   if (m.min > -fields::kInf) s += ", ≥ " + number(m.min);
   if (m.max < fields::kInf) s += ", ≤ " + number(m.max);

@@ -57,7 +57,9 @@ TEST(Fields, EveryListedKeyIsReadAndEveryReadKeyIsListed) {
 TEST(Fields, ValidateRangesComeFromTheList) {
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{mass: -1}")), "s.yaml: plant.mass = -1: must be > 0");
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {quantization: 50}}")),
-            "s.yaml: plant.sensor.quantization = 50: must be <= 1 m");
+            "s.yaml: plant.sensor.quantization = 50: must be <= 1 m (um?)");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: scurve, max_velocity: 1500}")),
+            "s.yaml: reference.max_velocity = 1500: must be <= 1000 m/s (mm/s?)");
   EXPECT_EQ(error_of(scenario("{type: cascade, kv: -3}", "{type: sine}")), "s.yaml: controller.kv = -3: must be >= 0");
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: accel_limited, max_velocity: 0}")),
             "s.yaml: reference.max_velocity = 0: must be > 0");

@@ -178,8 +178,12 @@ class CheckArchive {
         if (std::isnan(v) || v == kInf) validate::fail(key, v, "must be a number or -inf");
         break;
     }
-    if (v < m.min) validate::fail(key, v, "must be >= " + validate::format_number(m.min) + " " + m.unit);
-    if (v > m.max) validate::fail(key, v, "must be <= " + validate::format_number(m.max) + " " + m.unit);
+    // Beyond the hard bounds a value cannot be meant; the likely unit is named as in the warnings.
+    const std::string unit = std::string(m.unit) == "-" ? "" : std::string(" ") + m.unit;
+    if (v < m.min)
+      validate::fail(key, v, "must be >= " + validate::format_number(m.min) + unit + (*m.hint_low ? std::string(" (") + m.hint_low + "?)" : ""));
+    if (v > m.max)
+      validate::fail(key, v, "must be <= " + validate::format_number(m.max) + unit + (*m.hint_high ? std::string(" (") + m.hint_high + "?)" : ""));
   }
 
  private:

@@ -78,8 +78,8 @@ struct CascadeParams {
     a->Visit(FD_FIELD(friction_feedforward).doc("add the model's LuGre friction along the reference"));
     a->Visit(FD_FIELD(disturbance_observer_bandwidth).unit("rad/s").non_negative().plausible(0, 1e5).doc("x,v,d observer fed by the encoder; 0: off"));
     a->Visit(FD_FIELD(compensate_delay).doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
   }
   void validate(const std::string& prefix = "controller") const;
 };

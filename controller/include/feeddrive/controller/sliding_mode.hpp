@@ -138,8 +138,8 @@ struct SlidingModeParams {
     a->Visit(FD_FIELD(motion_observer_bandwidth).unit("rad/s").positive().plausible(1, 1e5).doc("pole of the x,v observer, p = exp(-w*T)"));
     a->Visit(FD_FIELD(motion_observer_disturbance).doc("with motion_state observer: estimate a disturbance acceleration and add m*d^"));
     a->Visit(FD_FIELD(compensate_delay).doc("predict the state to t_k + computation_delay (needs motion_state observer)"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
   }
   void validate(const std::string& prefix = "controller") const;
 };

@@ -116,7 +116,7 @@ struct RippleParams {
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(preset).doc("paper: start from the paper's values (ac 3 N, bc 1 N, af 0.03, bf 0.01, on); `ripple: paper` alone says the same; none: every part 0"));
     a->Visit(FD_FIELD(enabled).doc("the ripple force of eqs. 14-15 acts"));
-    a->Visit(FD_FIELD(pitch).unit("m").positive().plausible(1e-3, 0.2, "mm").doc("p, magnet pitch"));
+    a->Visit(FD_FIELD(pitch).unit("m").positive().at_most(10).plausible(1e-3, 0.2, "mm").doc("p, magnet pitch"));
     a->Visit(FD_FIELD(cogging_amplitude).unit("N").plausible(-2000, 2000).doc("ac, cogging amplitude"));
     a->Visit(FD_FIELD(cogging_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c1"));
     a->Visit(FD_FIELD(cogging_third).unit("N").plausible(-2000, 2000).doc("bc, cogging third harmonic (6*pi*x/p)"));

@@ -77,8 +77,8 @@ struct AccelLimitedParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
     a->Visit(FD_FIELD(start_time).unit("s"));
     a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
   }
@@ -100,9 +100,9 @@ struct SCurveParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().plausible(0, 500, "mm/s^2", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_jerk).unit("m/s^3").positive().plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_jerk).unit("m/s^3").positive().at_most(1e8).plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
     a->Visit(FD_FIELD(start_time).unit("s"));
     a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
   }
