@@ -69,7 +69,7 @@ BENCHMARK(BM_ControlPeriodFullModel)->MinTime(2.0);
 // is not in contact), where friction's bristle dynamics are fastest.
 void BM_ControlPeriodJerkLimitedMove(benchmark::State& state) {
   sim::Scenario s = sim::load_scenario(scenario_path("paper/smc_bl_jerk_limited.yaml"));
-  s.plant.ripple.enabled = true;
+  s.plant.ripple = plant::RippleParams::paper();
   s.controller.sliding_mode.model = s.plant;
   control_periods(state, s);
 }

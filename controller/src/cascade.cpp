@@ -14,12 +14,7 @@ double saturate(double u, double lo, double hi) {
 
 void CascadeParams::validate(const std::string& prefix) const {
   using namespace detail;
-  require_non_negative(prefix + ".kp", kp);
-  require_non_negative(prefix + ".kv", kv);
-  require_non_negative(prefix + ".ki", ki);
-  require_finite(prefix + ".velocity_feedforward", velocity_feedforward);
-  require_finite(prefix + ".acceleration_feedforward", acceleration_feedforward);
-  require_non_negative(prefix + ".disturbance_observer_bandwidth", disturbance_observer_bandwidth);
+  fields::check_fields(*this, prefix);  // the list's ranges (cascade.hpp)
   require_non_negative(prefix + ".model.sensor.quantization", quantization);
   require_non_negative(prefix + ".computation_delay", computation_delay);
   require_positive(prefix + ".model.mass", mass);
@@ -27,6 +22,14 @@ void CascadeParams::validate(const std::string& prefix) const {
   if (friction_feedforward) friction.validate(prefix + ".model.friction");
   require_range(prefix, u_min, u_max);
   require_positive(prefix + ".period", period);
+}
+
+void apply_tuning(CascadeParams& p, bool differenced_velocity) {
+  if (p.tuning != CascadeTuning::kRule) return;
+  const CascadeGains g = cascade_tuning(p.period, p.computation_delay, differenced_velocity, p.bandwidth_scale);
+  p.kp = g.kp;
+  p.kv = g.kv;
+  p.ki = g.ki;
 }
 
 CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,

@@ -8,32 +8,12 @@
 
 namespace feeddrive::controller {
 
-std::string to_string(OpenLoopKind k) {
-  switch (k) {
-    case OpenLoopKind::kStep: return "step";
-    case OpenLoopKind::kSine: return "sine";
-    case OpenLoopKind::kRamp: return "ramp";
-    case OpenLoopKind::kCsv: return "csv";
-  }
-  return "?";
-}
-
-OpenLoopKind open_loop_kind_from_string(const std::string& s) {
-  if (s == "step") return OpenLoopKind::kStep;
-  if (s == "sine") return OpenLoopKind::kSine;
-  if (s == "ramp") return OpenLoopKind::kRamp;
-  if (s == "csv") return OpenLoopKind::kCsv;
-  throw std::invalid_argument("expected one of step, sine, ramp, csv");
-}
+std::string to_string(OpenLoopKind k) { return fields::enum_name(k); }
+OpenLoopKind open_loop_kind_from_string(const std::string& s) { return fields::enum_from_name<OpenLoopKind>(s); }
 
 void OpenLoopParams::validate(const std::string& prefix) const {
   using namespace detail;
-  require_finite(prefix + ".amplitude", amplitude);
-  require_non_negative(prefix + ".frequency", frequency);
-  require_finite(prefix + ".phase", phase);
-  require_finite(prefix + ".offset", offset);
-  require_finite(prefix + ".rate", rate);
-  require_non_negative(prefix + ".start_time", start_time);
+  fields::check_fields(*this, prefix);  // the list's ranges (open_loop.hpp)
   require_positive(prefix + ".thrust_gain", thrust_gain);
   require_range(prefix, u_min, u_max);
   if (kind == OpenLoopKind::kCsv) {

@@ -11,46 +11,17 @@
 
 namespace feeddrive::controller {
 
-std::string to_string(Switching s) {
-  switch (s) {
-    case Switching::kSign: return "sgn";
-    case Switching::kSaturation: return "sat";
-    case Switching::kTanh: return "tanh";
-  }
-  return "?";
-}
-
-Switching switching_from_string(const std::string& s) {
-  if (s == "sgn") return Switching::kSign;
-  if (s == "sat") return Switching::kSaturation;
-  if (s == "tanh") return Switching::kTanh;
-  throw std::invalid_argument("expected one of sgn, sat, tanh");
-}
-
-std::string to_string(StateSource s) { return s == StateSource::kTrue ? "true" : "observer"; }
-
-StateSource state_source_from_string(const std::string& s) {
-  if (s == "true") return StateSource::kTrue;
-  if (s == "observer") return StateSource::kObserver;
-  throw std::invalid_argument("expected one of true, observer");
-}
-
-std::string to_string(MotionSource s) { return s == MotionSource::kMeasured ? "measured" : "observer"; }
-
-MotionSource motion_source_from_string(const std::string& s) {
-  if (s == "measured") return MotionSource::kMeasured;
-  if (s == "observer") return MotionSource::kObserver;
-  throw std::invalid_argument("expected one of measured, observer");
-}
+std::string to_string(Switching s) { return fields::enum_name(s); }
+Switching switching_from_string(const std::string& s) { return fields::enum_from_name<Switching>(s); }
+std::string to_string(StateSource s) { return fields::enum_name(s); }
+StateSource state_source_from_string(const std::string& s) { return fields::enum_from_name<StateSource>(s); }
+std::string to_string(MotionSource s) { return fields::enum_name(s); }
+MotionSource motion_source_from_string(const std::string& s) { return fields::enum_from_name<MotionSource>(s); }
 
 void SlidingModeParams::validate(const std::string& prefix) const {
   using namespace detail;
-  require_non_negative(prefix + ".eta", eta);
-  require_non_negative(prefix + ".k", k);
-  require_positive(prefix + ".lambda", lambda);
+  fields::check_fields(*this, prefix);  // the list's ranges (sliding_mode.hpp)
   if (switching != Switching::kSign) require_positive(prefix + ".boundary_layer", boundary_layer);
-  require_non_negative(prefix + ".observer_gain", observer_gain);
-  require_positive(prefix + ".motion_observer_bandwidth", motion_observer_bandwidth);
   require_range(prefix, u_min, u_max);
   require_positive(prefix + ".period", period);
   require_non_negative(prefix + ".computation_delay", computation_delay);

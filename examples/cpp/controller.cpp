@@ -64,6 +64,8 @@ fd::controller::SlidingModeParams params_from(const fd::run_info_t& info) {
   m.friction.bristle_stiffness = info.bristle_stiffness;
   m.friction.bristle_damping = info.bristle_damping;
   m.friction.viscous = info.viscous;
+  // The message carries the ripple's first harmonics; the third ones are the paper's.
+  if (info.ripple) m.ripple = fd::plant::RippleParams::paper();
   m.ripple.enabled = info.ripple;
   m.ripple.pitch = info.ripple_pitch;
   m.ripple.cogging_amplitude = info.cogging_amplitude;

@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
   fit::CsvOptions csv;
   bool no_plots = false, quiet = false;
   app.add_option("--scenario,-s", scenario_path, "the model: a feeddrive scenario YAML")->required();
+  std::vector<std::string> sets;
+  app.add_option("--set", sets, "KEY=VALUE: set a key of the model's scenario (dotted, e.g. plant.mass=110); repeatable")
+      ->type_name("KEY=VALUE");
   app.add_option("--data,-d", data_path, "measured data: CSV (t, x, u or force_N[, xd, v]) or an lcm-logger log (.lcm, .lcmlog, .log)")
       ->required();
   app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
@@ -92,7 +95,9 @@ int main(int argc, char** argv) {
     if (csv.decimal_comma && csv.separator == ',')
       throw BadInput("--decimal-comma needs another --separator (e.g. --separator ';'): the comma cannot be both");
     output::check_output_dir(out_dir);
-    const sim::Scenario scenario = sim::load_scenario(scenario_path);
+    std::vector<sim::KeySetting> settings;
+    for (const std::string& k : sets) settings.push_back(sim::parse_key_setting(k));
+    const sim::Scenario scenario = sim::load_scenario(scenario_path, settings);
     opt.plausibility.grinding_process =
         scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();
     if (!units.empty()) csv.units = fit::parse_units(units);

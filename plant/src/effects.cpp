@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <type_traits>
 #include <stdexcept>
 
 #include "feeddrive/plant/forces.hpp"
@@ -113,79 +114,87 @@ ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v
 
 namespace {
 
-// One row per effect: its name, its enabled flag and its parameters' fields, in vocabulary order.
-struct EffectRow {
-  std::string name;
-  std::function<bool&(EffectsParams&)> enabled;
-  std::vector<std::pair<std::string, std::function<double&(EffectsParams&)>>> params;
+// The vocabulary is EffectsParams::Serialize and each effect's Serialize (params.hpp): the
+// effects in order, each with `enabled` and its parameters (the numbers).
+
+// One effect's parameters: their names, or the field named `param`.
+class EffectFields {
+ public:
+  explicit EffectFields(const std::string* param = nullptr) : param_(param) {}
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    if constexpr (std::is_same_v<T, double>) {
+      names.push_back(f.meta.name);
+      if (param_ && *param_ == f.meta.name) found = f.value;
+    }
+  }
+  std::vector<std::string> names;
+  double* found{nullptr};
+
+ private:
+  const std::string* param_;
 };
 
-#define FD_PARAM(effect, field) \
-  { #field, [](EffectsParams& e) -> double& { return e.effect.field; } }
-#define FD_EFFECT(effect, ...) \
-  EffectRow { #effect, [](EffectsParams& e) -> bool& { return e.effect.enabled; }, { __VA_ARGS__ } }
+// The effects: their names and parameter names, or the effect named `name` in an EffectsParams.
+class EffectList {
+ public:
+  explicit EffectList(const std::string* name = nullptr, const std::string* param = nullptr) : name_(name), param_(param) {}
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    EffectFields inner(name_ && *name_ == f.meta.name ? param_ : nullptr);
+    f.value->Serialize(&inner);
+    names.push_back(f.meta.name);
+    parameters[f.meta.name] = inner.names;
+    if (name_ && *name_ == f.meta.name) {
+      enabled = &f.value->enabled;
+      param = inner.found;
+    }
+  }
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<std::string>> parameters;
+  bool* enabled{nullptr};
+  double* param{nullptr};
 
-const std::vector<EffectRow>& table() {
-  static const std::vector<EffectRow> rows = {
-      FD_EFFECT(constant_force, FD_PARAM(constant_force, force_N)),
-      FD_EFFECT(coulomb_friction, FD_PARAM(coulomb_friction, coulomb_N)),
-      FD_EFFECT(viscous_friction, FD_PARAM(viscous_friction, viscous_Ns_per_m)),
-      FD_EFFECT(stribeck_friction, FD_PARAM(stribeck_friction, static_N), FD_PARAM(stribeck_friction, coulomb_N),
-                FD_PARAM(stribeck_friction, stribeck_velocity_mps)),
-      FD_EFFECT(presliding, FD_PARAM(presliding, bristle_stiffness_N_per_m),
-                FD_PARAM(presliding, bristle_damping_Ns_per_m)),
-      FD_EFFECT(cogging_ripple, FD_PARAM(cogging_ripple, pitch_m), FD_PARAM(cogging_ripple, amplitude_N),
-                FD_PARAM(cogging_ripple, phase_rad), FD_PARAM(cogging_ripple, third_harmonic_N),
-                FD_PARAM(cogging_ripple, third_phase_rad)),
-      FD_EFFECT(reluctance_ripple, FD_PARAM(reluctance_ripple, pitch_m),
-                FD_PARAM(reluctance_ripple, relative_amplitude), FD_PARAM(reluctance_ripple, phase_rad)),
-      FD_EFFECT(grinding_force, FD_PARAM(grinding_force, gain_Ns_per_m), FD_PARAM(grinding_force, stiffness_N_per_m),
-                FD_PARAM(grinding_force, contact_position_m)),
-      FD_EFFECT(spring_force, FD_PARAM(spring_force, stiffness_N_per_m), FD_PARAM(spring_force, rest_position_m)),
-      FD_EFFECT(mass_error, FD_PARAM(mass_error, mass_kg)),
-      FD_EFFECT(input_delay, FD_PARAM(input_delay, delay_s)),
-  };
-  return rows;
+ private:
+  const std::string* name_;
+  const std::string* param_;
+};
+
+const EffectList& vocabulary() {
+  static const EffectList list = [] {
+    EffectList l;
+    EffectsParams e;
+    e.Serialize(&l);
+    return l;
+  }();
+  return list;
 }
 
-#undef FD_EFFECT
-#undef FD_PARAM
-
-const EffectRow& row(const std::string& name) {
-  for (const EffectRow& r : table())
-    if (r.name == name) return r;
-  throw std::invalid_argument("unknown effect '" + name + "'");
+EffectList find(EffectsParams& e, const std::string& name, const std::string* param) {
+  EffectList l(&name, param);
+  e.Serialize(&l);
+  if (!l.enabled) throw std::invalid_argument("unknown effect '" + name + "'");
+  return l;
 }
 
 }  // namespace
 
-const std::vector<std::string>& effect_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (const EffectRow& r : table()) n.push_back(r.name);
-    return n;
-  }();
-  return names;
-}
+const std::vector<std::string>& effect_names() { return vocabulary().names; }
 
 const std::vector<std::string>& effect_parameter_names(const std::string& name) {
-  static const std::map<std::string, std::vector<std::string>> names = [] {
-    std::map<std::string, std::vector<std::string>> n;
-    for (const EffectRow& r : table())
-      for (const auto& p : r.params) n[r.name].push_back(p.first);
-    return n;
-  }();
-  row(name);  // throws for an unknown name
-  return names.at(name);
+  const auto& p = vocabulary().parameters;
+  const auto it = p.find(name);
+  if (it == p.end()) throw std::invalid_argument("unknown effect '" + name + "'");
+  return it->second;
 }
 
 double& effect_parameter(EffectsParams& e, const std::string& name, const std::string& param) {
-  for (const auto& p : row(name).params)
-    if (p.first == param) return p.second(e);
-  throw std::invalid_argument("effect " + name + ": unknown parameter '" + param + "'");
+  const EffectList l = find(e, name, &param);
+  if (!l.param) throw std::invalid_argument("effect " + name + ": unknown parameter '" + param + "'");
+  return *l.param;
 }
 
-bool& effect_enabled(EffectsParams& e, const std::string& name) { return row(name).enabled(e); }
+bool& effect_enabled(EffectsParams& e, const std::string& name) { return *find(e, name, nullptr).enabled; }
 
 void set_effect(EffectsParams& e, const NamedEffect& effect) {
   effect_enabled(e, effect.name) = true;
@@ -193,12 +202,12 @@ void set_effect(EffectsParams& e, const NamedEffect& effect) {
 }
 
 std::vector<NamedEffect> enabled_effects(const EffectsParams& e) {
-  EffectsParams copy = e;  // the table hands out mutable references
+  EffectsParams copy = e;  // the list hands out mutable references
   std::vector<NamedEffect> out;
-  for (const EffectRow& r : table()) {
-    if (!r.enabled(copy)) continue;
-    NamedEffect ne{r.name, {}};
-    for (const auto& p : r.params) ne.parameters[p.first] = p.second(copy);
+  for (const std::string& name : effect_names()) {
+    if (!effect_enabled(copy, name)) continue;
+    NamedEffect ne{name, {}};
+    for (const std::string& param : effect_parameter_names(name)) ne.parameters[param] = effect_parameter(copy, name, param);
     out.push_back(ne);
   }
   return out;

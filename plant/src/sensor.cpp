@@ -7,8 +7,7 @@ namespace feeddrive::plant {
 Sensor::Sensor(const SensorParams& params, double period)
     : params_(params),
       period_(period),
-      difference_velocity_(params.velocity == "difference" ||
-                           (params.velocity == "auto" && !params.ideal())),
+      difference_velocity_(params.differenced_velocity()),
       rng_(params.seed),
       noise_(0.0, 1.0) {}
 

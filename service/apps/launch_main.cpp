@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
       spdlog::error("--out {}: the monitor wrote no results", output::shown(lo.out_dir));
       return 1;
     }
+    for (const std::string& w : s.warnings) spdlog::warn("{}", w);  // after the run, as feeddrive-sim does
     std::ifstream in(lo.out_dir + "/summary.json");
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const auto j = nlohmann::json::parse(text, nullptr, false);

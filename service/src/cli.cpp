@@ -12,6 +12,8 @@
 namespace feeddrive::service {
 
 void add_node_options(CLI::App& app, NodeOptions& opt) {
+  app.add_option("--set", opt.sets, "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
+      ->type_name("KEY=VALUE");
   app.add_option("--lcm-url", opt.lcm_url, "LCM URL (default: multicast, ttl=0, 4 MB receive buffer)")
       ->capture_default_str();
   app.add_option("--prefix", opt.prefix, "channel prefix: <prefix>_STATE, _CMD, _REF, ...")->capture_default_str();
@@ -63,7 +65,9 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
 
 RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
   std::string text;
-  RunScenario r{sim::load_scenario(path, &text), ""};
+  std::vector<sim::KeySetting> sets;
+  for (const std::string& k : opt.sets) sets.push_back(sim::parse_key_setting(k));
+  RunScenario r{sim::load_scenario(path, sets, &text), ""};
   // The run's scenario is the file and the tables it names (waypoints, an open-loop force
   // table), as parsed here: a table swapped while the run starts changes the hash as the file
   // does. A scenario that names no file hashes as its text alone.

@@ -50,6 +50,7 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
   if (!opt.key_file.empty() && opt.run_nonce != 0) a.insert(a.end(), {"--run-nonce", std::to_string(opt.run_nonce)});
   if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
+  for (const std::string& set : opt.sets) a.insert(a.end(), {"--set", set});
   return a;
 }
 

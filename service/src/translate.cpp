@@ -25,8 +25,8 @@ run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std
   m.initial_velocity = s.plant.initial.velocity;
   m.sensor_quantization = s.plant.sensor.quantization;
   m.sensor_noise_stddev = s.plant.sensor.noise_stddev;
-  // "auto" resolved as plant/sensor.hpp does: the true velocity only from an ideal sensor.
-  m.sensor_velocity = s.plant.sensor.velocity == "auto" ? (s.plant.sensor.ideal() ? "true" : "difference") : s.plant.sensor.velocity;
+  // "auto" resolved by the sensor's one rule: the true velocity only from an ideal sensor.
+  m.sensor_velocity = s.plant.sensor.differenced_velocity() ? "difference" : "true";
   m.current_step = -1;
   m.control_period = s.control_period;
   m.steps = s.steps();

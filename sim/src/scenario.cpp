@@ -14,6 +14,7 @@
 #include "feeddrive/csv/reader.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/simulation.hpp"
+#include "feeddrive/sim/yaml_archive.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
 namespace feeddrive::sim {
@@ -30,121 +31,59 @@ std::string output_shown(const std::string& s) {
 }
 
 // --- plant ---------------------------------------------------------------------------------
-
-void read_friction(MapReader r, plant::FrictionParams& f) {
-  std::string model = plant::to_string(f.model);
-  r.string("model", model);
-  try {
-    f.model = plant::friction_model_from_string(model);
-  } catch (const std::invalid_argument& e) {
-    r.fail("model", " = '" + model + "': " + e.what());
-  }
-  r.number("static_force", f.static_force);
-  r.number("coulomb_force", f.coulomb_force);
-  r.number("stribeck_velocity", f.stribeck_velocity);
-  r.number("stribeck_exponent", f.stribeck_exponent);
-  r.number("bristle_stiffness", f.bristle_stiffness);
-  r.number("bristle_damping", f.bristle_damping);
-  r.number("viscous", f.viscous);
-  r.number("damping_decay_velocity", f.damping_decay_velocity);
-  r.number("static_smoothing_velocity", f.static_smoothing_velocity);
-  r.finish();
-}
-
-void read_ripple(MapReader r, plant::RippleParams& p) {
-  r.boolean("enabled", p.enabled);
-  r.number("pitch", p.pitch);
-  r.number("cogging_amplitude", p.cogging_amplitude);
-  r.number("cogging_phase", p.cogging_phase);
-  r.number("cogging_third", p.cogging_third);
-  r.number("cogging_third_phase", p.cogging_third_phase);
-  r.number("reluctance_amplitude", p.reluctance_amplitude);
-  r.number("reluctance_phase", p.reluctance_phase);
-  r.number("reluctance_third", p.reluctance_third);
-  r.number("reluctance_third_phase", p.reluctance_third_phase);
-  r.finish();
-}
-
-void read_grinding(MapReader r, plant::GrindingParams& p) {
-  r.boolean("enabled", p.enabled);
-  r.number("stiffness", p.stiffness);
-  r.number("dullness", p.dullness);
-  r.number("workpiece_diameter", p.workpiece_diameter);
-  r.number("wheel_width", p.wheel_width);
-  r.number_or_infinite("contact_position", p.contact_position);
-  r.number("contact_width", p.contact_width);
-  r.finish();
-}
-
-void read_electrical(MapReader r, plant::ElectricalParams& p) {
-  r.boolean("enabled", p.enabled);
-  r.number("resistance", p.resistance);
-  r.number("inductance", p.inductance);
-  r.number("back_emf", p.back_emf);
-  r.finish();
-}
-
-void read_sensor(MapReader r, plant::SensorParams& p) {
-  r.number("quantization", p.quantization);
-  r.number("noise_stddev", p.noise_stddev);
-  r.unsigned_integer("seed", p.seed);
-  r.string("velocity", p.velocity);
-  r.finish();
-}
-
-void read_integrator(MapReader r, plant::IntegratorParams& p) {
-  r.number("rtol", p.rtol);
-  r.number("atol_position", p.atol_position);
-  r.number("atol_velocity", p.atol_velocity);
-  r.number("atol_bristle", p.atol_bristle);
-  r.number("atol_grinding", p.atol_grinding);
-  r.number("atol_current", p.atol_current);
-  r.integer("max_steps", p.max_steps);
-  r.finish();
-}
-
-void read_initial(MapReader r, plant::InitialState& p) {
-  r.number("position", p.position);
-  r.number("velocity", p.velocity);
-  r.number("bristle", p.bristle);
-  r.number("grinding", p.grinding);
-  r.number("current", p.current);
-  r.finish();
-}
+// Every section is read from its struct's one list (Serialize; sim/yaml_archive.hpp); what is
+// left here are the rules of their own: a ripple preset, effects enabled by being listed, the
+// cascade's tuning keys, file names resolved against the scenario's folder.
 
 // plant.effects.<name>: listing an effect enables it (an optional `enabled: false` switches it
-// off again); the parameters not given keep the struct's defaults. Names: plant/effects.hpp.
-void read_effects(MapReader r, plant::EffectsParams& p) {
-  for (const std::string& name : plant::effect_names()) {
-    const bool listed = r.has(name);
-    MapReader m = r.child(name);  // marks the name as known, for finish()'s hints
-    if (!listed) continue;
-    bool& enabled = plant::effect_enabled(p, name);
-    enabled = true;
-    m.boolean("enabled", enabled);
-    for (const std::string& param : plant::effect_parameter_names(name))
-      m.number(param, plant::effect_parameter(p, name, param));
+// off again); the parameters not given keep the struct's defaults.
+class EffectsReadArchive {
+ public:
+  explicit EffectsReadArchive(MapReader& r) : r_(r) {}
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    const bool listed = r_.has(f.meta.name);
+    MapReader m = r_.child(f.meta.name);  // marks the name as known, for finish()'s hints
+    if (!listed) return;
+    f.value->enabled = true;
+    read_fields(m, *f.value);
     m.finish();
   }
-  r.finish();
+
+ private:
+  MapReader& r_;
+};
+
+// plant.ripple: a map of keys, where `preset: paper` starts from the paper's values
+// (RippleParams::paper()), or the preset's name alone (`ripple: paper`). Without a preset every
+// part is 0 (issue 23: no surprising defaults).
+void read_ripple(MapReader& r, plant::RippleParams& p) {
+  std::string preset;
+  const bool scalar = r.scalar_text("ripple", preset);
+  MapReader m = scalar ? r.child_absent("ripple") : r.child("ripple");
+  if (!scalar) m.string("preset", preset);
+  if (!preset.empty()) {
+    try {
+      p = plant::RippleParams::of(fields::enum_from_name<plant::RipplePreset>(preset));
+    } catch (const std::invalid_argument& e) {
+      if (scalar) r.fail("ripple", " = '" + preset + "': expected a map of keys, or one of " + fields::enum_choices<plant::RipplePreset>());
+      m.fail("preset", " = '" + preset + "': " + e.what());
+    }
+  }
+  read_fields(m, p);
+  m.finish();
 }
 
-// The plant (with_effects) or a controller's model of it: a model has no effects, they are the
-// plant's discrepancy from the model.
+// The plant (with_effects) or a controller's model of it: a cascade's or plugin's model has no
+// effects, they are the plant's discrepancy from the model.
 void read_plant(MapReader r, PlantParams& p, bool with_effects) {
-  r.number("mass", p.mass);
-  r.number("amplifier_gain", p.amplifier_gain);
-  r.number("force_constant", p.force_constant);
-  r.number("input_limit", p.input_limit);
-  read_friction(r.child("friction"), p.friction);
-  read_ripple(r.child("ripple"), p.ripple);
-  read_grinding(r.child("grinding"), p.grinding);
-  read_electrical(r.child("electrical"), p.electrical);
-  read_sensor(r.child("sensor"), p.sensor);
-  read_integrator(r.child("integrator"), p.integrator);
-  read_initial(r.child("initial"), p.initial);
+  read_fields(r, p, {"ripple", "effects"});
+  read_ripple(r, p.ripple);
   if (with_effects) {
-    read_effects(r.child("effects"), p.effects);
+    MapReader e = r.child("effects");
+    EffectsReadArchive a(e);
+    p.effects.Serialize(&a);
+    e.finish();
   } else if (r.has("effects")) {
     r.fail("effects", ": only the sliding_mode controller's model takes effects (e.g. those "
                       "feeddrive-fit found); the cascade uses the model's mass and friction only");
@@ -154,39 +93,8 @@ void read_plant(MapReader r, PlantParams& p, bool with_effects) {
 
 // --- controller ----------------------------------------------------------------------------
 
-template <typename Enum, typename Parse>
-void read_enum(MapReader& r, const std::string& key, Enum& out, Parse parse, const std::string& current) {
-  std::string s = current;
-  r.string(key, s);
-  try {
-    out = parse(s);
-  } catch (const std::invalid_argument& e) {
-    r.fail(key, " = '" + s + "': " + e.what());
-  }
-}
-
 void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
-  r.number("eta", p.eta);
-  r.number("k", p.k);
-  r.number("lambda", p.lambda);
-  read_enum(r, "switching", p.switching, controller::switching_from_string, controller::to_string(p.switching));
-  r.number("boundary_layer", p.boundary_layer);
-  r.boolean("compensate_friction", p.compensate_friction);
-  r.boolean("compensate_ripple", p.compensate_ripple);
-  r.boolean("compensate_grinding", p.compensate_grinding);
-  r.boolean("feedforward_acceleration", p.feedforward_acceleration);
-  read_enum(r, "friction_state", p.friction_state, controller::state_source_from_string,
-            controller::to_string(p.friction_state));
-  read_enum(r, "grinding_state", p.grinding_state, controller::state_source_from_string,
-            controller::to_string(p.grinding_state));
-  r.number("observer_gain", p.observer_gain);
-  read_enum(r, "motion_state", p.motion_state, controller::motion_source_from_string,
-            controller::to_string(p.motion_state));
-  r.number("motion_observer_bandwidth", p.motion_observer_bandwidth);
-  r.boolean("motion_observer_disturbance", p.motion_observer_disturbance);
-  r.boolean("compensate_delay", p.compensate_delay);
-  r.number("u_min", p.u_min);
-  r.number("u_max", p.u_max);
+  read_fields(r, p);
   read_plant(r.child("model"), p.model, true);
 }
 
@@ -220,39 +128,24 @@ void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& b
   read_plant(r.child("model"), p.model, false);
 }
 
-// tuning: manual (kp, kv, ki as given) or rule (controller/cascade.hpp cascade_tuning(): from the
-// control period, the computation delay and whether the velocity is differenced from an encoder,
-// times bandwidth_scale); with the rule, kp, kv and ki must not be given.
-void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model, double period,
-                  double computation_delay) {
-  std::string tuning = "manual";
+// tuning: manual (kp, kv, ki as given) or rule (kp, kv, ki must then not be given; the gains are
+// set after loading by controller::apply_tuning, not here); bandwidth_scale only with the rule.
+void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model) {
+  std::string tuning = fields::enum_name(p.tuning);
   r.string("tuning", tuning);
-  if (tuning != "manual" && tuning != "rule") r.fail("tuning", " = '" + tuning + "': expected one of manual, rule");
-  if (tuning == "rule") {
+  try {
+    p.tuning = fields::enum_from_name<controller::CascadeTuning>(tuning);
+  } catch (const std::invalid_argument& e) {
+    r.fail("tuning", " = '" + tuning + "': " + e.what());
+  }
+  if (p.tuning == controller::CascadeTuning::kRule) {
     for (const char* key : {"kp", "kv", "ki"})
       if (r.has(key)) r.fail(key, ": set by tuning: rule (remove it, or use tuning: manual)");
-    double scale = 1.0;
-    r.number("bandwidth_scale", scale);
-    if (!(scale > 0.0)) r.fail("bandwidth_scale", " = " + std::to_string(scale) + ": must be > 0");
-    const plant::SensorParams& sensor = model.sensor;
-    const bool differenced = sensor.velocity == "difference" || (sensor.velocity == "auto" && !sensor.ideal());
-    const controller::CascadeGains g = controller::cascade_tuning(period, computation_delay, differenced, scale);
-    p.kp = g.kp;
-    p.kv = g.kv;
-    p.ki = g.ki;
+    read_fields(r, p, {"kp", "kv", "ki"});
   } else {
     if (r.has("bandwidth_scale")) r.fail("bandwidth_scale", ": only with tuning: rule");
-    r.number("kp", p.kp);
-    r.number("kv", p.kv);
-    r.number("ki", p.ki);
+    read_fields(r, p, {"bandwidth_scale"});
   }
-  r.number("velocity_feedforward", p.velocity_feedforward);
-  r.number("acceleration_feedforward", p.acceleration_feedforward);
-  r.boolean("friction_feedforward", p.friction_feedforward);
-  r.number("disturbance_observer_bandwidth", p.disturbance_observer_bandwidth);
-  r.boolean("compensate_delay", p.compensate_delay);
-  r.number("u_min", p.u_min);
-  r.number("u_max", p.u_max);
   read_plant(r.child("model"), model, false);
   p.mass = model.mass;
   p.thrust_gain = model.thrust_gain();
@@ -261,15 +154,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model,
 }
 
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
-  read_enum(r, "kind", p.kind, controller::open_loop_kind_from_string, controller::to_string(p.kind));
-  r.number("amplitude", p.amplitude);
-  r.number("frequency", p.frequency);
-  r.number("phase", p.phase);
-  r.number("offset", p.offset);
-  r.number("rate", p.rate);
-  r.number("start_time", p.start_time);
-  r.number("u_min", p.u_min);
-  r.number("u_max", p.u_max);
+  read_fields(r, p);
   r.string("file", file);
   if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
   r.record("file", file, true);
@@ -278,56 +163,21 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& fi
 
 // --- reference -----------------------------------------------------------------------------
 
-ReferenceType reference_type_from_string(MapReader& r, const std::string& s) {
-  if (s == "none") return ReferenceType::kNone;
-  if (s == "sine") return ReferenceType::kSine;
-  if (s == "step") return ReferenceType::kStep;
-  if (s == "accel_limited") return ReferenceType::kAccelLimited;
-  if (s == "scurve") return ReferenceType::kSCurve;
-  if (s == "ramp") return ReferenceType::kRamp;
-  if (s == "waypoints") return ReferenceType::kWaypoints;
-  r.fail("type", " = '" + s + "': expected one of none, sine, step, accel_limited, scurve, ramp, waypoints");
-}
-
 void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir) {
-  std::string type = "none";
+  std::string type = fields::enum_name(c.type);
   r.string("type", type);
-  c.type = reference_type_from_string(r, type);
+  try {
+    c.type = fields::enum_from_name<ReferenceType>(type);
+  } catch (const std::invalid_argument& e) {
+    r.fail("type", " = '" + type + "': " + e.what());
+  }
   switch (c.type) {
-    case ReferenceType::kNone:
-      break;
-    case ReferenceType::kSine:
-      r.number("amplitude", c.sine.amplitude);
-      r.number("frequency", c.sine.frequency);
-      r.number("phase", c.sine.phase);
-      r.number("offset", c.sine.offset);
-      r.number("start_time", c.sine.start_time);
-      break;
-    case ReferenceType::kStep:
-      r.number("amplitude", c.step.amplitude);
-      r.number("step_time", c.step.step_time);
-      r.number("initial", c.step.initial);
-      break;
-    case ReferenceType::kAccelLimited:
-      r.number("distance", c.accel_limited.distance);
-      r.number("max_velocity", c.accel_limited.max_velocity);
-      r.number("max_acceleration", c.accel_limited.max_acceleration);
-      r.number("start_time", c.accel_limited.start_time);
-      r.number("initial", c.accel_limited.initial);
-      break;
-    case ReferenceType::kSCurve:
-      r.number("distance", c.scurve.distance);
-      r.number("max_velocity", c.scurve.max_velocity);
-      r.number("max_acceleration", c.scurve.max_acceleration);
-      r.number("max_jerk", c.scurve.max_jerk);
-      r.number("start_time", c.scurve.start_time);
-      r.number("initial", c.scurve.initial);
-      break;
-    case ReferenceType::kRamp:
-      r.number("velocity", c.ramp.velocity);
-      r.number("start_time", c.ramp.start_time);
-      r.number("initial", c.ramp.initial);
-      break;
+    case ReferenceType::kNone: break;
+    case ReferenceType::kSine: read_fields(r, c.sine); break;
+    case ReferenceType::kStep: read_fields(r, c.step); break;
+    case ReferenceType::kAccelLimited: read_fields(r, c.accel_limited); break;
+    case ReferenceType::kSCurve: read_fields(r, c.scurve); break;
+    case ReferenceType::kRamp: read_fields(r, c.ramp); break;
     case ReferenceType::kWaypoints:
       c.waypoints_file = r.required_string("file");
       if (fs::path(c.waypoints_file).is_relative())
@@ -418,6 +268,51 @@ std::string steps_text(double n) {
   return buf;
 }
 
+// Issue 23 (unit sanity): every number of the run's lists outside its plausible range for a
+// linear feed drive (common/fields.hpp), and a move that the run cuts off.
+void find_warnings(Scenario& s) {
+  std::vector<std::string>& w = s.warnings;
+  const auto add = [&w](const std::vector<std::string>& more) { w.insert(w.end(), more.begin(), more.end()); };
+  {
+    fields::PlausibilityArchive top("", &w);
+    top.Visit(fields::field("control_period", s.control_period).unit("s").plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period"));
+    top.Visit(fields::field("controller.computation_delay", s.controller.computation_delay).unit("s").plausible(0, 0.01, "ms", "", "a servo drive's delay"));
+  }
+  PlantParams plant = s.plant;
+  if (!plant.ripple.enabled) plant.ripple = {};  // the keys of a section that is off do not act
+  if (!plant.grinding.enabled) plant.grinding = {};
+  if (!plant.electrical.enabled) plant.electrical = {};
+  add(fields::plausibility(plant, "plant"));
+  switch (s.controller.type) {
+    case ControllerType::kSlidingMode: add(fields::plausibility(s.controller.sliding_mode, "controller")); break;
+    case ControllerType::kCascade: add(fields::plausibility(s.controller.cascade, "controller")); break;
+    case ControllerType::kOpenLoop: add(fields::plausibility(s.controller.open_loop, "controller")); break;
+    case ControllerType::kPlugin: break;
+  }
+  switch (s.reference.type) {
+    case ReferenceType::kSine: add(fields::plausibility(s.reference.sine, "reference")); break;
+    case ReferenceType::kStep: add(fields::plausibility(s.reference.step, "reference")); break;
+    case ReferenceType::kAccelLimited: add(fields::plausibility(s.reference.accel_limited, "reference")); break;
+    case ReferenceType::kSCurve: add(fields::plausibility(s.reference.scurve, "reference")); break;
+    case ReferenceType::kRamp: add(fields::plausibility(s.reference.ramp, "reference")); break;
+    case ReferenceType::kNone:
+    case ReferenceType::kWaypoints: break;
+  }
+  const ReferenceType t = s.reference.type;
+  if (t == ReferenceType::kAccelLimited || t == ReferenceType::kSCurve || t == ReferenceType::kWaypoints) {
+    s.move_end_s = make_reference(s)->end_time();
+    if (s.move_end_s > s.duration)
+    {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "reference: the move ends at t = %.4g s, after duration = %.4g s: the run cuts it off (summary.json "
+                    "move_finished: false); a longer duration, or a distance in mm?",
+                    s.move_end_s, s.duration);
+      w.push_back(buf);
+    }
+  }
+}
+
 Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
   if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   MapReader top(root, "", resolved);
@@ -458,9 +353,13 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     s.controller.sliding_mode.computation_delay = s.controller.computation_delay;
   } else if (type == "cascade") {
     s.controller.type = ControllerType::kCascade;
-    read_cascade(c, s.controller.cascade, s.plant, s.control_period, s.controller.computation_delay);
+    PlantParams model = s.plant;
+    read_cascade(c, s.controller.cascade, model);
     s.controller.cascade.period = s.control_period;
     s.controller.cascade.computation_delay = s.controller.computation_delay;
+    if (!(s.controller.cascade.bandwidth_scale > 0.0))  // before the rule divides by it
+      c.fail("bandwidth_scale", " = " + validate::format_number(s.controller.cascade.bandwidth_scale) + ": must be > 0");
+    controller::apply_tuning(s.controller.cascade, model.sensor.differenced_velocity());
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
     read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
@@ -472,7 +371,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     s.controller.plugin.period = s.control_period;
     s.controller.plugin.computation_delay = s.controller.computation_delay;
   } else {
-    c.fail("type", " = '" + type + "': expected one of sliding_mode, cascade, open_loop, plugin");
+    c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
   }
   s.controller.model_given = c.has("model");
   c.finish();
@@ -528,6 +427,7 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
                         validate::format_number(s.control_period) + " s)");
   check_functions_of_time(s, root);
+  find_warnings(s);
   return s;
 }
 
@@ -587,6 +487,63 @@ Scenario load_scenario(const std::string& path, std::string* text_out) {
   if (text_out != nullptr) *text_out = text;
   const fs::path p(path);
   Scenario s = parse_scenario(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
+  s.path = path;
+  if (s.name.empty()) {
+    s.name = p.stem().string();
+    check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
+  }
+  return s;
+}
+
+KeySetting parse_key_setting(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw ScenarioError("--set " + text + ": expected key=value (a dotted scenario key, e.g. plant.mass=110)");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+void set_key(YAML::Node& root, const std::string& key, const std::string& value) {
+  std::vector<std::string> parts;
+  for (std::size_t b = 0;;) {
+    const std::size_t e = key.find('.', b);
+    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  YAML::Node cur = root;
+  std::string path;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    path += (path.empty() ? "" : ".") + parts[i];
+    YAML::Node next = cur[parts[i]];
+    if (!next.IsDefined() || next.IsNull()) {
+      cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      next = cur[parts[i]];
+    } else if (!next.IsMap()) {
+      throw ScenarioError(key + ": " + path + " is a single value in the scenario, not a map of keys");
+    }
+    cur.reset(next);
+  }
+  cur[parts.back()] = value;
+}
+
+Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& sets, std::string* text_out) {
+  if (sets.empty()) return load_scenario(path, text_out);
+  const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
+  const fs::path p(path);
+  const std::string origin = path + " with --set";
+  YAML::Node root;
+  try {
+    root = load_yaml_strict(text);
+    if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map");
+    for (const KeySetting& k : sets) set_key(root, k.key, k.value);
+  } catch (const ScenarioError& e) {
+    throw ScenarioError(origin + ": " + e.what());
+  }
+  YAML::Emitter em;
+  em << root;
+  const std::string yaml = std::string(em.c_str()) + "\n";
+  if (text_out != nullptr) *text_out = yaml;
+  Scenario s = parse_scenario(yaml, p.parent_path().empty() ? "." : p.parent_path().string(), origin);
   s.path = path;
   if (s.name.empty()) {
     s.name = p.stem().string();

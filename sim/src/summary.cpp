@@ -321,6 +321,13 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   // The gains a cascade runs with (tuning: rule chooses them: docs/controllers.md).
   if (s.controller.type == ControllerType::kCascade)
     j["cascade_gains"] = {{"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
+  // Issue 23: a move the run cut off, and the loader's plausibility warnings (scenario.hpp).
+  if (std::isnan(s.move_end_s)) {
+    j["move_finished"] = nullptr;  // the reference is not a move
+  } else {
+    j["move_finished"] = s.move_end_s <= s.duration;
+  }
+  j["warnings"] = s.warnings;
   if (!extra.empty()) {
     const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
     for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();

@@ -433,6 +433,19 @@ MapReader MapReader::child(const std::string& key) {
   return MapReader(n, key_path(key), resolved_);
 }
 
+bool MapReader::scalar_text(const std::string& key, std::string& out) const {
+  if (!node_.IsMap()) return false;
+  const YAML::Node n = node_[key];
+  if (!n.IsDefined() || n.IsNull() || !n.IsScalar()) return false;
+  out = n.Scalar();
+  return true;
+}
+
+MapReader MapReader::child_absent(const std::string& key) {
+  read_.insert(key);
+  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key), resolved_);
+}
+
 void MapReader::finish() const {
   if (!node_.IsMap()) return;
   for (const auto& kv : node_) {

@@ -22,17 +22,6 @@ std::uint64_t splitmix64(std::uint64_t& state) {
   return z ^ (z >> 31);
 }
 
-std::vector<std::string> split_key(const std::string& key) {
-  std::vector<std::string> parts;
-  for (std::size_t b = 0;;) {
-    const std::size_t e = key.find('.', b);
-    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) break;
-    b = e + 1;
-  }
-  return parts;
-}
-
 bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 0; }
 
 // plant.* keys change only the true plant under the nominal model rule, except the sensor the
@@ -163,21 +152,11 @@ std::vector<std::string> varied_keys(const Study& s) {
 }
 
 void set_key(YAML::Node& root, const std::string& key, const std::string& value) {
-  const std::vector<std::string> parts = split_key(key);
-  YAML::Node cur = root;
-  std::string path;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    path += (path.empty() ? "" : ".") + parts[i];
-    YAML::Node next = cur[parts[i]];
-    if (!next.IsDefined() || next.IsNull()) {
-      cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      next = cur[parts[i]];
-    } else if (!next.IsMap()) {
-      throw StudyError(key + ": " + path + " is a single value in the scenario, not a map of keys");
-    }
-    cur.reset(next);
+  try {
+    sim::set_key(root, key, value);
+  } catch (const sim::ScenarioError& e) {
+    throw StudyError(e.what());
   }
-  cur[parts.back()] = value;
 }
 
 std::string sha256_hex(const std::string& text) {

@@ -29,7 +29,13 @@ int main(int argc, char** argv) {
   CLI::App app{"feeddrive-study: runs a study of many scenarios (grid, Monte Carlo, controllers) on all cores or MPI ranks"};
   feeddrive::study::Options o;
   bool no_plots = false;
-  app.add_option("study", o.study, "study YAML file (docs/study.md)")->required();
+  app.add_option("study", o.study, "study YAML file (docs/study.md), or with --sweep a scenario file")->required();
+  app.add_option("--set", o.sets, "KEY=VALUE: set a scenario key in every case (after the study's own set); repeatable")
+      ->type_name("KEY=VALUE");
+  app.add_option("--sweep", o.sweeps,
+                 "KEY=V1,V2,... | KEY=START:STOP:N | KEY=log:START:STOP:N: vary a key of the scenario file given instead "
+                 "of a study (repeat for a grid)")
+      ->type_name("SWEEP");
   app.add_option("--out,-o", o.out, "output folder; a rerun into it skips the finished cases (not needed with --list)");
   app.add_option("-j,--jobs", o.jobs, "worker threads (default: every core; per MPI rank: the host's cores / its ranks)")
       ->check(CLI::Range(1, 4096));

@@ -1,5 +1,7 @@
 #include "feeddrive/study/report.hpp"
 
+#include "feeddrive/sim/key_tables.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -70,6 +72,25 @@ bool parse_number(const std::string& text, double& out) {
 
 
 }  // namespace
+
+// A varied key's values in its engineering unit: the unit its params list gives
+// (sim::key_unit), scaled to mm, um, mm/s or ms where the values are that small.
+struct AxisUnit {
+  std::string unit;
+  double factor{1.0};
+};
+AxisUnit axis_unit(const std::string& key, const std::vector<float>& x, std::size_t stride, std::size_t p) {
+  const std::string unit = sim::key_unit(key);
+  double top = 0.0;
+  for (std::size_t i = p; i < x.size(); i += stride)
+    if (std::isfinite(x[i])) top = std::max(top, std::abs(static_cast<double>(x[i])));
+  if (unit == "m" && top > 0 && top < 1e-3) return {"um", 1e6};
+  if (unit == "m" && top > 0 && top < 1.0) return {"mm", 1e3};
+  if (unit == "m/s" && top > 0 && top < 1.0) return {"mm/s", 1e3};
+  if (unit == "s" && top > 0 && top < 1.0) return {"ms", 1e3};
+  return {unit.empty() || unit == "-" ? std::string() : unit, 1.0};
+}
+std::string axis_label(const std::string& key, const AxisUnit& u) { return u.unit.empty() ? key : key + " [" + u.unit + "]"; }
 
 std::string csv_field(const std::string& value) {
   if (value.find_first_of(",\"\n\r") == std::string::npos) return value;
@@ -213,13 +234,14 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
   // The metric against each varied parameter, one series per controller.
   const std::vector<std::string>& params = d.params;
   for (std::size_t p = 0; p < params.size(); ++p) {
+    const AxisUnit ax = axis_unit(params[p], d.x, params.size(), p);
     std::vector<std::string> series;
     for (std::size_t c = 0; c < nc; ++c) {
       std::ostringstream data;
       long n = 0;
       for (std::size_t i = 0; i < d.cases; ++i) {
         if (d.controller[i] != c) continue;
-        const double x = d.x[i * params.size() + p], y = d.shown[i];
+        const double x = d.x[i * params.size() + p] * ax.factor, y = d.shown[i];
         if (!std::isfinite(x) || !(y > 0.0)) continue;
         data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
         ++n;
@@ -233,7 +255,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
     if (series.empty()) continue;
     const std::string png = "param_" + std::to_string(p) + ".png";
     gp << "set output '" << png << "'\nset title " << output::gnuplot_string(s.report.metric + " against " + params[p])
-       << "\nset xlabel " << output::gnuplot_string(params[p]) << "\nset ylabel " << ylabel << "\nset xtics rotate by 0\n"
+       << "\nset xlabel " << output::gnuplot_string(axis_label(params[p], ax)) << "\nset ylabel " << ylabel << "\nset xtics rotate by 0\n"
        << limit_line << "plot ";
     for (std::size_t i = 0; i < series.size(); ++i) gp << (i ? ", \\\n  " : "") << series[i];
     gp << '\n';
@@ -241,6 +263,43 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
   }
   if (md.str().empty()) return "No plot: no case gave a positive " + s.report.metric + ".\n\n";
   output::run_gnuplot(dir, gp.str());
+  return md.str();
+}
+
+// For every varied key with at most kMaxRows distinct values: the metric's median per value and
+// controller, the value in the key's engineering unit.
+std::string metric_by_value(const ReportData& d) {
+  constexpr std::size_t kMaxRows = 50;
+  const Study& s = d.s;
+  const std::size_t nc = s.controllers.size(), np = d.params.size();
+  std::ostringstream md;
+  for (std::size_t p = 0; p < np; ++p) {
+    const AxisUnit ax = axis_unit(d.params[p], d.x, np, p);
+    std::map<double, std::vector<std::vector<double>>> rows;  // value -> controller -> shown
+    for (std::size_t i = 0; i < d.cases; ++i) {
+      const double x = d.x[i * np + p];
+      if (!std::isfinite(x)) continue;
+      auto& r = rows[x];
+      r.resize(nc);
+      if (std::isfinite(d.shown[i])) r[d.controller[i]].push_back(d.shown[i]);
+    }
+    md << "\n## " << cell(s.report.metric) << " against " << cell(d.params[p]) << "\n\n";
+    if (rows.empty() || rows.size() > kMaxRows) {
+      md << (rows.empty() ? "No numeric value of this key.\n" : "More than 50 values (a distribution): see its plot.\n");
+      continue;
+    }
+    md << "| " << cell(axis_label(d.params[p], ax)) << " |";
+    for (std::size_t c = 0; c < nc; ++c) md << " " << cell(s.controllers[c].name) << " [" << s.report.unit << "] |";
+    md << "\n|---|";
+    for (std::size_t c = 0; c < nc; ++c) md << "---|";
+    md << "\n";
+    for (const auto& [x, per] : rows) {
+      md << "| " << num(x * ax.factor) << " |";
+      for (std::size_t c = 0; c < nc; ++c) md << " " << num(per[c].empty() ? NAN : median(per[c])) << " |";
+      md << "\n";
+    }
+    md << "\nThe median over the cases with that value (one case each in a one-key sweep).\n";
+  }
   return md.str();
 }
 
@@ -255,6 +314,11 @@ std::string report_md(const ReportData& d, const std::string& command, const std
      << failed << " failed, " << cached << " reused from an earlier run into this folder. Every number below is "
      << "`" << s.report.metric << "` in " << unit << " (one row per case in `results.csv`).\n\n";
 
+  md << (s.model == ModelRule::kNominal
+             ? "The controllers keep the **nominal model** (`model: nominal`): a case's `plant.*` variations (except "
+               "`plant.sensor.*`) change the drive, not the controller's model of it.\n\n"
+             : "Each controller's model **follows the varied plant** (`model: follows_plant`): every result is a "
+               "perfect-model result unless `controller.model.*` says otherwise.\n\n");
   const auto& t = d.table;
   const std::size_t nc = s.controllers.size();
   // Per controller: worst over everything.
@@ -325,6 +389,7 @@ std::string report_md(const ReportData& d, const std::string& command, const std
        << num(w.value) << " | " << cell(params) << " |\n";
   }
 
+  md << metric_by_value(d);
   md << "\n## Plots\n\n" << plots_markdown;
   if (failed > 0) {
     md << "## Failed cases\n\n| case | controller | family | error |\n|---|---|---|---|\n";

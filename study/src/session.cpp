@@ -1,5 +1,7 @@
 #include "feeddrive/study/session.hpp"
 
+#include "feeddrive/sim/scenario.hpp"
+
 #include <fcntl.h>
 #include <sched.h>
 #include <sys/file.h>
@@ -141,7 +143,18 @@ int run_study(const Options& o, Transport* t) {
   // (a study has up to 10^6: never all at once); here only the probe cases (cases.hpp) are
   // resolved, so the usual mistakes still stop the study before it writes anything.
   try {
-    study = load_study(o.study);
+    if (o.sweeps.empty()) {
+      study = load_study(o.study);
+    } else {  // SCENARIO --sweep ...: a study without a study file
+      std::vector<GridAxis> axes;
+      for (const std::string& sw : o.sweeps) axes.push_back(parse_sweep(sw));
+      study = sweep_study(o.study, axes);
+    }
+    // --set: settings of every case, after the study's own (as if its `set` ended with them).
+    for (const std::string& k : o.sets) {
+      const sim::KeySetting ks = sim::parse_key_setting(k);
+      study.set.push_back({ks.key, ks.value});
+    }
     if (!o.list) output::check_output_dir(o.out);
     total = case_count(study);
     resolver = std::make_unique<Resolver>(study);

@@ -403,3 +403,79 @@ Study load_study(const std::string& path) {
 }
 
 }  // namespace feeddrive::study
+
+namespace feeddrive::study {
+
+GridAxis parse_sweep(const std::string& text) {
+  const auto bad = [&](const std::string& why) -> StudyError {
+    return StudyError("--sweep " + text + ": " + why +
+                      " (KEY=V1,V2,... or KEY=START:STOP:N, linear, or KEY=log:START:STOP:N; docs/study.md)");
+  };
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) throw bad("expected KEY=VALUES");
+  GridAxis axis;
+  axis.keys = {text.substr(0, eq)};
+  std::string values = text.substr(eq + 1);
+  const bool log = values.rfind("log:", 0) == 0;
+  if (log) values = values.substr(4);
+  if (values.find(':') != std::string::npos) {
+    std::vector<std::string> parts;
+    for (std::size_t b = 0;;) {
+      const std::size_t e = values.find(':', b);
+      parts.push_back(values.substr(b, e == std::string::npos ? std::string::npos : e - b));
+      if (e == std::string::npos) break;
+      b = e + 1;
+    }
+    if (parts.size() != 3) throw bad("a range is START:STOP:N");
+    double a = 0, z = 0;
+    char* end = nullptr;
+    a = std::strtod(parts[0].c_str(), &end);
+    if (parts[0].empty() || *end || !std::isfinite(a)) throw bad("START = '" + parts[0] + "' is not a finite number");
+    z = std::strtod(parts[1].c_str(), &end);
+    if (parts[1].empty() || *end || !std::isfinite(z)) throw bad("STOP = '" + parts[1] + "' is not a finite number");
+    const long n = std::strtol(parts[2].c_str(), &end, 10);
+    if (parts[2].empty() || *end || n < 2 || n > 10000) throw bad("N = '" + parts[2] + "' must be an integer in [2, 10000]");
+    if (log && !(a > 0 && z > 0)) throw bad("a logarithmic range needs START and STOP > 0");
+    for (long i = 0; i < n; ++i) {
+      const double f = static_cast<double>(i) / static_cast<double>(n - 1);
+      const double v = i == n - 1 ? z : log ? a * std::pow(z / a, f) : a + (z - a) * f;
+      axis.values.push_back({validate::format_number(v)});
+    }
+  } else {
+    if (log) throw bad("log: needs START:STOP:N");
+    for (std::size_t b = 0;;) {
+      const std::size_t e = values.find(',', b);
+      std::string v = values.substr(b, e == std::string::npos ? std::string::npos : e - b);
+      while (!v.empty() && v.front() == ' ') v.erase(v.begin());
+      while (!v.empty() && v.back() == ' ') v.pop_back();
+      if (v.empty()) throw bad("an empty value");
+      axis.values.push_back({v});
+      if (e == std::string::npos) break;
+      b = e + 1;
+    }
+  }
+  return axis;
+}
+
+Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>& axes) {
+  Study s;
+  const fs::path p(scenario_path);
+  s.name = p.stem().string() + " sweep";
+  s.base_yaml = text::read_text_file<StudyError>(scenario_path, "scenario file");
+  try {
+    sim::load_yaml_strict(s.base_yaml);
+  } catch (const sim::ScenarioError& e) {
+    throw StudyError(scenario_path + ": " + e.what());
+  }
+  s.base_dir = p.parent_path().empty() ? "." : p.parent_path().string();
+  s.controllers.push_back({"base", "", {}, {}});
+  s.families.push_back(Family{"sweep", {}, axes, {}});
+  try {
+    s.validate();
+  } catch (const std::invalid_argument& e) {
+    throw StudyError(scenario_path + ": " + e.what());
+  }
+  return s;
+}
+
+}  // namespace feeddrive::study

@@ -34,7 +34,7 @@ SlidingModeParams full_model_params() {
   p.model.amplifier_gain = 2.0;
   p.model.force_constant = 90.0;  // Ka*Kf = 180 N/V
   p.model.friction.model = plant::FrictionModel::kLuGre;
-  p.model.ripple.enabled = true;
+  p.model.ripple = plant::RippleParams::paper();
   p.model.ripple.cogging_phase = 0.3;
   p.model.ripple.cogging_third_phase = -0.7;
   p.model.ripple.reluctance_phase = 0.5;

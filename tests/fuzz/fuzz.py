@@ -50,7 +50,7 @@ NULLABLE_SUMMARY = {
     "position_error_rms_settled_m",
     "velocity_error_max_abs_settled_mps",
     # move metrics: null for a reference that is no move, a move not finished or not settled
-    "move_start_s", "move_end_s", "move_distance_m", "rise_time_s", "overshoot_m", "overshoot_percent",
+    "move_finished", "move_start_s", "move_end_s", "move_distance_m", "rise_time_s", "overshoot_m", "overshoot_percent",
     "settling_band_m", "settling_time_s", "settle_after_move_s", "position_error_max_abs_during_move_m",
     "position_error_rms_during_move_m", "position_error_max_abs_after_move_m",
     "controller_model",  # open_loop has no model

@@ -164,7 +164,7 @@ TEST(Effects, DynamicsJacobianMatchesFiniteDifferences) {
   p.effects.grinding_force = {true, 5e6, 3e7, -1.0};
   p.effects.mass_error = {true, 90.0};
   p.electrical.enabled = true;
-  p.ripple.enabled = true;
+  p.ripple = feeddrive::plant::RippleParams::paper();
   const EffectiveParams ep(p);
   ASSERT_EQ(ep.params().friction.model, FrictionModel::kLuGre);
   std::mt19937_64 rng(11);
@@ -345,7 +345,7 @@ TEST(EffectsPlant, InputDelayShiftsAnyCommandSequence) {
 // A zero delay takes the piecewise path but must give the undelayed plant's numbers exactly.
 TEST(EffectsPlant, ZeroInputDelayIsBitForBitTheUndelayedPlant) {
   PlantParams p;
-  p.ripple.enabled = true;
+  p.ripple = feeddrive::plant::RippleParams::paper();
   p.grinding.enabled = true;
   PlantParams q = p;
   q.effects.input_delay = {true, 0.0};

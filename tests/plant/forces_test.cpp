@@ -111,7 +111,7 @@ TEST(Dynamics, AnalyticJacobianMatchesFiniteDifferences) {
     PlantParams p;
     p.friction.model = fm;
     p.friction.damping_decay_velocity = 0.05;
-    p.ripple.enabled = true;
+    p.ripple = feeddrive::plant::RippleParams::paper();
     p.grinding.enabled = true;
     p.grinding.contact_position = -1.0;
     p.electrical.enabled = true;

@@ -63,7 +63,7 @@ TEST(Plant, GrindingForceFirstOrderLag) {
 // Cogging alone on a body at rest: initial acceleration -Fcog(x0)/m (Xie & Liang eq. 15).
 TEST(Plant, CoggingPushesTowardStableDetent) {
   PlantParams p = frictionless();
-  p.ripple.enabled = true;
+  p.ripple = feeddrive::plant::RippleParams::paper();
   p.ripple.cogging_third = 0.0;
   p.initial.position = p.ripple.pitch / 4;  // sin(pi/2) = 1: Fcog = ac
   const double a0 = derivative(p, State{p.initial.position, 0, 0, 0, 0}, 0.0)[kV];

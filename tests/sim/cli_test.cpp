@@ -64,7 +64,7 @@ const char* kGood = R"(
 name: cli-check
 duration: 0.05
 control_period: 1e-4
-plant: {friction: {model: lugre}, ripple: {enabled: true}, grinding: {enabled: true}}
+plant: {friction: {model: lugre}, ripple: paper, grinding: {enabled: true}}
 controller: {type: sliding_mode, switching: sat, boundary_layer: 1e-3}
 reference: {type: scurve, distance: 0.001, max_velocity: 0.02, max_acceleration: 1, max_jerk: 50}
 )";
@@ -118,6 +118,38 @@ TEST(Cli, BadInputExitsTwoWithOneLine) {
                    "control_period = 0: must be > 0");
   expect_bad_input(std::string(kGood).replace(s.find("plant: {"), 8, "plant: {mass: .nan, "), "plant.mass = '.nan'");
   expect_bad_input(std::string(kGood).replace(s.find("plant: {"), 8, "plant: {mass: , "), "plant.mass: missing value");
+}
+
+// Issue 23: --set KEY=VALUE goes through the same reader as the file's keys.
+TEST(Cli, SetIsCheckedLikeTheFile) {
+  const fs::path scen = write_file("set.yaml", kGood);
+  const fs::path out = scratch() / "cli_set_out";
+  fs::remove_all(out);
+  for (const auto& [set, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"plant.mas=110", "with --set: plant.mas: unknown key (did you mean 'mass'?)"},
+           {"plant.mass=-1", "with --set: plant.mass = -1: must be > 0"},
+           {"controller.switching=sign", "controller.switching = 'sign': expected one of sgn, sat, tanh"},
+           {"plant.mass", "--set plant.mass: expected key=value"},
+           {"plant.friction.model.x=1", "plant.friction.model.x: plant.friction.model is a single value in the scenario"}}) {
+    const ProcResult r = run_sim(scen.string() + " --set " + set + " --out " + out.string());
+    EXPECT_EQ(r.code, 2) << set << ": " << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // A value that loads but is implausible for a linear drive: a warning naming the likely unit,
+  // and summary.json lists it; a move cut off by `duration` too (issue 23, unit sanity).
+  const ProcResult r = run_sim(scen.string() + " --set reference.max_velocity=500 --set reference.distance=200 --out " +
+                               out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("reference.max_velocity: 500 m/s is above any linear drive (10 m/s); mm/s?"), std::string::npos) << r.err;
+  std::ifstream js(out / "summary.json");
+  const auto j = nlohmann::json::parse(js);
+  EXPECT_FALSE(j["move_finished"].get<bool>());
+  const std::string warnings = j["warnings"].dump();
+  EXPECT_NE(warnings.find("reference.distance: 200 m is above the travel of any linear feed drive (5 m); mm?"), std::string::npos)
+      << warnings;
+  EXPECT_NE(warnings.find("the run cuts it off"), std::string::npos) << warnings;
 }
 
 TEST(Cli, UnreadableScenarioAndMissingArguments) {

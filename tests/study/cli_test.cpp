@@ -201,3 +201,39 @@ TEST(StudyCli, ACaseWithoutAValueOfTheMetricIsNotCountedAsFailed) {
 }
 
 }  // namespace
+
+namespace {
+// Issue 23: a sweep without a study file, and --set on every case; the report has a table of the
+// metric against each value, in the key's engineering unit, and names the model rule.
+TEST(StudyCli, SweepWithoutAStudyFileReportsTheMetricAgainstEachValue) {
+  const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
+  const fs::path out = scratch() / "sweep";
+  const ProcResult r = study(scen + " --sweep plant.mass=80:120:3 --set duration=0.02 --out " + out.string() + " -j 2 --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(out / "results.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 cases
+  const std::string md = slurp(out / "report.md");
+  EXPECT_NE(md.find("| plant.mass [kg] |"), std::string::npos) << md;
+  for (const char* v : {"| 80 |", "| 100 |", "| 120 |"}) EXPECT_NE(md.find(v), std::string::npos) << v << "\n" << md;
+  EXPECT_NE(md.find("nominal model"), std::string::npos);
+  // A length in its engineering unit: 1e-9 .. 1e-7 m shown in um.
+  const fs::path q = scratch() / "sweep_q";
+  const ProcResult rq = study(scen + " --sweep plant.sensor.quantization=log:1e-9:1e-7:3 --set duration=0.02 --out " +
+                              q.string() + " -j 2 --no-plots");
+  ASSERT_EQ(rq.code, 0) << rq.err;
+  const std::string mq = slurp(q / "report.md");
+  EXPECT_NE(mq.find("| plant.sensor.quantization [um] |"), std::string::npos) << mq;
+  EXPECT_NE(mq.find("| 0.01 |"), std::string::npos) << mq;  // 1e-8 m
+  // Bad sweeps and settings: exit 2, one line.
+  for (const auto& [args, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"--sweep plant.mass=1:2", "--sweep plant.mass=1:2: a range is START:STOP:N"},
+           {"--sweep plant.mass=log:-1:2:3", "START and STOP > 0"},
+           {"--sweep plant.mas=1,2", "plant.mas: unknown key (did you mean 'mass'?)"},
+           {"--sweep plant.mass=1,2 --set plant.mass", "--set plant.mass: expected key=value"}}) {
+    const ProcResult b = study(scen + " " + args + " --out " + (scratch() / "bad_sweep").string());
+    EXPECT_EQ(b.code, 2) << args << ": " << b.err;
+    EXPECT_NE(b.err.find(expected), std::string::npos) << b.err;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+  }
+}
+}  // namespace

@@ -180,46 +180,29 @@ void require_finite_end(const std::string& prefix, double distance, double start
 // validate(): every number must be finite; limits must be > 0; a frequency must be >= 0.
 
 void SineParams::validate(const std::string& prefix) const {
-  detail::require_finite(prefix + ".amplitude", amplitude);
-  detail::require_non_negative(prefix + ".frequency", frequency);
-  detail::require_finite(prefix + ".phase", phase);
-  detail::require_finite(prefix + ".offset", offset);
-  detail::require_finite(prefix + ".start_time", start_time);
+  fields::check_fields(*this, prefix);
 }
 
 void StepParams::validate(const std::string& prefix) const {
-  detail::require_finite(prefix + ".amplitude", amplitude);
-  detail::require_finite(prefix + ".step_time", step_time);
-  detail::require_finite(prefix + ".initial", initial);
+  fields::check_fields(*this, prefix);
 }
 
 void AccelLimitedParams::validate(const std::string& prefix) const {
-  detail::require_finite(prefix + ".distance", distance);
-  detail::require_positive(prefix + ".max_velocity", max_velocity);
-  detail::require_positive(prefix + ".max_acceleration", max_acceleration);
-  detail::require_finite(prefix + ".start_time", start_time);
-  detail::require_finite(prefix + ".initial", initial);
+  fields::check_fields(*this, prefix);
   if (!std::isfinite(initial + distance))
     detail::fail(prefix + ".distance", distance, "initial + distance overflows");
   require_finite_end(prefix, distance, start_time, plan_accel_limited(*this).duration());
 }
 
 void SCurveParams::validate(const std::string& prefix) const {
-  detail::require_finite(prefix + ".distance", distance);
-  detail::require_positive(prefix + ".max_velocity", max_velocity);
-  detail::require_positive(prefix + ".max_acceleration", max_acceleration);
-  detail::require_positive(prefix + ".max_jerk", max_jerk);
-  detail::require_finite(prefix + ".start_time", start_time);
-  detail::require_finite(prefix + ".initial", initial);
+  fields::check_fields(*this, prefix);
   if (!std::isfinite(initial + distance))
     detail::fail(prefix + ".distance", distance, "initial + distance overflows");
   require_finite_end(prefix, distance, start_time, plan_scurve(*this).duration());
 }
 
 void RampParams::validate(const std::string& prefix) const {
-  detail::require_finite(prefix + ".velocity", velocity);
-  detail::require_finite(prefix + ".start_time", start_time);
-  detail::require_finite(prefix + ".initial", initial);
+  fields::check_fields(*this, prefix);
 }
 
 // ------------------------------------------------------------------------------------------

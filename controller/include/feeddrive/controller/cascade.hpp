@@ -26,6 +26,9 @@
 // The tuning rule (cascade_tuning()) sets kv, ki, kp from the sample period, the computation
 // delay and the sensor; see docs/controllers.md ("Cascade tuning rule").
 
+#include <utility>
+#include <vector>
+
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/delay_line.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
@@ -34,7 +37,16 @@
 
 namespace feeddrive::controller {
 
+/// controller.tuning: kp, kv, ki as given, or from cascade_tuning() (the rule).
+enum class CascadeTuning { kManual, kRule };
+inline const std::vector<std::pair<CascadeTuning, const char*>>& enum_names(CascadeTuning) {
+  static const std::vector<std::pair<CascadeTuning, const char*>> n = {{CascadeTuning::kManual, "manual"}, {CascadeTuning::kRule, "rule"}};
+  return n;
+}
+
 struct CascadeParams {
+  CascadeTuning tuning{CascadeTuning::kManual};
+  double bandwidth_scale{1.0};  ///< with the rule: multiplies its bandwidth
   double kp{100.0};            ///< position gain [1/s]
   double kv{600.0};            ///< velocity gain [1/s]
   double ki{40000.0};          ///< velocity integral gain [1/s^2]
@@ -51,8 +63,31 @@ struct CascadeParams {
   double u_min{-10.0};         ///< [V]
   double u_max{10.0};          ///< [V]
   double period{1e-4};         ///< T [s]
+
+  /// The scenario keys (controller.*); quantization, computation_delay, mass, thrust_gain,
+  /// friction and period come from the scenario (controller.model, control_period, ...).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(tuning).doc("manual: kp, kv, ki as given; rule: from the control period, computation_delay and the sensor (kp, kv, ki then not given)"));
+    a->Visit(FD_FIELD(bandwidth_scale).unit("-").positive().plausible(0.01, 10).doc("with tuning rule: multiplies the rule's bandwidth"));
+    a->Visit(FD_FIELD(kp).unit("1/s").non_negative().plausible(0, 1e4).doc("position gain"));
+    a->Visit(FD_FIELD(kv).unit("1/s").non_negative().plausible(0, 1e5).doc("velocity gain"));
+    a->Visit(FD_FIELD(ki).unit("1/s^2").non_negative().plausible(0, 1e9).doc("velocity integral gain"));
+    a->Visit(FD_FIELD(velocity_feedforward).unit("-").plausible(0, 2).doc("kff_v"));
+    a->Visit(FD_FIELD(acceleration_feedforward).unit("-").plausible(0, 2).doc("kff_a"));
+    a->Visit(FD_FIELD(friction_feedforward).doc("add the model's LuGre friction along the reference"));
+    a->Visit(FD_FIELD(disturbance_observer_bandwidth).unit("rad/s").non_negative().plausible(0, 1e5).doc("x,v,d observer fed by the encoder; 0: off"));
+    a->Visit(FD_FIELD(compensate_delay).doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
+  }
   void validate(const std::string& prefix = "controller") const;
 };
+
+/// With tuning rule: sets kp, kv, ki from cascade_tuning() with the params' period,
+/// computation_delay and bandwidth_scale; `differenced_velocity`: the model's sensor differences
+/// the velocity from the encoder (plant::SensorParams::differenced_velocity()). Manual: no change.
+void apply_tuning(CascadeParams& p, bool differenced_velocity);
 
 /// The cascade tuning rule (docs/controllers.md, "Cascade tuning rule"): with the effective
 /// loop delay tau = d + T/2 (zero-order hold) + T/2 (velocity differenced from the encoder;

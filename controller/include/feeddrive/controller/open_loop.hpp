@@ -9,6 +9,7 @@
 //          (feeddrive::csv, columns t and force_N or u); this library reads no files.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "feeddrive/controller/controller.hpp"
@@ -16,6 +17,10 @@
 namespace feeddrive::controller {
 
 enum class OpenLoopKind { kStep, kSine, kRamp, kCsv };
+inline const std::vector<std::pair<OpenLoopKind, const char*>>& enum_names(OpenLoopKind) {
+  static const std::vector<std::pair<OpenLoopKind, const char*>> n = {{OpenLoopKind::kStep, "step"}, {OpenLoopKind::kSine, "sine"}, {OpenLoopKind::kRamp, "ramp"}, {OpenLoopKind::kCsv, "csv"}};
+  return n;
+}
 std::string to_string(OpenLoopKind k);
 OpenLoopKind open_loop_kind_from_string(const std::string& s);  ///< "step"|"sine"|"ramp"|"csv"
 
@@ -33,6 +38,21 @@ struct OpenLoopParams {
   double thrust_gain{260.0};  ///< Ka*Kf [N/V] used to turn force into u
   double u_min{-1e9};       ///< [V]
   double u_max{1e9};        ///< [V]
+
+  /// The scenario keys (controller.*); the table and thrust_gain come from the scenario
+  /// (controller.file, the plant's Ka*Kf).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(kind).doc("step, sine, ramp or csv"));
+    a->Visit(FD_FIELD(amplitude).unit("N").plausible(-1e5, 1e5).doc("step height, sine amplitude, ramp cap (0 = none)"));
+    a->Visit(FD_FIELD(frequency).unit("Hz").non_negative().plausible(0, 1e4).doc("sine"));
+    a->Visit(FD_FIELD(phase).unit("rad").plausible(-7, 7, "deg").doc("sine"));
+    a->Visit(FD_FIELD(offset).unit("N").plausible(-1e5, 1e5).doc("added to every kind"));
+    a->Visit(FD_FIELD(rate).unit("N/s").plausible(-1e7, 1e7).doc("ramp slope"));
+    a->Visit(FD_FIELD(start_time).unit("s").non_negative().doc("before it only the offset acts"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().doc("output saturation, lower; finite, < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().doc("output saturation, upper; finite, > u_min"));
+  }
   void validate(const std::string& prefix = "controller") const;
 };
 

@@ -45,6 +45,8 @@
 
 #include <memory>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/delay_line.hpp"
@@ -55,6 +57,10 @@
 namespace feeddrive::controller {
 
 enum class Switching { kSign, kSaturation, kTanh };
+inline const std::vector<std::pair<Switching, const char*>>& enum_names(Switching) {
+  static const std::vector<std::pair<Switching, const char*>> n = {{Switching::kSign, "sgn"}, {Switching::kSaturation, "sat"}, {Switching::kTanh, "tanh"}};
+  return n;
+}
 std::string to_string(Switching s);
 Switching switching_from_string(const std::string& s);  ///< "sgn" | "sat" | "tanh"
 
@@ -63,6 +69,10 @@ enum class StateSource {
   kTrue,      ///< from the plant's true state (the paper's "all states available")
   kObserver,  ///< from an observer driven by the measured velocity
 };
+inline const std::vector<std::pair<StateSource, const char*>>& enum_names(StateSource) {
+  static const std::vector<std::pair<StateSource, const char*>> n = {{StateSource::kTrue, "true"}, {StateSource::kObserver, "observer"}};
+  return n;
+}
 std::string to_string(StateSource s);
 StateSource state_source_from_string(const std::string& s);  ///< "true" | "observer"
 
@@ -71,6 +81,10 @@ enum class MotionSource {
   kMeasured,  ///< the measured position and velocity as they are (the paper)
   kObserver,  ///< a model-based observer of x and v (state_observer.hpp) fed by the encoder
 };
+inline const std::vector<std::pair<MotionSource, const char*>>& enum_names(MotionSource) {
+  static const std::vector<std::pair<MotionSource, const char*>> n = {{MotionSource::kMeasured, "measured"}, {MotionSource::kObserver, "observer"}};
+  return n;
+}
 std::string to_string(MotionSource s);
 MotionSource motion_source_from_string(const std::string& s);  ///< "measured" | "observer"
 
@@ -103,6 +117,30 @@ struct SlidingModeParams {
   double u_max{10.0};         ///< [V]
   plant::PlantParams model;   ///< the controller's model of the drive
   double period{1e-4};        ///< control period T [s] (for the observers)
+
+  /// The scenario keys (controller.*); model, period and computation_delay come from the
+  /// scenario (controller.model, control_period, controller.computation_delay).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(eta).unit("m/s^2").non_negative().plausible(0, 1000, "mm/s^2").doc("constant reaching rate"));
+    a->Visit(FD_FIELD(k).unit("1/s").non_negative().plausible(0, 1e4).doc("proportional reaching rate"));
+    a->Visit(FD_FIELD(lambda).unit("1/s").positive().plausible(0.1, 1e5).doc("sliding-surface slope"));
+    a->Visit(FD_FIELD(switching).doc("sgn, sat (sat(S/phi)) or tanh (tanh(S/phi))"));
+    a->Visit(FD_FIELD(boundary_layer).unit("m/s").unchecked().plausible(1e-9, 1.0, "mm/s").doc("phi, for sat and tanh (> 0 there)"));
+    a->Visit(FD_FIELD(compensate_friction).doc("the model friction term of eq. 19"));
+    a->Visit(FD_FIELD(compensate_ripple).doc("the model ripple term of eq. 19"));
+    a->Visit(FD_FIELD(compensate_grinding).doc("the model grinding term of eq. 19"));
+    a->Visit(FD_FIELD(feedforward_acceleration).doc("the m*xd'' term"));
+    a->Visit(FD_FIELD(friction_state).doc("true: the friction estimate from the plant's true z (the paper); observer: from the bristle observer"));
+    a->Visit(FD_FIELD(grinding_state).doc("the same choice for the grinding force"));
+    a->Visit(FD_FIELD(observer_gain).unit("1/s").non_negative().plausible(0, 1e5).doc("correction gain of the bristle observer"));
+    a->Visit(FD_FIELD(motion_state).doc("measured: e and de/dt from the measured x and v (the paper); observer: from the x,v observer"));
+    a->Visit(FD_FIELD(motion_observer_bandwidth).unit("rad/s").positive().plausible(1, 1e5).doc("pole of the x,v observer, p = exp(-w*T)"));
+    a->Visit(FD_FIELD(motion_observer_disturbance).doc("with motion_state observer: estimate a disturbance acceleration and add m*d^"));
+    a->Visit(FD_FIELD(compensate_delay).doc("predict the state to t_k + computation_delay (needs motion_state observer)"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
+  }
   void validate(const std::string& prefix = "controller") const;
 };
 

@@ -10,6 +10,10 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include "feeddrive/common/fields.hpp"
 
 namespace feeddrive::plant {
 
@@ -20,9 +24,18 @@ enum class FrictionModel {
   kNone,    ///< No friction.
 };
 
+inline const std::vector<std::pair<FrictionModel, const char*>>& enum_names(FrictionModel) {
+  static const std::vector<std::pair<FrictionModel, const char*>> n = {
+      {FrictionModel::kLuGre, "lugre"}, {FrictionModel::kStatic, "static"}, {FrictionModel::kNone, "none"}};
+  return n;
+}
 std::string to_string(FrictionModel m);
 /// Parses "lugre" | "static" | "none"; throws std::invalid_argument otherwise.
 FrictionModel friction_model_from_string(const std::string& s);
+
+// Every struct below lists its keys once, in Serialize (common/fields.hpp): name, unit, validity
+// rule, plausible range for a linear feed drive, one line of meaning. The scenario reader,
+// validate()'s ranges, the plausibility warnings and docs/scenario.md's tables come from it.
 
 /// LuGre / static friction parameters. Defaults: Xie & Liang Table 1, delta = 2.
 struct FrictionParams {
@@ -40,22 +53,79 @@ struct FrictionParams {
   /// eps [m/s] of the static model's smoothed sign tanh(v/eps). Only used by kStatic.
   double static_smoothing_velocity{1e-5};
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(model).doc("friction law: lugre, static (Coulomb + Stribeck + viscous map) or none"));
+    a->Visit(FD_FIELD(static_force).unit("N").positive().plausible(0.1, 2e4, "", "", "a linear guide").doc("Fs, stiction level of g(v)"));
+    a->Visit(FD_FIELD(coulomb_force).unit("N").positive().plausible(0.1, 2e4, "", "", "a linear guide").doc("Fc, Coulomb level of g(v); <= static_force"));
+    a->Visit(FD_FIELD(stribeck_velocity).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s").doc("vs, Stribeck velocity"));
+    a->Visit(FD_FIELD(stribeck_exponent).unit("-").positive().plausible(0.3, 5.0).doc("delta, shape of exp(-|v/vs|^delta)"));
+    a->Visit(FD_FIELD(bristle_stiffness).unit("N/m").positive().plausible(1e3, 1e10, "", "N/um").doc("sigma0 (lugre)"));
+    a->Visit(FD_FIELD(bristle_damping).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1 (lugre)"));
+    a->Visit(FD_FIELD(viscous).unit("N*s/m").non_negative().plausible(0, 1e5).doc("sigma2, viscous coefficient"));
+    a->Visit(FD_FIELD(damping_decay_velocity).unit("m/s").non_negative().plausible(0, 1.0, "mm/s").doc("vd: > 0 gives sigma1(v) = sigma1*exp(-(v/vd)^2); 0 keeps sigma1 constant"));
+    a->Visit(FD_FIELD(static_smoothing_velocity).unit("m/s").positive().plausible(1e-9, 1e-2, "mm/s").doc("eps of the static model's sign tanh(v/eps) (static only)"));
+  }
   void validate(const std::string& prefix = "friction") const;
 };
 
-/// Force ripple (Van den Braembussche et al. 1996; Xie & Liang eqs. 14-15).
+/// Named sets of ripple values (plant.ripple.preset, or `ripple: paper`).
+enum class RipplePreset {
+  kNone,   ///< every part 0: the ripple is only what the keys give
+  kPaper,  ///< Xie & Liang's values (Table 1): ac = 3 N, bc = 1 N, af = 0.03, bf = 0.01, on
+};
+inline const std::vector<std::pair<RipplePreset, const char*>>& enum_names(RipplePreset) {
+  static const std::vector<std::pair<RipplePreset, const char*>> n = {{RipplePreset::kNone, "none"},
+                                                                      {RipplePreset::kPaper, "paper"}};
+  return n;
+}
+
+/// Force ripple (Van den Braembussche et al. 1996; Xie & Liang eqs. 14-15). Every part is 0
+/// unless given or taken from a preset (RippleParams::paper(), the paper's values): a user who
+/// writes only cogging_amplitude gets only that part (issue 23).
 struct RippleParams {
+  RipplePreset preset{RipplePreset::kNone};
   bool enabled{false};
   double pitch{0.03};             ///< p [m], magnet pitch.
-  double cogging_amplitude{3.0};  ///< ac [N].
+  double cogging_amplitude{0.0};  ///< ac [N].
   double cogging_phase{0.0};      ///< phi_c1 [rad].
-  double cogging_third{1.0};      ///< bc [N], third harmonic (6*pi*x/p).
+  double cogging_third{0.0};      ///< bc [N], third harmonic (6*pi*x/p).
   double cogging_third_phase{0.0};///< phi_c3 [rad].
-  double reluctance_amplitude{0.03};   ///< af [-], fraction of the desired force.
+  double reluctance_amplitude{0.0};    ///< af [-], fraction of the desired force.
   double reluctance_phase{0.0};        ///< phi_11 [rad].
-  double reluctance_third{0.01};       ///< bf [-].
+  double reluctance_third{0.0};        ///< bf [-].
   double reluctance_third_phase{0.0};  ///< phi_12 [rad].
 
+  /// The preset's values (kNone: the defaults above).
+  static RippleParams of(RipplePreset preset) {
+    RippleParams r;
+    r.preset = preset;
+    if (preset == RipplePreset::kPaper) {
+      r.enabled = true;
+      r.cogging_amplitude = 3.0;
+      r.cogging_third = 1.0;
+      r.reluctance_amplitude = 0.03;
+      r.reluctance_third = 0.01;
+    }
+    return r;
+  }
+  /// The paper's ripple (Xie & Liang Table 1), enabled.
+  static RippleParams paper() { return of(RipplePreset::kPaper); }
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(preset).doc("paper: start from the paper's values (ac 3 N, bc 1 N, af 0.03, bf 0.01, on); `ripple: paper` alone says the same; none: every part 0"));
+    a->Visit(FD_FIELD(enabled).doc("the ripple force of eqs. 14-15 acts"));
+    a->Visit(FD_FIELD(pitch).unit("m").positive().at_most(10).plausible(1e-3, 0.2, "mm").doc("p, magnet pitch"));
+    a->Visit(FD_FIELD(cogging_amplitude).unit("N").plausible(-2000, 2000).doc("ac, cogging amplitude"));
+    a->Visit(FD_FIELD(cogging_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c1"));
+    a->Visit(FD_FIELD(cogging_third).unit("N").plausible(-2000, 2000).doc("bc, cogging third harmonic (6*pi*x/p)"));
+    a->Visit(FD_FIELD(cogging_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c3"));
+    a->Visit(FD_FIELD(reluctance_amplitude).unit("-").plausible(-0.5, 0.5, "%").doc("af, fraction of the desired force; |af| + |bf| < 1"));
+    a->Visit(FD_FIELD(reluctance_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_11"));
+    a->Visit(FD_FIELD(reluctance_third).unit("-").plausible(-0.5, 0.5, "%").doc("bf, third harmonic fraction"));
+    a->Visit(FD_FIELD(reluctance_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_12"));
+  }
   void validate(const std::string& prefix = "ripple") const;
 };
 
@@ -73,6 +143,16 @@ struct GrindingParams {
   /// contact surface. 0: a step.
   double contact_width{1e-6};
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("the Hahn-Lindsay grinding force of eq. 13 acts"));
+    a->Visit(FD_FIELD(stiffness).unit("N/m").positive().plausible(1e5, 1e10, "", "N/um").doc("ke, wheel-work-machine stiffness"));
+    a->Visit(FD_FIELD(dullness).unit("N*s/m^3").positive().plausible(1e6, 1e13).doc("c, force per material removal rate"));
+    a->Visit(FD_FIELD(workpiece_diameter).unit("m").positive().plausible(1e-3, 2.0, "mm").doc("dw"));
+    a->Visit(FD_FIELD(wheel_width).unit("m").positive().plausible(1e-3, 0.5, "mm").doc("bs"));
+    a->Visit(FD_FIELD(contact_position).unit("m").minus_inf_allowed().plausible(-5, 5, "mm").doc("contact for x > contact_position; -.inf: always in contact"));
+    a->Visit(FD_FIELD(contact_width).unit("m").non_negative().plausible(0, 1e-2, "um").doc("w: the force rises linearly over (contact_position, contact_position + w); 0: a step"));
+  }
   /// C = c*pi*dw*bs [N*s/m]: the steady-state force per infeed velocity.
   double damping() const;
   /// tau = C/ke [s]: the time constant of eq. 13.
@@ -88,6 +168,13 @@ struct ElectricalParams {
   double inductance{2e-3};    ///< L [H].
   double back_emf{100.0};     ///< Ke [V*s/m].
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("the R-L armature circuit is modelled"));
+    a->Visit(FD_FIELD(resistance).unit("ohm").positive().plausible(1e-3, 100).doc("R"));
+    a->Visit(FD_FIELD(inductance).unit("H").positive().plausible(1e-6, 1.0, "mH").doc("L"));
+    a->Visit(FD_FIELD(back_emf).unit("V*s/m").non_negative().plausible(0, 2000).doc("Ke"));
+  }
   void validate(const std::string& prefix = "electrical") const;
 };
 
@@ -99,14 +186,29 @@ struct ElectricalParams {
 struct ConstantForceEffect {  ///< F = force_N (gravity on an incline, cable weight, offset)
   bool enabled{false};
   double force_N{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(force_N).unit("N").plausible(-1e4, 1e4).doc("the constant force"));
+  }
 };
 struct CoulombFrictionEffect {  ///< F = coulomb_N*sgn(v), sgn smoothed as tanh(v/eps) (eps: friction.static_smoothing_velocity)
   bool enabled{false};
   double coulomb_N{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(coulomb_N).unit("N").non_negative().plausible(0, 2e4));
+  }
 };
 struct ViscousFrictionEffect {  ///< F = viscous_Ns_per_m*v
   bool enabled{false};
   double viscous_Ns_per_m{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(viscous_Ns_per_m).unit("N*s/m").non_negative().plausible(0, 1e5));
+  }
 };
 /// F = sgn(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta)), delta =
 /// friction.stribeck_exponent, sgn smoothed as for coulomb_friction.
@@ -115,6 +217,13 @@ struct StribeckFrictionEffect {
   double static_N{0.0};
   double coulomb_N{0.0};
   double stribeck_velocity_mps{0.01};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(static_N).unit("N").plausible(0, 2e4).doc("static_N >= coulomb_N"));
+    a->Visit(FD_FIELD(coulomb_N).unit("N").non_negative().plausible(0, 2e4));
+    a->Visit(FD_FIELD(stribeck_velocity_mps).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s"));
+  }
 };
 /// The LuGre bristle dynamics (Canudas de Wit 1995): the friction becomes LuGre with
 /// sigma0 = bristle_stiffness_N_per_m and sigma1 = bristle_damping_Ns_per_m, keeping Fs, Fc, vs,
@@ -123,6 +232,12 @@ struct PreslidingEffect {
   bool enabled{false};
   double bristle_stiffness_N_per_m{2e6};
   double bristle_damping_Ns_per_m{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(bristle_stiffness_N_per_m).unit("N/m").positive().plausible(1e3, 1e10, "", "N/um").doc("sigma0 of the LuGre friction it makes"));
+    a->Visit(FD_FIELD(bristle_damping_Ns_per_m).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1"));
+  }
 };
 /// F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
 struct CoggingRippleEffect {
@@ -132,6 +247,15 @@ struct CoggingRippleEffect {
   double phase_rad{0.0};
   double third_harmonic_N{0.0};
   double third_phase_rad{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(pitch_m).unit("m").positive().plausible(1e-3, 0.2, "mm"));
+    a->Visit(FD_FIELD(amplitude_N).unit("N").plausible(-2000, 2000));
+    a->Visit(FD_FIELD(phase_rad).unit("rad").plausible(-7, 7, "deg"));
+    a->Visit(FD_FIELD(third_harmonic_N).unit("N").plausible(-2000, 2000));
+    a->Visit(FD_FIELD(third_phase_rad).unit("rad").plausible(-7, 7, "deg"));
+  }
 };
 /// F = Ka*Kf*u*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)  (the thrust actually produced)
 struct ReluctanceRippleEffect {
@@ -139,6 +263,13 @@ struct ReluctanceRippleEffect {
   double pitch_m{0.03};
   double relative_amplitude{0.0};
   double phase_rad{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(pitch_m).unit("m").positive().plausible(1e-3, 0.2, "mm"));
+    a->Visit(FD_FIELD(relative_amplitude).unit("-").plausible(-0.5, 0.5, "%").doc("|relative_amplitude| < 1"));
+    a->Visit(FD_FIELD(phase_rad).unit("rad").plausible(-7, 7, "deg"));
+  }
 };
 /// Hahn-Lindsay grinding force (the grinding section's model) with C = gain_Ns_per_m,
 /// ke = stiffness_N_per_m and contact past contact_position_m. Uses the Fg state.
@@ -147,22 +278,45 @@ struct GrindingForceEffect {
   double gain_Ns_per_m{7.85e6};
   double stiffness_N_per_m{2e7};
   double contact_position_m{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(gain_Ns_per_m).unit("N*s/m").positive().plausible(1e3, 1e10).doc("C"));
+    a->Visit(FD_FIELD(stiffness_N_per_m).unit("N/m").positive().plausible(1e5, 1e10, "", "N/um").doc("ke"));
+    a->Visit(FD_FIELD(contact_position_m).unit("m").plausible(-5, 5, "mm"));
+  }
 };
 /// F = stiffness_N_per_m*(x - rest_position_m)  (a cable carrier)
 struct SpringForceEffect {
   bool enabled{false};
   double stiffness_N_per_m{0.0};
   double rest_position_m{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(stiffness_N_per_m).unit("N/m").non_negative().plausible(0, 1e7));
+    a->Visit(FD_FIELD(rest_position_m).unit("m").plausible(-5, 5, "mm"));
+  }
 };
 /// The true moving mass replaces PlantParams::mass.
 struct MassErrorEffect {
   bool enabled{false};
   double mass_kg{102.04};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(mass_kg).unit("kg").positive().plausible(0.5, 5000, "g").doc("the true moving mass"));
+  }
 };
 /// The thrust acts delay_s after the command: F_thrust(t) = Ka*Kf*u(t - delay_s) (u = 0 before t0).
 struct InputDelayEffect {
   bool enabled{false};
   double delay_s{0.0};
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(FD_FIELD(delay_s).unit("s").non_negative().plausible(0, 0.1, "ms"));
+  }
 };
 
 struct EffectsParams {
@@ -178,23 +332,59 @@ struct EffectsParams {
   MassErrorEffect mass_error;
   InputDelayEffect input_delay;
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(constant_force).doc("F = force_N (gravity on an incline, cable weight, an offset)"));
+    a->Visit(FD_FIELD(coulomb_friction).doc("F = coulomb_N*sgn_eps(v)"));
+    a->Visit(FD_FIELD(viscous_friction).doc("F = viscous_Ns_per_m*v"));
+    a->Visit(FD_FIELD(stribeck_friction).doc("F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))"));
+    a->Visit(FD_FIELD(presliding).doc("the friction becomes LuGre with sigma0, sigma1 below, keeping Fs, Fc, vs, delta, sigma2 of friction"));
+    a->Visit(FD_FIELD(cogging_ripple).doc("F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)"));
+    a->Visit(FD_FIELD(reluctance_ripple).doc("F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)"));
+    a->Visit(FD_FIELD(grinding_force).doc("the grinding section's force on, with C = gain_Ns_per_m, ke = stiffness_N_per_m, contact past contact_position_m"));
+    a->Visit(FD_FIELD(spring_force).doc("F = stiffness_N_per_m*(x - rest_position_m) (a cable carrier)"));
+    a->Visit(FD_FIELD(mass_error).doc("the true moving mass mass_kg replaces plant.mass"));
+    a->Visit(FD_FIELD(input_delay).doc("F_thrust(t) = Ka*Kf*u(t - delay_s)"));
+  }
   bool any() const;
   void validate(const std::string& prefix = "effects") const;
 };
+
+/// How the measured velocity is formed (SensorParams::velocity).
+enum class VelocityMeasurement {
+  kAuto,        ///< the true velocity when the sensor is ideal, else kDifference
+  kTrue,        ///< the true velocity (a tachometer-like ideal sensor; only with an ideal sensor)
+  kDifference,  ///< (x_meas[k] - x_meas[k-1]) / T, what a drive computes from an encoder
+};
+inline const std::vector<std::pair<VelocityMeasurement, const char*>>& enum_names(VelocityMeasurement) {
+  static const std::vector<std::pair<VelocityMeasurement, const char*>> n = {
+      {VelocityMeasurement::kAuto, "auto"}, {VelocityMeasurement::kTrue, "true"}, {VelocityMeasurement::kDifference, "difference"}};
+  return n;
+}
 
 /// Position sensor (encoder) model. Both effects off by default.
 struct SensorParams {
   double quantization{0.0};    ///< q [m]; 0 = ideal. x_meas = q*round((x + n)/q).
   double noise_stddev{0.0};    ///< standard deviation of Gaussian position noise n [m].
   std::uint64_t seed{1};       ///< seed of the noise generator (std::mt19937_64).
-  /// How the measured velocity is formed:
-  ///   "auto": the true velocity when the sensor is ideal, else "difference";
-  ///   "true": the true velocity (a tachometer-like ideal sensor; only with an ideal sensor:
-  ///           validate() refuses it with quantization or noise, which measure position only);
-  ///   "difference": (x_meas[k] - x_meas[k-1]) / T, what a drive computes from an encoder.
-  std::string velocity{"auto"};
+  /// How the measured velocity is formed; kTrue only with an ideal sensor: validate() refuses
+  /// it with quantization or noise, which measure position only.
+  VelocityMeasurement velocity{VelocityMeasurement::kAuto};
 
   bool ideal() const { return quantization == 0.0 && noise_stddev == 0.0; }
+  /// The one rule of kAuto: the velocity is differenced from the counts unless the sensor is
+  /// ideal (then it is the true velocity).
+  bool differenced_velocity() const {
+    return velocity == VelocityMeasurement::kDifference || (velocity == VelocityMeasurement::kAuto && !ideal());
+  }
+  template <class Archive>
+  void Serialize(Archive* a) {
+    // 0 or in [1e-12, 1] m: beyond, the measurement overflows or rounds to nothing (validate()).
+    a->Visit(FD_FIELD(quantization).unit("m").non_negative().at_most(1.0).plausible(1e-10, 1e-4, "um").doc("encoder count q; 0 = ideal; else in [1e-12, 1]"));
+    a->Visit(FD_FIELD(noise_stddev).unit("m").non_negative().at_most(1.0).plausible(0, 1e-4, "um").doc("standard deviation of Gaussian position noise; at most 1"));
+    a->Visit(FD_FIELD(seed).doc("seed of the noise generator"));
+    a->Visit(FD_FIELD(velocity).doc("auto: true for an ideal sensor, else difference; true (a tachometer) only with an ideal sensor; difference: (x_k - x_k-1)/T"));
+  }
   void validate(const std::string& prefix = "sensor") const;
 };
 
@@ -209,6 +399,16 @@ struct IntegratorParams {
   double atol_current{1e-9};     ///< [A]
   long max_steps{100000};        ///< per control period.
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(rtol).unit("-").positive().plausible(1e-14, 1e-3).doc("CVODE relative tolerance"));
+    a->Visit(FD_FIELD(atol_position).unit("m").positive().plausible(1e-18, 1e-6).doc("absolute tolerance of x"));
+    a->Visit(FD_FIELD(atol_velocity).unit("m/s").positive().plausible(1e-18, 1e-6).doc("absolute tolerance of v"));
+    a->Visit(FD_FIELD(atol_bristle).unit("m").positive().plausible(1e-18, 1e-6).doc("absolute tolerance of z"));
+    a->Visit(FD_FIELD(atol_grinding).unit("N").positive().plausible(1e-15, 1e-3).doc("absolute tolerance of Fg"));
+    a->Visit(FD_FIELD(atol_current).unit("A").positive().plausible(1e-15, 1e-3).doc("absolute tolerance of i"));
+    a->Visit(FD_FIELD(max_steps).unit("-").positive().doc("CVODE steps per control period"));
+  }
   void validate(const std::string& prefix = "integrator") const;
 };
 
@@ -219,6 +419,15 @@ struct InitialState {
   double bristle{0.0};   ///< z [m]
   double grinding{0.0};  ///< Fg [N]
   double current{0.0};   ///< i [A]
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(position).unit("m").plausible(-5, 5, "mm").doc("x(0)"));
+    a->Visit(FD_FIELD(velocity).unit("m/s").plausible(-10, 10, "mm/s").doc("v(0)"));
+    a->Visit(FD_FIELD(bristle).unit("m").plausible(-1e-3, 1e-3).doc("z(0)"));
+    a->Visit(FD_FIELD(grinding).unit("N").plausible(-1e5, 1e5).doc("Fg(0)"));
+    a->Visit(FD_FIELD(current).unit("A").plausible(-1000, 1000).doc("i(0)"));
+  }
 };
 
 /// Everything that defines the plant.
@@ -239,6 +448,21 @@ struct PlantParams {
   InitialState initial;
   EffectsParams effects;  ///< model-discrepancy effects (docs/fit.md); all off by default
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(mass).unit("kg").positive().plausible(0.5, 5000, "g").doc("m, moving mass"));
+    a->Visit(FD_FIELD(amplifier_gain).unit("A/V").positive().plausible(0.01, 100).doc("Ka (V/V with the electrical option); Ka*Kf = thrust per volt"));
+    a->Visit(FD_FIELD(force_constant).unit("N/A").positive().plausible(1, 2000).doc("Kf"));
+    a->Visit(FD_FIELD(input_limit).unit("V").positive().plausible(1, 1000).doc("the amplifier's input range: a larger |u| is clipped, a NaN/inf u is rejected and 0 V applied"));
+    a->Visit(FD_FIELD(friction));
+    a->Visit(FD_FIELD(ripple));
+    a->Visit(FD_FIELD(grinding));
+    a->Visit(FD_FIELD(electrical));
+    a->Visit(FD_FIELD(sensor));
+    a->Visit(FD_FIELD(integrator));
+    a->Visit(FD_FIELD(initial));
+    a->Visit(FD_FIELD(effects));
+  }
   double thrust_gain() const { return amplifier_gain * force_constant; }  ///< Ka*Kf [N/V]
   void validate(const std::string& prefix = "plant") const;
   /// For an integrator failure message: the `n` fastest rates of the model [1/s] with the keys

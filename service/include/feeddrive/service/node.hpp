@@ -16,6 +16,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/resend_request_t.hpp"
@@ -49,6 +50,9 @@ struct NodeOptions {
   /// the monitor hashes the file it read.
   std::string scenario_hash;
   std::string key_file;              ///< --key: authenticate every message with this key; "": off
+  /// --set key=value: scenario settings applied before the scenario is read (sim::load_scenario),
+  /// the same in every process (the scenario hash covers them).
+  std::vector<std::string> sets;
   /// --run-nonce, with --key: the run's nonce (feeddrive-launch draws it and gives it to every
   /// process it starts); 0: the plant draws one and the others take it from its fresh heartbeat.
   std::int64_t run_nonce{0};

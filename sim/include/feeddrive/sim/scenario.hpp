@@ -13,6 +13,7 @@
 // Loading is strict: an unknown or misspelt key, a missing value, a non-number, NaN or a value
 // that fails validate() throws ScenarioError with a one-line message naming the key and value.
 
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -35,7 +36,21 @@ class ScenarioError : public BadInput {
 };
 
 enum class ControllerType { kSlidingMode, kCascade, kOpenLoop, kPlugin };
+inline const std::vector<std::pair<ControllerType, const char*>>& enum_names(ControllerType) {
+  static const std::vector<std::pair<ControllerType, const char*>> n = {{ControllerType::kSlidingMode, "sliding_mode"},
+                                                                        {ControllerType::kCascade, "cascade"},
+                                                                        {ControllerType::kOpenLoop, "open_loop"},
+                                                                        {ControllerType::kPlugin, "plugin"}};
+  return n;
+}
 enum class ReferenceType { kNone, kSine, kStep, kAccelLimited, kSCurve, kRamp, kWaypoints };
+inline const std::vector<std::pair<ReferenceType, const char*>>& enum_names(ReferenceType) {
+  static const std::vector<std::pair<ReferenceType, const char*>> n = {
+      {ReferenceType::kNone, "none"},   {ReferenceType::kSine, "sine"},          {ReferenceType::kStep, "step"},
+      {ReferenceType::kAccelLimited, "accel_limited"}, {ReferenceType::kSCurve, "scurve"}, {ReferenceType::kRamp, "ramp"},
+      {ReferenceType::kWaypoints, "waypoints"}};
+  return n;
+}
 
 struct ReferenceConfig {
   ReferenceType type{ReferenceType::kNone};
@@ -99,6 +114,14 @@ struct Scenario {
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};
+  /// Values that load but are implausible for a linear feed drive (each naming the key, the
+  /// value, the bound and the likely unit: "reference.max_velocity: 500 m/s is above any linear
+  /// drive (10 m/s); mm/s?"), and a move that does not finish within `duration`. The loader
+  /// never prints: the tools show them and summary.json lists them.
+  std::vector<std::string> warnings;
+  /// When the reference is a move (accel_limited, scurve, waypoints): its end time [s]; NaN
+  /// otherwise. The move finishes within the run iff move_end_s <= duration.
+  double move_end_s{std::numeric_limits<double>::quiet_NaN()};
 
   /// The drive as it runs: `plant` with the controller's computation delay added to the input
   /// delay (plant.effects.input_delay; the plant applies each command that long after its
@@ -115,6 +138,23 @@ struct Scenario {
 /// `text`, if given, receives the file's bytes as read (a process that must prove it runs the
 /// same scenario as others hashes exactly these).
 Scenario load_scenario(const std::string& path, std::string* text = nullptr);
+
+/// One `--set key=value` of a tool: a dotted scenario key and a YAML scalar.
+struct KeySetting {
+  std::string key;
+  std::string value;
+};
+/// Parses "key=value" (the key a dotted path, the value a scalar). Throws ScenarioError
+/// "--set TEXT: expected key=value" otherwise.
+KeySetting parse_key_setting(const std::string& text);
+/// Writes `value` (a YAML scalar) at the dotted `key` of the map `root`, creating maps on the
+/// way. Throws ScenarioError "<key>: <part> is a single value in the scenario, not a map of keys".
+void set_key(YAML::Node& root, const std::string& key, const std::string& value);
+/// A scenario file with settings applied before it is read (feeddrive-sim, -launch, -fit --set):
+/// the same loader, so a setting is checked like the file's own keys (unknown key with "did you
+/// mean", type, range). Errors name the file and "--set" when a setting is at fault. `text`
+/// receives the scenario as run: the file's bytes without settings, else the YAML with them.
+Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& sets, std::string* text = nullptr);
 /// Parses and validates YAML text; base_dir resolves relative file names; origin names the
 /// source in messages. If `resolved` is given it receives every scalar key the loader read with
 /// its effective value (given or default; file names resolved against base_dir): the complete

@@ -63,6 +63,11 @@ class MapReader {
   std::string required_string(const std::string& key);
   /// A nested map (absent = empty).
   MapReader child(const std::string& key);
+  /// If `key` holds a single value (not a map), its text in `out` and true.
+  bool scalar_text(const std::string& key, std::string& out) const;
+  /// An empty nested map at `key` (marked as read), whatever the node holds: the defaults of a
+  /// section given in another form (`ripple: paper`) are recorded under its path.
+  MapReader child_absent(const std::string& key);
   /// Marks `key` as known (read by the caller some other way, e.g. a list), for finish().
   void known(const std::string& key) { read_.insert(key); }
   /// Throws for every key present in the node but never read.

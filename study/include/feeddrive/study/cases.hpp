@@ -79,8 +79,7 @@ double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::u
 /// appearance (the parameter columns of results.csv).
 std::vector<std::string> varied_keys(const Study& s);
 
-/// Writes `value` (a YAML scalar) at the dotted `key` of the map `root`, creating maps on the
-/// way. Throws StudyError if a part of the path is not a map.
+/// sim::set_key, with its error as a StudyError.
 void set_key(YAML::Node& root, const std::string& key, const std::string& value);
 
 struct ResolvedCase {

@@ -10,13 +10,16 @@
 // place), so an interrupted run loses at most the cases that were running.
 
 #include <string>
+#include <vector>
 
 #include "feeddrive/study/transport.hpp"
 
 namespace feeddrive::study {
 
 struct Options {
-  std::string study;
+  std::string study;  ///< the study file, or with `sweeps` the scenario file
+  std::vector<std::string> sets;    ///< --set KEY=VALUE: every case, after the study's own set
+  std::vector<std::string> sweeps;  ///< --sweep: the grid of a study without a study file (spec.hpp parse_sweep)
   std::string out;
   int jobs{0};  ///< worker threads of this process; 0: every core it may use (per MPI rank: shared)
   bool quiet{false};

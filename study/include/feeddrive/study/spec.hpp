@@ -135,6 +135,16 @@ struct Study {
   long total_cases() const;
 };
 
+/// One --sweep of feeddrive-study: "KEY=V1,V2,..." (values as written), "KEY=START:STOP:N" (N
+/// values, linear) or "KEY=log:START:STOP:N" (N values, logarithmic; START, STOP > 0). Throws
+/// StudyError "--sweep TEXT: why", one line.
+GridAxis parse_sweep(const std::string& text);
+
+/// A study without a study file (feeddrive-study SCENARIO --sweep ...): the scenario is the base,
+/// its controller the only one, and one family "sweep" whose grid has one axis per sweep (their
+/// Cartesian product). Validated.
+Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>& axes);
+
 /// Loads a study file (relative paths inside it are relative to its folder).
 Study load_study(const std::string& path);
 /// Parses study YAML text; base_dir resolves the file names in it, origin names it in errors.

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/fields.hpp"
+
 namespace feeddrive::trajectory {
 
 /// One sample of a reference.
@@ -34,6 +36,14 @@ struct SineParams {
   double phase{0.0};       ///< [rad]
   double offset{0.0};      ///< [m]
   double start_time{0.0};  ///< t0 [s]; before it the sample is the t0 value with zero derivatives
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(amplitude).unit("m").plausible(-2, 2, "mm"));
+    a->Visit(FD_FIELD(frequency).unit("Hz").non_negative().plausible(0, 1000));
+    a->Visit(FD_FIELD(phase).unit("rad").plausible(-7, 7, "deg"));
+    a->Visit(FD_FIELD(offset).unit("m").plausible(-5, 5, "mm"));
+    a->Visit(FD_FIELD(start_time).unit("s"));
+  }
   void validate(const std::string& prefix = "reference") const;
 };
 std::unique_ptr<Trajectory> make_sine(const SineParams& p);
@@ -44,6 +54,12 @@ struct StepParams {
   double amplitude{0.1};   ///< [m]
   double step_time{1.0};   ///< [s]
   double initial{0.0};     ///< [m]
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(amplitude).unit("m").plausible(-5, 5, "mm"));
+    a->Visit(FD_FIELD(step_time).unit("s"));
+    a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
+  }
   void validate(const std::string& prefix = "reference") const;
 };
 std::unique_ptr<Trajectory> make_step(const StepParams& p);
@@ -58,6 +74,14 @@ struct AccelLimitedParams {
   double max_acceleration{0.4};  ///< [m/s^2]
   double start_time{0.0};        ///< [s]
   double initial{0.0};           ///< start position [m]
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
+    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(FD_FIELD(start_time).unit("s"));
+    a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
+  }
   void validate(const std::string& prefix = "reference") const;
 };
 std::unique_ptr<Trajectory> make_accel_limited(const AccelLimitedParams& p);
@@ -73,6 +97,15 @@ struct SCurveParams {
   double max_jerk{2.4};           ///< [m/s^3]
   double start_time{0.0};         ///< [s]
   double initial{0.0};            ///< [m]
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
+    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_jerk).unit("m/s^3").positive().at_most(1e8).plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
+    a->Visit(FD_FIELD(start_time).unit("s"));
+    a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
+  }
   void validate(const std::string& prefix = "reference") const;
 };
 /// The segment durations of a planned S-curve.
@@ -95,6 +128,12 @@ struct RampParams {
   double velocity{1e-6};   ///< [m/s]
   double start_time{0.0};  ///< [s]
   double initial{0.0};     ///< [m]
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(velocity).unit("m/s").plausible(-10, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(start_time).unit("s"));
+    a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
+  }
   void validate(const std::string& prefix = "reference") const;
 };
 std::unique_ptr<Trajectory> make_ramp(const RampParams& p);

@@ -1,0 +1,241 @@
+#pragma once
+// One list per parameter struct (Drake's Serialize style, drake/common/name_value.h): each params
+// struct declares its fields once, next to the struct,
+//
+//   template <class Archive>
+//   void Serialize(Archive* a) {
+//     a->Visit(FD_FIELD(mass).unit("kg").positive().plausible(1, 5000).doc("moving mass m"));
+//     a->Visit(FD_FIELD(friction).doc("friction law and parameters"));   // a nested params struct
+//   }
+//
+// and every consumer of the keys is an archive that visits that list:
+//   * the scenario's YAML reader (sim/yaml_archive.hpp): strict, unknown keys with "did you mean";
+//   * validate()'s per-field ranges (check_fields() below), with the one-line messages of
+//     validate.hpp ("plant.mass = -1: must be > 0");
+//   * the plausibility warnings for a linear feed drive (plausibility() below);
+//   * the key tables of docs/scenario.md (feeddrive-keys, checked for drift by a test);
+//   * the study's key access and --set, through the scenario reader.
+// Adding a key is one Visit line (docs/contributing.md, "How to add a scenario key").
+//
+// Header-only; no dependency beyond the standard library.
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "feeddrive/common/validate.hpp"
+
+namespace feeddrive::fields {
+
+/// The validity rule of a number (hard: validate() throws, the tools exit 2).
+enum class Check {
+  kFinite,       ///< any finite number
+  kPositive,     ///< > 0
+  kNonNegative,  ///< >= 0
+  kNotPlusInf,   ///< a number or -inf (written -.inf), never NaN or +inf
+  kNone,         ///< not checked by check_fields (a rule of its own in validate())
+};
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// What the list says of one field besides its name and value.
+struct Meta {
+  const char* name{""};
+  const char* unit{"-"};  ///< engineering unit as written in the docs ("m", "N*s/m", "-")
+  const char* doc{""};    ///< one line for the key table
+  Check check{Check::kFinite};
+  /// Further hard bounds: a value outside cannot be meant (exit 2, "must be <= 1 m").
+  double min{-kInf}, max{kInf};
+  /// The plausible range for a linear feed drive of a machine tool: outside it the loader warns,
+  /// naming the likely unit the value was written in (`hint_high` above, `hint_low` below).
+  double plausible_lo{-kInf}, plausible_hi{kInf};
+  const char* hint_high{""};
+  const char* hint_low{""};
+  const char* plausible_why{""};  ///< e.g. "any linear drive"
+  bool allow_inf() const { return check == Check::kNotPlusInf; }
+};
+
+/// A field: its Meta and a reference to its value. Built by FD_FIELD(x) and refined by chaining.
+template <typename T>
+struct Field {
+  Meta meta;
+  T* value;
+  Field unit(const char* u) const { return with([&](Meta& m) { m.unit = u; }); }
+  Field doc(const char* d) const { return with([&](Meta& m) { m.doc = d; }); }
+  Field positive() const { return with([](Meta& m) { m.check = Check::kPositive; }); }
+  Field non_negative() const { return with([](Meta& m) { m.check = Check::kNonNegative; }); }
+  Field minus_inf_allowed() const { return with([](Meta& m) { m.check = Check::kNotPlusInf; }); }
+  Field unchecked() const { return with([](Meta& m) { m.check = Check::kNone; }); }
+  Field at_most(double hi) const { return with([&](Meta& m) { m.max = hi; }); }
+  Field at_least(double lo) const { return with([&](Meta& m) { m.min = lo; }); }
+  /// Plausible for a linear feed drive in [lo, hi]; outside, a warning naming `hint_high`
+  /// (above hi) or `hint_low` (below lo) as the unit the value was probably written in.
+  Field plausible(double lo, double hi, const char* hint_high = "", const char* hint_low = "",
+                  const char* why = "any linear feed drive") const {
+    return with([&](Meta& m) {
+      m.plausible_lo = lo;
+      m.plausible_hi = hi;
+      m.hint_high = hint_high;
+      m.hint_low = hint_low;
+      m.plausible_why = why;
+    });
+  }
+
+ private:
+  template <typename F>
+  Field with(F f) const {
+    Field c = *this;
+    f(c.meta);
+    return c;
+  }
+};
+
+template <typename T>
+Field<T> field(const char* name, T& value) {
+  Field<T> f{Meta{}, &value};
+  f.meta.name = name;
+  return f;
+}
+
+/// FD_FIELD(mass): the field named as the member, Drake's DRAKE_NVP.
+#define FD_FIELD(x) ::feeddrive::fields::field(#x, x)
+
+// --- enums --------------------------------------------------------------------------------
+// An enum is listed by an ADL function next to it:
+//   inline const std::vector<std::pair<FrictionModel, const char*>>& enum_names(FrictionModel);
+// and is an enum end to end: read from its name, written by its name, one table.
+
+template <typename E, typename = void>
+struct is_named_enum : std::false_type {};
+template <typename E>
+struct is_named_enum<E, std::void_t<decltype(enum_names(std::declval<E>()))>> : std::is_enum<E> {};
+
+template <typename E>
+std::string enum_choices() {
+  std::string s;
+  for (const auto& [v, n] : enum_names(E{})) s += (s.empty() ? "" : ", ") + std::string(n);
+  return s;
+}
+
+template <typename E>
+const char* enum_name(E e) {
+  for (const auto& [v, n] : enum_names(E{}))
+    if (v == e) return n;
+  return "?";
+}
+
+/// The enum value named `s`; throws std::invalid_argument("expected one of a, b, c").
+template <typename E>
+E enum_from_name(const std::string& s) {
+  for (const auto& [v, n] : enum_names(E{}))
+    if (s == n) return v;
+  throw std::invalid_argument("expected one of " + enum_choices<E>());
+}
+
+// --- nested structs -----------------------------------------------------------------------
+
+template <typename T, typename = void>
+struct is_serializable : std::false_type {};
+template <typename T>
+struct is_serializable<T, std::void_t<decltype(std::declval<T&>().Serialize(static_cast<int*>(nullptr)))>>
+    : std::true_type {};
+// (Serialize is a template, so the probe above with Archive = int only checks that it exists.)
+
+// --- check_fields: validate()'s per-field ranges ------------------------------------------
+
+/// Checks every number of `obj`'s list against its Check and bounds, throwing
+/// std::invalid_argument "<prefix>.<name> = <value>: <why>" (validate.hpp). Nested structs,
+/// strings, flags and enums are skipped (the nested ones have their own validate()). `skip`
+/// names fields a rule of the struct's validate() leaves out (e.g. the static friction model's
+/// bristle keys).
+class CheckArchive {
+ public:
+  CheckArchive(std::string prefix, std::vector<std::string> skip) : prefix_(std::move(prefix)), skip_(std::move(skip)) {}
+  template <typename T>
+  void Visit(const Field<T>& f) {
+    if constexpr (std::is_same_v<T, double>) {
+      for (const auto& s : skip_)
+        if (s == f.meta.name) return;
+      check(prefix_ + "." + f.meta.name, *f.value, f.meta);
+    } else if constexpr (std::is_same_v<T, long>) {
+      for (const auto& s : skip_)
+        if (s == f.meta.name) return;
+      check(prefix_ + "." + f.meta.name, static_cast<double>(*f.value), f.meta);
+    }
+  }
+  static void check(const std::string& key, double v, const Meta& m) {
+    switch (m.check) {
+      case Check::kNone: return;
+      case Check::kFinite: validate::require_finite(key, v); break;
+      case Check::kPositive: validate::require_positive(key, v); break;
+      case Check::kNonNegative: validate::require_non_negative(key, v); break;
+      case Check::kNotPlusInf:
+        if (std::isnan(v) || v == kInf) validate::fail(key, v, "must be a number or -inf");
+        break;
+    }
+    // Beyond the hard bounds a value cannot be meant; the likely unit is named as in the warnings.
+    const std::string unit = std::string(m.unit) == "-" ? "" : std::string(" ") + m.unit;
+    if (v < m.min)
+      validate::fail(key, v, "must be >= " + validate::format_number(m.min) + unit + (*m.hint_low ? std::string(" (") + m.hint_low + "?)" : ""));
+    if (v > m.max)
+      validate::fail(key, v, "must be <= " + validate::format_number(m.max) + unit + (*m.hint_high ? std::string(" (") + m.hint_high + "?)" : ""));
+  }
+
+ private:
+  std::string prefix_;
+  std::vector<std::string> skip_;
+};
+
+template <typename S>
+void check_fields(const S& obj, const std::string& prefix, std::vector<std::string> skip = {}) {
+  CheckArchive a(prefix, std::move(skip));
+  const_cast<S&>(obj).Serialize(&a);  // the archive only reads
+}
+
+// --- plausibility -------------------------------------------------------------------------
+
+/// One line per number of `obj`'s list (nested structs included) outside its plausible range:
+///   "reference.max_velocity: 500 m/s is above any linear feed drive (10 m/s); mm/s?"
+class PlausibilityArchive {
+ public:
+  explicit PlausibilityArchive(std::string prefix, std::vector<std::string>* out) : prefix_(std::move(prefix)), out_(out) {}
+  template <typename T>
+  void Visit(const Field<T>& f) {
+    const std::string key = prefix_.empty() ? f.meta.name : prefix_ + "." + f.meta.name;
+    if constexpr (std::is_same_v<T, double>) {
+      const Meta& m = f.meta;
+      const double v = *f.value;
+      if (!std::isfinite(v)) return;
+      const std::string unit = std::string(m.unit) == "-" ? "" : std::string(" ") + m.unit;
+      if (v > m.plausible_hi)
+        out_->push_back(key + ": " + validate::format_number(v) + unit + " is above " + m.plausible_why + " (" +
+                        validate::format_number(m.plausible_hi) + unit + ")" + hint(m.hint_high));
+      else if (v < m.plausible_lo && v != 0.0)  // 0 switches a part off
+        out_->push_back(key + ": " + validate::format_number(v) + unit + " is below " + m.plausible_why + " (" +
+                        validate::format_number(m.plausible_lo) + unit + ")" + hint(m.hint_low));
+    } else if constexpr (is_serializable<T>::value) {
+      PlausibilityArchive child(key, out_);
+      f.value->Serialize(&child);
+    }
+  }
+
+ private:
+  static std::string hint(const char* h) { return *h ? std::string("; ") + h + "?" : std::string(); }
+  std::string prefix_;
+  std::vector<std::string>* out_;
+};
+
+template <typename S>
+std::vector<std::string> plausibility(const S& obj, const std::string& prefix) {
+  std::vector<std::string> out;
+  PlausibilityArchive a(prefix, &out);
+  const_cast<S&>(obj).Serialize(&a);
+  return out;
+}
+
+}  // namespace feeddrive::fields

@@ -1,0 +1,129 @@
+// The one list per params struct (common/fields.hpp): the reader, validate()'s ranges, the
+// plausibility warnings and the docs' key tables all come from it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "feeddrive/sim/key_tables.hpp"
+#include "feeddrive/sim/scenario.hpp"
+#include "scenario_error.hpp"
+
+namespace feeddrive::sim {
+namespace {
+
+using test::error_of;
+
+std::string scenario(const std::string& controller, const std::string& reference, const std::string& plant = "{}") {
+  return "duration: 0.01\ncontrol_period: 1e-4\nplant: " + plant + "\ncontroller: " + controller + "\nreference: " + reference +
+         "\n";
+}
+
+// Every key a list declares is read by the loader (it appears among the resolved keys of a
+// scenario of its controller and reference type), and every plant key the loader reads is listed:
+// no key is spelled outside its list.
+TEST(Fields, EveryListedKeyIsReadAndEveryReadKeyIsListed) {
+  std::set<std::string> read;
+  const std::pair<const char*, const char*> runs[] = {
+      {"{type: sliding_mode}", "{type: sine}"},
+      {"{type: cascade}", "{type: step}"},
+      {"{type: cascade, tuning: rule}", "{type: accel_limited}"},
+      {"{type: open_loop}", "{type: scurve}"},
+      {"{type: sliding_mode}", "{type: ramp}"},
+  };
+  const std::string effects =
+      "{effects: {constant_force: {}, coulomb_friction: {}, viscous_friction: {}, stribeck_friction: {}, presliding: {},"
+      " cogging_ripple: {}, reluctance_ripple: {}, grinding_force: {}, spring_force: {}, mass_error: {}, input_delay: {}}}";
+  for (const auto& [c, r] : runs) {
+    ResolvedKeys keys;
+    parse_scenario(scenario(c, r, effects), ".", "s.yaml", &keys);
+    for (const auto& [k, v] : keys) read.insert(k);
+  }
+  const std::vector<std::string> listed = listed_keys();
+  for (const std::string& k : listed) {
+    // A nested section's own row ("plant.friction") is not a key; its fields are.
+    if (k == "plant.effects" || k.rfind("plant.effects.", 0) == 0) {
+      if (std::count(k.begin(), k.end(), '.') == 2) continue;  // plant.effects.<name>
+    }
+    EXPECT_TRUE(read.count(k)) << k << " is listed but the loader never reads it";
+  }
+  for (const std::string& k : read) {
+    if (k.rfind("plant.", 0) != 0) continue;
+    EXPECT_NE(std::find(listed.begin(), listed.end(), k), listed.end()) << k << " is read but not in a list";
+  }
+}
+
+TEST(Fields, ValidateRangesComeFromTheList) {
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{mass: -1}")), "s.yaml: plant.mass = -1: must be > 0");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {quantization: 50}}")),
+            "s.yaml: plant.sensor.quantization = 50: must be <= 1 m (um?)");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: scurve, max_velocity: 1500}")),
+            "s.yaml: reference.max_velocity = 1500: must be <= 1000 m/s (mm/s?)");
+  EXPECT_EQ(error_of(scenario("{type: cascade, kv: -3}", "{type: sine}")), "s.yaml: controller.kv = -3: must be >= 0");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: accel_limited, max_velocity: 0}")),
+            "s.yaml: reference.max_velocity = 0: must be > 0");
+}
+
+TEST(Fields, EnumsAreReadByTheirNames) {
+  const Scenario s = parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {velocity: difference}}"));
+  EXPECT_EQ(s.plant.sensor.velocity, plant::VelocityMeasurement::kDifference);
+  EXPECT_TRUE(s.plant.sensor.differenced_velocity());
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {velocity: tacho}}")),
+            "s.yaml: plant.sensor.velocity = 'tacho': expected one of auto, true, difference");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode, switching: sign}", "{type: sine}")),
+            "s.yaml: controller.switching = 'sign': expected one of sgn, sat, tanh");
+}
+
+// The cascade's tuning rule is applied after reading (controller::apply_tuning), from the
+// model's sensor: differenced velocity halves... the loop delay grows by T/2 (cascade.hpp).
+TEST(Fields, CascadeTuningRuleIsAppliedAfterReading) {
+  const Scenario ideal = parse_scenario(scenario("{type: cascade, tuning: rule}", "{type: sine}"));
+  const Scenario encoder =
+      parse_scenario(scenario("{type: cascade, tuning: rule}", "{type: sine}", "{sensor: {quantization: 1e-7}}"));
+  const controller::CascadeGains g = controller::cascade_tuning(1e-4, 0.0, false);
+  EXPECT_DOUBLE_EQ(ideal.controller.cascade.kv, g.kv);
+  EXPECT_DOUBLE_EQ(encoder.controller.cascade.kv, controller::cascade_tuning(1e-4, 0.0, true).kv);
+  EXPECT_EQ(error_of(scenario("{type: cascade, tuning: rule, kp: 3}", "{type: sine}")),
+            "s.yaml: controller.kp: set by tuning: rule (remove it, or use tuning: manual)");
+}
+
+// Issue 23: the ripple's parts are 0 unless the paper's ripple is named.
+TEST(Fields, RippleIsZeroUnlessThePaperIsNamed) {
+  const Scenario own = parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {enabled: true, cogging_amplitude: 6}}"));
+  EXPECT_DOUBLE_EQ(own.plant.ripple.cogging_amplitude, 6.0);
+  EXPECT_DOUBLE_EQ(own.plant.ripple.cogging_third, 0.0);
+  EXPECT_DOUBLE_EQ(own.plant.ripple.reluctance_amplitude, 0.0);
+  const Scenario paper = parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: paper}"));
+  EXPECT_TRUE(paper.plant.ripple.enabled);
+  EXPECT_DOUBLE_EQ(paper.plant.ripple.cogging_amplitude, 3.0);
+  EXPECT_DOUBLE_EQ(paper.plant.ripple.cogging_third, 1.0);
+  EXPECT_DOUBLE_EQ(paper.plant.ripple.reluctance_amplitude, 0.03);
+  EXPECT_DOUBLE_EQ(paper.plant.ripple.reluctance_third, 0.01);
+  const Scenario paper6 =
+      parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {preset: paper, cogging_amplitude: 6}}"));
+  EXPECT_DOUBLE_EQ(paper6.plant.ripple.cogging_amplitude, 6.0);
+  EXPECT_DOUBLE_EQ(paper6.plant.ripple.cogging_third, 1.0);
+  // The resolved keys read back to the same ripple (feeddrive-study's cases).
+  ResolvedKeys keys;
+  parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: paper}"), ".", "s.yaml", &keys);
+  const Scenario back = parse_scenario(resolved_yaml(keys));
+  EXPECT_DOUBLE_EQ(back.plant.ripple.cogging_third, 1.0);
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: papers}")),
+            "s.yaml: plant.ripple = 'papers': expected a map of keys, or one of none, paper");
+}
+
+TEST(Fields, KeyTablesListEverySection) {
+  const auto tables = key_tables();
+  ASSERT_FALSE(tables.empty());
+  EXPECT_EQ(tables.front().first, "plant");
+  EXPECT_NE(tables.front().second.find("| `mass` | kg | 102.04 | > 0 | 0.5 … 5000 |"), std::string::npos);
+  const std::string doc = "a\n<!-- keys: reference.ramp (x) -->\nold\n<!-- /keys -->\nb\n";
+  const std::string out = with_key_tables(doc);
+  EXPECT_EQ(out.find("old"), std::string::npos);
+  EXPECT_NE(out.find("| `velocity` | m/s |"), std::string::npos);
+  EXPECT_EQ(with_key_tables(out), out);
+}
+
+}  // namespace
+}  // namespace feeddrive::sim
