@@ -8,6 +8,7 @@
 #include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/simulation.hpp"
 
 namespace feeddrive::sim {
 namespace {
@@ -180,10 +181,20 @@ std::vector<std::string> listed_keys() {
   return out;
 }
 
+std::string record_column_table() {
+  std::string t = "| Column | Unit | Meaning |\n|---|---|---|\n";
+  Record r;
+  visit_record_columns(r, [&t](const char* name, const char* unit, const char* meaning, double&) {
+    t += std::string("| `") + name + "` | " + unit + " | " + escape(meaning) + " |\n";
+  });
+  return t;
+}
+
 std::string with_key_tables(const std::string& doc) {
   static const std::string kOpen = "<!-- keys: ";
   static const std::string kClose = "<!-- /keys -->";
-  const auto tables = key_tables();
+  auto tables = key_tables();
+  tables.emplace_back("columns", record_column_table());  // not keys: not in key_tables()
   std::string out;
   std::size_t pos = 0;
   for (;;) {

@@ -11,17 +11,18 @@
 namespace feeddrive::sim {
 
 const std::vector<std::string>& record_columns() {
-  static const std::vector<std::string> kColumns = {
-      "t", "xd", "vd", "ad", "jd", "x", "x_measured", "v", "v_measured", "z", "fg", "i", "u",
-      "u_unsaturated", "f_thrust", "f_friction", "f_ripple", "f_grinding", "sliding", "z_estimate"};
+  static const std::vector<std::string> kColumns = [] {
+    std::vector<std::string> c;
+    Record r;
+    visit_record_columns(r, [&](const char* name, const char*, const char*, double&) { c.emplace_back(name); });
+    return c;
+  }();
   return kColumns;
 }
 
 void record_values(const Record& r, double* out) {
-  const double v[kRecordColumns] = {r.t, r.xd, r.vd, r.ad, r.jd, r.x, r.x_measured, r.v, r.v_measured, r.z,
-                                    r.fg, r.i, r.u, r.u_unsaturated, r.f_thrust, r.f_friction, r.f_ripple,
-                                    r.f_grinding, r.sliding, r.z_estimate};
-  for (std::size_t c = 0; c < kRecordColumns; ++c) out[c] = v[c];
+  std::size_t c = 0;
+  visit_record_columns(r, [&](const char*, const char*, const char*, const double& v) { out[c++] = v; });
 }
 
 std::vector<double> record_values(const Record& r) {

@@ -17,6 +17,9 @@ namespace feeddrive::sim {
 /// controller.cascade, controller.open_loop, reference.<type> for every type with keys.
 std::vector<std::pair<std::string, std::string>> key_tables();
 
+/// The column table of timeseries.csv (marker name `columns`), from visit_record_columns.
+std::string record_column_table();
+
 /// `doc` with every marked table replaced by its generated text. Throws std::invalid_argument
 /// naming a marker without its end or a table name that does not exist.
 std::string with_key_tables(const std::string& doc);
