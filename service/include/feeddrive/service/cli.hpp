@@ -1,6 +1,8 @@
 #pragma once
-// Command-line wiring shared by the service processes: the common options and one main()
-// skeleton (logging, signals, exit codes: 0 done, 1 the run failed, 2 bad input).
+// Command-line wiring shared by the service processes: the common options, the run's scenario
+// and the main() body of a run process, on tool::run (feeddrive/tool/main.hpp: logging, the
+// interrupt handlers and the one exit-code mapping: 0 done, 1 the run failed, 2 bad input,
+// 128 + signal interrupted).
 
 #include <CLI/CLI.hpp>
 
