@@ -16,7 +16,7 @@ prio=(chrt -f 20)
 "${prio[@]}" timeout 300 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 300 feeddrive-launch "$TMP/truth.yaml" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
-sleep 0.5
+wait_logged "$LOGDIR/run.lcmlog" FD
 kill -INT $lg; wait $lg || true
 [ -s "$LOGDIR/run.lcmlog" ] || fail "lcm-logger wrote no log"
 # The unmutated log: complete, and fitted (the base line every mutation is measured against).

@@ -21,7 +21,7 @@ scen=$SRC/tests/service/scenarios/short_jerk.yaml
 lcm-logger --lcm-url="$URL" --channel='SPY_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 120 feeddrive-launch "$scen" --out "$TMP/mp" --no-plots -q --prefix SPY --lcm-url "$URL"
-sleep 0.3
+wait_logged "$LOGDIR/run.lcmlog" SPY
 kill -INT $lg; wait $lg || true
 
 mkdir -p "$TMP/java"
