@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "feeddrive/record/channels.hpp"
 #include "feeddrive/service/bus.hpp"
 #include "feeddrive/service/node.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -81,18 +82,44 @@ inline sim::Scenario scenario(long steps) {
                              "  max_acceleration: 1.15\n  max_jerk: 2.4\n");
 }
 
-/// Runs `f` (a node's run()) and returns the RunFailure's message ("" if it returned) and how
-/// long it took [s].
+/// The channels of the tests' runs (prefix FD).
+inline const record::Channels kCh("FD");
+
+/// The command for step k in the scripted runs [V]: within the input limit, different for every
+/// step, so a command applied at the wrong step shows.
+inline double u_of(std::int64_t k) { return 0.5 + 0.01 * static_cast<double>(k); }
+
+/// Runs `f` (a node's run()) and returns its RunFailure's one line ("" if it returned).
 template <typename F>
-std::pair<std::string, double> run_failure(F&& f) {
-  const std::int64_t start = service::mono_us();
-  std::string what;
+std::string failure_of(F&& f) {
   try {
     f();
   } catch (const service::RunFailure& e) {
-    what = e.what();
+    return e.what();
   }
-  return {what, static_cast<double>(service::mono_us() - start) * 1e-6};
+  return "";
+}
+
+/// Checks that `failure` names a conflict on `channel` at `step` between two `type` messages
+/// whose `fields` differ, as Node::admit says it.
+inline void expect_conflict(const std::string& failure, const std::string& channel, std::int64_t step, const std::string& type,
+                            const std::string& fields) {
+  const std::string line = "conflict on " + channel + " step " + std::to_string(step) + ": two different " + type +
+                           " for one step (" + fields + " differ)";
+  EXPECT_NE(failure.find(line), std::string::npos) << failure;
+}
+
+/// Runs `run` (returns the run's failure line) and checks the failure starts with `expected` and
+/// came no earlier than the timeout `limit_s` (the protocol never gives up early) and no later
+/// than 10 s after it (a hang; generous for a loaded machine).
+template <typename F>
+void expect_failure_after(double limit_s, const std::string& expected, F&& run) {
+  const std::int64_t start = service::mono_us();
+  const std::string failure = run();
+  const double took = static_cast<double>(service::mono_us() - start) * 1e-6;
+  EXPECT_EQ(failure.substr(0, expected.size()), expected) << failure;
+  EXPECT_GE(took, limit_s);
+  EXPECT_LT(took, limit_s + 10.0);
 }
 
 }  // namespace feeddrive::protocol_test

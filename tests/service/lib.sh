@@ -61,12 +61,6 @@ wait_on_bus() {
   port=${port%%\?*}
   wait_until 10 "${2:-process} $1 joined the LCM bus on port $port" on_bus "$port" "$1" "${2:-}"
 }
-# wait_logged LOG PREFIX: waits until the stock lcm-logger writing LOG has recorded the run's
-# summary (PREFIX_SUMMARY, the monitor's last message after every step), so that it can be
-# stopped without losing the end of the run. Fails after 10 s.
-wait_logged() {
-  wait_until 10 "lcm-logger recorded ${2}_SUMMARY in $1" grep -aq "${2}_SUMMARY" "$1"
-}
 # json FILE JQ-FILTER
 json() { jq -r "$2" "$1"; }
 # Runs feeddrive-sim on a scenario into DIR (the in-process reference result).
