@@ -29,8 +29,9 @@ namespace feeddrive::monitor {
 using service::mono_us;
 using service::us;
 
-MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt)
-    : Node(mopt.attach ? service::kAttachedMonitorRole : "monitor", opt, service::Receive::kBatched),
+MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt,
+                         lcm_t* shared_lcm)
+    : Node(mopt.attach ? service::kAttachedMonitorRole : "monitor", opt, service::Receive::kBatched, shared_lcm),
       s_(s),
       mopt_(mopt),
       rec_(mopt.attach),

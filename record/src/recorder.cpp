@@ -238,7 +238,8 @@ std::vector<Missing> Recorder::missing_until(std::int64_t upto, std::size_t per_
   const std::int64_t end = std::min(upto, next_ + 4096);
   for (std::int64_t k = next_; k <= end && (states < per_kind || commands < per_kind || refs < per_kind); ++k) {
     if (states < per_kind && !states_.count(k)) out.push_back({"state", "plant", k}), ++states;
-    if (refs < per_kind && k / 16 != last_block && !refs_.count(k)) {
+    // The end-of-run marker (step steps_) has no reference of its own: none to ask for.
+    if (refs < per_kind && k / 16 != last_block && (steps_ < 0 || k < steps_) && !refs_.count(k)) {
       out.push_back({"reference", "trajectory", k}), ++refs;
       last_block = k / 16;
     }

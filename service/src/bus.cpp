@@ -24,15 +24,23 @@ std::int64_t mono_us() {
       .count();
 }
 
-Bus::Bus(const std::string& url, Receive receive) : url_(url), lcm_(url), receive_(receive) {
+Bus::Bus(const std::string& url, Receive receive, lcm_t* shared)
+    : url_(url), shared_(shared != nullptr), lcm_(shared != nullptr ? lcm::LCM(shared) : lcm::LCM(url)), receive_(receive) {
   if (!lcm_.good())
     throw std::runtime_error("cannot open LCM at '" + url +
                              "' (is there a multicast route? see docs/lcm-contract.md)");
   // Direct and batched: liblcm only publishes (it opens its receive socket and thread on the
   // first subscribe or handle, which then never come); our reader takes the group's datagrams.
-  if (receive != Receive::kEvent)
+  if (receive != Receive::kEvent && !shared_)
     if (const std::optional<UdpmAddress> a = parse_udpm_url(url)) reader_ = std::make_unique<UdpmReader>(*a);
   if (!reader_) receive_ = Receive::kEvent;
+}
+
+Bus::~Bus() {
+  // lcm::LCM's destructor frees its subscriptions without taking them off the instance: on a
+  // shared one (which lives on) a later message would reach the freed handlers.
+  if (shared_)
+    for (lcm::Subscription* s : subscriptions_) lcm_.unsubscribe(s);
 }
 
 bool Bus::log_due(std::int64_t& last) {
@@ -85,7 +93,10 @@ void Bus::subscribe_raw(const std::string& channel,
   }
   lcm::Subscription* sub = lcm_.subscribe(channel, &Raw::handle, raws_.back().get());
   // LCM drops silently when a subscription's queue overflows (default 30 messages).
-  if (sub != nullptr) sub->setQueueCapacity(100000);
+  if (sub != nullptr) {
+    sub->setQueueCapacity(100000);
+    subscriptions_.push_back(sub);
+  }
 }
 
 void Bus::rethrow_handler_error() {

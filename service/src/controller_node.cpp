@@ -6,8 +6,8 @@
 
 namespace feeddrive::service {
 
-ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt)
-    : Node("controller", opt), controller_(std::move(c)), commands_(bus(), channels().command) {
+ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt, lcm_t* shared_lcm)
+    : Node("controller", opt, Receive::kDirect, shared_lcm), controller_(std::move(c)), commands_(bus(), channels().command) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {

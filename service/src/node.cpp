@@ -47,8 +47,8 @@ std::string seconds_text(double s) {
   return buf;
 }
 
-Node::Node(std::string role, const NodeOptions& opt, Receive receive)
-    : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive), ch_(opt.prefix) {
+Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* shared_lcm)
+    : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive, shared_lcm), ch_(opt.prefix) {
   if (!opt.key_file.empty()) bus_.set_auth(read_key_file(opt.key_file));
   const bool keyed = !opt.key_file.empty();
   if (keyed && opt.run_id != 0 && opt.run_nonce != 0) {

@@ -17,8 +17,8 @@ namespace {
 std::int64_t realtime_guard_us(std::int64_t period_us) { return std::min<std::int64_t>(period_us / 5, 25); }
 }  // namespace
 
-PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt)
-    : Node("plant", opt),
+PlantNode::PlantNode(const sim::Scenario& s, const NodeOptions& opt, lcm_t* shared_lcm)
+    : Node("plant", opt, Receive::kDirect, shared_lcm),
       s_(s),
       steps_(s.steps()),
       drive_(s.drive(), s.control_period),

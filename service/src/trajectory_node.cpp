@@ -6,8 +6,8 @@
 
 namespace feeddrive::service {
 
-TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt)
-    : Node("trajectory", opt, Receive::kBatched), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
+TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt, lcm_t* shared_lcm)
+    : Node("trajectory", opt, Receive::kBatched, shared_lcm), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {

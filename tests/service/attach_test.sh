@@ -11,15 +11,16 @@ source "$(dirname "$0")/lib.sh" "$@"
 scen=$TMP/long.yaml
 sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
 timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --lcm-url "$URL" & l=$!
-sleep 1.0
+wait_on_bus $l feeddrive-monitor
+sleep 1.0  # under test: joining a run 1 s after its start (a deliberate point, not a wait)
 timeout 120 feeddrive-monitor "$scen" --attach --out "$TMP/attached" --no-plots --lcm-url "$URL" --step-timeout 5 2> "$TMP/attached.err" & m=$!
 # Then it loses the CPU for 1 s (SIGSTOP: what a loaded machine does to it), while the run goes
 # on: its 4 MB socket buffer holds about 0.1 s of the run, the rest is dropped by the kernel, and
 # it must get every step back by asking (the publishers keep the last 65,536 steps and linger
 # after the end while it still records).
-sleep 0.5
+wait_on_bus $m
 mon=$(pgrep -P $m) || fail "no feeddrive-monitor --attach under timeout $m"
-kill -STOP "$mon"; sleep 1.0; kill -CONT "$mon"
+kill -STOP "$mon"; sleep 1.0; kill -CONT "$mon"  # the pause under test
 wait $l || fail "the run failed"
 wait $m || { tail -5 "$TMP/attached.err" >&2; fail "the attached monitor failed"; }
 total=$(( $(wc -l < "$TMP/run/timeseries.csv") - 1 ))

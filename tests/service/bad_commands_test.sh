@@ -23,7 +23,7 @@ pass "NaN rejected and 1e9 V clipped: $got commands counted"
 
 sim_run "$scen" "$TMP/sim"
 timeout 60 "$BUILD/tests/fd-test-peer" junk --seconds 4 --lcm-url "$URL" > /dev/null & j=$!
-sleep 0.2
+wait_on_bus $j
 timeout 120 feeddrive-launch "$scen" --out "$TMP/junk" --no-plots -q --lcm-url "$URL"
 wait $j
 same_csv "$TMP/sim/timeseries.csv" "$TMP/junk/timeseries.csv"

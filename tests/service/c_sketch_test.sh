@@ -14,7 +14,7 @@ cc -O2 -Wall -Wextra -Werror -Wno-unused-parameter -I"$TMP/gen" "$TMP/controller
   -o "$TMP/controller" || fail "the C sketch does not compile"
 scen=$SRC/scenarios/paper/smc_bl_jerk_limited.yaml
 timeout 120 "$TMP/controller" "$URL" FD 2> "$TMP/c.err" & c=$!
-sleep 0.3
+wait_on_bus $c  # subscribed before the run starts
 timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --external controller --lcm-url "$URL"
 wait $c || { cat "$TMP/c.err" >&2; fail "the C controller failed"; }
 grep -q "run smc_bl_jerk_limited (lockstep): T = 0.0001 s, 15000 steps, m = 102.04 kg, Ka\*Kf = 260 N/V" "$TMP/c.err" ||

@@ -33,7 +33,7 @@ for n in range(100):
     time.sleep(0.1)
 PY
 timeout 60 feeddrive-launch "$scen" --out "$TMP/v2" --no-plots -q --lcm-url "$URL" --run-id 77 --external controller 2> "$TMP/v2.err" & l=$!
-sleep 1
+wait_on_bus $l feeddrive-monitor  # the run's monitor hears the heartbeats from the first one
 start=$(date +%s.%N)
 timeout 20 python3 "$TMP/v2.py" "$port" 77 controller & p=$!
 set +e; wait $l; rc=$?; set -e
@@ -71,7 +71,7 @@ fp=$(grep -o "0x[0-9a-f]*LL" "$TMP/gen/feeddrive_process_status_t.c" | head -n 1
 [ -n "$fp" ] || fail "no fingerprint in the generated process_status_t"
 timeout 60 feeddrive-launch "$SRC/scenarios/paper/smc_bl_ramp_all_forces.yaml" --out "$TMP/other" --no-plots -q \
   --lcm-url "$URL" --run-id 78 2> "$TMP/other.err" & l=$!
-sleep 0.3
+wait_on_bus $l feeddrive-monitor
 timeout 20 python3 "$TMP/v2.py" "$port" 999 plant "$fp" & p=$!
 wait $l || { cat "$TMP/other.err"; fail "another run's plant on the group: the run failed"; }
 kill $p 2>/dev/null || true

@@ -15,6 +15,9 @@ for role in controller plant trajectory; do
   start=$(date +%s)
   timeout 60 feeddrive-launch "$scen" --out "$out" --no-plots --external "$role" "${opts[@]}" 2> "$TMP/launch-$role.err" & l=$!
   "feeddrive-$role" "$scen" "${opts[@]}" -q & p=$!   # no timeout wrapper: $p must be the process itself
+  wait_on_bus $p
+  # The fault under test: the process dies 1.5 s into its run (the run takes about 3 s), a
+  # deliberate point in time, not a wait for something.
   sleep 1.5
   kill -9 $p; echo "killed $role"
   set +e; wait $l; rc=$?; set -e

@@ -65,7 +65,7 @@ feeddrive-launch s.yaml --out killed --no-plots -q --lcm-url "$URL" > killed.log
 for _ in $(seq 200); do [ "$(running_children $launcher)" = 4 ] && break; sleep 0.05; done
 [ "$(running_children $launcher)" = 4 ] || fail "the launcher did not start four processes within 10 s"
 kids=$(pgrep -P $launcher | tr '\n' ' ')
-sleep 1  # mid-run
+sleep 1  # the fault under test: the launcher killed 1 s into the run (deliberate, not a wait)
 kill -KILL $launcher
 wait $launcher 2> /dev/null || true
 left=4

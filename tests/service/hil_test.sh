@@ -133,7 +133,7 @@ restart() {
   timeout 60 "$TMP/adapter" --url "$URL" "$@" --exit-at 3000 2> /dev/null & a=$!
   timeout 60 feeddrive-launch "$hil" --out "$TMP/$name" --no-plots -q --lcm-url "$URL" --external plant "$@" 2> "$TMP/$name.err" & l=$!
   wait $a || true
-  sleep 0.5
+  sleep 0.5  # under test: the new adapter comes 0.5 s after the old one died (deliberate, not a wait)
   start=$(date +%s.%N)
   timeout 60 "$TMP/adapter" --url "$URL" "$@" 2> /dev/null & a2=$!
   set +e

@@ -25,20 +25,41 @@ export PATH="$BIN:$PATH"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
 pass() { echo "PASS: $*"; }
-# wait_on_bus PID: waits until process PID (or a child of it: timeout, chrt) has a UDP socket on
-# the URL's port, i.e. has joined the LCM bus, so it cannot miss the start of what follows. A
-# fixed sleep is not enough on a loaded machine. Fails after 10 s.
-wait_on_bus() {
-  local port=${URL#udpm://*:} pids pid
-  port=${port%%\?*}
-  for _ in $(seq 100); do
-    pids="$1 $(pgrep -P "$1" | tr "\n" " " || true)"
-    for pid in $pids; do
-      ss -Huanp "sport = :$port" 2>/dev/null | grep -q "pid=$pid," && return 0
-    done
-    sleep 0.1
+# wait_until SECONDS WHAT COMMAND...: runs COMMAND every 50 ms until it succeeds; fails naming
+# WHAT after SECONDS. The wait on a condition with a deadline that replaces a fixed sleep: a
+# sleep long enough on a loaded machine wastes time on every other, and one short enough here
+# fails there.
+wait_until() {
+  local seconds=$1 what=$2 i
+  shift 2
+  for ((i = 0; i < seconds * 20; i++)); do
+    "$@" && return 0
+    sleep 0.05
   done
-  fail "process $1 did not join the LCM bus on port $port within 10 s"
+  fail "$what: not within $seconds s"
+}
+# descendants PID: the processes below PID (its children, theirs, ...).
+descendants() {
+  local c
+  for c in $(pgrep -P "$1" || true); do echo "$c"; descendants "$c"; done
+}
+# on_bus PORT PID [NAME]: PID or a process below it (timeout, chrt, feeddrive-launch's children),
+# named NAME if given, has a UDP socket on PORT.
+on_bus() {
+  local pid
+  for pid in $2 $(descendants "$2"); do
+    [ -z "${3:-}" ] || [ "$(cat "/proc/$pid/comm" 2>/dev/null)" = "${3:0:15}" ] || continue  # comm: 15 characters
+    ss -Huanp "sport = :$1" 2>/dev/null | grep -q "pid=$pid," && return 0
+  done
+  return 1
+}
+# wait_on_bus PID [NAME]: waits until process PID or a process below it (named NAME if given:
+# feeddrive-launch's feeddrive-monitor) has a UDP socket on the URL's port, i.e. has joined the
+# LCM bus, so it cannot miss the start of what follows. Fails after 10 s.
+wait_on_bus() {
+  local port=${URL#udpm://*:}
+  port=${port%%\?*}
+  wait_until 10 "${2:-process} $1 joined the LCM bus on port $port" on_bus "$port" "$1" "${2:-}"
 }
 # json FILE JQ-FILTER
 json() { jq -r "$2" "$1"; }

@@ -20,6 +20,10 @@ grep -q "lcm-logger (pid [0-9]*, [a-z-]* priority) on the bus: the run is paced 
   { cat "$TMP/launch.err"; fail "the launcher did not pace the run for the stock logger"; }
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.seen | length')" -ge 1 ] || fail "the monitor did not see the logger"
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.faster_than_it_records')" = false ] || fail "paced run reported too fast"
+# Stays a fixed pause: the stock lcm-logger writes its file through a buffer it flushes only as
+# events come (--flush-interval) and does not drain its socket on SIGINT, so nothing outside it
+# shows that it has the run's last messages (waiting for FD_SUMMARY in its file timed out in
+# logger_test.sh: the tail sat in its buffer).
 sleep 0.5
 kill -INT $lg; wait $lg || true
 timeout 120 feeddrive-log2csv "$LOGDIR/run.lcmlog" --scenario "$scen" --out "$TMP/conv" -q 2> "$TMP/conv.err"

@@ -16,7 +16,8 @@ grep -q '^duration: 10.0' "$scen" || fail "could not lengthen the scenario"
 opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
 timeout 60 feeddrive-launch "$scen" --out "$TMP/stall" --no-plots --external controller "${opts[@]}" 2> "$TMP/launch.err" & l=$!
 feeddrive-controller "$scen" "${opts[@]}" 2> "$TMP/controller.err" & c=$!
-sleep 1.5
+wait_on_bus $c
+sleep 1.5      # the fault under test: stopped 1.5 s into its run (a deliberate point, not a wait)
 kill -STOP $c; echo "controller stopped"
 sleep 3.5      # past the 2 s step timeout: the plant has failed meanwhile
 kill -CONT $c; echo "controller resumed"
@@ -41,7 +42,8 @@ pass "stalled controller: every process names it"
 # which names the controller.
 timeout 60 feeddrive-launch "$scen" --out "$TMP/kill" --no-plots --external controller "${opts[@]}" 2> "$TMP/kill.err" & l=$!
 feeddrive-controller "$scen" "${opts[@]}" 2> /dev/null & c=$!
-sleep 1.5
+wait_on_bus $c
+sleep 1.5      # the fault under test: killed 1.5 s into its run (a deliberate point, not a wait)
 kill -KILL $c
 set +e; wait $l; rl=$?; wait $c; set -e
 [ $rl -ne 0 ] || fail "launch exited 0 with its controller killed"

@@ -430,7 +430,7 @@ TEST(Cli, InterruptLeavesNoOutputAndNoStagingFolder) {
     // wait until the run has started writing (its staging folder exists), then interrupt it
     for (int i = 0; i < 200 && !has_staging("cli_interrupted"); ++i) ::usleep(20000);
     ASSERT_TRUE(has_staging("cli_interrupted"));
-    ::usleep(300000);
+    ::usleep(300000);  // under test: the signal 0.3 s into the run (deliberate, not a wait)
     ::kill(pid, sig);
     int status = 0;
     ::waitpid(pid, &status, 0);

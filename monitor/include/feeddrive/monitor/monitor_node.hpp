@@ -49,7 +49,9 @@ struct MonitorOptions {
 class MonitorNode : public service::Node {
  public:
   /// Opens the output (staged folder, timeseries.csv) at once: rows are written as they complete.
-  MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt);
+  /// `shared_lcm`: see service::Node (in-process tests); nullptr in the process.
+  MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt, const MonitorOptions& mopt,
+              lcm_t* shared_lcm = nullptr);
   /// Returns true if the run completed and its results were written; tries to write the
   /// results in every case.
   bool run();

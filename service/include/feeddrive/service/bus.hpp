@@ -75,7 +75,11 @@ class Bus {
  public:
   /// Throws std::runtime_error naming the URL when LCM cannot be initialised. kDirect and
   /// kBatched fall back to kEvent for URLs other than udpm:// (memq://, file://).
-  explicit Bus(const std::string& url, Receive receive = Receive::kDirect);
+  /// `shared`: instead of opening `url`, publish and receive through this liblcm instance, which
+  /// the caller opened, owns and keeps until the bus is gone (kEvent). Several buses on one
+  /// memq:// instance hear each other in one process: the protocol tests (tests/protocol).
+  explicit Bus(const std::string& url, Receive receive = Receive::kDirect, lcm_t* shared = nullptr);
+  ~Bus();
   /// kBatched: how long poll() sleeps before it takes what is queued.
   static constexpr std::chrono::microseconds kBatchInterval{1000};
   Bus(const Bus&) = delete;
@@ -164,8 +168,10 @@ class Bus {
   void rethrow_handler_error();
 
   std::string url_;
+  bool shared_;  ///< lcm_ wraps the caller's instance: ~Bus() takes its subscriptions off it
   lcm::LCM lcm_;
   std::vector<std::unique_ptr<Raw>> raws_;
+  std::vector<lcm::Subscription*> subscriptions_;  ///< liblcm's (kEvent)
   Receive receive_;
   std::unique_ptr<UdpmReader> reader_;  ///< kDirect and kBatched on udpm:// URLs
   MessageSink tap_;

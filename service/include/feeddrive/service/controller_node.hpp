@@ -20,7 +20,8 @@ namespace feeddrive::service {
 
 class ControllerNode : public Node {
  public:
-  ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt);
+  /// `shared_lcm`: see Node (in-process tests); nullptr in the process.
+  ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt, lcm_t* shared_lcm = nullptr);
   void run();
 
  private:

@@ -74,8 +74,10 @@ struct RunFailure : std::runtime_error {
 class Node {
  public:
   /// `receive`: kDirect for the roles on a step's critical path (plant, controller), kBatched
-  /// for the others (monitor, trajectory): see bus.hpp.
-  Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kDirect);
+  /// for the others (monitor, trajectory): see bus.hpp. `shared_lcm`: the bus publishes and
+  /// receives through this liblcm instance instead of opening opt.lcm_url (Bus: in-process
+  /// tests over one memq:// instance); nullptr in the processes.
+  Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kDirect, lcm_t* shared_lcm = nullptr);
   virtual ~Node() = default;
 
   const std::string& role() const { return role_; }

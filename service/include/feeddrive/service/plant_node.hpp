@@ -38,7 +38,8 @@ namespace feeddrive::service {
 
 class PlantNode : public Node {
  public:
-  PlantNode(const sim::Scenario& s, const NodeOptions& opt);
+  /// `shared_lcm`: see Node (in-process tests); nullptr in the process.
+  PlantNode(const sim::Scenario& s, const NodeOptions& opt, lcm_t* shared_lcm = nullptr);
   /// Runs to the end; returns normally when the run completed, throws RunFailure otherwise.
   void run();
 

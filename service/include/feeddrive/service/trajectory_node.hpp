@@ -23,7 +23,8 @@ class TrajectoryNode : public Node {
  public:
   static constexpr std::int64_t kBlock = 16;
   static constexpr std::int64_t kLead = 256;
-  TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt);
+  /// `shared_lcm`: see Node (in-process tests); nullptr in the process.
+  TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt, lcm_t* shared_lcm = nullptr);
   void run();
 
  private:
