@@ -35,14 +35,6 @@ StateSource state_source_from_string(const std::string& s) {
   throw std::invalid_argument("expected one of true, observer");
 }
 
-std::string to_string(MotionSource s) { return s == MotionSource::kMeasured ? "measured" : "observer"; }
-
-MotionSource motion_source_from_string(const std::string& s) {
-  if (s == "measured") return MotionSource::kMeasured;
-  if (s == "observer") return MotionSource::kObserver;
-  throw std::invalid_argument("expected one of measured, observer");
-}
-
 void SlidingModeParams::validate(const std::string& prefix) const {
   using namespace detail;
   require_non_negative(prefix + ".eta", eta);

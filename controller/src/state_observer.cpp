@@ -1,8 +1,18 @@
 #include "feeddrive/controller/state_observer.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace feeddrive::controller {
+
+std::string to_string(MotionSource s) { return s == MotionSource::kMeasured ? "measured" : "observer"; }
+
+MotionSource motion_source_from_string(const std::string& s) {
+  if (s == "measured") return MotionSource::kMeasured;
+  if (s == "observer") return MotionSource::kObserver;
+  throw std::invalid_argument("expected one of measured, observer");
+}
+
 
 StateObserver::StateObserver(double bandwidth, double period, bool with_disturbance,
                              double quantization)

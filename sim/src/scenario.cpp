@@ -225,6 +225,12 @@ void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& b
 // times bandwidth_scale); with the rule, kp, kv and ki must not be given.
 void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model, double period,
                   double computation_delay) {
+  // What the tuning rule depends on, read first.
+  read_enum(r, "motion_state", p.motion_state, controller::motion_source_from_string,
+            controller::to_string(p.motion_state));
+  r.number("velocity_filter_cutoff", p.velocity_filter_cutoff);
+  r.boolean("compensate_delay", p.compensate_delay);
+  const bool observer = p.motion_state == controller::MotionSource::kObserver;
   std::string tuning = "manual";
   r.string("tuning", tuning);
   if (tuning != "manual" && tuning != "rule") r.fail("tuning", " = '" + tuning + "': expected one of manual, rule");
@@ -235,8 +241,13 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model,
     r.number("bandwidth_scale", scale);
     if (!(scale > 0.0)) r.fail("bandwidth_scale", " = " + std::to_string(scale) + ": must be > 0");
     const plant::SensorParams& sensor = model.sensor;
-    const bool differenced = sensor.velocity == "difference" || (sensor.velocity == "auto" && !sensor.ideal());
-    const controller::CascadeGains g = controller::cascade_tuning(period, computation_delay, differenced, scale);
+    // The observer's v^ is no backward difference; the Smith predictor (observer with
+    // compensate_delay) takes the known delay out of the loop; a velocity filter adds its lag.
+    const bool differenced =
+        !observer && (sensor.velocity == "difference" || (sensor.velocity == "auto" && !sensor.ideal()));
+    const double delay = observer && p.compensate_delay ? 0.0 : computation_delay;
+    const double lag = p.velocity_filter_cutoff > 0.0 ? 1.0 / (2.0 * M_PI * p.velocity_filter_cutoff) : 0.0;
+    const controller::CascadeGains g = controller::cascade_tuning(period, delay, differenced, scale, lag);
     p.kp = g.kp;
     p.kv = g.kv;
     p.ki = g.ki;
@@ -250,7 +261,6 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams model,
   r.number("acceleration_feedforward", p.acceleration_feedforward);
   r.boolean("friction_feedforward", p.friction_feedforward);
   r.number("disturbance_observer_bandwidth", p.disturbance_observer_bandwidth);
-  r.boolean("compensate_delay", p.compensate_delay);
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
   read_plant(r.child("model"), model, false);
