@@ -426,6 +426,7 @@ std::vector<std::string> summary_metric_names() {
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
+  m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
   std::vector<std::string> names;
   for (auto it = j.begin(); it != j.end(); ++it)

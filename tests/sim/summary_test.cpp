@@ -4,6 +4,7 @@
 // as null by the JSON writer, with exit 0 (found by fuzz.lcm_log).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -335,6 +336,15 @@ TEST(Summary, SignalQualityOfAConstantAndOfASlowRate) {
   SummaryBuilder one(s);
   one.add(Record{});
   EXPECT_TRUE(nlohmann::json::parse(summary_json(one.summary(0.0, {}), s))["control_step_rms_V"].is_null());
+}
+
+// Every control-signal figure is a study metric (summary_metric_names(): what a study records
+// per case and what report.metric may name), the null-able ones included.
+TEST(Summary, SignalFiguresAreStudyMetrics) {
+  const std::vector<std::string> names = summary_metric_names();
+  for (const char* key : {"control_step_rms_V", "control_direction_changes_per_s", "control_saturated_fraction",
+                          "force_hf_rms_N", "force_hf_limit_N"})
+    EXPECT_NE(std::find(names.begin(), names.end(), key), names.end()) << key;
 }
 
 }  // namespace
