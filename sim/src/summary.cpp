@@ -339,6 +339,10 @@ std::string summary_headline(const std::string& text) {
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
   if (j.value("control_chattering", false))
     line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
+  if (j.contains("control_signal_within_limits") && j["control_signal_within_limits"] == false)
+    line += ", CONTROL SIGNAL OUTSIDE LIMITS (step rms " + num("control_step_rms_V") + " V, " +
+            num("control_direction_changes_per_s") + " direction changes/s, " + num("force_hf_rms_N") +
+            " N above 1 kHz, saturated " + num("control_saturated_fraction") + ")";
   if (j.contains("controller_model") && j["controller_model"] == "plant") line += ", model = plant";
   return line;
 }

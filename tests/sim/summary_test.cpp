@@ -347,5 +347,28 @@ TEST(Summary, SignalFiguresAreStudyMetrics) {
     EXPECT_NE(std::find(names.begin(), names.end(), key), names.end()) << key;
 }
 
+// The final line names a command outside the signal limits with its figures, and says nothing
+// of a command within them.
+TEST(Summary, HeadlineFlagsASignalOutsideTheLimits) {
+  Scenario s;
+  s.control_period = 1e-4;
+  const auto line = [&](double amplitude) {
+    SummaryBuilder b(s);
+    for (long k = 0; k < 1000; ++k) {
+      Record r;
+      r.t = k * 1e-4;
+      r.u = r.u_unsaturated = (k % 2) ? amplitude : -amplitude;
+      b.add(r);
+    }
+    return summary_headline(summary_json(b.summary(0.0, {}), s));
+  };
+  // +-1 V every period over 0.1 s: 2 V steps, 998 direction changes (the first direction is not
+  // one), 9,980 /s: outside
+  EXPECT_NE(line(1.0).find("CONTROL SIGNAL OUTSIDE LIMITS (step rms 2 V, 9980 direction changes/s"), std::string::npos)
+      << line(1.0);
+  // +-0.005 V: under the band h and the limits: no flag
+  EXPECT_EQ(line(0.005).find("OUTSIDE"), std::string::npos) << line(0.005);
+}
+
 }  // namespace
 }  // namespace feeddrive::sim

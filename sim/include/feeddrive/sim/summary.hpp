@@ -140,7 +140,8 @@ double controller_output_range(const Scenario& s);
 std::string controller_model_source(const Scenario& s);
 /// The headline of a run for a tool's final line, from summary.json's text: "max |e| = 1.367e-06
 /// m, rms e = ..., u in [..., ...] V" (the measured error where the run has no true state), and
-/// ", CONTROL CHATTERS (n reversals/s)" when control_chattering. feeddrive-sim and -launch print it.
+/// ", CONTROL CHATTERS (n reversals/s)" when control_chattering, ", CONTROL SIGNAL OUTSIDE LIMITS
+/// (...)" when control_signal_within_limits is false. feeddrive-sim and -launch print it.
 std::string summary_headline(const std::string& summary_json_text);
 
 /// The metrics of a stream of records.
