@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "check.hpp"
 
@@ -17,6 +18,9 @@ void CascadeParams::validate(const std::string& prefix) const {
   fields::check_fields(*this, prefix);  // the list's ranges (cascade.hpp)
   require_non_negative(prefix + ".model.sensor.quantization", quantization);
   require_non_negative(prefix + ".computation_delay", computation_delay);
+  require_non_negative(prefix + ".velocity_filter_cutoff", velocity_filter_cutoff);
+  if (motion_state == MotionSource::kObserver && !(disturbance_observer_bandwidth > 0.0))
+    throw std::invalid_argument(prefix + ".motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
   require_positive(prefix + ".model.mass", mass);
   require_positive(prefix + ".model.thrust_gain", thrust_gain);
   if (friction_feedforward) friction.validate(prefix + ".model.friction");
@@ -26,15 +30,18 @@ void CascadeParams::validate(const std::string& prefix) const {
 
 void apply_tuning(CascadeParams& p, bool differenced_velocity) {
   if (p.tuning != CascadeTuning::kRule) return;
-  const CascadeGains g = cascade_tuning(p.period, p.computation_delay, differenced_velocity, p.bandwidth_scale);
+  const bool observer = p.motion_state == MotionSource::kObserver;
+  const double delay = observer && p.compensate_delay ? 0.0 : p.computation_delay;
+  const double lag = p.velocity_filter_cutoff > 0.0 ? 1.0 / (2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff) : 0.0;
+  const CascadeGains g = cascade_tuning(p.period, delay, differenced_velocity && !observer, p.bandwidth_scale, lag);
   p.kp = g.kp;
   p.kv = g.kv;
   p.ki = g.ki;
 }
 
 CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
-                            double scale) {
-  const double tau = computation_delay + 0.5 * period + (differenced_velocity ? 0.5 * period : 0.0);
+                            double scale, double extra_lag) {
+  const double tau = computation_delay + 0.5 * period + (differenced_velocity ? 0.5 * period : 0.0) + extra_lag;
   const double pi = 3.14159265358979323846;
   const double wv = scale * (pi / 4.0 - std::atan(0.25)) / tau;
   const double kv = wv / std::sqrt(1.0 + 1.0 / 16.0);
@@ -46,22 +53,56 @@ CascadeController::CascadeController(const CascadeParams& p)
       friction_ff_(p.friction, p.period, 0.0),
       observer_(p.disturbance_observer_bandwidth > 0.0 ? p.disturbance_observer_bandwidth : 1.0,
                 p.period, true, p.quantization),
-      delay_line_(p.compensate_delay ? p.computation_delay : 0.0, 1e-9 * p.period) {}
+      delay_line_(p.compensate_delay ? p.computation_delay : 0.0, 1e-9 * p.period),
+      velocity_filter_gain_(p.velocity_filter_cutoff > 0.0
+                                ? -std::expm1(-2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff * p.period)
+                                : 1.0) {}
+
+double CascadeController::filter_velocity(double v) {
+  if (!std::isfinite(v)) return v;  // a non-finite sample is not kept (saturate() gives u = 0)
+  if (!v_filter_started_) {
+    v_filtered_ = v;
+    v_filter_started_ = true;
+  } else {
+    v_filtered_ += velocity_filter_gain_ * (v - v_filtered_);
+  }
+  return v_filtered_;
+}
 
 Command CascadeController::update(const trajectory::Sample& ref_now, const plant::Measurement& meas,
                                   const Truth* /*truth*/) {
   const bool delayed = p_.compensate_delay && p_.computation_delay > 0.0 && std::isfinite(meas.t);
-  // Feedback compares the measurement with the reference now; the feedforward forces are for
-  // when the command acts (t_k + d): "feedforward with preview".
-  const trajectory::Sample& ref = ref_now;
+  // The feedforward forces are for when the command acts (t_k + d): "feedforward with preview".
   const trajectory::Sample ahead = delayed ? preview(ref_now, p_.computation_delay) : ref_now;
   const bool dob = p_.disturbance_observer_bandwidth > 0.0;
   if (dob) observer_.correct(meas.x, meas.v);
   const double d_hat = dob && observer_.initialised() ? observer_.disturbance() : 0.0;
   const double f_ff = p_.friction_feedforward ? friction_ff_.estimate(ahead.velocity) : 0.0;
+  // Model: m^*x'' = Ka*Kf*u_acting - F^f_ff (held over the period); d^ takes up the rest.
+  const auto model_acceleration = [&](double u) { return (p_.thrust_gain * u - f_ff) / p_.mass; };
 
-  const double v_cmd = p_.velocity_feedforward * ref.velocity + p_.kp * (ref.position - meas.x);
-  const double ev = v_cmd - meas.v;
+  // The state and reference the feedback acts on: the measurement and the reference now, or the
+  // observer's estimate (predicted to t_k + d with the reference previewed there).
+  double x = meas.x;
+  double v = meas.v;
+  trajectory::Sample ref = ref_now;
+  if (p_.motion_state == MotionSource::kObserver && dob && observer_.initialised()) {
+    x = observer_.position();
+    v = observer_.velocity();
+    if (delayed) {
+      for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, meas.t + p_.computation_delay)) {
+        const double tau = piece.t1 - piece.t0;
+        const double a = model_acceleration(piece.u) + d_hat;
+        x += v * tau + 0.5 * a * tau * tau;
+        v += a * tau;
+      }
+      ref = ahead;
+    }
+  }
+  v = filter_velocity(v);
+
+  const double v_cmd = p_.velocity_feedforward * ref.velocity + p_.kp * (ref.position - x);
+  const double ev = v_cmd - v;
   const double force =
       p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ahead.acceleration - d_hat) +
       f_ff;
@@ -75,21 +116,20 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
 
   if (p_.friction_feedforward) friction_ff_.advance(ahead.velocity, 0.0);
   if (dob && observer_.initialised()) {
-    // Model: m^*x'' = Ka*Kf*u_acting - F^f_ff (held over the period); d^ takes up the rest.
     if (delayed) {
       delay_line_.push(meas.t, cmd.u);
       double dv = 0.0, dx = 0.0;
       const double t_end = meas.t + p_.period;
       for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, t_end)) {
         const double tau = piece.t1 - piece.t0;
-        const double a = (p_.thrust_gain * piece.u - f_ff) / p_.mass;
+        const double a = model_acceleration(piece.u);
         dv += a * tau;
         dx += a * tau * (0.5 * tau + (t_end - piece.t1));
       }
       observer_.predict_increments(dv, dx);
       delay_line_.forget_before(t_end);
     } else {
-      observer_.predict((p_.thrust_gain * cmd.u - f_ff) / p_.mass);
+      observer_.predict(model_acceleration(cmd.u));
     }
   }
   return cmd;

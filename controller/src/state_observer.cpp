@@ -1,8 +1,14 @@
 #include "feeddrive/controller/state_observer.hpp"
 
 #include <cmath>
+#include <stdexcept>
+
+#include "feeddrive/common/fields.hpp"
 
 namespace feeddrive::controller {
+
+std::string to_string(MotionSource s) { return fields::enum_name(s); }
+MotionSource motion_source_from_string(const std::string& s) { return fields::enum_from_name<MotionSource>(s); }
 
 StateObserver::StateObserver(double bandwidth, double period, bool with_disturbance,
                              double quantization)

@@ -42,6 +42,24 @@ SummaryBuilder::SummaryBuilder(const Scenario& s)
   }
   chatter_delta_ = 0.01 * controller_output_range(s);
   m_.control_chatter_threshold_V = chatter_delta_;
+  direction_band_ = 0.001 * controller_output_range(s);
+  m_.control_direction_band_V = direction_band_;
+  thrust_gain_ = s.plant.thrust_gain();
+  m_.force_hf_limit_N = kSignalLimits.force_hf_rms_deltas * thrust_gain_ * chatter_delta_;
+  // 2nd-order Butterworth high-pass at f_c, bilinear with pre-warping: K = tan(pi f_c T),
+  // H(z) = (1 - 2z^-1 + z^-2) / ((1 + sqrt2 K + K^2) + 2(K^2 - 1) z^-1 + (1 - sqrt2 K + K^2) z^-2)
+  // (e.g. R. Bristow-Johnson, "Audio EQ cookbook", HPF with Q = 1/sqrt2); |H| at f is the analog
+  // prototype's at the warped frequency tan(pi f T)/K: (w^2)/sqrt(1 + w^4).
+  const double fc = kSignalLimits.hf_corner_hz;
+  m_.force_hf_corner_Hz = fc;
+  hf_defined_ = control_period_ > 0.0 && fc < 0.5 / control_period_;
+  if (hf_defined_) {
+    const double k = std::tan(3.14159265358979323846 * fc * control_period_);
+    const double norm = 1.0 / (1.0 + std::sqrt(2.0) * k + k * k);
+    hb0_ = norm;
+    ha1_ = 2.0 * (k * k - 1.0) * norm;
+    ha2_ = (1.0 - std::sqrt(2.0) * k + k * k) * norm;
+  }
 }
 
 namespace {
@@ -122,10 +140,54 @@ void SummaryBuilder::add(const Record& q) {
   m.control_max = std::max(m.control_max, q.u);
   if (n_ > 0) total_variation_ += std::abs(static_cast<long double>(q.u) - last_.u);
   if (q.u != q.u_unsaturated) ++m.control_saturated_steps;
+  add_signal(q.u);
   m.max_position_m = std::max(m.max_position_m, q.x);
   m.min_position_m = std::min(m.min_position_m, q.x);
   last_ = q;
   ++n_;
+}
+
+void SummaryBuilder::add_signal(double u) {
+  // long double (as the sums): a finite but absurd command (1e308 V) keeps a finite force
+  const long double force = static_cast<long double>(thrust_gain_) * u;
+  if (n_ == 0) {
+    extreme_ = u;
+    hx1_ = hx2_ = force;  // at rest on the first force: a constant passes as 0
+  } else {
+    const long double du = static_cast<long double>(u) - last_.u;
+    sdu_ += du * du;
+    // turning points with hysteresis h: extreme_ is the running max (rising) or min (falling),
+    // or the first u until u has moved h away from it
+    const double h = std::max(direction_band_, std::numeric_limits<double>::min());
+    if (direction_ == 1) {
+      if (u > extreme_) {
+        extreme_ = u;
+      } else if (extreme_ - u >= h) {
+        ++direction_changes_;
+        direction_ = -1;
+        extreme_ = u;
+      }
+    } else if (direction_ == -1) {
+      if (u < extreme_) {
+        extreme_ = u;
+      } else if (u - extreme_ >= h) {
+        ++direction_changes_;
+        direction_ = 1;
+        extreme_ = u;
+      }
+    } else if (std::abs(u - extreme_) >= h) {
+      direction_ = u > extreme_ ? 1 : -1;
+      extreme_ = u;
+    }
+  }
+  if (hf_defined_) {
+    const long double y = hb0_ * (force - 2.0L * hx1_ + hx2_) - ha1_ * hy1_ - ha2_ * hy2_;
+    hx2_ = hx1_;
+    hx1_ = force;
+    hy2_ = hy1_;
+    hy1_ = y;
+    shf_ += y * y;
+  }
 }
 
 void SummaryBuilder::add_move(const Record& q) {
@@ -186,6 +248,22 @@ void SummaryBuilder::finish_move(Summary& m) const {
   if (n_after_ > 0) m.position_error_max_abs_after_move_m = max_after_;
 }
 
+void SummaryBuilder::finish_signal(Summary& m) const {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  const auto n = static_cast<long double>(n_);
+  m.control_step_rms_V = n_ > 1 ? saturated(std::sqrt(sdu_ / (n - 1.0L))) : kNone;
+  m.control_direction_changes_per_s = m.sim_time_s > 0.0 ? static_cast<double>(direction_changes_) / m.sim_time_s : 0.0;
+  m.control_saturated_fraction = static_cast<double>(m.control_saturated_steps) / static_cast<double>(n_);
+  m.force_hf_rms_N = hf_defined_ ? saturated(std::sqrt(shf_ / n)) : kNone;
+  const SignalLimits& l = kSignalLimits;
+  // Every limit that has a value must hold (a run of one step has no step-to-step change; a
+  // rate without content above f_c has no HF figure: those limits are not checked).
+  m.control_signal_within_limits =
+      !(m.control_step_rms_V > l.step_rms_deltas * chatter_delta_) &&
+      m.control_direction_changes_per_s <= l.direction_changes_per_s &&
+      m.control_saturated_fraction <= l.saturated_fraction && !(m.force_hf_rms_N > m.force_hf_limit_N);
+}
+
 Summary SummaryBuilder::summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) const {
   Summary m = m_;
   m.steps = n_;
@@ -207,6 +285,7 @@ Summary SummaryBuilder::summary(double wall_time_s, const std::optional<plant::C
   m.position_error_rms_m = n_e_ > 0 ? static_cast<double>(std::sqrt(se_ / static_cast<long double>(n_e_))) : kNone;
   m.velocity_error_rms_mps = n_ev_ > 0 ? static_cast<double>(std::sqrt(sev_ / static_cast<long double>(n_ev_))) : kNone;
   m.control_total_variation = saturated(total_variation_);
+  finish_signal(m);
   if (n_settled_ > 0)
     m.position_error_rms_settled_m =
         n_e_settled_ > 0 ? static_cast<double>(std::sqrt(se_settled_ / static_cast<long double>(n_e_settled_))) : kNone;
@@ -260,6 +339,10 @@ std::string summary_headline(const std::string& text) {
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
   if (j.value("control_chattering", false))
     line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
+  if (j.contains("control_signal_within_limits") && j["control_signal_within_limits"] == false)
+    line += ", CONTROL SIGNAL OUTSIDE LIMITS (step rms " + num("control_step_rms_V") + " V, " +
+            num("control_direction_changes_per_s") + " direction changes/s, " + num("force_hf_rms_N") +
+            " N above 1 kHz, saturated " + num("control_saturated_fraction") + ")";
   if (j.contains("controller_model") && j["controller_model"] == "plant") line += ", model = plant";
   return line;
 }
@@ -314,6 +397,15 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   j["control_chatter_threshold_V"] = m.control_chatter_threshold_V;
   j["control_reversals_per_s"] = val(m.control_reversals_per_s);
   j["control_chattering"] = m.steps > 0 ? nlohmann::ordered_json(m.control_chattering) : nlohmann::ordered_json();
+  // Control-signal quality (summary.hpp, docs/scenario.md "Control-signal quality").
+  j["control_step_rms_V"] = opt(m.control_step_rms_V);
+  j["control_direction_band_V"] = m.control_direction_band_V;
+  j["control_direction_changes_per_s"] = val(m.control_direction_changes_per_s);
+  j["control_saturated_fraction"] = val(m.control_saturated_fraction);
+  j["force_hf_corner_Hz"] = m.force_hf_corner_Hz;
+  j["force_hf_rms_N"] = opt(m.force_hf_rms_N);
+  j["force_hf_limit_N"] = m.force_hf_limit_N;
+  j["control_signal_within_limits"] = m.steps > 0 ? nlohmann::ordered_json(m.control_signal_within_limits) : nlohmann::ordered_json();
   // Whose parameters the controller's model holds: "plant" means every result is a
   // perfect-model result (docs/scenario.md).
   const std::string model = controller_model_source(s);
@@ -345,6 +437,7 @@ std::vector<std::string> summary_metric_names() {
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
+  m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
   std::vector<std::string> names;
   for (auto it = j.begin(); it != j.end(); ++it)

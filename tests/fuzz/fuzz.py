@@ -56,6 +56,9 @@ NULLABLE_SUMMARY = {
     "controller_model",  # open_loop has no model
     # the plant's CVODE counts are null where it ran in another process (a log, the monitor)
     "integrator_steps", "integrator_rhs_evals", "integrator_jac_evals", "integrator_error_test_fails",
+    # control-signal quality: no step-to-step change in a run of one step; nothing above 1 kHz
+    # is representable at a control period of 0.5 ms or more
+    "control_step_rms_V", "force_hf_rms_N",
 }
 # timeseries.csv columns that must be finite in every row (the diagnostic columns
 # u_unsaturated, sliding, z_estimate are NaN where a controller has none).

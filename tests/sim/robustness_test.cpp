@@ -70,6 +70,28 @@ controller: {type: cascade, tuning: rule, bandwidth_scale: 0.5, computation_dela
   EXPECT_EQ(s.controller.cascade.ki, g.ki);
   EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, tuning: rule, kv: 3000}\n"),
             "s.yaml: controller.kv: set by tuning: rule (remove it, or use tuning: manual)");
+  // The observer's v^ is no difference (no T/2), the Smith predictor takes the delay out of the
+  // loop (observer with compensate_delay), a velocity filter adds its time constant 1/(2 pi f_v).
+  const Scenario o = parse_scenario(R"(
+duration: 0.01
+control_period: 1e-4
+plant: {sensor: {quantization: 5e-8}}
+controller: {type: cascade, tuning: rule, computation_delay: 1e-3, motion_state: observer, compensate_delay: true,
+             disturbance_observer_bandwidth: 2000, velocity_filter_cutoff: 2000}
+)");
+  const controller::CascadeGains go = controller::cascade_tuning(1e-4, 0.0, false, 1.0, 1.0 / (2.0 * M_PI * 2000.0));
+  EXPECT_EQ(o.controller.cascade.kv, go.kv);
+  EXPECT_EQ(o.controller.cascade.ki, go.ki);
+  EXPECT_EQ(o.controller.cascade.motion_state, controller::MotionSource::kObserver);
+  EXPECT_EQ(o.controller.cascade.velocity_filter_cutoff, 2000.0);
+  // Without the observer the delay stays in tau; the filter's lag is added.
+  const Scenario f = parse_scenario("duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {quantization: 5e-8}}\n"
+                                    "controller: {type: cascade, tuning: rule, computation_delay: 1e-3, velocity_filter_cutoff: 1000}\n");
+  EXPECT_EQ(f.controller.cascade.kv, controller::cascade_tuning(1e-4, 1e-3, true, 1.0, 1.0 / (2.0 * M_PI * 1000.0)).kv);
+  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, motion_state: observer}\n"),
+            "s.yaml: controller.motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
+  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, motion_state: guess}\n"),
+            "s.yaml: controller.motion_state = 'guess': expected one of measured, observer");
   EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, tuning: fast}\n"),
             "s.yaml: controller.tuning = 'fast': expected one of manual, rule");
 }

@@ -4,7 +4,9 @@
 // as null by the JSON writer, with exit 0 (found by fuzz.lcm_log).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -242,6 +244,130 @@ TEST(Summary, MoveMetricsApplyOnlyToMoves) {
     EXPECT_TRUE(j[key].is_null()) << key;
   EXPECT_EQ(j["control_reversals_per_s"], 0.0);
   EXPECT_EQ(j["control_chattering"], false);
+}
+
+// Control-signal quality (summary.hpp, docs/scenario.md "Control-signal quality") on commands
+// whose figures are known in closed form. Scenario{}: T = 1e-4 s, u in [-10, 10] V (delta = 0.2 V,
+// h = 0.02 V), Ka*Kf = 260 N/V.
+Summary signal_summary(double period, long n, const std::function<double(long)>& u,
+                       const std::function<bool(long)>& saturated = [](long) { return false; }) {
+  Scenario s;
+  s.control_period = period;
+  SummaryBuilder b(s);
+  for (long k = 0; k < n; ++k) {
+    Record r;
+    r.t = static_cast<double>(k) * period;
+    r.u = u(k);
+    r.u_unsaturated = saturated(k) ? 2.0 * r.u : r.u;
+    b.add(r);
+  }
+  return b.summary(0.0, {});
+}
+
+TEST(Summary, SignalQualityOfASquareWave) {
+  // +-1 V, toggling every 50 steps (a 100 Hz square wave) for 10,000 steps (1 s): 199 edges of
+  // 2 V each among 9,999 differences; every edge after the first reverses the direction (198);
+  // the first 250 steps marked saturated: 2.5 %.
+  const Summary m = signal_summary(1e-4, 10000, [](long k) { return (k / 50) % 2 == 0 ? 1.0 : -1.0; },
+                                   [](long k) { return k < 250; });
+  EXPECT_NEAR(m.control_step_rms_V, std::sqrt(199.0 * 4.0 / 9999.0), 1e-12);  // rounding only
+  EXPECT_NEAR(m.control_direction_changes_per_s, 198.0, 1e-9);               // sim_time = 1 s
+  EXPECT_NEAR(m.control_saturated_fraction, 0.025, 1e-15);
+  EXPECT_DOUBLE_EQ(m.control_direction_band_V, 0.02);
+  EXPECT_DOUBLE_EQ(m.force_hf_limit_N, 260.0 * 0.2);
+  // 0.28 V RMS from step to step exceeds delta = 0.2 V; so does 2.5 % saturation: fails
+  EXPECT_FALSE(m.control_signal_within_limits);
+}
+
+// |H| of the pre-warped bilinear 2nd-order Butterworth high-pass at f: w^2/sqrt(1 + w^4),
+// w = tan(pi f T)/tan(pi f_c T) (the analog prototype at the warped frequency).
+double highpass_gain(double f, double fc, double period) {
+  const double w = std::tan(M_PI * f * period) / std::tan(M_PI * fc * period);
+  return w * w / std::sqrt(1.0 + w * w * w * w);
+}
+
+TEST(Summary, SignalQualityOfSines) {
+  const double T = 1e-4, A = 1.0;
+  for (const double f : {2000.0, 100.0}) {
+    // A cosine, so the high-pass (at rest on the first sample) starts without a jump in slope:
+    // its start transient decays within ~0.2 ms (1/(sqrt2 pi f_c)) and carries < 1e-4 of the
+    // energy of the 1 s run, hence the relative tolerance 1e-3 on the RMS.
+    const Summary m = signal_summary(T, 10000, [&](long k) { return A * std::cos(2.0 * M_PI * f * k * T); });
+    // du_k = -2A sin(w T/2) sin(w (k - 1/2) T): RMS sqrt2 A sin(w T/2) over whole periods
+    EXPECT_NEAR(m.control_step_rms_V / (std::sqrt(2.0) * A * std::sin(M_PI * f * T)), 1.0, 1e-3) << f;
+    // two turning points a period, the first direction taken without a count: 2f - 1 or 2f
+    EXPECT_NEAR(m.control_direction_changes_per_s, 2.0 * f, 1.0) << f;
+    EXPECT_NEAR(m.force_hf_rms_N / (260.0 * A / std::sqrt(2.0) * highpass_gain(f, 1000.0, T)), 1.0, 1e-3) << f;
+    EXPECT_EQ(m.control_saturated_fraction, 0.0);
+  }
+  // 2 kHz at 1 V: 0.98 of 184 N RMS above 1 kHz, 4,000 changes/s: out of limits. 100 Hz at
+  // 0.1 V: 0.0044 V step RMS, 200 changes/s, 0.17 N above 1 kHz: within.
+  EXPECT_FALSE(signal_summary(T, 10000, [&](long k) { return std::cos(2.0 * M_PI * 2000.0 * k * T); })
+                   .control_signal_within_limits);
+  EXPECT_TRUE(signal_summary(T, 10000, [&](long k) { return 0.1 * std::cos(2.0 * M_PI * 100.0 * k * T); })
+                  .control_signal_within_limits);
+}
+
+TEST(Summary, SignalQualityOfAConstantAndOfASlowRate) {
+  // A constant command: no change, no turning point, nothing above 1 kHz (exactly: the filter
+  // starts at rest on the first sample and its numerator sums to 0).
+  const Summary c = signal_summary(1e-4, 1000, [](long) { return 3.0; });
+  EXPECT_EQ(c.control_step_rms_V, 0.0);
+  EXPECT_EQ(c.control_direction_changes_per_s, 0.0);
+  EXPECT_EQ(c.force_hf_rms_N, 0.0);
+  EXPECT_TRUE(c.control_signal_within_limits);
+  // Noise smaller than the band h = 0.02 V (+-0.009 V every step) is no change of direction.
+  EXPECT_EQ(signal_summary(1e-4, 1000, [](long k) { return k % 2 ? 0.009 : -0.009; }).control_direction_changes_per_s, 0.0);
+  // At T = 1 ms nothing above 1 kHz is representable (Nyquist 500 Hz): null, never 0.
+  Scenario s;
+  s.control_period = 1e-3;
+  SummaryBuilder b(s);
+  for (long k = 0; k < 10; ++k) {
+    Record r;
+    r.t = k * 1e-3;
+    r.u = r.u_unsaturated = (k % 2) ? 1.0 : -1.0;
+    b.add(r);
+  }
+  const auto j = nlohmann::json::parse(summary_json(b.summary(0.0, {}), s));
+  EXPECT_TRUE(j["force_hf_rms_N"].is_null());
+  EXPECT_TRUE(j["control_step_rms_V"].is_number());
+  EXPECT_EQ(j["control_signal_within_limits"], false);  // 2 V steps
+  // One step has no step-to-step change: null.
+  SummaryBuilder one(s);
+  one.add(Record{});
+  EXPECT_TRUE(nlohmann::json::parse(summary_json(one.summary(0.0, {}), s))["control_step_rms_V"].is_null());
+}
+
+// Every control-signal figure is a study metric (summary_metric_names(): what a study records
+// per case and what report.metric may name), the null-able ones included.
+TEST(Summary, SignalFiguresAreStudyMetrics) {
+  const std::vector<std::string> names = summary_metric_names();
+  for (const char* key : {"control_step_rms_V", "control_direction_changes_per_s", "control_saturated_fraction",
+                          "force_hf_rms_N", "force_hf_limit_N"})
+    EXPECT_NE(std::find(names.begin(), names.end(), key), names.end()) << key;
+}
+
+// The final line names a command outside the signal limits with its figures, and says nothing
+// of a command within them.
+TEST(Summary, HeadlineFlagsASignalOutsideTheLimits) {
+  Scenario s;
+  s.control_period = 1e-4;
+  const auto line = [&](double amplitude) {
+    SummaryBuilder b(s);
+    for (long k = 0; k < 1000; ++k) {
+      Record r;
+      r.t = k * 1e-4;
+      r.u = r.u_unsaturated = (k % 2) ? amplitude : -amplitude;
+      b.add(r);
+    }
+    return summary_headline(summary_json(b.summary(0.0, {}), s));
+  };
+  // +-1 V every period over 0.1 s: 2 V steps, 998 direction changes (the first direction is not
+  // one), 9,980 /s: outside
+  EXPECT_NE(line(1.0).find("CONTROL SIGNAL OUTSIDE LIMITS (step rms 2 V, 9980 direction changes/s"), std::string::npos)
+      << line(1.0);
+  // +-0.005 V: under the band h and the limits: no flag
+  EXPECT_EQ(line(0.005).find("OUTSIDE"), std::string::npos) << line(0.005);
 }
 
 }  // namespace

@@ -22,6 +22,15 @@
 //   F^f_ff) use the reference previewed to t_k + d (delay_line.hpp, preview()), when the command
 //   acts; the feedback compares the measurement with the reference at t_k; the disturbance
 //   observer predicts with the command that acts.
+// * Observer feedback (motion_state = observer; needs w_d > 0): the loops feed back the
+//   observer's x^, v^ instead of the encoder's x_m and backward-differenced v_m, as the
+//   sliding-mode controller does. With compensate_delay as well, the same Smith predictor as the
+//   sliding-mode law (sliding_mode.hpp): x^, v^ predicted over [t_k, t_k + d] through the
+//   commands already issued (model acceleration and d^ held at their t_k values), compared with
+//   the reference previewed to t_k + d.
+// * Velocity filter (velocity_filter_cutoff f_v > 0 [Hz]): the velocity fed back passes a
+//   first-order low-pass 1/(1 + s/(2 pi f_v)), discretised exactly for a sample held over T:
+//   v_f,k = v_f,k-1 + (1 - exp(-2 pi f_v T))*(v_k - v_f,k-1), started at the first finite v.
 //
 // The tuning rule (cascade_tuning()) sets kv, ki, kp from the sample period, the computation
 // delay and the sensor; see docs/controllers.md ("Cascade tuning rule").
@@ -57,6 +66,10 @@ struct CascadeParams {
   double quantization{0.0};    ///< encoder count q [m] for the observer's dead zone
   double computation_delay{0.0};  ///< d [s]: the command acts d after its sample
   bool compensate_delay{false};   ///< preview the reference by d; observer predicts with the acting command
+  /// Feed back the observer's x^, v^ (observer; needs disturbance_observer_bandwidth > 0) or the
+  /// measurement (measured, the default); with compensate_delay: predicted to t_k + d.
+  MotionSource motion_state{MotionSource::kMeasured};
+  double velocity_filter_cutoff{0.0};  ///< f_v [Hz] of the velocity low-pass; 0 = none
   double mass{102.04};         ///< m^ [kg]
   double thrust_gain{260.0};   ///< (Ka*Kf)^ [N/V]
   plant::FrictionParams friction;  ///< the model's friction (friction feedforward)
@@ -77,7 +90,9 @@ struct CascadeParams {
     a->Visit(FD_FIELD(acceleration_feedforward).unit("-").plausible(0, 2).doc("kff_a"));
     a->Visit(FD_FIELD(friction_feedforward).doc("add the model's LuGre friction along the reference"));
     a->Visit(FD_FIELD(disturbance_observer_bandwidth).unit("rad/s").non_negative().plausible(0, 1e5).doc("x,v,d observer fed by the encoder; 0: off"));
-    a->Visit(FD_FIELD(compensate_delay).doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command"));
+    a->Visit(FD_FIELD(compensate_delay).doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command (with motion_state observer: the feedback state too)"));
+    a->Visit(FD_FIELD(motion_state).doc("the x, v fed back: measured (the encoder, velocity as the sensor gives it) or observer (x^, v^; needs disturbance_observer_bandwidth > 0)"));
+    a->Visit(FD_FIELD(velocity_filter_cutoff).unit("Hz").non_negative().plausible(0, 1e5).doc("first-order low-pass on the velocity fed back; 0: none"));
     a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
     a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
   }
@@ -86,7 +101,10 @@ struct CascadeParams {
 
 /// With tuning rule: sets kp, kv, ki from cascade_tuning() with the params' period,
 /// computation_delay and bandwidth_scale; `differenced_velocity`: the model's sensor differences
-/// the velocity from the encoder (plant::SensorParams::differenced_velocity()). Manual: no change.
+/// the velocity from the encoder (plant::SensorParams::differenced_velocity()). The observer's v^
+/// is no backward difference; the Smith predictor (motion_state observer with compensate_delay)
+/// takes the known delay out of the loop; a velocity filter adds its lag 1/(2 pi f_v).
+/// Manual: no change.
 void apply_tuning(CascadeParams& p, bool differenced_velocity);
 
 /// The cascade tuning rule (docs/controllers.md, "Cascade tuning rule"): with the effective
@@ -95,11 +113,13 @@ void apply_tuning(CascadeParams& p, bool differenced_velocity);
 /// at w_v with phase margin 45 deg when the PI corner is w_v/4:
 ///   w_v = (pi/4 - atan(1/4))/tau,  kv = w_v/sqrt(1 + 1/16),  ki = kv*w_v/4,  kp = w_v/4.
 /// `scale` multiplies w_v (1 = the rule). Returns {kp, kv, ki}.
+/// `extra_lag` [s] adds to tau (a velocity filter's time constant 1/(2 pi f_v)); a delay that
+/// the Smith predictor removes (motion_state observer with compensate_delay) is passed as 0.
 struct CascadeGains {
   double kp, kv, ki;
 };
 CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
-                            double scale = 1.0);
+                            double scale = 1.0, double extra_lag = 0.0);
 
 class CascadeController final : public Controller {
  public:
@@ -109,11 +129,15 @@ class CascadeController final : public Controller {
   std::string name() const override { return "cascade"; }
 
  private:
+  double filter_velocity(double v);  ///< the velocity low-pass (identity without a cutoff)
   CascadeParams p_;
   double integral_{0.0};
   FrictionObserver friction_ff_;
   StateObserver observer_;
   DelayLine delay_line_;
+  double velocity_filter_gain_{1.0};  // 1 - exp(-2 pi f_v T); 1 = no filter
+  double v_filtered_{0.0};
+  bool v_filter_started_{false};
 };
 
 }  // namespace feeddrive::controller

@@ -76,18 +76,6 @@ inline const std::vector<std::pair<StateSource, const char*>>& enum_names(StateS
 std::string to_string(StateSource s);
 StateSource state_source_from_string(const std::string& s);  ///< "true" | "observer"
 
-/// Where x and v in e and de/dt come from.
-enum class MotionSource {
-  kMeasured,  ///< the measured position and velocity as they are (the paper)
-  kObserver,  ///< a model-based observer of x and v (state_observer.hpp) fed by the encoder
-};
-inline const std::vector<std::pair<MotionSource, const char*>>& enum_names(MotionSource) {
-  static const std::vector<std::pair<MotionSource, const char*>> n = {{MotionSource::kMeasured, "measured"}, {MotionSource::kObserver, "observer"}};
-  return n;
-}
-std::string to_string(MotionSource s);
-MotionSource motion_source_from_string(const std::string& s);  ///< "measured" | "observer"
-
 struct SlidingModeParams {
   double eta{5.0};      ///< [m/s^2]
   double k{10.0};       ///< [1/s]

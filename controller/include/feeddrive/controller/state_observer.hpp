@@ -23,7 +23,25 @@
 // (derived by matching det(zI - (I-LC)A) to (z-p)^n). The model carries the fast dynamics and
 // the encoder only corrects slow drift, so w_o can sit far below the quantization noise band.
 
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace feeddrive::controller {
+
+/// Where a controller's feedback takes x and v from (the sliding-mode law's e and de/dt, the
+/// cascade's loops).
+enum class MotionSource {
+  kMeasured,  ///< the measured position and velocity as they are (the paper)
+  kObserver,  ///< a model-based observer of x and v (this StateObserver) fed by the encoder
+};
+inline const std::vector<std::pair<MotionSource, const char*>>& enum_names(MotionSource) {
+  static const std::vector<std::pair<MotionSource, const char*>> n = {{MotionSource::kMeasured, "measured"},
+                                                                      {MotionSource::kObserver, "observer"}};
+  return n;
+}
+std::string to_string(MotionSource s);
+MotionSource motion_source_from_string(const std::string& s);  ///< "measured" | "observer"
 
 class StateObserver {
  public:

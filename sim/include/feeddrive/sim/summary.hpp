@@ -36,6 +36,21 @@
 // control_reversals_per_s = reversals / sim_time; the control chatters (control_chattering) when
 // that rate is at least 5 % of the control rate (0.05/T: 500 /s at T = 0.1 ms). A sgn switching
 // law in a band reverses every period (rate 1/T); a smooth law tracking a smooth reference never.
+//
+// Control-signal quality (docs/scenario.md, "Control-signal quality"; issue 24 item 3), with
+// delta = the chatter threshold above and F = Ka*Kf*u the commanded force (the plant's Ka*Kf):
+//   control_step_rms_V        sqrt(mean over k >= 1 of (u_k - u_{k-1})^2)
+//   control_direction_changes_per_s  turning points of u with hysteresis h = 0.1 % of the output
+//                             range (control_direction_band_V; 0.02 V for +-10 V, 4 LSB of a 12-bit
+//                             +-10 V DAC): u changes direction when it falls h below its last
+//                             maximum (or rises h above its last minimum); per simulated second.
+//                             A sine of amplitude > h/2 at f Hz: 2f; a square wave: one per edge.
+//   control_saturated_fraction  control_saturated_steps / steps
+//   force_hf_rms_N            RMS of F after a 2nd-order Butterworth high-pass at f_c = 1 kHz
+//                             (bilinear transform with the corner pre-warped, started at rest on
+//                             the first F: a constant gives 0); null when f_c >= 1/(2T)
+//                             (no content above f_c is representable at that rate).
+//   control_signal_within_limits  all four within kSignalLimits (below; sources in the docs).
 
 #include <limits>
 #include <optional>
@@ -92,9 +107,30 @@ struct Summary {
   double control_chatter_threshold_V{0.0};
   double control_reversals_per_s{0.0};
   bool control_chattering{false};
+  // Control-signal quality (above); NaN = no value (null)
+  double control_step_rms_V{kNaN};
+  double control_direction_band_V{0.0};
+  double control_direction_changes_per_s{0.0};
+  double control_saturated_fraction{0.0};
+  double force_hf_corner_Hz{0.0};
+  double force_hf_rms_N{kNaN};
+  double force_hf_limit_N{0.0};  ///< Ka*Kf*delta: the limit on force_hf_rms_N
+  bool control_signal_within_limits{false};
 
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// The limits a command must keep to pass (docs/scenario.md, "Control-signal quality": current-
+/// loop bandwidth of servo amplifiers, thermal limit of a linear motor). In units of delta (the
+/// chatter threshold, 1 % of the output range) where they scale with the command range.
+struct SignalLimits {
+  double step_rms_deltas{1.0};            ///< control_step_rms_V <= 1 delta
+  double direction_changes_per_s{2000.0};  ///< 2 per period of a 1 kHz current loop
+  double saturated_fraction{0.01};        ///< 1 % of the run at the amplifier's peak
+  double force_hf_rms_deltas{1.0};        ///< force_hf_rms_N <= Ka*Kf*delta
+  double hf_corner_hz{1000.0};            ///< f_c of force_hf_rms_N
+};
+inline constexpr SignalLimits kSignalLimits{};
 
 /// The controller's output range u_max - u_min [V] of a scenario (chatter threshold).
 double controller_output_range(const Scenario& s);
@@ -104,7 +140,8 @@ double controller_output_range(const Scenario& s);
 std::string controller_model_source(const Scenario& s);
 /// The headline of a run for a tool's final line, from summary.json's text: "max |e| = 1.367e-06
 /// m, rms e = ..., u in [..., ...] V" (the measured error where the run has no true state), and
-/// ", CONTROL CHATTERS (n reversals/s)" when control_chattering. feeddrive-sim and -launch print it.
+/// ", CONTROL CHATTERS (n reversals/s)" when control_chattering, ", CONTROL SIGNAL OUTSIDE LIMITS
+/// (...)" when control_signal_within_limits is false. feeddrive-sim and -launch print it.
 std::string summary_headline(const std::string& summary_json_text);
 
 /// The metrics of a stream of records.
@@ -122,6 +159,8 @@ class SummaryBuilder {
  private:
   void add_move(const Record& q);
   void finish_move(Summary& m) const;
+  void add_signal(double u);
+  void finish_signal(Summary& m) const;
   double settled_after_, control_period_;
   Summary m_;
   long n_{0}, n_settled_{0};
@@ -147,6 +186,16 @@ class SummaryBuilder {
   double chatter_delta_{0.0};
   double du_prev_{0.0};
   long reversals_{0};
+  // control-signal quality
+  long double sdu_{0.0L};  // sum of (u_k - u_{k-1})^2
+  double direction_band_{0.0}, extreme_{0.0};
+  int direction_{0};  // +1 rising, -1 falling, 0 not yet moved by the band
+  long direction_changes_{0};
+  double thrust_gain_{0.0};
+  bool hf_defined_{false};
+  double hb0_{0.0}, ha1_{0.0}, ha2_{0.0};  // high-pass: b = hb0*(1, -2, 1), a = (1, ha1, ha2)
+  long double hx1_{0.0L}, hx2_{0.0L}, hy1_{0.0L}, hy2_{0.0L};
+  long double shf_{0.0L};  // sum of squares of the high-passed force
 };
 
 /// All records in memory at once (SummaryBuilder over r.records).
