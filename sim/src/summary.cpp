@@ -347,7 +347,10 @@ std::string summary_headline(const std::string& text) {
   return line;
 }
 
-std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
+namespace {
+// The one assembly of the summary's fields (summary_json writes it, summary_metrics reads its
+// numbers without a text round trip).
+nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   nlohmann::ordered_json j;
   // Metrics over an empty window are null (summary.hpp), never 0.
   const auto val = [&](double v) { return m.steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
@@ -420,6 +423,12 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
     j["move_finished"] = s.move_end_s <= s.duration;
   }
   j["warnings"] = s.warnings;
+  return j;
+}
+}  // namespace
+
+std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
+  nlohmann::ordered_json j = summary_object(m, s);
   if (!extra.empty()) {
     const nlohmann::ordered_json e = nlohmann::ordered_json::parse(extra);
     for (auto it = e.begin(); it != e.end(); ++it) j[it.key()] = it.value();
@@ -438,11 +447,17 @@ std::vector<std::string> summary_metric_names() {
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
   m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
-  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
   std::vector<std::string> names;
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (it.value().is_number() && !is_wall_clock_metric(it.key())) names.push_back(it.key());
+  for (const auto& [key, value] : summary_metrics(m, Scenario{})) names.push_back(key);
   return names;
+}
+
+std::vector<std::pair<std::string, double>> summary_metrics(const Summary& m, const Scenario& s) {
+  const nlohmann::ordered_json j = summary_object(m, s);
+  std::vector<std::pair<std::string, double>> out;
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.value().is_number() && !is_wall_clock_metric(it.key())) out.emplace_back(it.key(), it.value().get<double>());
+  return out;
 }
 
 }  // namespace feeddrive::sim

@@ -22,11 +22,7 @@ Outcome run_case(const std::string& yaml) {
     sim::SummaryBuilder builder(s);
     const sim::RunStats st = sim::run(s, [&builder](const sim::Record& q) { builder.add(q); });
     const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
-    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(sim::summary_json(sum, s));
-    for (auto it = j.begin(); it != j.end(); ++it) {
-      if (!it.value().is_number() || sim::is_wall_clock_metric(it.key())) continue;
-      o.metrics.emplace_back(it.key(), it.value().get<double>());
-    }
+    o.metrics = sim::summary_metrics(sum, s);
     o.ok = true;
   } catch (const interrupt::Interrupted& e) {
     o.ok = false;

@@ -55,6 +55,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "feeddrive/common/quantile.hpp"
@@ -210,5 +211,8 @@ bool is_wall_clock_metric(const std::string& key);
 /// an empty window included), except the wall-clock ones, in the order written. What a study
 /// records per case and what its report.metric may name.
 std::vector<std::string> summary_metric_names();
+/// The drive's metrics of a run, by name, as summary_json writes them as numbers (its nulls and
+/// the wall-clock figures left out): what a study records per case, without a JSON text.
+std::vector<std::pair<std::string, double>> summary_metrics(const Summary& sum, const Scenario& s);
 
 }  // namespace feeddrive::sim
