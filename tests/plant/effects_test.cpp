@@ -157,7 +157,8 @@ TEST(Effects, GradientMatchesCentralDifferences) {
 
 // derivative() and jacobian() with every effect that enters f on (the additive ones, presliding
 // and grinding_force folded in, mass_error) and the electrical option (d/di of the reluctance
-// effect): the analytic Jacobian against central differences, as in forces_test.cpp.
+// effect): the analytic Jacobian against central differences (jacobian_check.hpp), and the
+// EffectiveParams overload against the PlantParams one.
 TEST(Effects, DynamicsJacobianMatchesFiniteDifferences) {
   PlantParams p = all_additive();
   p.friction.model = FrictionModel::kStatic;
