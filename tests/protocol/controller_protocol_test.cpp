@@ -199,7 +199,7 @@ TEST_F(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
 // A lost reference: the controller holds state 5 and asks for reference 5 on FD_RESEND (after
 // one resend interval); the trajectory sends it, the step is answered, the run goes on.
 TEST_F(ControllerProtocol, AsksForAMissingReference) {
-  ControllerNode& node = make_node();
+  make_node();
   Trajectory traj(memq, s, {5});
   Plant plant(memq, s);
   run_to_end(plant);
