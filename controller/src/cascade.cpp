@@ -118,15 +118,9 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
   if (dob && observer_.initialised()) {
     if (delayed) {
       delay_line_.push(meas.t, cmd.u);
-      double dv = 0.0, dx = 0.0;
       const double t_end = meas.t + p_.period;
-      for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, t_end)) {
-        const double tau = piece.t1 - piece.t0;
-        const double a = model_acceleration(piece.u);
-        dv += a * tau;
-        dx += a * tau * (0.5 * tau + (t_end - piece.t1));
-      }
-      observer_.predict_increments(dv, dx);
+      const DelayLine::Increments inc = delay_line_.increments(meas.t, t_end, model_acceleration);
+      observer_.predict_increments(inc.dv, inc.dx);
       delay_line_.forget_before(t_end);
     } else {
       observer_.predict(model_acceleration(cmd.u));

@@ -23,6 +23,18 @@ std::vector<DelayLine::Piece> DelayLine::pieces(double t0, double t1) const {
   return out;
 }
 
+DelayLine::Increments DelayLine::increments(double t0, double t1,
+                                            const std::function<double(double)>& acceleration) const {
+  Increments out;
+  for (const Piece& piece : pieces(t0, t1)) {
+    const double tau = piece.t1 - piece.t0;
+    const double a = acceleration(piece.u);
+    out.dv += a * tau;
+    out.dx += a * tau * (0.5 * tau + (t1 - piece.t1));
+  }
+  return out;
+}
+
 void DelayLine::forget_before(double t) {
   // Keep the last command acting at t and everything after it.
   while (issued_.size() >= 2 && issued_[1].t + delay_ <= t + snap_) issued_.pop_front();

@@ -46,6 +46,25 @@ TEST(DelayLine, SplitsAPeriodAtTheSwitchTimes) {
   EXPECT_EQ(n[0].u, 4.0);
 }
 
+// increments() integrates the piecewise-constant model acceleration twice over [t0, t1]: the
+// commands of SplitsAPeriodAtTheSwitchTimes with a(u) = 2u act as a = 2 on [0.5, 0.625] and
+// a = 4 on [0.625, 0.75]. By hand from rest: v = 2*0.125 = 0.25, x = 2*0.125^2/2 = 0.015625 after
+// the first piece; then v += 4*0.125 -> 0.75, x += 0.25*0.125 + 4*0.125^2/2 -> 0.078125. Exact:
+// every number is a binary fraction.
+TEST(DelayLine, IncrementsIntegrateThePiecewiseAccelerationTwice) {
+  DelayLine line(0.375, 1e-12);
+  line.push(0.0, 1.0);
+  line.push(0.25, 2.0);
+  line.push(0.5, 3.0);
+  const DelayLine::Increments inc = line.increments(0.5, 0.75, [](double u) { return 2.0 * u; });
+  EXPECT_EQ(inc.dv, 0.75);
+  EXPECT_EQ(inc.dx, 0.078125);
+  // Before the first command acts, nothing does: a(0) over the whole interval.
+  const DelayLine::Increments none = line.increments(0.0, 0.25, [](double u) { return 2.0 * u + 1.0; });
+  EXPECT_EQ(none.dv, 0.25);
+  EXPECT_EQ(none.dx, 0.03125);
+}
+
 // preview() is the cubic's Taylor expansion: exact for a cubic x(t) = a + b t + c t^2 + j t^3/6.
 // Tolerance 1e-15 relative: rounding of a few operations.
 TEST(DelayLine, PreviewIsExactForACubicSegment) {

@@ -1,6 +1,8 @@
 #pragma once
 // Helpers of the paper-reproduction tests: load a scenario of scenarios/paper/, run it
 // in-process, and read values off the records.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <functional>
 #include <string>
@@ -54,6 +56,22 @@ inline sim::Scenario halved_tolerances(sim::Scenario s) {
   i.atol_grinding /= 2;
   i.atol_current /= 2;
   return s;
+}
+
+/// The sub-um claims that hold for every controller configuration the paper runs them with, on
+/// its three closed-loop moves (each run of the same configuration):
+/// - jerk-limited (Figs. 21-22): |e| <= 0.8 um, control within [-2, 4] V;
+/// - accel-limited (Fig. 20): larger than the jerk-limited error, at most 4.4 um;
+/// - ramp with all three forces (Fig. 23): the plant starts at rest, so e_v(0) = 1 um/s; the
+///   claim holds from the second sample on (notes Sec. 3.5), and < 4 nm/s after 0.25 s.
+inline void expect_sub_um_claims(const PaperRun& jerk, const PaperRun& accel, const PaperRun& ramp) {
+  EXPECT_LE(jerk.sum.position_error_max_abs_m, 0.8e-6);
+  EXPECT_GE(jerk.sum.control_min, -2.0);
+  EXPECT_LE(jerk.sum.control_max, 4.0);
+  EXPECT_GT(accel.sum.position_error_max_abs_m, jerk.sum.position_error_max_abs_m);
+  EXPECT_LE(accel.sum.position_error_max_abs_m, 4.4e-6);
+  EXPECT_LT(ramp.sum.velocity_error_max_abs_after_first_mps, 150e-9);
+  EXPECT_LT(ramp.sum.velocity_error_max_abs_settled_mps, 4e-9);
 }
 
 }  // namespace feeddrive::paper

@@ -104,13 +104,7 @@ TEST(HalvedTolerancesBeyond, EveryClaimStillHolds) {
   const PaperRun jerk = simulate(halved_tolerances(scenario("beyond_jerk_limited")));
   const PaperRun accel = simulate(halved_tolerances(scenario("beyond_accel_limited")));
   const PaperRun ramp = simulate(halved_tolerances(scenario("beyond_ramp_all_forces")));
-  EXPECT_LE(jerk.sum.position_error_max_abs_m, 0.8e-6);
-  EXPECT_GE(jerk.sum.control_min, -2.0);
-  EXPECT_LE(jerk.sum.control_max, 4.0);
-  EXPECT_GT(accel.sum.position_error_max_abs_m, jerk.sum.position_error_max_abs_m);
-  EXPECT_LE(accel.sum.position_error_max_abs_m, 4.4e-6);
-  EXPECT_LT(ramp.sum.velocity_error_max_abs_after_first_mps, 150e-9);
-  EXPECT_LT(ramp.sum.velocity_error_max_abs_settled_mps, 4e-9);
+  expect_sub_um_claims(jerk, accel, ramp);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/plant/plant.hpp"
+#include "jacobian_check.hpp"
 
 namespace feeddrive::plant {
 namespace {
@@ -156,7 +157,8 @@ TEST(Effects, GradientMatchesCentralDifferences) {
 
 // derivative() and jacobian() with every effect that enters f on (the additive ones, presliding
 // and grinding_force folded in, mass_error) and the electrical option (d/di of the reluctance
-// effect): the analytic Jacobian against central differences, as in forces_test.cpp.
+// effect): the analytic Jacobian against central differences (jacobian_check.hpp), and the
+// EffectiveParams overload against the PlantParams one.
 TEST(Effects, DynamicsJacobianMatchesFiniteDifferences) {
   PlantParams p = all_additive();
   p.friction.model = FrictionModel::kStatic;
@@ -167,32 +169,9 @@ TEST(Effects, DynamicsJacobianMatchesFiniteDifferences) {
   p.ripple = feeddrive::plant::RippleParams::paper();
   const EffectiveParams ep(p);
   ASSERT_EQ(ep.params().friction.model, FrictionModel::kLuGre);
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> ux(-0.05, 0.05), uv(-0.1, 0.1), uz(-5e-5, 5e-5),
-      ufg(-50, 50), ui(-5, 5), uu(-3, 3);
-  const StateVector scale{1e-2, 1e-1, 1e-5, 10.0, 1.0};
-  for (int trial = 0; trial < 200; ++trial) {
-    const State s{ux(rng), uv(rng), uz(rng), ufg(rng), ui(rng)};
-    const double u = uu(rng);
-    const Jacobian J = jacobian(p, s, u);
-    const Jacobian Je = jacobian(ep, s, u);
-    for (int c = 0; c < kStateSize; ++c) {
-      const double h = 1e-6 * scale[c];
-      StateVector yp = s.to_vector(), ym = s.to_vector();
-      yp[c] += h;
-      ym[c] -= h;
-      const StateVector fp = derivative(p, State::from_vector(yp), u);
-      const StateVector fm = derivative(p, State::from_vector(ym), u);
-      for (int r = 0; r < kStateSize; ++r) {
-        EXPECT_EQ(J[r][c], Je[r][c]);  // both overloads fold the same effects
-        const double fd = (fp[r] - fm[r]) / (2 * h);
-        // Truncation O(h^2) plus round-off ~1e-15*|f|/h of the difference quotient.
-        const double tol =
-            1e-5 * std::abs(J[r][c]) + 1e-14 * std::max(std::abs(fp[r]), std::abs(fm[r])) / h + 1e-12;
-        EXPECT_NEAR(J[r][c], fd, tol) << "row " << r << " col " << c;
-      }
-    }
-  }
+  test::expect_jacobian_matches_differences(p, 11, 0.1, [&](const State& s, double u, const Jacobian& J) {
+    EXPECT_EQ(J, jacobian(ep, s, u));  // both overloads fold the same effects
+  });
 }
 
 TEST(Effects, ForcesReportTheExtraForceAndTheAccelerationSubtractsIt) {

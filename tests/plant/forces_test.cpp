@@ -7,6 +7,7 @@
 
 #include "feeddrive/plant/dynamics.hpp"
 #include "feeddrive/plant/forces.hpp"
+#include "jacobian_check.hpp"
 
 namespace feeddrive::plant {
 namespace {
@@ -116,30 +117,8 @@ TEST(Dynamics, AnalyticJacobianMatchesFiniteDifferences) {
     p.grinding.contact_position = -1.0;
     p.electrical.enabled = true;
     p.friction.static_smoothing_velocity = 1e-2;
-    std::mt19937_64 rng(42);
-    std::uniform_real_distribution<double> ux(-0.05, 0.05), uv(-0.5, 0.5), uz(-5e-5, 5e-5),
-        ufg(-50, 50), ui(-5, 5), uu(-3, 3);
-    const StateVector scale{1e-2, 1e-1, 1e-5, 10.0, 1.0};
-    for (int trial = 0; trial < 200; ++trial) {
-      State s{ux(rng), uv(rng), uz(rng), ufg(rng), ui(rng)};
-      const double u = uu(rng);
-      const Jacobian J = jacobian(p, s, u);
-      for (int c = 0; c < kStateSize; ++c) {
-        const double h = 1e-6 * scale[c];
-        StateVector yp = s.to_vector(), ym = s.to_vector();
-        yp[c] += h;
-        ym[c] -= h;
-        const StateVector fp = derivative(p, State::from_vector(yp), u);
-        const StateVector fm_ = derivative(p, State::from_vector(ym), u);
-        for (int r = 0; r < kStateSize; ++r) {
-          const double fd = (fp[r] - fm_[r]) / (2 * h);
-          // Truncation O(h^2) plus round-off ~1e-15*|f|/h of the difference quotient.
-          const double tol = 1e-5 * std::abs(J[r][c]) + 1e-14 * std::max(std::abs(fp[r]), std::abs(fm_[r])) / h +
-                             1e-12;
-          EXPECT_NEAR(J[r][c], fd, tol) << "friction " << to_string(fm) << " row " << r << " col " << c;
-        }
-      }
-    }
+    SCOPED_TRACE("friction " + to_string(fm));
+    test::expect_jacobian_matches_differences(p, 42, 0.5);
   }
 }
 

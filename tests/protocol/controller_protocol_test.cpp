@@ -59,8 +59,8 @@ struct Trajectory {
 
 /// A scripted plant: plant::Plant behind a Bus. Publishes state 0 at once and state k+1 when
 /// the first command k arrives (state N: the end-of-run marker), each state `copies` times.
-/// `next_step(k)` may publish something else instead (a skipped step, a conflict): it returns
-/// true when it did. Computes, as each state goes out, the command a second controller built
+/// `next_step(plant, k)` may publish something else instead (a skipped step, a conflict): it
+/// returns true when it did. Computes, as each state goes out, the command a second controller built
 /// from the same scenario gives for it (`expected`): the node's must be bit-identical.
 struct Plant {
   std::unique_ptr<service::Bus> bus;
@@ -72,14 +72,15 @@ struct Plant {
   std::map<std::int64_t, drive_state_t> sent;
   std::map<std::int64_t, controller::Command> expected;
   std::vector<control_command_t> commands;  ///< every command received, copies too
-  std::function<bool(std::int64_t)> next_step;
-  Plant(const Memq& m, const sim::Scenario& sc, int copies_ = 1, std::function<bool(std::int64_t)> hook = {})
+  std::function<bool(Plant&, std::int64_t)> next_step;
+  Plant(const Memq& m, const sim::Scenario& sc, int copies_ = 1,
+        std::function<bool(Plant&, std::int64_t)> hook = {})
       : bus(peer(m)), s(sc), drive(sc.drive(), sc.control_period), twin(sim::make_controller(sc)), refs(references(sc)),
         copies(copies_), next_step(std::move(hook)) {
     bus->subscribe<control_command_t>(kCh.command, [this](const control_command_t& c, std::int64_t) {
       commands.push_back(c);
       if (sent.count(c.seq + 1) || c.seq >= s.steps()) return;  // answered already
-      if (next_step && next_step(c.seq + 1)) return;
+      if (next_step && next_step(*this, c.seq + 1)) return;
       drive.advance(c.u, s.time_of(c.seq + 1));
       publish(state(c.seq + 1));
     });
@@ -127,16 +128,38 @@ void expect_twin_commands(const Plant& p) {
   }
 }
 
-// Lockstep: state k (with reference k there) -> command k -> state k+1 ... -> end of run.
-TEST(ControllerProtocol, LockstepAnswersEachStateOnceWithItsCommand) {
+/// Each test: one memq:// instance, the short scenario and the controller node under test on it.
+class ControllerProtocol : public ::testing::Test {
+ protected:
   Memq memq;
   const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+  std::unique_ptr<ControllerNode> node_;
+
+  /// The node under test: the scenario's controller over memq, with `opt`.
+  ControllerNode& make_node(const service::NodeOptions& opt = node_options()) {
+    node_ = std::make_unique<ControllerNode>(sim::make_controller(s), opt, memq.lcm);
+    return *node_;
+  }
+  /// Starts `plant`, runs the node to the end of the run and checks every command against the
+  /// twin's (expect_twin_commands).
+  void run_to_end(Plant& plant) {
+    plant.start();
+    node_->run();
+    expect_twin_commands(plant);
+  }
+  /// Starts `plant` and runs the node; returns its failure line ("" if the run ended).
+  std::string run_to_failure(Plant& plant) {
+    plant.start();
+    return failure_of([&] { node_->run(); });
+  }
+};
+
+// Lockstep: state k (with reference k there) -> command k -> state k+1 ... -> end of run.
+TEST_F(ControllerProtocol, LockstepAnswersEachStateOnceWithItsCommand) {
+  ControllerNode& node = make_node();
   Trajectory traj(memq, s);
   Plant plant(memq, s);
-  plant.start();
-  node.run();
-  expect_twin_commands(plant);
+  run_to_end(plant);
   EXPECT_EQ(plant.commands.size(), static_cast<std::size_t>(kSteps)) << "one command per step";
   EXPECT_EQ(node.duplicates, 0);
   EXPECT_EQ(node.resends, 0);
@@ -146,13 +169,11 @@ TEST(ControllerProtocol, LockstepAnswersEachStateOnceWithItsCommand) {
 // A repeated state (the plant re-publishes it: the command was lost) gets the same command
 // again, from the outbox: the controller is not run twice (the twin's commands still match at
 // every later step). A resend request on FD_CMD (the monitor's) re-publishes that command too.
-TEST(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+TEST_F(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
+  ControllerNode& node = make_node();
   Trajectory traj(memq, s);
   auto monitor = peer(memq);
-  Plant plant(memq, s, 2, [&](std::int64_t k) {
+  Plant plant(memq, s, 2, [&](Plant&, std::int64_t k) {
     if (k == 8) {
       resend_request_t r{};
       r.requester = "monitor";
@@ -162,9 +183,7 @@ TEST(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
     }
     return false;
   });
-  plant.start();
-  node.run();
-  expect_twin_commands(plant);
+  run_to_end(plant);
   std::map<std::int64_t, int> copies;
   for (const control_command_t& c : plant.commands) {
     ++copies[c.seq];
@@ -179,15 +198,11 @@ TEST(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
 
 // A lost reference: the controller holds state 5 and asks for reference 5 on FD_RESEND (after
 // one resend interval); the trajectory sends it, the step is answered, the run goes on.
-TEST(ControllerProtocol, AsksForAMissingReference) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+TEST_F(ControllerProtocol, AsksForAMissingReference) {
+  make_node();
   Trajectory traj(memq, s, {5});
   Plant plant(memq, s);
-  plant.start();
-  node.run();
-  expect_twin_commands(plant);
+  run_to_end(plant);
   ASSERT_FALSE(traj.requests.empty());
   EXPECT_EQ(traj.requests.front().seq, 5);
   EXPECT_EQ(traj.requests.front().requester, "controller");
@@ -195,52 +210,40 @@ TEST(ControllerProtocol, AsksForAMissingReference) {
 
 // Two different states for one step (another plant on the bus): the run fails, naming the
 // channel, the step and the field.
-TEST(ControllerProtocol, TwoDifferentStatesForOneStepFailTheRun) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+TEST_F(ControllerProtocol, TwoDifferentStatesForOneStepFailTheRun) {
+  ControllerNode& node = make_node();
   Trajectory traj(memq, s);
-  Plant* pp = nullptr;
-  Plant plant(memq, s, 1, [&](std::int64_t k) {
+  Plant plant(memq, s, 1, [](Plant& pl, std::int64_t k) {
     if (k != 3) return false;
-    drive_state_t m = pp->state(3);
-    pp->publish(m);
+    drive_state_t m = pl.state(3);
+    pl.publish(m);
     m.x_measured += 1e-6;
-    pp->bus->publish(kCh.state, m);
+    pl.bus->publish(kCh.state, m);
     return true;
   });
-  pp = &plant;
-  plant.start();
-  const std::string what = failure_of([&] { node.run(); });
+  const std::string what = run_to_failure(plant);
   expect_conflict(what, kCh.state, 3, "drive_state_t", "x_measured");
   EXPECT_EQ(node.conflicts, 1);
 }
 
 // A state that skips a step (state 4 while step 3 has no command): the plant's protocol error,
 // named as the plant's, not left to look like the controller's stall.
-TEST(ControllerProtocol, ASkippedStepIsThePlantsProtocolError) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+TEST_F(ControllerProtocol, ASkippedStepIsThePlantsProtocolError) {
+  make_node();
   Trajectory traj(memq, s);
-  Plant* pp = nullptr;
-  Plant plant(memq, s, 1, [&](std::int64_t k) {
+  Plant plant(memq, s, 1, [](Plant& pl, std::int64_t k) {
     if (k != 3) return false;
-    pp->publish(pp->state(4));
+    pl.publish(pl.state(4));
     return true;
   });
-  pp = &plant;
-  plant.start();
-  const std::string what = failure_of([&] { node.run(); });
+  const std::string what = run_to_failure(plant);
   EXPECT_EQ(what.rfind("protocol error of the plant: it published state 4 while step 3 has no command yet", 0), 0u) << what;
 }
 
 // A plant of another run publishing its own state 0 first: counted as foreign, not answered, not
 // a conflict with this run's state 0.
-TEST(ControllerProtocol, StatesOfAnotherRunAreCountedAndIgnored) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), node_options(), memq.lcm);
+TEST_F(ControllerProtocol, StatesOfAnotherRunAreCountedAndIgnored) {
+  ControllerNode& node = make_node();
   Trajectory traj(memq, s);
   auto other = peer(memq, 99);
   drive_state_t foreign{};
@@ -250,32 +253,26 @@ TEST(ControllerProtocol, StatesOfAnotherRunAreCountedAndIgnored) {
   foreign.previous = service::no_applied();
   other->publish(kCh.state, foreign);
   Plant plant(memq, s);
-  plant.start();
-  node.run();
-  expect_twin_commands(plant);
+  run_to_end(plant);
   EXPECT_EQ(node.bus().foreign(), 1);
   EXPECT_EQ(node.conflicts, 0);
 }
 
 // No plant: --start-timeout, naming the plant. Lower bound: the protocol; upper: a hang (10 s).
-TEST(ControllerProtocol, NoPlantFailsAfterTheStartTimeout) {
-  Memq memq;
+TEST_F(ControllerProtocol, NoPlantFailsAfterTheStartTimeout) {
   service::NodeOptions opt = node_options();
   opt.start_timeout_s = 0.3;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), opt, memq.lcm);
+  ControllerNode& node = make_node(opt);
   expect_failure_after(0.3, "no state from the plant for step 0 within 0.3 s",
                        [&] { return failure_of([&] { node.run(); }); });
 }
 
 // State 0 but no trajectory: the controller asks for reference 0 meanwhile (every resend
 // interval), then fails naming the trajectory.
-TEST(ControllerProtocol, NoTrajectoryFailsAfterTheStartTimeout) {
-  Memq memq;
+TEST_F(ControllerProtocol, NoTrajectoryFailsAfterTheStartTimeout) {
   service::NodeOptions opt = node_options();
   opt.start_timeout_s = 0.3;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), opt, memq.lcm);
+  ControllerNode& node = make_node(opt);
   std::vector<resend_request_t> asked;
   auto listener = peer(memq);
   listener->subscribe<resend_request_t>(kCh.resend, [&](const resend_request_t& r, std::int64_t) { asked.push_back(r); });
@@ -290,14 +287,12 @@ TEST(ControllerProtocol, NoTrajectoryFailsAfterTheStartTimeout) {
 }
 
 // A plant that stops after step 3 (no heartbeat either): --step-timeout, naming the plant.
-TEST(ControllerProtocol, ASilentPlantFailsAfterTheStepTimeout) {
-  Memq memq;
+TEST_F(ControllerProtocol, ASilentPlantFailsAfterTheStepTimeout) {
   service::NodeOptions opt = node_options();
   opt.step_timeout_s = 0.2;
-  const sim::Scenario s = scenario(kSteps);
-  ControllerNode node(sim::make_controller(s), opt, memq.lcm);
+  ControllerNode& node = make_node(opt);
   Trajectory traj(memq, s);
-  Plant plant(memq, s, 1, [](std::int64_t k) { return k >= 4; });
+  Plant plant(memq, s, 1, [](Plant&, std::int64_t k) { return k >= 4; });
   plant.start();
   expect_failure_after(0.2, "no state from the plant for step 4 within 0.2 s",
                        [&] { return failure_of([&] { node.run(); }); });

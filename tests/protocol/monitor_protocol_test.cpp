@@ -154,17 +154,36 @@ void expect_complete_record(const std::string& name) {
   }
 }
 
-// Lockstep: every step recorded, the run announced done with every step acknowledged, its
-// self-description (run_info_t) and summary published.
-TEST(MonitorProtocol, RecordsEveryStepAndAcknowledgesIt) {
+/// Each test: one memq:// instance, the run's script, a listener for what the monitor
+/// publishes, a peer to publish the run's messages on, and the monitor under test.
+class MonitorProtocol : public ::testing::Test {
+ protected:
   Memq memq;
   const Script script;
-  MonitorNode node(script.s, node_options(), monitor_options("lockstep"), memq.lcm);
-  Listener listener(memq);
-  auto run = peer(memq);
-  script.publish(*run);
-  EXPECT_TRUE(node.run());
-  listener.wait_for_the_end();
+  Listener listener{memq};
+  std::unique_ptr<service::Bus> run = peer(memq);
+  std::unique_ptr<MonitorNode> node_;
+
+  /// The monitor under test, recording to out_dir(name), with `opt`.
+  MonitorNode& make_node(const std::string& name, const service::NodeOptions& opt = node_options()) {
+    node_ = std::make_unique<MonitorNode>(script.s, opt, monitor_options(name), memq.lcm);
+    return *node_;
+  }
+  /// Publishes the script (Script::publish, with `skip`), runs the monitor and waits for its
+  /// closing messages; returns what run() returned (true: the run completed).
+  bool run_script(const std::function<bool(const std::string&, std::int64_t)>& skip = {}) {
+    script.publish(*run, skip);
+    const bool completed = node_->run();
+    listener.wait_for_the_end();
+    return completed;
+  }
+};
+
+// Lockstep: every step recorded, the run announced done with every step acknowledged, its
+// self-description (run_info_t) and summary published.
+TEST_F(MonitorProtocol, RecordsEveryStepAndAcknowledgesIt) {
+  MonitorNode& node = make_node("lockstep");
+  EXPECT_TRUE(run_script());
   const run_summary_t& sum = node.summary();
   EXPECT_TRUE(sum.completed) << sum.failure;
   EXPECT_EQ(sum.steps, kSteps);
@@ -188,12 +207,8 @@ TEST(MonitorProtocol, RecordsEveryStepAndAcknowledgesIt) {
 // A lost command: the monitor asks for it on FD_RESEND (only for it: every other message of the
 // run is there), the controller re-sends it, the record is complete. A state that arrives twice
 // is a duplicate, recorded once.
-TEST(MonitorProtocol, AsksForWhatIsMissingAndIgnoresDuplicates) {
-  Memq memq;
-  const Script script;
-  MonitorNode node(script.s, node_options(), monitor_options("resend"), memq.lcm);
-  Listener listener(memq);
-  auto run = peer(memq);
+TEST_F(MonitorProtocol, AsksForWhatIsMissingAndIgnoresDuplicates) {
+  MonitorNode& node = make_node("resend");
   run->subscribe<resend_request_t>(kCh.resend, [&](const resend_request_t& r, std::int64_t) {
     if (r.channel == kCh.command && r.seq == 7) run->publish(kCh.command, script.commands[7]);
   });
@@ -214,20 +229,14 @@ TEST(MonitorProtocol, AsksForWhatIsMissingAndIgnoresDuplicates) {
 }
 
 // Two different states for one step: the run fails naming it; what was recorded is kept.
-TEST(MonitorProtocol, TwoDifferentStatesForOneStepFailTheRun) {
-  Memq memq;
-  const Script script;
-  MonitorNode node(script.s, node_options(), monitor_options("state_conflict"), memq.lcm);
-  Listener listener(memq);
-  auto run = peer(memq);
+TEST_F(MonitorProtocol, TwoDifferentStatesForOneStepFailTheRun) {
+  MonitorNode& node = make_node("state_conflict");
   drive_state_t other = script.states[5];
   other.x_measured += 1e-6;
-  script.publish(*run, [&](const std::string& what, std::int64_t k) {
+  EXPECT_FALSE(run_script([&](const std::string& what, std::int64_t k) {
     if (what == "state" && k == 6) run->publish(kCh.state, other);  // after state 5
     return false;
-  });
-  EXPECT_FALSE(node.run());
-  listener.wait_for_the_end();
+  }));
   expect_conflict(node.summary().failure, kCh.state, 5, "drive_state_t", "x_measured");
   EXPECT_FALSE(node.summary().completed);
   EXPECT_EQ(node.summary().conflicts, 1);
@@ -237,20 +246,14 @@ TEST(MonitorProtocol, TwoDifferentStatesForOneStepFailTheRun) {
 
 // Two different commands for one step (a forged one raced the controller's): the run fails and
 // the failure says which one the plant applied (its state 6 says: the first, 0.55 V).
-TEST(MonitorProtocol, ACommandConflictNamesTheCommandThePlantApplied) {
-  Memq memq;
-  const Script script;
-  MonitorNode node(script.s, node_options(), monitor_options("command_conflict"), memq.lcm);
-  Listener listener(memq);
-  auto run = peer(memq);
+TEST_F(MonitorProtocol, ACommandConflictNamesTheCommandThePlantApplied) {
+  MonitorNode& node = make_node("command_conflict");
   control_command_t forged = script.commands[5];
   forged.u = forged.u_unsaturated = -1.0;
-  script.publish(*run, [&](const std::string& what, std::int64_t k) {
+  EXPECT_FALSE(run_script([&](const std::string& what, std::int64_t k) {
     if (what == "command" && k == 6) run->publish(kCh.command, forged);  // after command 5
     return false;
-  });
-  EXPECT_FALSE(node.run());
-  listener.wait_for_the_end();
+  }));
   const std::string failure = node.summary().failure;
   EXPECT_EQ(failure.rfind("conflict on FD_CMD step 5", 0), 0u) << failure;
   EXPECT_NE(failure.find("the plant applied u = 0.55 V from an unknown sender at step 5 (the other command, u = -1 V"),
@@ -259,19 +262,13 @@ TEST(MonitorProtocol, ACommandConflictNamesTheCommandThePlantApplied) {
 
 // Messages of another run (a second run on the group): counted as foreign, never recorded, the
 // run completes.
-TEST(MonitorProtocol, MessagesOfAnotherRunAreCountedAndIgnored) {
-  Memq memq;
-  const Script script;
-  MonitorNode node(script.s, node_options(), monitor_options("foreign"), memq.lcm);
-  Listener listener(memq);
+TEST_F(MonitorProtocol, MessagesOfAnotherRunAreCountedAndIgnored) {
+  MonitorNode& node = make_node("foreign");
   auto other = peer(memq, 99);
   drive_state_t foreign = script.states[3];
   foreign.x_measured = 1.0;
   other->publish(kCh.state, foreign);
-  auto run = peer(memq);
-  script.publish(*run);
-  EXPECT_TRUE(node.run());
-  listener.wait_for_the_end();
+  EXPECT_TRUE(run_script());
   EXPECT_TRUE(node.summary().completed) << node.summary().failure;
   EXPECT_EQ(node.summary().foreign, 1);
   EXPECT_EQ(node.summary().conflicts, 0);
@@ -281,14 +278,10 @@ TEST(MonitorProtocol, MessagesOfAnotherRunAreCountedAndIgnored) {
 // A command that never comes (and no controller heartbeat: nobody is waiting on someone else):
 // after --step-timeout the run fails naming the message and its role, having asked for it
 // meanwhile; the steps before it are recorded. Lower bound: the protocol; upper: a hang (10 s).
-TEST(MonitorProtocol, AMissingCommandFailsAfterTheStepTimeout) {
-  Memq memq;
-  const Script script;
+TEST_F(MonitorProtocol, AMissingCommandFailsAfterTheStepTimeout) {
   service::NodeOptions opt = node_options();
   opt.step_timeout_s = 0.3;
-  MonitorNode node(script.s, opt, monitor_options("step_timeout"), memq.lcm);
-  Listener listener(memq);
-  auto run = peer(memq);
+  MonitorNode& node = make_node("step_timeout", opt);
   script.publish(*run, [](const std::string& what, std::int64_t k) { return what == "command" && k == 7; });
   expect_failure_after(0.3, "step 7 incomplete for 0.3 s: no command 7 from the controller", [&] {
     EXPECT_FALSE(node.run());
@@ -301,13 +294,10 @@ TEST(MonitorProtocol, AMissingCommandFailsAfterTheStepTimeout) {
 }
 
 // Nothing at all: --start-timeout, naming what step 0 lacks, the plant's state first.
-TEST(MonitorProtocol, NoRunFailsAfterTheStartTimeout) {
-  Memq memq;
-  const Script script;
+TEST_F(MonitorProtocol, NoRunFailsAfterTheStartTimeout) {
   service::NodeOptions opt = node_options();
   opt.start_timeout_s = 0.3;
-  MonitorNode node(script.s, opt, monitor_options("start_timeout"), memq.lcm);
-  Listener listener(memq);
+  MonitorNode& node = make_node("start_timeout", opt);
   expect_failure_after(0.3, "step 0 incomplete for 0.3 s: no state 0 from the plant", [&] {
     EXPECT_FALSE(node.run());
     return node.summary().failure;

@@ -93,18 +93,38 @@ void expect_states_of_a_plant_driven_by(const sim::Scenario& s, const std::map<s
   }
 }
 
-// Lockstep: state k, command k, state k+1 ... the end-of-run marker N; every state once (the
-// controller answers at once, within the plant's poll), nothing counted as duplicate or conflict.
-TEST(PlantProtocol, LockstepStepsApplyEachCommandToItsStep) {
+/// The controller's usual answer: command k with u_of(k), once, to the first copy of state k.
+std::vector<control_command_t> answer_first_copy(std::int64_t k, int copy) {
+  return copy == 1 ? std::vector<control_command_t>{command(k, u_of(k))} : std::vector<control_command_t>{};
+}
+
+/// Each test: one memq:// instance, the short scenario and the plant node under test on it.
+class PlantProtocol : public ::testing::Test {
+ protected:
   Memq memq;
   const sim::Scenario s = scenario(kSteps);
-  PlantNode plant(s, node_options(), memq.lcm);
-  Controller ctl(memq, [](std::int64_t k, int copy) {
-    return copy == 1 ? std::vector<control_command_t>{command(k, u_of(k))} : std::vector<control_command_t>{};
-  });
-  plant.run();
-  ctl.wait_for_the_end();
-  expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  std::unique_ptr<PlantNode> plant_;
+
+  /// The node under test: the scenario's plant over memq, with `opt`.
+  PlantNode& make_plant(const service::NodeOptions& opt = node_options()) {
+    plant_ = std::make_unique<PlantNode>(s, opt, memq.lcm);
+    return *plant_;
+  }
+  /// Runs the plant to the end of the run and checks the states `ctl` heard against a plant
+  /// driven directly by u_of (expect_states_of_a_plant_driven_by).
+  void run_to_end(Controller& ctl) {
+    plant_->run();
+    ctl.wait_for_the_end();
+    expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  }
+};
+
+// Lockstep: state k, command k, state k+1 ... the end-of-run marker N; every state once (the
+// controller answers at once, within the plant's poll), nothing counted as duplicate or conflict.
+TEST_F(PlantProtocol, LockstepStepsApplyEachCommandToItsStep) {
+  PlantNode& plant = make_plant();
+  Controller ctl(memq, answer_first_copy);
+  run_to_end(ctl);
   EXPECT_EQ(ctl.states.front().seq, 0);
   EXPECT_TRUE(ctl.states.back().end_of_run);
   EXPECT_EQ(plant.duplicates, 0);
@@ -115,16 +135,12 @@ TEST(PlantProtocol, LockstepStepsApplyEachCommandToItsStep) {
 // A lost command: the controller ignores the first copy of every state, so the plant must
 // re-publish each state (every resend interval, 2 ms) until it is answered; the copies are the
 // same message (the sensor noise is drawn once per step) and the run is the same.
-TEST(PlantProtocol, ResendsAStateUntilItIsAnswered) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  PlantNode plant(s, node_options(), memq.lcm);
+TEST_F(PlantProtocol, ResendsAStateUntilItIsAnswered) {
+  PlantNode& plant = make_plant();
   Controller ctl(memq, [](std::int64_t k, int copy) {
     return copy == 2 ? std::vector<control_command_t>{command(k, u_of(k))} : std::vector<control_command_t>{};
   });
-  plant.run();
-  ctl.wait_for_the_end();
-  expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  run_to_end(ctl);
   EXPECT_GE(plant.resends, kSteps) << "each of the N states went out again at least once";
   for (std::int64_t k = 0; k < kSteps; ++k) EXPECT_GE(ctl.copies[k], 2) << k;
   const auto firsts = ctl.firsts();
@@ -136,17 +152,13 @@ TEST(PlantProtocol, ResendsAStateUntilItIsAnswered) {
 
 // A command sent twice (the controller re-publishes it) is applied once: a duplicate, counted,
 // the run unchanged.
-TEST(PlantProtocol, ARepeatedCommandIsADuplicate) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  PlantNode plant(s, node_options(), memq.lcm);
+TEST_F(PlantProtocol, ARepeatedCommandIsADuplicate) {
+  PlantNode& plant = make_plant();
   Controller ctl(memq, [](std::int64_t k, int copy) {
     return copy == 1 ? std::vector<control_command_t>{command(k, u_of(k)), command(k, u_of(k))}
                      : std::vector<control_command_t>{};
   });
-  plant.run();
-  ctl.wait_for_the_end();
-  expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  run_to_end(ctl);
   // The second copy of command k is handled at the plant's next poll (the last one at the
   // controller's poll for the end, wait_for_the_end, at the latest).
   EXPECT_EQ(plant.duplicates, kSteps);
@@ -155,9 +167,8 @@ TEST(PlantProtocol, ARepeatedCommandIsADuplicate) {
 
 // Two different commands for one step (a second publisher): by default the run fails naming the
 // channel, the step and the fields; state 4 is never published.
-TEST(PlantProtocol, TwoDifferentCommandsForOneStepFailTheRun) {
-  Memq memq;
-  PlantNode plant(scenario(kSteps), node_options(), memq.lcm);
+TEST_F(PlantProtocol, TwoDifferentCommandsForOneStepFailTheRun) {
+  PlantNode& plant = make_plant();
   Controller ctl(memq, [](std::int64_t k, int copy) {
     std::vector<control_command_t> v;
     if (copy == 1) v.push_back(command(k, u_of(k)));
@@ -171,47 +182,36 @@ TEST(PlantProtocol, TwoDifferentCommandsForOneStepFailTheRun) {
 }
 
 // --on-conflict keep-first: the second command is dropped and counted; the first one acts.
-TEST(PlantProtocol, KeepFirstAppliesTheFirstOfTwoCommands) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
+TEST_F(PlantProtocol, KeepFirstAppliesTheFirstOfTwoCommands) {
   service::NodeOptions opt = node_options();
   opt.on_conflict = service::ConflictPolicy::kKeepFirst;
-  PlantNode plant(s, opt, memq.lcm);
+  PlantNode& plant = make_plant(opt);
   Controller ctl(memq, [](std::int64_t k, int copy) {
     std::vector<control_command_t> v;
     if (copy == 1) v.push_back(command(k, u_of(k)));
     if (copy == 1 && k == 3) v.push_back(command(k, -1.0));
     return v;
   });
-  plant.run();
-  ctl.wait_for_the_end();
-  expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  run_to_end(ctl);
   EXPECT_EQ(plant.conflicts, 1);
 }
 
 // A controller of another run answering first on the same channels: its commands are counted as
 // foreign and never applied; this run's controller drives the plant.
-TEST(PlantProtocol, CommandsOfAnotherRunAreCountedAndIgnored) {
-  Memq memq;
-  const sim::Scenario s = scenario(kSteps);
-  PlantNode plant(s, node_options(), memq.lcm);
+TEST_F(PlantProtocol, CommandsOfAnotherRunAreCountedAndIgnored) {
+  PlantNode& plant = make_plant();
   Controller other(memq, [](std::int64_t k, int copy) {
     return copy == 1 ? std::vector<control_command_t>{command(k, -2.0)} : std::vector<control_command_t>{};
   }, 99);
-  Controller ctl(memq, [](std::int64_t k, int copy) {
-    return copy == 1 ? std::vector<control_command_t>{command(k, u_of(k))} : std::vector<control_command_t>{};
-  });
-  plant.run();
-  ctl.wait_for_the_end();
-  expect_states_of_a_plant_driven_by(s, ctl.firsts(), u_of);
+  Controller ctl(memq, answer_first_copy);
+  run_to_end(ctl);
   EXPECT_EQ(plant.bus().foreign(), kSteps) << "one foreign command per step";
   EXPECT_EQ(plant.conflicts, 0);
 }
 
 // A command for a step the plant has not reached: the controller's protocol error, named.
-TEST(PlantProtocol, ACommandAheadOfTheStepFailsTheRun) {
-  Memq memq;
-  PlantNode plant(scenario(kSteps), node_options(), memq.lcm);
+TEST_F(PlantProtocol, ACommandAheadOfTheStepFailsTheRun) {
+  PlantNode& plant = make_plant();
   Controller ctl(memq, [](std::int64_t k, int copy) {
     return copy == 1 ? std::vector<control_command_t>{command(k == 3 ? 5 : k, u_of(k))} : std::vector<control_command_t>{};
   });
@@ -222,11 +222,10 @@ TEST(PlantProtocol, ACommandAheadOfTheStepFailsTheRun) {
 // No controller: the plant fails after --start-timeout at step 0, naming the controller. The
 // lower bound is the protocol (it never gives up early, re-publishing state 0 meanwhile); the
 // upper bound only catches a hang (10 s: generous for a loaded machine).
-TEST(PlantProtocol, NoControllerFailsAfterTheStartTimeout) {
-  Memq memq;
+TEST_F(PlantProtocol, NoControllerFailsAfterTheStartTimeout) {
   service::NodeOptions opt = node_options();
   opt.start_timeout_s = 0.3;
-  PlantNode plant(scenario(kSteps), opt, memq.lcm);
+  PlantNode& plant = make_plant(opt);
   Controller silent(memq, [](std::int64_t, int) { return std::vector<control_command_t>{}; });
   expect_failure_after(0.3, "no command from the controller for step 0 within 0.3 s",
                        [&] { return failure_of([&] { plant.run(); }); });
@@ -235,11 +234,10 @@ TEST(PlantProtocol, NoControllerFailsAfterTheStartTimeout) {
 
 // A controller that stops answering mid-run (and sends no heartbeat, so it is not waiting on
 // someone else): --step-timeout at that step.
-TEST(PlantProtocol, ASilentControllerFailsAfterTheStepTimeout) {
-  Memq memq;
+TEST_F(PlantProtocol, ASilentControllerFailsAfterTheStepTimeout) {
   service::NodeOptions opt = node_options();
   opt.step_timeout_s = 0.2;
-  PlantNode plant(scenario(kSteps), opt, memq.lcm);
+  PlantNode& plant = make_plant(opt);
   Controller ctl(memq, [](std::int64_t k, int copy) {
     return copy == 1 && k < 5 ? std::vector<control_command_t>{command(k, u_of(k))} : std::vector<control_command_t>{};
   });
@@ -250,12 +248,11 @@ TEST(PlantProtocol, ASilentControllerFailsAfterTheStepTimeout) {
 // The monitor's flow control (--monitor-window 4): the plant never runs more than 4 steps ahead
 // of the monitor's acknowledged step. The scripted monitor acknowledges step 2 and no more: the
 // plant publishes states 0..5 and then fails after --step-timeout naming the monitor.
-TEST(PlantProtocol, StaysWithinTheMonitorsWindowAndFailsWithoutItsAcknowledgement) {
-  Memq memq;
+TEST_F(PlantProtocol, StaysWithinTheMonitorsWindowAndFailsWithoutItsAcknowledgement) {
   service::NodeOptions opt = node_options();
   opt.monitor_window = 4;
   opt.step_timeout_s = 0.2;
-  PlantNode plant(scenario(kSteps), opt, memq.lcm);
+  PlantNode& plant = make_plant(opt);
   auto monitor = peer(memq);
   const auto ack = [&](std::int64_t acked) {
     process_status_t st{};
@@ -277,12 +274,11 @@ TEST(PlantProtocol, StaysWithinTheMonitorsWindowAndFailsWithoutItsAcknowledgemen
 }
 
 // No monitor at all with a window: the plant waits --start-timeout for the first acknowledgement.
-TEST(PlantProtocol, NoMonitorFailsAfterTheStartTimeout) {
-  Memq memq;
+TEST_F(PlantProtocol, NoMonitorFailsAfterTheStartTimeout) {
   service::NodeOptions opt = node_options();
   opt.monitor_window = 4;
   opt.start_timeout_s = 0.3;
-  PlantNode plant(scenario(kSteps), opt, memq.lcm);
+  PlantNode& plant = make_plant(opt);
   Controller ctl(memq, [](std::int64_t k, int) { return std::vector<control_command_t>{command(k, u_of(k))}; });
   expect_failure_after(0.3, "no acknowledgement from the monitor for step 0 within 0.3 s (is feeddrive-monitor running?)",
                        [&] { return failure_of([&] { plant.run(); }); });

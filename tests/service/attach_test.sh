@@ -9,7 +9,7 @@ source "$(dirname "$0")/lib.sh" "$@"
 # 10 s of the jerk-limited move (100,000 steps, about 3 s of lockstep at 33,000 steps/s): long
 # enough to join after 1 s and be stopped for 1 s.
 scen=$TMP/long.yaml
-sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+jerk_move "$scen" 10.0
 timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --lcm-url "$URL" & l=$!
 wait_on_bus $l feeddrive-monitor
 sleep 1.0  # under test: joining a run 1 s after its start (a deliberate point, not a wait)

@@ -7,8 +7,7 @@ source "$(dirname "$0")/lib.sh" "$@"
 # The jerk-limited move held for 10 s (100,000 steps, ~10 s of lockstep): still running when a
 # process is killed after 1.5 s, however fast the machine.
 scen=$TMP/long.yaml
-sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
-grep -q '^duration: 10.0' "$scen" || fail "could not lengthen the scenario"
+jerk_move "$scen" 10.0
 opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
 for role in controller plant trajectory; do
   out=$TMP/$role

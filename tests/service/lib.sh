@@ -63,6 +63,12 @@ wait_on_bus() {
 }
 # json FILE JQ-FILTER
 json() { jq -r "$2" "$1"; }
+# jerk_move FILE SECONDS: the paper's jerk-limited move (scenarios/paper/smc_bl_jerk_limited.yaml)
+# with its duration set to SECONDS, written to FILE; fails the test if no duration line was set.
+jerk_move() {
+  sed "s/^duration: .*/duration: $2/" "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$1"
+  grep -q "^duration: $2\$" "$1" || fail "could not set the duration of $1 to $2"
+}
 # Runs feeddrive-sim on a scenario into DIR (the in-process reference result).
 sim_run() { timeout 300 feeddrive-sim "$1" --out "$2" --no-plots --quiet; }
 # Same bytes or fail, naming the first differing line.

@@ -19,7 +19,7 @@ done
 # The recording options hold for the monitor too (one writer, sim::RunWriter): every 7th row, three
 # columns, the same bytes as feeddrive-sim, and the summary still of every step.
 scen=$TMP/options.yaml
-sed 's/^duration: .*/duration: 0.3/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
+jerk_move "$scen" 0.3
 printf 'output: {every: 7, columns: [t, x, u]}\n' >> "$scen"
 sim_run "$scen" "$TMP/sim_options"
 timeout 300 feeddrive-launch "$scen" --out "$TMP/mp_options" --no-plots -q --lcm-url "$URL"

@@ -11,8 +11,7 @@
 #    which names the channel and the step and says it may be a stale step number.
 source "$(dirname "$0")/lib.sh" "$@"
 scen=$TMP/long.yaml
-sed 's/^duration: .*/duration: 10.0/' "$SRC/scenarios/paper/smc_bl_jerk_limited.yaml" > "$scen"
-grep -q '^duration: 10.0' "$scen" || fail "could not lengthen the scenario"
+jerk_move "$scen" 10.0
 opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
 timeout 60 feeddrive-launch "$scen" --out "$TMP/stall" --no-plots --external controller "${opts[@]}" 2> "$TMP/launch.err" & l=$!
 feeddrive-controller "$scen" "${opts[@]}" 2> "$TMP/controller.err" & c=$!

@@ -10,6 +10,7 @@
 // plant's rule: floating-point t_j + d may miss a period boundary by a few ulps).
 
 #include <deque>
+#include <functional>
 #include <vector>
 
 #include "feeddrive/trajectory/trajectory.hpp"
@@ -29,6 +30,15 @@ class DelayLine {
   void push(double t, double u);
   /// The pieces of [t0, t1] with their acting command.
   std::vector<Piece> pieces(double t0, double t1) const;
+  /// The velocity and position increments over [t0, t1] of the model acceleration a(u) of the
+  /// command acting on each piece (piecewise constant: the double integral of a piecewise-constant
+  /// acceleration):  dv = sum_i a_i*tau_i,  dx = sum_i a_i*tau_i*(tau_i/2 + (t1 - t1_i)), with
+  /// tau_i = t1_i - t0_i the length of piece i. What StateObserver::predict_increments takes.
+  struct Increments {
+    double dv = 0.0;  ///< [m/s]
+    double dx = 0.0;  ///< [m]
+  };
+  Increments increments(double t0, double t1, const std::function<double(double)>& acceleration) const;
   /// Drops the commands that no longer act at or after t.
   void forget_before(double t);
   double delay() const { return delay_; }

@@ -50,4 +50,22 @@ int run_node(NodeType& node) {
   return 0;
 }
 
+/// The main() body of a run process built from the scenario alone (feeddrive-plant,
+/// feeddrive-trajectory): the scenario argument and the common options, the scenario loaded and
+/// its hash checked against the monitor's run_info_t, then NodeType(scenario, opt) under
+/// run_node, all inside run_process.
+template <typename NodeType>
+int run_scenario_node(CLI::App& app, int argc, char** argv) {
+  std::string scenario_path;
+  NodeOptions opt;
+  app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
+  add_node_options(app, opt);
+  return run_process(app, argc, argv, opt, [&] {
+    const RunScenario rs = load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    opt.scenario_hash = rs.sha256;  // checked against the monitor's run_info_t
+    NodeType node(rs.scenario, opt);
+    return run_node(node);
+  });
+}
+
 }  // namespace feeddrive::service
