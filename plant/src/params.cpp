@@ -33,8 +33,9 @@ void FrictionParams::validate(const std::string& prefix) const {
     fail(prefix + ".static_force", static_force, "must be >= coulomb_force");
 }
 
+// A section that is off is checked as well: a key written in it must be valid even while it does
+// not act (docs/scenario.md, "Valid (else exit 2)"); the loader warns that it does not act.
 void RippleParams::validate(const std::string& prefix) const {
-  if (!enabled) return;
   fields::check_fields(*this, prefix);
   // |r(x)| < 1 keeps the thrust's sign: F_des*(1 - r(x)) never reverses.
   if (std::abs(reluctance_amplitude) + std::abs(reluctance_third) >= 1.0)
@@ -48,12 +49,10 @@ double GrindingParams::damping() const {
 double GrindingParams::time_constant() const { return damping() / stiffness; }
 
 void GrindingParams::validate(const std::string& prefix) const {
-  if (!enabled) return;
   fields::check_fields(*this, prefix);
 }
 
 void ElectricalParams::validate(const std::string& prefix) const {
-  if (!enabled) return;
   fields::check_fields(*this, prefix);
 }
 

@@ -309,7 +309,7 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   // The true state where it exists (a simulated plant), else the measurement (hardware).
   const bool truth = reduced.has_samples(kX);
   std::ostringstream gp;
-  gp << "data = 'plot.csv'\nset xlabel 't [s]'\n";
+  gp << "data = 'plot.csv'\nset xlabel 't [s]'\nset autoscale xfix\n";  // the run's time span, not rounded to a tick
   gp << "set output 'position.png'\nset multiplot layout 2,1 title " << t << "\n"
      << "set ylabel 'position [mm]'\n"
      << (truth ? panel({{kXd, "*1e3", "lw 2 ", "x_d"}, {kX, "*1e3", "", "x"}}, "no position recorded")
@@ -323,7 +323,7 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n" << panel({{kU, "", "", "u"}}, "no command recorded");
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
      << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}},
-              "no friction, ripple or grinding force in this run", true);
+              "no friction, ripple or grinding force of the paper model in this run (forces of plant.effects are not drawn)", true);
   dir.plot(gp.str());
 }
 

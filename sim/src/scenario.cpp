@@ -278,11 +278,12 @@ void find_warnings(Scenario& s) {
     top.Visit(fields::field("control_period", s.control_period).unit("s").plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period"));
     top.Visit(fields::field("controller.computation_delay", s.controller.computation_delay).unit("s").plausible(0, 0.01, "ms", "", "a servo drive's delay"));
   }
-  PlantParams plant = s.plant;
-  if (!plant.ripple.enabled) plant.ripple = {};  // the keys of a section that is off do not act
-  if (!plant.grinding.enabled) plant.grinding = {};
-  if (!plant.electrical.enabled) plant.electrical = {};
-  add(fields::plausibility(plant, "plant"));
+  add(fields::plausibility(s.plant, "plant"));  // sections that are off too: their keys were written
+  const auto warned = [&w](const std::string& key, std::size_t from) {
+    for (std::size_t i = from; i < w.size(); ++i)
+      if (w[i].rfind(key, 0) == 0) return true;
+    return false;
+  };
   switch (s.controller.type) {
     case ControllerType::kSlidingMode: add(fields::plausibility(s.controller.sliding_mode, "controller")); break;
     case ControllerType::kCascade: add(fields::plausibility(s.controller.cascade, "controller")); break;
@@ -299,15 +300,24 @@ void find_warnings(Scenario& s) {
     case ReferenceType::kWaypoints: break;
   }
   const ReferenceType t = s.reference.type;
-  if (t == ReferenceType::kAccelLimited || t == ReferenceType::kSCurve || t == ReferenceType::kWaypoints) {
+  if (t == ReferenceType::kAccelLimited || t == ReferenceType::kSCurve || t == ReferenceType::kWaypoints ||
+      t == ReferenceType::kStep) {
     s.move_end_s = make_reference(s)->end_time();
-    if (s.move_end_s > s.duration)
-    {
-      char buf[200];
+    if (s.move_end_s > s.duration) {
+      // The likely cause: a distance or a start in the wrong unit (already warned above), else
+      // a duration too short for the move.
+      double start = 0.0;
+      if (t == ReferenceType::kAccelLimited) start = s.reference.accel_limited.start_time;
+      if (t == ReferenceType::kSCurve) start = s.reference.scurve.start_time;
+      if (t == ReferenceType::kStep) start = s.reference.step.step_time;
+      const char* hint = warned("reference.distance", 0) ? "a distance in mm?"
+                         : start >= s.duration     ? (t == ReferenceType::kStep ? "a step_time in ms?" : "a start_time in ms?")
+                                                   : "a longer duration?";
+      char buf[240];
       std::snprintf(buf, sizeof buf,
                     "reference: the move ends at t = %.4g s, after duration = %.4g s: the run cuts it off (summary.json "
-                    "move_finished: false); a longer duration, or a distance in mm?",
-                    s.move_end_s, s.duration);
+                    "move_finished: false); %s",
+                    s.move_end_s, s.duration, hint);
       w.push_back(buf);
     }
   }
@@ -337,6 +347,20 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     MapReader plant = top.child("plant");
     s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
     read_plant(plant, s.plant, true);
+    // A section given with keys but off: its keys do not act (a forgotten enabled: true).
+    const YAML::Node pn = root["plant"];
+    const std::pair<const char*, bool> sections[] = {
+        {"ripple", s.plant.ripple.enabled}, {"grinding", s.plant.grinding.enabled}, {"electrical", s.plant.electrical.enabled}};
+    for (const auto& [name, on] : sections) {
+      if (on || !pn.IsMap()) continue;
+      const YAML::Node sec = pn[name];
+      if (!sec.IsMap()) continue;
+      for (const auto& kv : sec)
+        if (kv.first.IsScalar() && kv.first.Scalar() != "enabled") {
+          s.warnings.push_back(std::string("plant.") + name + ": keys given, but the section is off (enabled: false): they do not act; enabled: true?");
+          break;
+        }
+    }
   }
 
   MapReader c = top.child("controller");

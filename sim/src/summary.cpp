@@ -230,6 +230,9 @@ void SummaryBuilder::finish_move(Summary& m) const {
   m.move_start_s = move_start_;
   if (distance_ != 0.0) {
     if (!std::isnan(t10_) && !std::isnan(t90_)) m.rise_time_s = t90_ - t10_;
+  }
+  // An overshoot exists only for a move that ended within the run (null otherwise, never 0).
+  if (distance_ != 0.0 && last_.t >= move_end_) {
     m.overshoot_m = overshoot_;
     m.overshoot_percent = 100.0 * overshoot_ / std::abs(distance_);
   }
@@ -337,13 +340,15 @@ std::string summary_headline(const std::string& text) {
            j["settling_band_m"].is_number() && j.contains("move_end_s") && j["move_end_s"].is_number() &&
            j["move_end_s"].get<double>() <= j.value("sim_time_s", 0.0))  // a move that ended within the run
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
+  if (j.contains("move_finished") && j["move_finished"] == false) line += ", MOVE CUT OFF at the end of the run";
   if (j.value("control_chattering", false))
     line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
   if (j.contains("control_signal_within_limits") && j["control_signal_within_limits"] == false)
     line += ", CONTROL SIGNAL OUTSIDE LIMITS (step rms " + num("control_step_rms_V") + " V, " +
             num("control_direction_changes_per_s") + " direction changes/s, " + num("force_hf_rms_N") +
             " N above 1 kHz, saturated " + num("control_saturated_fraction") + ")";
-  if (j.contains("controller_model") && j["controller_model"] == "plant") line += ", model = plant";
+  if (j.contains("controller_model") && (j["controller_model"] == "plant" || j["controller_model"] == "plant_without_effects"))
+    line += ", model = " + j["controller_model"].get<std::string>();
   return line;
 }
 

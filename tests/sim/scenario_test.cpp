@@ -29,6 +29,34 @@ std::string with(const std::string& from, const std::string& to) {
   return s.replace(pos, from.size(), to);
 }
 
+// Issue 23, review: a section that is off still has its written keys checked (exit 2), and the
+// loader warns that they do not act (a forgotten `enabled: true`).
+TEST(Scenario, ASectionThatIsOffIsCheckedAndWarnedAbout) {
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {ripple: {pitch: -1}}")), "s.yaml: plant.ripple.pitch = -1: must be > 0");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {grinding: {workpiece_diameter: -1}}")),
+            "s.yaml: plant.grinding.workpiece_diameter = -1: must be > 0");
+  const Scenario s = parse_scenario(with("plant: {}", "plant: {ripple: {cogging_amplitude: 6, pitch: 0.03}}"));
+  EXPECT_FALSE(s.plant.ripple.enabled);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0], "plant.ripple: keys given, but the section is off (enabled: false): they do not act; enabled: true?");
+  // `enabled: false` alone is no key of the section's physics: no warning.
+  EXPECT_TRUE(parse_scenario(with("plant: {}", "plant: {ripple: {enabled: false}}")).warnings.empty());
+}
+
+// A step after the end of the run is a move the run cuts off (was: null, and a perfect-looking
+// max |e| = 0), with the likely unit named.
+TEST(Scenario, AStepAfterTheRunIsAMoveCutOff) {
+  const Scenario s = parse_scenario(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
+                                         "reference: {type: step, amplitude: 1e-5, step_time: 500}"));
+  EXPECT_EQ(s.move_end_s, 500.0);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("the run cuts it off (summary.json move_finished: false); a step_time in ms?"), std::string::npos)
+      << s.warnings[0];
+  const Scenario in_time = parse_scenario(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
+                                               "reference: {type: step, amplitude: 1e-5, step_time: 0.005}"));
+  EXPECT_TRUE(in_time.warnings.empty());
+}
+
 TEST(Scenario, MinimalUsesDefaultsAndModelEqualsPlant) {
   const Scenario s = parse_scenario(kMinimal);
   EXPECT_EQ(s.steps(), 100);

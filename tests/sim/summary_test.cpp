@@ -246,6 +246,26 @@ TEST(Summary, MoveMetricsApplyOnlyToMoves) {
   EXPECT_EQ(j["control_chattering"], false);
 }
 
+// A move the run cuts off has no overshoot: null, never 0 (issue 23 review: 0.0 read as "none").
+TEST(Summary, AMoveCutOffHasNoOvershoot) {
+  Scenario s;
+  s.control_period = 1e-4;
+  s.reference.type = ReferenceType::kAccelLimited;  // default move: ends well after 0.05 s
+  const auto ref = make_reference(s);
+  ASSERT_GT(ref->end_time(), 0.1);
+  SummaryBuilder b(s);
+  for (long k = 0; k < 500; ++k) {  // 0.05 s of it
+    Record r;
+    r.t = k * 1e-4;
+    r.xd = ref->sample(r.t).position;
+    r.x = r.x_measured = r.xd;
+    b.add(r);
+  }
+  const auto j = nlohmann::json::parse(summary_json(b.summary(0.1, {}), s));
+  EXPECT_TRUE(j["move_start_s"].is_number());
+  for (const char* key : {"overshoot_m", "overshoot_percent", "rise_time_s", "settling_time_s"}) EXPECT_TRUE(j[key].is_null()) << key;
+}
+
 // Control-signal quality (summary.hpp, docs/scenario.md "Control-signal quality") on commands
 // whose figures are known in closed form. Scenario{}: T = 1e-4 s, u in [-10, 10] V (delta = 0.2 V,
 // h = 0.02 V), Ka*Kf = 260 N/V.
