@@ -542,10 +542,29 @@ void set_key(YAML::Node& root, const std::string& key, const std::string& value)
     if (!next.IsDefined() || next.IsNull()) {
       cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
       next = cur[parts[i]];
+    } else if (path == "plant.ripple" && next.IsScalar() && next.Scalar() != "true" && next.Scalar() != "false") {
+      // `ripple: paper` is the preset's short form: a part set on top of it keeps the preset.
+      YAML::Node m(YAML::NodeType::Map);
+      m["preset"] = next.Scalar();
+      cur[parts[i]] = m;
+      next = cur[parts[i]];
     } else if (!next.IsMap()) {
       throw ScenarioError(key + ": " + path + " is a single value in the scenario, not a map of keys");
     }
     cur.reset(next);
+  }
+  // A list or a map in YAML's flow style (`[t, x, u]`, `{model: none}`) is read as YAML, as the
+  // file would read it; anything else is the scalar as written.
+  const std::size_t first = value.find_first_not_of(" \t");
+  if (first != std::string::npos && (value[first] == '[' || value[first] == '{')) {
+    YAML::Node v;
+    try {
+      v = load_yaml_strict(value);
+    } catch (const std::exception& e) {
+      throw ScenarioError(key + " = " + value + ": not a YAML list or map (" + e.what() + ")");
+    }
+    cur[parts.back()] = v;
+    return;
   }
   cur[parts.back()] = value;
 }

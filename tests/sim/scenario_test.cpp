@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/sim/yaml_reader.hpp"
 #include "scenario_error.hpp"
 
 namespace feeddrive::sim {
@@ -55,6 +56,26 @@ TEST(Scenario, AStepAfterTheRunIsAMoveCutOff) {
   const Scenario in_time = parse_scenario(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
                                                "reference: {type: step, amplitude: 1e-5, step_time: 0.005}"));
   EXPECT_TRUE(in_time.warnings.empty());
+}
+
+// --set with a list or a map in YAML's flow style reads it as the file would; a part set on
+// `ripple: paper` keeps the preset (issue 23 review).
+TEST(Scenario, SetKeyTakesFlowListsAndMapsAndPartsOfAPreset) {
+  YAML::Node root = load_yaml_strict(kMinimal);
+  set_key(root, "output.columns", "[t, x, u]");
+  set_key(root, "plant.friction", "{model: none}");
+  root["plant"]["ripple"] = "paper";
+  set_key(root, "plant.ripple.cogging_amplitude", "6");
+  YAML::Emitter em;
+  em << root;
+  const Scenario s = parse_scenario(em.c_str());
+  EXPECT_EQ(s.output.columns, (std::vector<std::string>{"t", "x", "u"}));
+  EXPECT_EQ(s.plant.friction.model, plant::FrictionModel::kNone);
+  EXPECT_TRUE(s.plant.ripple.enabled);
+  EXPECT_EQ(s.plant.ripple.cogging_amplitude, 6.0);
+  EXPECT_NE(s.plant.ripple.reluctance_amplitude, 0.0);  // the paper's other parts kept
+  YAML::Node bad = load_yaml_strict(kMinimal);
+  EXPECT_THROW(set_key(bad, "output.columns", "[t, x"), ScenarioError);
 }
 
 TEST(Scenario, MinimalUsesDefaultsAndModelEqualsPlant) {
