@@ -6,13 +6,16 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/summary.hpp"
+#include "feeddrive/trajectory/trajectory.hpp"
 
 namespace feeddrive::analysis {
 namespace {
@@ -47,12 +50,40 @@ struct Plan {
   long settle, n;
 };
 
+// The plan in doubles (M, N and the settling may be beyond any long for an option that cannot be
+// meant: validate refuses those before plan() converts).
+struct PlanSize {
+  double f, settle, n, m;
+};
+
+PlanSize plan_size(double f, double T, const FrequencyResponseOptions& o) {
+  const double m = std::max<double>(o.block_cycles, std::ceil(o.block_time * f));
+  const double n = std::max(1.0, std::round(m / (f * T)));
+  const double f_whole = m / (n * T);
+  const double settle = std::round(std::max(o.settle_cycles / f_whole, o.settle_time) / T);
+  return {f_whole, settle, n, m};
+}
+
 Plan plan(double f, double T, const FrequencyResponseOptions& o) {
-  const long m = std::max<long>(o.block_cycles, static_cast<long>(std::ceil(o.block_time * f)));
-  const long n = std::max<long>(1, std::lround(static_cast<double>(m) / (f * T)));
-  const double f_whole = static_cast<double>(m) / (static_cast<double>(n) * T);
-  const long settle = std::lround(std::max(o.settle_cycles / f_whole, o.settle_time) / T);
-  return {f_whole, settle, n};
+  const PlanSize p = plan_size(f, T, o);
+  return {p.f, static_cast<long>(p.settle), static_cast<long>(p.n)};
+}
+
+// The measured range of a field of the reference's list (reference.max_velocity for --fr-velocity).
+struct MetaOf {
+  const char* name;
+  fields::Meta meta{};
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    if (std::string(f.meta.name) == name) meta = f.meta;
+  }
+};
+
+fields::Meta max_velocity_meta() {
+  trajectory::AccelLimitedParams p;
+  MetaOf m{"max_velocity"};
+  p.Serialize(&m);
+  return m.meta;
 }
 
 Run run_once(const sim::Scenario& base, const Plan& p, double ref_amplitude, double force_amplitude, double v_feed) {
@@ -153,27 +184,84 @@ double cross_log_f(double f0, double f1, double g0, double g1, double level) {
 
 }  // namespace
 
+std::vector<double> FrequencyResponseOptions::requested(const sim::Scenario& s) const {
+  std::vector<double> fs = frequencies;
+  if (fs.empty()) {
+    const double hi = f_max > 0.0 ? f_max : 0.4 / s.control_period;
+    for (int i = 0; i < points; ++i)
+      fs.push_back(points == 1 ? f_min : f_min * std::pow(hi / f_min, static_cast<double>(i) / (points - 1)));
+  }
+  std::sort(fs.begin(), fs.end());
+  return fs;
+}
+
+double FrequencyResponseOptions::total_steps(const sim::Scenario& s) const {
+  const double runs = (reference_amplitude > 0.0 ? 1.0 : 0.0) + (force_amplitude > 0.0 ? 1.0 : 0.0);
+  double steps = 0.0;
+  for (double f : requested(s)) {
+    const PlanSize p = plan_size(f, s.control_period, *this);
+    steps += runs * (p.settle + 2.0 * p.n);
+  }
+  return steps;
+}
+
+std::vector<std::string> FrequencyResponseOptions::warnings() const {
+  std::vector<std::string> out;
+  fields::PlausibilityArchive a("", &out);
+  double speed = std::abs(feed_velocity);
+  fields::Field<double> f{max_velocity_meta(), &speed};
+  f.meta.name = "--fr-velocity";
+  a.Visit(f);
+  return out;
+}
+
 void FrequencyResponseOptions::validate(const sim::Scenario& s) const {
   const auto bad = [](const std::string& option, double v, const std::string& why) {
     throw std::invalid_argument(option + " " + validate::format_number(v) + ": " + why);
   };
+  if (s.controller.type == sim::ControllerType::kOpenLoop)
+    throw std::invalid_argument("controller.type open_loop: no feedback loop to measure (the frequency response needs a "
+                                "closed loop: sliding_mode, cascade or plugin)");
   const double nyquist = 0.5 / s.control_period;
+  const std::string below = "below Nyquist " + validate::format_number(nyquist) + " Hz";
   for (double f : frequencies)
-    if (!(f > 0.0) || !(f < nyquist)) bad("--fr-frequencies", f, "must be > 0 and below Nyquist " + validate::format_number(nyquist) + " Hz");
+    if (!(f > 0.0) || !(f < nyquist)) bad("--fr-frequencies", f, "must be > 0 and " + below);
   if (frequencies.empty()) {
-    if (!(f_min > 0.0) || !(f_min < nyquist)) bad("--fr-from", f_min, "must be > 0 and below Nyquist " + validate::format_number(nyquist) + " Hz");
+    if (!(f_min > 0.0) || !(f_min < nyquist)) bad("--fr-from", f_min, "must be > 0 and " + below);
     if (f_max != 0.0 && (!(f_max > f_min) || !(f_max < nyquist)))
-      bad("--fr-to", f_max, "must be above --fr-from and below Nyquist " + validate::format_number(nyquist) + " Hz");
+      bad("--fr-to", f_max, "must be above --fr-from and " + below);
     if (points < 1 || points > 1000) bad("--fr-points", points, "must be 1 to 1000");
   }
   if (!(reference_amplitude >= 0.0) || !std::isfinite(reference_amplitude)) bad("--fr-amplitude", reference_amplitude, "must be >= 0 [m]");
   if (!(force_amplitude >= 0.0) || !std::isfinite(force_amplitude)) bad("--fr-force", force_amplitude, "must be >= 0 [N]");
   if (reference_amplitude == 0.0 && force_amplitude == 0.0) bad("--fr-amplitude", 0.0, "and --fr-force 0: nothing to measure");
   if (!(acceleration_limit >= 0.0) || !std::isfinite(acceleration_limit)) bad("--fr-acceleration", acceleration_limit, "must be >= 0 [m/s^2]");
-  if (!std::isfinite(feed_velocity)) bad("--fr-velocity", feed_velocity, "must be finite [m/s]");
-  if (!(settle_cycles >= 0.0) || !(settle_time >= 0.0)) bad("--fr-settle", settle_time, "must be >= 0");
+  // the hard bound of reference.max_velocity (trajectory.hpp), with its likely unit
+  const fields::Meta vmax = max_velocity_meta();
+  if (!std::isfinite(feed_velocity) || std::abs(feed_velocity) > vmax.max)
+    bad("--fr-velocity", feed_velocity,
+        "must be within +-" + validate::format_number(vmax.max) + " m/s, as reference.max_velocity (" + vmax.hint_high + "?)");
+  if (!(settle_cycles >= 0.0) || !(settle_time >= 0.0) || !std::isfinite(settle_time)) bad("--fr-settle", settle_time, "must be >= 0 and finite [s]");
   if (block_cycles < 1) bad("block_cycles", block_cycles, "must be >= 1");
   if (jobs < 1 || jobs > 256) bad("--jobs", jobs, "must be 1 to 256");
+  // A frequency moved to whole cycles (M/(N T)) must stay below Nyquist: on it, sin(pi k) = 0.
+  for (double f : requested(s)) {
+    const PlanSize p = plan_size(f, s.control_period, *this);
+    if (p.f >= nyquist)
+      bad(frequencies.empty() ? "--fr-to" : "--fr-frequencies", f,
+          "is measured as " + validate::format_number(p.m) + " cycles in " + validate::format_number(p.n) +
+              " samples, i.e. at " + validate::format_number(p.f) + " Hz: must be " + below);
+  }
+  // The whole measurement is bounded as a scenario's run is (docs/scenario.md, Limits).
+  if (const double n = total_steps(s); !(n <= sim::kMaxSteps)) {
+    char buf[320];
+    const std::vector<double> fs = requested(s);
+    std::snprintf(buf, sizeof buf,
+                  "frequency response: %.3g steps (%zu frequencies from %.4g Hz, --fr-settle %.4g s); a run has at most %.3g "
+                  "steps (docs/scenario.md, Limits): a higher lowest frequency or a shorter --fr-settle",
+                  n, fs.size(), fs.front(), settle_time, sim::kMaxSteps);
+    throw std::invalid_argument(buf);
+  }
 }
 
 FrequencyResponse measure_frequency_response(const sim::Scenario& s, const FrequencyResponseOptions& o) {
@@ -181,13 +269,9 @@ FrequencyResponse measure_frequency_response(const sim::Scenario& s, const Frequ
   const auto t0 = std::chrono::steady_clock::now();
   FrequencyResponse r;
   r.options = o;
-  std::vector<double> fs = o.frequencies;
-  if (fs.empty()) {
-    const double f_max = o.f_max > 0.0 ? o.f_max : 0.4 / s.control_period;
-    for (int i = 0; i < o.points; ++i)
-      fs.push_back(o.points == 1 ? o.f_min : o.f_min * std::pow(f_max / o.f_min, static_cast<double>(i) / (o.points - 1)));
-  }
-  std::sort(fs.begin(), fs.end());
+  r.warnings = s.warnings;
+  for (const std::string& w : o.warnings()) r.warnings.push_back(w);
+  const std::vector<double> fs = o.requested(s);
   // a quarter of the controller's force range (half of u_max - u_min) over the mass
   r.acceleration_limit = o.acceleration_limit > 0.0
                              ? o.acceleration_limit
@@ -235,50 +319,75 @@ std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>&
 }
 
 void compute_figures(FrequencyResponse& r) {
-  const auto& p = r.points;
+  {  // every figure from these points only (a copy with other points is computed afresh)
+    FrequencyResponse fresh;
+    fresh.options = r.options;
+    fresh.acceleration_limit = r.acceleration_limit;
+    fresh.points = std::move(r.points);
+    fresh.warnings = std::move(r.warnings);
+    fresh.wall_time_s = r.wall_time_s;
+    r = std::move(fresh);
+  }
+  // A doubtful point supplies no figure: its ratio is not a frequency response.
+  std::vector<const FrequencyPoint*> ref, dist;
+  for (const FrequencyPoint& q : r.points) {
+    if (q.has_reference && !q.reference_doubtful()) ref.push_back(&q);
+    if (q.has_disturbance && !q.disturbance_doubtful()) dist.push_back(&q);
+  }
   const double kBw = -20.0 * std::log10(std::sqrt(2.0));  // -3.01 dB
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p[i].has_reference) {
-      const double g = db(p[i].closed_loop);
-      if (std::isnan(r.peak_db) || g > r.peak_db) r.peak_db = g, r.peak_hz = p[i].frequency_hz;
-      if (std::isnan(r.bandwidth_hz) && g < kBw && i > 0 && db(p[i - 1].closed_loop) >= kBw)
-        r.bandwidth_hz = cross_log_f(p[i - 1].frequency_hz, p[i].frequency_hz, db(p[i - 1].closed_loop), g, kBw);
+  std::size_t imax = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    const double g = db(ref[i]->closed_loop);
+    if (std::isnan(r.peak_db) || g > r.peak_db) r.peak_db = g, r.peak_hz = ref[i]->frequency_hz, imax = i;
+    if (std::isnan(r.bandwidth_hz) && g < kBw && i > 0 && db(ref[i - 1]->closed_loop) >= kBw) {
+      r.bandwidth_hz = cross_log_f(ref[i - 1]->frequency_hz, ref[i]->frequency_hz, db(ref[i - 1]->closed_loop), g, kBw);
+      r.bandwidth_between_hz[0] = ref[i - 1]->frequency_hz;
+      r.bandwidth_between_hz[1] = ref[i]->frequency_hz;
     }
-    if (p[i].has_disturbance) {
-      const double ms = std::abs(p[i].sensitivity), k = p[i].stiffness_N_per_um();
-      if (std::isnan(r.sensitivity_peak) || ms > r.sensitivity_peak) r.sensitivity_peak = ms, r.sensitivity_peak_hz = p[i].frequency_hz;
-      if (std::isnan(r.min_stiffness_N_per_um) || k < r.min_stiffness_N_per_um) r.min_stiffness_N_per_um = k, r.min_stiffness_hz = p[i].frequency_hz;
-    }
+  }
+  // a resonance peak is a maximum inside the range; at its edge it is only where the range stops
+  r.peak_inside = ref.size() >= 3 && imax > 0 && imax + 1 < ref.size();
+  if (!ref.empty() && std::isnan(r.bandwidth_hz)) r.bandwidth_outside = db(ref.front()->closed_loop) < kBw ? -1 : 1;
+  for (const FrequencyPoint* q : dist) {
+    const double ms = std::abs(q->sensitivity), k = q->stiffness_N_per_um();
+    if (std::isnan(r.sensitivity_peak) || ms > r.sensitivity_peak) r.sensitivity_peak = ms, r.sensitivity_peak_hz = q->frequency_hz;
+    if (std::isnan(r.min_stiffness_N_per_um) || k < r.min_stiffness_N_per_um) r.min_stiffness_N_per_um = k, r.min_stiffness_hz = q->frequency_hz;
   }
   // phase of L unwrapped from the lowest frequency, started in (-360, 0]
   std::vector<cd> loop;
-  for (const FrequencyPoint& q : p) loop.push_back(q.loop);
+  for (const FrequencyPoint* q : dist) loop.push_back(q->loop);
   const std::vector<double> phase = unwrapped_phase_deg(loop, true);
-  std::size_t ic = p.size();
-  for (std::size_t i = 1; i < p.size(); ++i) {
-    if (!p[i].has_disturbance) break;
-    const double g0 = db(p[i - 1].loop), g1 = db(p[i].loop);
+  const auto f_at = [&](std::size_t i, double a) {
+    return std::exp(std::log(dist[i - 1]->frequency_hz) + a * (std::log(dist[i]->frequency_hz) - std::log(dist[i - 1]->frequency_hz)));
+  };
+  for (std::size_t i = 1; i < dist.size(); ++i) {
+    const double g0 = db(dist[i - 1]->loop), g1 = db(dist[i]->loop);
     if (g0 >= 0.0 && g1 < 0.0) {
-      r.crossover_hz = cross_log_f(p[i - 1].frequency_hz, p[i].frequency_hz, g0, g1, 0.0);
       const double a = (0.0 - g0) / (g1 - g0);
+      r.crossover_hz = f_at(i, a);
       double pm = 180.0 + phase[i - 1] + a * (phase[i] - phase[i - 1]);
       pm = std::fmod(pm, 360.0);
       if (pm > 180.0) pm -= 360.0;
       if (pm <= -180.0) pm += 360.0;
       r.phase_margin_deg = pm;
-      ic = i;
       break;
     }
   }
-  for (std::size_t i = ic; i < p.size(); ++i) {
-    // the next crossing of -180 + n*360 going down
+  if (std::isnan(r.crossover_hz)) return;
+  // Every crossing of -180 + n*360 (MATLAB allmargin): above the crossover the first one going
+  // down is the gain margin; below it (a conditionally stable loop, |L| > 1 there) the one nearest
+  // 0 dB is the lower gain margin: lowering the gain by that much makes the loop unstable.
+  for (std::size_t i = 1; i < dist.size(); ++i) {
     const double k0 = std::floor((phase[i - 1] + 180.0) / 360.0), k1 = std::floor((phase[i] + 180.0) / 360.0);
-    if (k1 < k0) {
-      const double level = k0 * 360.0 - 180.0;
-      const double a = (level - phase[i - 1]) / (phase[i] - phase[i - 1]);
-      const double g = db(p[i - 1].loop) + a * (db(p[i].loop) - db(p[i - 1].loop));
-      r.phase_crossover_hz = std::exp(std::log(p[i - 1].frequency_hz) + a * (std::log(p[i].frequency_hz) - std::log(p[i - 1].frequency_hz)));
-      r.gain_margin_db = -g;
+    if (k0 == k1) continue;
+    const double level = std::max(k0, k1) * 360.0 - 180.0;
+    const double a = (level - phase[i - 1]) / (phase[i] - phase[i - 1]);
+    const double gm = -(db(dist[i - 1]->loop) + a * (db(dist[i]->loop) - db(dist[i - 1]->loop)));
+    const double f = f_at(i, a);
+    if (f < r.crossover_hz) {
+      if (std::isnan(r.lower_gain_margin_db) || gm > r.lower_gain_margin_db) r.lower_gain_margin_db = gm, r.lower_phase_crossover_hz = f;
+    } else if (k1 < k0) {
+      r.gain_margin_db = gm, r.phase_crossover_hz = f;
       break;
     }
   }

@@ -14,8 +14,6 @@
 namespace feeddrive::analysis {
 namespace {
 
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
-
 std::string g(double v, const char* fmt = "%.4g") {
   if (std::isnan(v)) return "n/a";
   char b[40];
@@ -23,7 +21,6 @@ std::string g(double v, const char* fmt = "%.4g") {
   return b;
 }
 double db(std::complex<double> h) { return 20.0 * std::log10(std::abs(h)); }
-double deg(std::complex<double> h) { return std::arg(h) * kDeg; }
 
 std::string controller_text(const sim::Scenario& s) {
   static const char* const kNames[] = {"sliding_mode", "cascade", "open_loop", "plugin"};
@@ -35,20 +32,59 @@ std::string controller_text(const sim::Scenario& s) {
 
 // Where a figure could not be found in the measured range, say why (never a silent blank).
 std::string bandwidth_text(const FrequencyResponse& r) {
-  if (!std::isnan(r.bandwidth_hz)) return g(r.bandwidth_hz) + " Hz";
-  if (r.points.empty() || !r.points.front().has_reference) return "n/a (no reference run)";
-  if (db(r.points.front().closed_loop) < -3.0103) return "below the lowest frequency measured";
-  return "above the highest frequency measured (|T| >= -3 dB throughout)";
+  if (!(r.options.reference_amplitude > 0.0)) return "not measured (--fr-amplitude 0)";
+  if (!std::isnan(r.bandwidth_hz))
+    return g(r.bandwidth_hz) + " Hz (interpolated in log f between the measured points " + g(r.bandwidth_between_hz[0]) + " and " +
+           g(r.bandwidth_between_hz[1]) + " Hz)";
+  if (r.bandwidth_outside < 0) return "below the lowest frequency measured";
+  if (r.bandwidth_outside > 0) return "above the highest frequency measured (|T| >= -3 dB throughout)";
+  return "none (every point doubtful)";
+}
+
+std::string peak_text(const FrequencyResponse& r) {
+  if (!(r.options.reference_amplitude > 0.0)) return "peak |T|: not measured (--fr-amplitude 0)";
+  if (std::isnan(r.peak_db)) return "peak |T|: none (every point doubtful)";
+  if (r.peak_inside) return "peak |T| " + g(r.peak_db, "%.2f") + " dB at " + g(r.peak_hz) + " Hz";
+  const bool low = !r.points.empty() && r.peak_hz <= r.points.front().frequency_hz * (1 + 1e-12);
+  return std::string("no peak inside the measured range (|T| largest at the ") + (low ? "lowest" : "highest") + " frequency: " +
+         g(r.peak_db, "%.2f") + " dB at " + g(r.peak_hz) + " Hz)";
+}
+
+std::string margins_text(const FrequencyResponse& r) {
+  std::ostringstream t;
+  const std::string top = r.points.empty() ? "n/a" : g(r.points.back().frequency_hz);
+  t << "peak sensitivity Ms " << g(r.sensitivity_peak, "%.3f") << " (" << g(20 * std::log10(r.sensitivity_peak), "%.2f") << " dB) at "
+    << g(r.sensitivity_peak_hz) << " Hz; ";
+  if (std::isnan(r.phase_margin_deg)) t << "phase margin: none found (|L| does not cross 0 dB downward up to " << top << " Hz)";
+  else t << "phase margin " << g(r.phase_margin_deg, "%.1f") << " deg at " << g(r.crossover_hz) << " Hz";
+  if (!std::isnan(r.crossover_hz) && std::isnan(r.gain_margin_db))
+    t << "; gain margin: none found (arg L does not cross -180 deg above the crossover up to " << top << " Hz)";
+  else if (!std::isnan(r.gain_margin_db))
+    t << "; gain margin " << g(r.gain_margin_db, "%.1f") << " dB at " << g(r.phase_crossover_hz) << " Hz";
+  if (!std::isnan(r.lower_gain_margin_db))
+    t << "; lower gain margin " << g(r.lower_gain_margin_db, "%.1f") << " dB at " << g(r.lower_phase_crossover_hz)
+      << " Hz (arg L crosses -180 deg below the crossover: conditionally stable, a loop gain lowered by "
+      << g(-r.lower_gain_margin_db, "%.1f") << " dB is unstable)";
+  return t.str();
 }
 
 // The frequencies whose response is mostly not at the excitation's frequency, or drifts.
 std::string doubtful_points(const FrequencyResponse& r) {
   std::string out;
   for (const FrequencyPoint& p : r.points)
-    if (std::max(p.closed_loop_nonfundamental, p.disturbance_nonfundamental) > 0.5 * std::sqrt(2.0) ||
-        std::max(p.closed_loop_drift, p.disturbance_drift) > 0.1)
-      out += (out.empty() ? "" : ", ") + g(p.frequency_hz);
+    if (p.doubtful()) out += (out.empty() ? "" : ", ") + g(p.frequency_hz);
   return out;
+}
+
+// The phases along f, unwrapped (no jump of more than 180 deg between neighbours; the loop's from
+// (-360, 0], as the margins take it): the table, the CSV and the plots show the same numbers.
+struct Phases {
+  std::vector<double> t, gd, l, s;
+};
+Phases phases(const FrequencyResponse& r) {
+  std::vector<std::complex<double>> t, gd, l, si;
+  for (const FrequencyPoint& p : r.points) t.push_back(p.closed_loop), gd.push_back(p.compliance), l.push_back(p.loop), si.push_back(p.sensitivity);
+  return {unwrapped_phase_deg(t), unwrapped_phase_deg(gd), unwrapped_phase_deg(l, true), unwrapped_phase_deg(si)};
 }
 
 }  // namespace
@@ -61,35 +97,36 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
     << " m/s^2 / w^2); force " << g(o.force_amplitude) << " N at the amplifier input; feed velocity " << g(o.feed_velocity)
     << " m/s. Friction makes the result amplitude-dependent.\n";
   t << "   f [Hz]  A_ref [m]   |T| [dB]  arg T [deg]  k_dyn [N/um]  arg G_d [deg]  |L| [dB]  arg L [deg]  |S| [dB]  drift  nonfund  sat\n";
-  for (const FrequencyPoint& p : r.points) {
+  const Phases ph = phases(r);
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    const FrequencyPoint& p = r.points[i];
     char line[256];
-    std::snprintf(line, sizeof line, "%9.4g  %9.3g  %9s  %11s  %12s  %13s  %8s  %11s  %8s  %5s  %7s  %3ld\n", p.frequency_hz,
+    std::snprintf(line, sizeof line, "%9.4g  %9.3g  %9s  %11s  %12s  %13s  %8s  %11s  %8s  %5s  %7s  %3ld%s\n", p.frequency_hz,
                   p.reference_amplitude_m, p.has_reference ? g(db(p.closed_loop), "%.3f").c_str() : "-",
-                  p.has_reference ? g(deg(p.closed_loop), "%.2f").c_str() : "-",
-                  p.has_disturbance ? g(p.stiffness_N_per_um()).c_str() : "-", p.has_disturbance ? g(deg(p.compliance), "%.1f").c_str() : "-",
-                  p.has_disturbance ? g(db(p.loop), "%.2f").c_str() : "-", p.has_disturbance ? g(deg(p.loop), "%.1f").c_str() : "-",
+                  p.has_reference ? g(ph.t[i], "%.2f").c_str() : "-",
+                  p.has_disturbance ? g(p.stiffness_N_per_um()).c_str() : "-", p.has_disturbance ? g(ph.gd[i], "%.1f").c_str() : "-",
+                  p.has_disturbance ? g(db(p.loop), "%.2f").c_str() : "-", p.has_disturbance ? g(ph.l[i], "%.1f").c_str() : "-",
                   p.has_disturbance ? g(db(p.sensitivity), "%.2f").c_str() : "-",
                   g(std::max(p.closed_loop_drift, p.disturbance_drift), "%.1e").c_str(),
-                  g(std::max(p.closed_loop_nonfundamental, p.disturbance_nonfundamental), "%.3f").c_str(), p.saturated_steps);
+                  g(std::max(p.closed_loop_nonfundamental, p.disturbance_nonfundamental), "%.3f").c_str(), p.saturated_steps,
+                  p.doubtful() ? "  doubtful" : "");
     t << line;
   }
-  t << "closed-loop bandwidth (-3 dB): " << bandwidth_text(r) << "; peak |T| " << g(r.peak_db, "%.2f") << " dB at " << g(r.peak_hz)
-    << " Hz\n";
-  const std::string top = r.points.empty() ? "n/a" : g(r.points.back().frequency_hz);
-  t << "peak sensitivity Ms " << g(r.sensitivity_peak, "%.3f") << " (" << g(20 * std::log10(r.sensitivity_peak), "%.2f") << " dB) at "
-    << g(r.sensitivity_peak_hz) << " Hz; ";
-  if (std::isnan(r.phase_margin_deg)) t << "phase margin: none found (|L| does not cross 0 dB downward up to " << top << " Hz)";
-  else t << "phase margin " << g(r.phase_margin_deg, "%.1f") << " deg at " << g(r.crossover_hz) << " Hz";
-  if (std::isnan(r.gain_margin_db)) t << "; gain margin: none found (arg L does not cross -180 deg above the crossover up to " << top << " Hz)\n";
-  else t << "; gain margin " << g(r.gain_margin_db, "%.1f") << " dB at " << g(r.phase_crossover_hz) << " Hz\n";
+  t << "phases unwrapped along f (arg L from (-360, 0])\n";
   const std::string doubtful = doubtful_points(r);
   if (!doubtful.empty())
     t << "WARNING: at " << doubtful << " Hz more than half of the power of the position's response is at other frequencies (nonfund > 0.71) or the two "
       << "blocks differ by more than 10 %: the ratio there is not a frequency response (chatter, stick-slip, a response that "
-      << "wanders), and the figures above that use those points are doubtful. What may help: an amplitude well above the "
-      << "chatter's, a longer --fr-settle (a transient), a smooth switching law.\n";
-  t << "least dynamic stiffness " << g(r.min_stiffness_N_per_um) << " N/um at " << g(r.min_stiffness_hz) << " Hz (force amplitude "
-    << g(o.force_amplitude) << " N)\n";
+      << "wanders), and those points are left out of every summary figure below (bandwidth, peak, Ms, margins, least stiffness). "
+      << "What may help: an amplitude well above the chatter's, a longer --fr-settle (a transient), a smooth switching law.\n";
+  t << "closed-loop bandwidth (-3 dB): " << bandwidth_text(r) << "; " << peak_text(r) << "\n";
+  if (!(o.force_amplitude > 0.0)) {
+    t << "peak sensitivity, phase and gain margins, dynamic stiffness: not measured (--fr-force 0)\n";
+  } else {
+    t << margins_text(r) << "\n";
+    t << "least dynamic stiffness " << g(r.min_stiffness_N_per_um) << " N/um at " << g(r.min_stiffness_hz) << " Hz (force amplitude "
+      << g(o.force_amplitude) << " N)\n";
+  }
   return t.str();
 }
 
@@ -101,13 +138,8 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
                            "stiffness_N_per_um", "L_dB", "L_deg", "S_dB", "S_deg", "T_drift", "T_nonfundamental",
                            "disturbance_drift", "disturbance_nonfundamental", "saturated_steps"});
     const double nan = std::nan("");
-    // phases unwrapped along the frequency axis (the loop's from (-360, 0], as the margins take it)
-    std::vector<std::complex<double>> t, gd, l, si;
-    for (const FrequencyPoint& p : r.points) {
-      t.push_back(p.closed_loop), gd.push_back(p.compliance), l.push_back(p.loop), si.push_back(p.sensitivity);
-    }
-    const auto t_deg = unwrapped_phase_deg(t), gd_deg = unwrapped_phase_deg(gd), l_deg = unwrapped_phase_deg(l, true),
-               s_deg = unwrapped_phase_deg(si);
+    const Phases ph = phases(r);
+    const auto &t_deg = ph.t, &gd_deg = ph.gd, &l_deg = ph.l, &s_deg = ph.s;
     for (std::size_t i = 0; i < r.points.size(); ++i) {
       const FrequencyPoint& p = r.points[i];
       const bool a = p.has_reference, d = p.has_disturbance;
@@ -139,18 +171,27 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
                      {"block_time_s", o.block_time}};
   j["bandwidth_hz"] = num(r.bandwidth_hz);
   j["bandwidth"] = bandwidth_text(r);
-  j["closed_loop_peak_db"] = num(r.peak_db);
-  j["closed_loop_peak_hz"] = num(r.peak_hz);
+  j["bandwidth_between_hz"] = std::isnan(r.bandwidth_hz) ? nlohmann::ordered_json()
+                                                         : nlohmann::ordered_json({r.bandwidth_between_hz[0], r.bandwidth_between_hz[1]});
+  // a resonance peak only inside the measured range (at its edge |T| is largest only where the range stops)
+  j["closed_loop_peak_db"] = r.peak_inside ? num(r.peak_db) : nlohmann::ordered_json();
+  j["closed_loop_peak_hz"] = r.peak_inside ? num(r.peak_hz) : nlohmann::ordered_json();
+  j["closed_loop_peak"] = peak_text(r);
   j["sensitivity_peak"] = num(r.sensitivity_peak);
   j["sensitivity_peak_hz"] = num(r.sensitivity_peak_hz);
   j["phase_margin_deg"] = num(r.phase_margin_deg);
   j["crossover_hz"] = num(r.crossover_hz);
   j["gain_margin_db"] = num(r.gain_margin_db);
   j["phase_crossover_hz"] = num(r.phase_crossover_hz);
+  j["lower_gain_margin_db"] = num(r.lower_gain_margin_db);
+  j["lower_phase_crossover_hz"] = num(r.lower_phase_crossover_hz);
+  if (!(o.force_amplitude > 0.0)) j["margins"] = "not measured (--fr-force 0)";
   j["min_dynamic_stiffness_N_per_um"] = num(r.min_stiffness_N_per_um);
   j["min_dynamic_stiffness_hz"] = num(r.min_stiffness_hz);
   const std::string doubtful = doubtful_points(r);
   j["doubtful_frequencies_hz"] = doubtful.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(doubtful);
+  j["doubtful_points"] = "left out of every summary figure (not a frequency response)";
+  j["warnings"] = r.warnings;
   j["wall_time_s"] = r.wall_time_s;
   folder.write_text("frequency_response.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::string plot_error;

@@ -63,6 +63,8 @@ int main(int argc, char** argv) {
       if (!quiet) std::fputs(analysis::frequency_response_table(scenario, r).c_str(), stdout);
       const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, !no_plots);
       if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
+      // as after a run: the scenario's and the options' plausibility warnings (frequency_response.json too)
+      for (const std::string& w : r.warnings) spdlog::warn("{}", w);
       spdlog::info("{} frequencies in {:.1f} s -> {}", r.points.size(), r.wall_time_s, out_dir);
       return kExitOk;
     }

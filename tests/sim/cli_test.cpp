@@ -486,6 +486,27 @@ TEST(Cli, FrequencyResponseWritesTableDataAndBodePlots) {
   EXPECT_EQ(e.code, 2);
   EXPECT_EQ(e.err, "error: --fr-frequencies 7000: must be > 0 and below Nyquist 5000 Hz\n");
   EXPECT_FALSE(fs::exists(bad));
+  // review F10: an open-loop controller has no loop to measure: one line, exit 2
+  const fs::path ol = write_file("fr_ol.yaml",
+                                 "name: fr_ol\nduration: 1.0\ncontrol_period: 1.0e-4\nplant: {friction: {model: none}}\n"
+                                 "controller: {type: open_loop, kind: step, amplitude: 12.0}\nreference: {type: none}\n");
+  const ProcResult eo = run_sim(ol.string() + " --out " + bad.string() + " --frequency-response --fr-frequencies 50");
+  EXPECT_EQ(eo.code, 2);
+  EXPECT_EQ(eo.err.rfind("error: controller.type open_loop: no feedback loop to measure", 0), 0u) << eo.err;
+  EXPECT_EQ(std::count(eo.err.begin(), eo.err.end(), '\n'), 1) << eo.err;
+  // review F9, F8: the scenario's plausibility warnings are logged and written, as after a run;
+  // a run not made says "not measured"
+  const fs::path heavy = scratch() / "fr_heavy";
+  const fs::path h_out = scratch() / "fr_heavy_stdout.txt", h_err = scratch() / "fr_heavy_stderr.txt";
+  const std::string cmd = kSim + " " + scn.string() + " --out " + heavy.string() +
+                          " --set plant.mass=5e4 --frequency-response --fr-frequencies 50 --fr-force 0 --no-plots > " +
+                          h_out.string() + " 2> " + h_err.string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(h_err);
+  EXPECT_NE(slurp(h_err).find("plant.mass: 50000 kg is above"), std::string::npos) << slurp(h_err);
+  EXPECT_NE(slurp(h_out).find("not measured (--fr-force 0)"), std::string::npos) << slurp(h_out);
+  const auto jh = nlohmann::json::parse(slurp(heavy / "frequency_response.json"));
+  ASSERT_TRUE(jh["warnings"].is_array());
+  EXPECT_NE(jh["warnings"][0].get<std::string>().find("plant.mass: 50000 kg is above"), std::string::npos) << jh["warnings"];
 }
 
 }  // namespace

@@ -26,15 +26,26 @@
 //                 other frequencies (harmonics from friction, stick-slip, chatter, noise)
 // A point where nonfundamental > 1/sqrt(2) (more of the power elsewhere than at f) or drift > 0.1
 // is named as doubtful in the table and in frequency_response.json (doubtful_frequencies_hz): its
-// ratio is not a frequency response, and neither is a figure interpolated from it.
+// ratio is not a frequency response, so it supplies no summary figure (compute_figures leaves it
+// out, and the outputs say so).
 // Friction makes the result depend on the amplitude: A(f), F and v_feed are in every output.
 //
-// Summary figures (FrequencyResponse): closed-loop bandwidth (the first -3 dB crossing of |T|,
-// interpolated in log f), resonance peak of |T|, peak sensitivity Ms = max |S_i|, phase margin at
-// the first downward crossing of |L| = 1, gain margin at the first -180 deg crossing of arg L above
-// it, least dynamic stiffness and where; NaN where the measured range holds no such point.
+// Summary figures (FrequencyResponse), from the points that are not doubtful: closed-loop
+// bandwidth (the first -3 dB crossing of |T|, interpolated in log f between the two measured
+// points around it, which are kept), resonance peak of |T| (a peak only when the largest |T| is
+// inside the measured range, not at its edge), peak sensitivity Ms = max |S_i|, phase margin at
+// the first downward crossing of |L| = 1, gain margin at the first downward -180 deg crossing of
+// arg L above it, and (MATLAB allmargin) the lower gain margin at a -180 deg crossing below it (a
+// conditionally stable loop: lowering the gain by that much makes it unstable), least dynamic
+// stiffness and where; NaN where the measured range holds no such point.
+//
+// Bounds (validate): every frequency as measured (moved to whole cycles) below Nyquist 1/(2T); the
+// whole measurement's steps (runs x (settle + 2 blocks)) at most sim::kMaxSteps, as a scenario's
+// run; --fr-velocity as reference.max_velocity (the same hard bound, the same plausibility
+// warning); a controller with a feedback loop (not open_loop).
 
 #include <complex>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -58,7 +69,18 @@ struct FrequencyResponseOptions {
   int jobs{1};                ///< frequencies measured in parallel (threads)
   /// Throws std::invalid_argument naming the option and its value (the tool exits 2).
   void validate(const sim::Scenario& s) const;
+  /// The frequencies asked for [Hz], ascending (before they are moved to whole cycles).
+  std::vector<double> requested(const sim::Scenario& s) const;
+  /// Plant steps of the whole measurement (every run's settling and two blocks), in double:
+  /// inf or above sim::kMaxSteps for an option that cannot be meant.
+  double total_steps(const sim::Scenario& s) const;
+  /// The options' plausibility warnings ("--fr-velocity: 50 m/s is above any linear drive (10 m/s); mm/s?").
+  std::vector<std::string> warnings() const;
 };
+
+/// Above this share of the power at other frequencies, or this drift, a point is doubtful.
+inline constexpr double kDoubtfulNonfundamental = 0.70710678118654752;  // 1/sqrt(2)
+inline constexpr double kDoubtfulDrift = 0.1;
 
 struct FrequencyPoint {
   double frequency_hz{0.0};          ///< as measured (moved to whole cycles in a block)
@@ -69,14 +91,27 @@ struct FrequencyPoint {
   long saturated_steps{0};  ///< measured samples with the controller's output saturated (both runs)
   bool has_reference{false}, has_disturbance{false};
   double stiffness_N_per_um() const { return 1e-6 / std::abs(compliance); }
+  bool reference_doubtful() const {
+    return has_reference && (closed_loop_nonfundamental > kDoubtfulNonfundamental || closed_loop_drift > kDoubtfulDrift);
+  }
+  bool disturbance_doubtful() const {
+    return has_disturbance && (disturbance_nonfundamental > kDoubtfulNonfundamental || disturbance_drift > kDoubtfulDrift);
+  }
+  bool doubtful() const { return reference_doubtful() || disturbance_doubtful(); }
 };
 
 struct FrequencyResponse {
   FrequencyResponseOptions options;
   double acceleration_limit{0.0};  ///< a_lim used [m/s^2]
   std::vector<FrequencyPoint> points;  ///< in frequency order
+  std::vector<std::string> warnings;  ///< the scenario's plausibility warnings and the options'
   double bandwidth_hz{kNaN};
-  double peak_db{kNaN}, peak_hz{kNaN};
+  double bandwidth_between_hz[2]{kNaN, kNaN};  ///< the measured points the bandwidth is interpolated between
+  /// Where no -3 dB crossing was found: -1 |T| below -3 dB at the lowest (non-doubtful) point, +1 above throughout.
+  int bandwidth_outside{0};
+  double peak_db{kNaN}, peak_hz{kNaN};  ///< the largest |T| measured, and where
+  bool peak_inside{false};              ///< not at the lowest or highest frequency: a resonance peak
+  double lower_gain_margin_db{kNaN}, lower_phase_crossover_hz{kNaN};  ///< -180 deg below the crossover
   double sensitivity_peak{kNaN}, sensitivity_peak_hz{kNaN};  ///< Ms (linear), at
   double phase_margin_deg{kNaN}, crossover_hz{kNaN};
   double gain_margin_db{kNaN}, phase_crossover_hz{kNaN};
