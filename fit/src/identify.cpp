@@ -276,14 +276,18 @@ const std::vector<Spec>& specs() {
       s.push_back(sp);
     }
     {
-      // Not an effect: the model-form parameter eps of sgn_eps(v) = tanh(v/eps), as ln eps,
-      // between 1 um/s and 2 % of the peak speed (a wider band would stand in for viscous friction).
+      // Not an effect: the model-form parameters of the smoothed sign (plant/forces.hpp)
+      // sgn_eps(v) = (1 - b) tanh(v/eps) + b v/sqrt(v^2 + eps^2): ln eps, between 1 um/s and 2 %
+      // of the peak speed (a wider band would stand in for viscous friction), and the shape b in
+      // [0, 1]. Real friction changes sign over a finite velocity band of a shape no one knows
+      // beforehand; fixing it to tanh leaves the difference to be patched by named effects
+      // (Stribeck, viscous, presliding) at the low speeds of reversals and creeping moves.
       Spec sp;
       sp.name = kSmoothing;
-      sp.dim = 1;
-      sp.lower = {{0, std::log(1e-6)}};
+      sp.dim = 2;
+      sp.lower = {{0, std::log(1e-6)}, {1, 0.0}};
       sp.upper = [](const Ctx& c) {
-        return std::vector<std::pair<int, double>>{{0, std::log(std::max(2e-6, 0.02 * c.rec.v_max_abs))}};
+        return std::vector<std::pair<int, double>>{{0, std::log(std::max(2e-6, 0.02 * c.rec.v_max_abs))}, {1, 1.0}};
       };
       s.push_back(sp);
     }
@@ -318,6 +322,7 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
     const Theta t(th + b.offset, th + b.offset + b.spec->dim);
     if (b.spec->name == kSmoothing) {
       p.friction.static_smoothing_velocity = std::exp(t[0]);
+      p.friction.static_smoothing_shape = t[1];
     } else if (b.spec->name == kOffset) {
       plant::set_effect(p.effects, Effect{"constant_force", {{"force_N", c.offset_bound * std::tanh(t[0])}}});
     } else {
@@ -500,7 +505,7 @@ bool has_coulomb_term(const plant::PlantParams& model) {
 int FreeSet::parameters(const plant::PlantParams& model) const {
   int k = 0;
   for (const std::string& n : effects) k += spec(n).dim;
-  if (form && has_coulomb_term(model)) k += 1;
+  if (form && has_coulomb_term(model)) k += spec(kSmoothing).dim;
   return k;
 }
 
@@ -522,6 +527,7 @@ std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& mode
   if (free.form && has_coulomb_term(model)) {
     blocks.push_back({&spec(kSmoothing), static_cast<int>(theta.size())});
     theta.push_back(std::log(model.friction.static_smoothing_velocity));
+    theta.push_back(model.friction.static_smoothing_shape);
   }
   if (free.offset_bound > 0.0) {
     blocks.push_back({&spec(kOffset), static_cast<int>(theta.size())});

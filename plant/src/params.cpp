@@ -30,6 +30,13 @@ FrictionModel friction_model_from_string(const std::string& s) {
   throw std::invalid_argument("expected one of lugre, static, none");
 }
 
+namespace {
+// b of the smoothed sign (forces.hpp, smoothed_sign): a blend weight in [0, 1].
+void require_smoothing_shape(const std::string& key, double b) {
+  if (!(b >= 0.0 && b <= 1.0)) fail(key, b, "must be in [0, 1]");
+}
+}  // namespace
+
 void FrictionParams::validate(const std::string& prefix) const {
   if (model == FrictionModel::kNone) return;
   require_positive(prefix + ".coulomb_force", coulomb_force);
@@ -45,6 +52,7 @@ void FrictionParams::validate(const std::string& prefix) const {
     require_non_negative(prefix + ".bristle_damping", bristle_damping);
   } else {
     require_positive(prefix + ".static_smoothing_velocity", static_smoothing_velocity);
+    require_smoothing_shape(prefix + ".static_smoothing_shape", static_smoothing_shape);
   }
 }
 
@@ -193,8 +201,10 @@ void PlantParams::validate(const std::string& prefix) const {
     lugre.bristle_damping = effects.presliding.bristle_damping_Ns_per_m;
     lugre.validate(prefix + ".friction");
   }
-  if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled)  // sgn = tanh(v/eps)
+  if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled) {  // sgn_eps(v)
     require_positive(prefix + ".friction.static_smoothing_velocity", friction.static_smoothing_velocity);
+    require_smoothing_shape(prefix + ".friction.static_smoothing_shape", friction.static_smoothing_shape);
+  }
   if (effects.stribeck_friction.enabled)
     require_positive(prefix + ".friction.stribeck_exponent", friction.stribeck_exponent);
   if (effects.grinding_force.enabled) {  // dullness = C/(pi*dw*bs)

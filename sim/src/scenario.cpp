@@ -48,6 +48,7 @@ void read_friction(MapReader r, plant::FrictionParams& f) {
   r.number("viscous", f.viscous);
   r.number("damping_decay_velocity", f.damping_decay_velocity);
   r.number("static_smoothing_velocity", f.static_smoothing_velocity);
+  r.number("static_smoothing_shape", f.static_smoothing_shape);
   r.finish();
 }
 

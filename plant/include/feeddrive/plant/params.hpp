@@ -37,8 +37,12 @@ struct FrictionParams {
   /// vd [m/s]: if > 0, sigma1(v) = sigma1*exp(-(v/vd)^2) (passivity remedy, Olsson et al. 1998).
   /// 0 (default) keeps the paper's constant sigma1.
   double damping_decay_velocity{0.0};
-  /// eps [m/s] of the static model's smoothed sign tanh(v/eps). Only used by kStatic.
+  /// eps [m/s] of the smoothed sign sgn_eps(v) (forces.hpp, smoothed_sign) of the static model
+  /// and of the Coulomb-type effects.
   double static_smoothing_velocity{1e-5};
+  /// b [-] in [0, 1], the shape of the smoothed sign: 0 (default) tanh(v/eps), 1 the algebraic
+  /// v/sqrt(v^2 + eps^2), between a blend (forces.hpp, smoothed_sign).
+  double static_smoothing_shape{0.0};
 
   void validate(const std::string& prefix = "friction") const;
 };
