@@ -546,6 +546,40 @@ void clamp_to_bounds(Theta& theta, const std::vector<Block>& blocks, const Ctx& 
   }
 }
 
+// The start of the smoothed sign's (eps, b), if they are free: the best of the given start and a
+// grid, eps geometric over its bounds (8 values), b in {0, 1/2, 1}, the other parameters held.
+// From a small eps the least-squares problem is flat in eps: the stick windows are left out
+// (mask_stiction) and above them tanh(v/eps) is saturated, so a real transition of 100 um/s or
+// more is not found from the default 10 um/s (the solver drifts to the bound instead).
+template <class Rss>
+void start_form(const Record& rec, const plant::PlantParams& model, const std::vector<Block>& blocks, Theta& theta,
+                const Ctx& ctx, const Rss& rss_of) {
+  const Block* form = nullptr;
+  for (const Block& b : blocks)
+    if (b.spec->name == kSmoothing) form = &b;
+  if (!form) return;
+  const int o = form->offset;
+  const double lo = form->spec->lower[0].second, hi = form->spec->upper(ctx)[0].second;
+  const auto rss_at = [&](double ln_eps, double b) {
+    Theta t = theta;
+    t[o] = ln_eps;
+    t[o + 1] = b;
+    const Eigen::VectorXd r = force_residual(rec, with_theta(model, blocks, t.data(), ctx));
+    return r.allFinite() ? rss_of(r) : std::numeric_limits<double>::infinity();
+  };
+  double best = rss_at(theta[o], theta[o + 1]), best_eps = theta[o], best_b = theta[o + 1];
+  constexpr int kEps = 8;
+  for (int i = 0; i < kEps; ++i) {
+    const double ln_eps = lo + (hi - lo) * i / (kEps - 1);
+    for (double b : {0.0, 0.5, 1.0}) {
+      const double s = rss_at(ln_eps, b);
+      if (s < best) best = s, best_eps = ln_eps, best_b = b;
+    }
+  }
+  theta[o] = best_eps;
+  theta[o + 1] = best_b;
+}
+
 }  // namespace
 
 JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
@@ -566,6 +600,7 @@ JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const F
   out.converged = true;
   if (blocks.empty()) return out;
   clamp_to_bounds(theta, blocks, ctx);
+  start_form(rec, model, blocks, theta, ctx, weighted_rss);
   const Solved sol = solve(rec, model, blocks, theta, ctx, max_iterations, weights);
   if (!(sol.rss < out.rss)) return out;
   out.params = with_theta(model, blocks, sol.theta.data(), ctx);
