@@ -276,14 +276,18 @@ const std::vector<Spec>& specs() {
       s.push_back(sp);
     }
     {
-      // Not an effect: the model-form parameter eps of sgn_eps(v) = tanh(v/eps), as ln eps,
-      // between 1 um/s and 2 % of the peak speed (a wider band would stand in for viscous friction).
+      // Not an effect: the model-form parameters of the smoothed sign (plant/forces.hpp)
+      // sgn_eps(v) = (1 - b) tanh(v/eps) + b v/sqrt(v^2 + eps^2): ln eps, between 1 um/s and 2 %
+      // of the peak speed (a wider band would stand in for viscous friction), and the shape b in
+      // [0, 1]. Real friction changes sign over a finite velocity band of a shape no one knows
+      // beforehand; fixing it to tanh leaves the difference to be patched by named effects
+      // (Stribeck, viscous, presliding) at the low speeds of reversals and creeping moves.
       Spec sp;
       sp.name = kSmoothing;
-      sp.dim = 1;
-      sp.lower = {{0, std::log(1e-6)}};
+      sp.dim = 2;
+      sp.lower = {{0, std::log(1e-6)}, {1, 0.0}};
       sp.upper = [](const Ctx& c) {
-        return std::vector<std::pair<int, double>>{{0, std::log(std::max(2e-6, 0.02 * c.rec.v_max_abs))}};
+        return std::vector<std::pair<int, double>>{{0, std::log(std::max(2e-6, 0.02 * c.rec.v_max_abs))}, {1, 1.0}};
       };
       s.push_back(sp);
     }
@@ -318,6 +322,7 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
     const Theta t(th + b.offset, th + b.offset + b.spec->dim);
     if (b.spec->name == kSmoothing) {
       p.friction.static_smoothing_velocity = std::exp(t[0]);
+      p.friction.static_smoothing_shape = t[1];
     } else if (b.spec->name == kOffset) {
       plant::set_effect(p.effects, Effect{"constant_force", {{"force_N", c.offset_bound * std::tanh(t[0])}}});
     } else {
@@ -500,7 +505,7 @@ bool has_coulomb_term(const plant::PlantParams& model) {
 int FreeSet::parameters(const plant::PlantParams& model) const {
   int k = 0;
   for (const std::string& n : effects) k += spec(n).dim;
-  if (form && has_coulomb_term(model)) k += 1;
+  if (form && has_coulomb_term(model)) k += spec(kSmoothing).dim;
   return k;
 }
 
@@ -522,6 +527,7 @@ std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& mode
   if (free.form && has_coulomb_term(model)) {
     blocks.push_back({&spec(kSmoothing), static_cast<int>(theta.size())});
     theta.push_back(std::log(model.friction.static_smoothing_velocity));
+    theta.push_back(model.friction.static_smoothing_shape);
   }
   if (free.offset_bound > 0.0) {
     blocks.push_back({&spec(kOffset), static_cast<int>(theta.size())});
@@ -538,6 +544,40 @@ void clamp_to_bounds(Theta& theta, const std::vector<Block>& blocks, const Ctx& 
     if (b.spec->upper)
       for (auto [i, v] : b.spec->upper(ctx)) theta[b.offset + i] = std::min(theta[b.offset + i], v);
   }
+}
+
+// The start of the smoothed sign's (eps, b), if they are free: the best of the given start and a
+// grid, eps geometric over its bounds (8 values), b in {0, 1/2, 1}, the other parameters held.
+// From a small eps the least-squares problem is flat in eps: the stick windows are left out
+// (mask_stiction) and above them tanh(v/eps) is saturated, so a real transition of 100 um/s or
+// more is not found from the default 10 um/s (the solver drifts to the bound instead).
+template <class Rss>
+void start_form(const Record& rec, const plant::PlantParams& model, const std::vector<Block>& blocks, Theta& theta,
+                const Ctx& ctx, const Rss& rss_of) {
+  const Block* form = nullptr;
+  for (const Block& b : blocks)
+    if (b.spec->name == kSmoothing) form = &b;
+  if (!form) return;
+  const int o = form->offset;
+  const double lo = form->spec->lower[0].second, hi = form->spec->upper(ctx)[0].second;
+  const auto rss_at = [&](double ln_eps, double b) {
+    Theta t = theta;
+    t[o] = ln_eps;
+    t[o + 1] = b;
+    const Eigen::VectorXd r = force_residual(rec, with_theta(model, blocks, t.data(), ctx));
+    return r.allFinite() ? rss_of(r) : std::numeric_limits<double>::infinity();
+  };
+  double best = rss_at(theta[o], theta[o + 1]), best_eps = theta[o], best_b = theta[o + 1];
+  constexpr int kEps = 8;
+  for (int i = 0; i < kEps; ++i) {
+    const double ln_eps = lo + (hi - lo) * i / (kEps - 1);
+    for (double b : {0.0, 0.5, 1.0}) {
+      const double s = rss_at(ln_eps, b);
+      if (s < best) best = s, best_eps = ln_eps, best_b = b;
+    }
+  }
+  theta[o] = best_eps;
+  theta[o + 1] = best_b;
 }
 
 }  // namespace
@@ -560,6 +600,7 @@ JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const F
   out.converged = true;
   if (blocks.empty()) return out;
   clamp_to_bounds(theta, blocks, ctx);
+  start_form(rec, model, blocks, theta, ctx, weighted_rss);
   const Solved sol = solve(rec, model, blocks, theta, ctx, max_iterations, weights);
   if (!(sol.rss < out.rss)) return out;
   out.params = with_theta(model, blocks, sol.theta.data(), ctx);

@@ -40,6 +40,7 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
   if (has_coulomb_term(fitted)) {
     if (!root["plant"]["friction"]) root["plant"]["friction"] = YAML::Node(YAML::NodeType::Map);
     root["plant"]["friction"]["static_smoothing_velocity"] = fitted.friction.static_smoothing_velocity;
+    root["plant"]["friction"]["static_smoothing_shape"] = fitted.friction.static_smoothing_shape;
   }
   YAML::Emitter em;
   em.SetDoublePrecision(15);
@@ -117,6 +118,8 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["conclusion"] = r.conclusion;
   j["model_form"] = {{"coulomb_transition_velocity_initial_mps", r.smoothing_initial},
                      {"coulomb_transition_velocity_final_mps", r.smoothing_final},
+                     {"coulomb_transition_shape_initial", r.shape_initial},
+                     {"coulomb_transition_shape_final", r.shape_final},
                      {"fitted", r.smoothing_fitted}};
   const Envelope& env = r.envelope;
   j["record"] = {{"travel_m", env.travel}, {"peak_speed_mps", env.v_max}, {"peak_thrust_N", env.peak_thrust},
@@ -275,9 +278,10 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     }
     if (r.smoothing_fitted) {
       std::snprintf(buf, sizeof buf,
-                    "\nModel form (not an effect): the Coulomb transition velocity eps of tanh(v/eps) was refitted, "
-                    "%.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity).\n",
-                    r.smoothing_initial * 1e3, r.smoothing_final * 1e3);
+                    "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
+                    "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
+                    "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
+                    r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
       md << buf;
     }
     {

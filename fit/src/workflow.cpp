@@ -76,6 +76,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   out.initial = model;
   out.envelope = envelope(rec, model);
   out.smoothing_initial = model.friction.static_smoothing_velocity;
+  out.shape_initial = model.friction.static_smoothing_shape;
   // The effects added so far. The model-form parameter eps is refitted with them at the start and
   // after every addition (recalibrate), and held in the many candidate, cross-validation and
   // backward fits between: with a static friction model every change of eps recomputes the
@@ -481,12 +482,16 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     out.steps.push_back(st);
   }
   // eps means nothing to a model without a Coulomb-type term (e.g. once presliding made it LuGre)
-  if (!has_coulomb_term(current)) current.friction.static_smoothing_velocity = model.friction.static_smoothing_velocity;
+  if (!has_coulomb_term(current)) {
+    current.friction.static_smoothing_velocity = model.friction.static_smoothing_velocity;
+    current.friction.static_smoothing_shape = model.friction.static_smoothing_shape;
+  }
   if (current.effects.constant_force.enabled && !contains(added, "constant_force"))
     out.asymmetry_offset = current.effects.constant_force.force_N;
   out.fitted = current;
   out.smoothing_final = current.friction.static_smoothing_velocity;
-  out.smoothing_fitted = out.smoothing_final != out.smoothing_initial;
+  out.shape_final = current.friction.static_smoothing_shape;
+  out.smoothing_fitted = out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial;
   out.replay_final = rp;
   out.force_rms_final = rms(r, n);
   out.final_localisation = localise(rec, r, rp);
@@ -584,8 +589,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   if (out.asymmetry_offset != 0.0)
     out.conclusion += fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
   if (out.smoothing_fitted)
-    out.conclusion += fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s", out.smoothing_initial * 1e3,
-                          out.smoothing_final * 1e3);
+    out.conclusion += fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
+                          out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
   say(out.conclusion);
   return out;
 }

@@ -59,12 +59,11 @@ PlantParams effective_params(const PlantParams& p) {
 
 double extra_force(const PlantParams& p, double x, double v, double thrust) {
   const EffectsParams& fx = p.effects;
-  const double eps = p.friction.static_smoothing_velocity;
   double F = 0.0;
   if (fx.constant_force.enabled) F += fx.constant_force.force_N;
-  if (fx.coulomb_friction.enabled) F += fx.coulomb_friction.coulomb_N * std::tanh(v / eps);
+  if (fx.coulomb_friction.enabled) F += fx.coulomb_friction.coulomb_N * smoothed_sign(p.friction, v);
   if (fx.viscous_friction.enabled) F += fx.viscous_friction.viscous_Ns_per_m * v;
-  if (fx.stribeck_friction.enabled) F += std::tanh(v / eps) * stribeck(stribeck_curve(p), v);
+  if (fx.stribeck_friction.enabled) F += smoothed_sign(p.friction, v) * stribeck(stribeck_curve(p), v);
   if (fx.cogging_ripple.enabled) {
     const CoggingRippleEffect& c = fx.cogging_ripple;
     const double th = kTwoPi * x / c.pitch_m;
@@ -80,19 +79,13 @@ double extra_force(const PlantParams& p, double x, double v, double thrust) {
 
 ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v, double thrust) {
   const EffectsParams& fx = p.effects;
-  const double eps = p.friction.static_smoothing_velocity;
   ExtraForceGradient g;
-  // d/dv tanh(v/eps) = (1 - tanh^2)/eps
-  if (fx.coulomb_friction.enabled) {
-    const double th = std::tanh(v / eps);
-    g.dv += fx.coulomb_friction.coulomb_N * (1.0 - th * th) / eps;
-  }
+  if (fx.coulomb_friction.enabled) g.dv += fx.coulomb_friction.coulomb_N * smoothed_sign_derivative(p.friction, v);
   if (fx.viscous_friction.enabled) g.dv += fx.viscous_friction.viscous_Ns_per_m;
   if (fx.stribeck_friction.enabled) {
-    // d/dv [tanh(v/eps)*g(v)] = (1 - tanh^2)/eps*g(v) + tanh(v/eps)*g'(v)
+    // d/dv [sgn_eps(v)*g(v)] = sgn_eps'(v)*g(v) + sgn_eps(v)*g'(v)
     const FrictionParams curve = stribeck_curve(p);
-    const double th = std::tanh(v / eps);
-    g.dv += (1.0 - th * th) / eps * stribeck(curve, v) + th * stribeck_derivative(curve, v);
+    g.dv += smoothed_sign_derivative(p.friction, v) * stribeck(curve, v) + smoothed_sign(p.friction, v) * stribeck_derivative(curve, v);
   }
   if (fx.cogging_ripple.enabled) {
     const CoggingRippleEffect& c = fx.cogging_ripple;

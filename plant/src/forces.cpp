@@ -46,12 +46,27 @@ double lugre_zdot(const FrictionParams& p, double v, double z) {
   return v - p.bristle_stiffness * std::abs(v) * z / stribeck(p, v);
 }
 
+double smoothed_sign(const FrictionParams& p, double v) {
+  const double eps = p.static_smoothing_velocity, b = p.static_smoothing_shape;
+  const double th = std::tanh(v / eps);
+  return b == 0.0 ? th : (1.0 - b) * th + b * v / std::sqrt(v * v + eps * eps);
+}
+
+double smoothed_sign_derivative(const FrictionParams& p, double v) {
+  const double eps = p.static_smoothing_velocity, b = p.static_smoothing_shape;
+  const double th = std::tanh(v / eps);
+  const double d_tanh = (1.0 - th * th) / eps;
+  if (b == 0.0) return d_tanh;
+  const double q = v * v + eps * eps;
+  return (1.0 - b) * d_tanh + b * eps * eps / (q * std::sqrt(q));
+}
+
 double friction_force(const FrictionParams& p, double v, double z) {
   switch (p.model) {
     case FrictionModel::kLuGre:
       return p.bristle_stiffness * z + micro_damping(p, v) * lugre_zdot(p, v, z) + p.viscous * v;
     case FrictionModel::kStatic:
-      return stribeck(p, v) * std::tanh(v / p.static_smoothing_velocity) + p.viscous * v;
+      return stribeck(p, v) * smoothed_sign(p, v) + p.viscous * v;
     case FrictionModel::kNone:
       return 0.0;
   }
@@ -76,9 +91,7 @@ FrictionJacobian friction_jacobian(const FrictionParams& p, double v, double z) 
       break;
     }
     case FrictionModel::kStatic: {
-      const double eps = p.static_smoothing_velocity;
-      const double th = std::tanh(v / eps);
-      J.dF_dv = stribeck_derivative(p, v) * th + stribeck(p, v) * (1.0 - th * th) / eps + p.viscous;
+      J.dF_dv = stribeck_derivative(p, v) * smoothed_sign(p, v) + stribeck(p, v) * smoothed_sign_derivative(p, v) + p.viscous;
       break;
     }
     case FrictionModel::kNone:

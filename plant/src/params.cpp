@@ -21,11 +21,18 @@ FrictionModel friction_model_from_string(const std::string& s) { return fields::
 // Each validate(): the ranges of the struct's list (Serialize, params.hpp), then the rules that
 // tie fields together.
 
+namespace {
+// b of the smoothed sign (forces.hpp, smoothed_sign): a blend weight in [0, 1].
+void require_smoothing_shape(const std::string& key, double b) {
+  if (!(b >= 0.0 && b <= 1.0)) fail(key, b, "must be in [0, 1]");
+}
+}  // namespace
+
 void FrictionParams::validate(const std::string& prefix) const {
   if (model == FrictionModel::kNone) return;
   // The keys of the other law are not used, so not checked.
   if (model == FrictionModel::kLuGre) {
-    fields::check_fields(*this, prefix, {"static_smoothing_velocity"});
+    fields::check_fields(*this, prefix, {"static_smoothing_velocity", "static_smoothing_shape"});
   } else {
     fields::check_fields(*this, prefix, {"bristle_stiffness", "bristle_damping"});
   }
@@ -121,8 +128,10 @@ void PlantParams::validate(const std::string& prefix) const {
     lugre.bristle_damping = effects.presliding.bristle_damping_Ns_per_m;
     lugre.validate(prefix + ".friction");
   }
-  if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled)  // sgn = tanh(v/eps)
+  if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled) {  // sgn_eps(v)
     require_positive(prefix + ".friction.static_smoothing_velocity", friction.static_smoothing_velocity);
+    require_smoothing_shape(prefix + ".friction.static_smoothing_shape", friction.static_smoothing_shape);
+  }
   if (effects.stribeck_friction.enabled)
     require_positive(prefix + ".friction.stribeck_exponent", friction.stribeck_exponent);
   if (effects.grinding_force.enabled) {  // dullness = C/(pi*dw*bs)

@@ -462,6 +462,9 @@ TEST(EffectsParams, ValidateNamesKeyAndValue) {
   p.friction.static_smoothing_velocity = 0.0;  // unused by LuGre
   p.effects.coulomb_friction.enabled = true;
   EXPECT_EQ(error_of(p), "plant.friction.static_smoothing_velocity = 0: must be > 0");
+  p.friction.static_smoothing_velocity = 1e-5;
+  p.friction.static_smoothing_shape = 1.5;  // a blend weight of tanh and the algebraic form
+  EXPECT_EQ(error_of(p), "plant.friction.static_smoothing_shape = 1.5: must be in [0, 1]");
 }
 
 }  // namespace

@@ -104,6 +104,38 @@ TEST(Dynamics, JacobianInsideTheContactBand) {
   }
 }
 
+// The smoothed sign's two ends are the closed forms (b = 0: tanh(v/eps), b = 1: v/sqrt(v^2 + eps^2),
+// to the last bits: 1e-15), a blend is their weighted sum, and its derivative matches central
+// differences (h = 1e-4 eps: truncation O(h^2/eps^3) ~ 1e-8/eps relative, far inside 1e-6).
+TEST(Forces, SmoothedSignBlendsTanhAndTheAlgebraicForm) {
+  FrictionParams p;
+  p.model = FrictionModel::kStatic;
+  p.static_smoothing_velocity = 2e-4;
+  const double eps = p.static_smoothing_velocity;
+  for (double v : {-3e-3, -2e-4, -1e-5, 0.0, 7e-5, 6e-4, 0.05}) {
+    p.static_smoothing_shape = 0.0;
+    const double th = smoothed_sign(p, v);
+    EXPECT_NEAR(th, std::tanh(v / eps), 1e-15) << v;
+    p.static_smoothing_shape = 1.0;
+    const double al = smoothed_sign(p, v);
+    EXPECT_NEAR(al, v / std::sqrt(v * v + eps * eps), 1e-15) << v;
+    p.static_smoothing_shape = 0.3;
+    EXPECT_NEAR(smoothed_sign(p, v), 0.7 * th + 0.3 * al, 1e-15) << v;
+    for (double b : {0.0, 0.3, 1.0}) {
+      p.static_smoothing_shape = b;
+      const double h = 1e-4 * eps;
+      const double fd = (smoothed_sign(p, v + h) - smoothed_sign(p, v - h)) / (2 * h);
+      EXPECT_NEAR(smoothed_sign_derivative(p, v), fd, 1e-6 * std::abs(fd) + 1e-9 / eps) << v << " b " << b;
+    }
+  }
+  // the algebraic form is the slower one: at v = 3 eps it is still 5 % short of 1, tanh 0.5 %
+  p.static_smoothing_shape = 1.0;
+  EXPECT_NEAR(smoothed_sign(p, 3 * eps), 3.0 / std::sqrt(10.0), 1e-12);
+  EXPECT_LT(smoothed_sign(p, 3 * eps), 0.95);
+  p.static_smoothing_shape = 0.0;
+  EXPECT_GT(smoothed_sign(p, 3 * eps), 0.995);
+}
+
 // Central finite differences of derivative() against jacobian(), on seeded random states with
 // every sub-model on. Step h_j = 1e-6 * scale_j; the tolerance 1e-5 relative to the row scale
 // covers the O(h^2) truncation and the cancellation error (~1e-16/h relative).

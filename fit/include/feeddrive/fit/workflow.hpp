@@ -1,7 +1,7 @@
 #pragma once
 // The model-discrepancy loop of feeddrive-fit (docs/fit.md, "Naming the effects"): bidirectional
 // stepwise selection (Efroymson 1960) with joint refits.
-//   0. model form: the Coulomb transition velocity of a static friction model is refitted;
+//   0. model form: the Coulomb transition velocity and shape of a static friction model are refitted;
 //   1. forward: every candidate whose prerequisites hold (plausibility.hpp) is fitted alone, then
 //      jointly with every effect added so far; it is scored by BIC(model) - BIC(model + it);
 //      candidates with implausible fitted values are passed over, with the reason;
@@ -67,7 +67,8 @@ struct FitResult {
   Localisation final_localisation;
   Envelope envelope;                   ///< what the record spans (plausibility rules)
   double smoothing_initial{0.0}, smoothing_final{0.0};  ///< eps of sgn_eps [m/s], before and after
-  bool smoothing_fitted{false};
+  double shape_initial{0.0}, shape_final{0.0};          ///< b of sgn_eps [-] (0 tanh, 1 algebraic), before and after
+  bool smoothing_fitted{false};                         ///< eps or b was refitted
   /// The model-form offset of a friction direction asymmetry (within kAsymmetryTolerance of the
   /// friction level), carried by constant_force in `fitted` but not named as an effect [N].
   double asymmetry_offset{0.0};

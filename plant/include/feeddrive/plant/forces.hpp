@@ -23,9 +23,19 @@ double micro_damping_derivative(const FrictionParams& p, double v);
 /// LuGre bristle dynamics  dz/dt = v - sigma0*|v|*z/g(v)   (Canudas de Wit 1995 eq. 1).
 double lugre_zdot(const FrictionParams& p, double v, double z);
 
+/// Smoothed sign of the static friction model and of the Coulomb-type effects (effects.hpp):
+///   sgn_eps(v) = (1 - b)*tanh(v/eps) + b*v/sqrt(v^2 + eps^2),
+/// eps = static_smoothing_velocity, b = static_smoothing_shape in [0, 1]. The two are the usual
+/// regularisations of sgn(v) in static friction maps; they differ in how the level is reached:
+/// tanh exponentially (1 - 2 exp(-2|v|/eps)), the algebraic form slowly (1 - eps^2/(2 v^2)), so a
+/// real transition can lie between them. b = 0 (the default) is tanh.
+double smoothed_sign(const FrictionParams& p, double v);
+/// d sgn_eps / dv = (1 - b)*(1 - tanh^2(v/eps))/eps + b*eps^2/(v^2 + eps^2)^(3/2).
+double smoothed_sign_derivative(const FrictionParams& p, double v);
+
 /// Friction force by the selected model:
 ///  LuGre:  F = sigma0*z + sigma1(v)*dz/dt + sigma2*v                (Canudas de Wit 1995 eq. 2)
-///  static: F = g(v)*tanh(v/eps) + sigma2*v   (Coulomb+Stribeck+viscous, smoothed sign)
+///  static: F = g(v)*sgn_eps(v) + sigma2*v   (Coulomb+Stribeck+viscous, smoothed sign)
 ///  none:   F = 0
 double friction_force(const FrictionParams& p, double v, double z);
 

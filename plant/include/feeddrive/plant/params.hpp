@@ -50,8 +50,12 @@ struct FrictionParams {
   /// vd [m/s]: if > 0, sigma1(v) = sigma1*exp(-(v/vd)^2) (passivity remedy, Olsson et al. 1998).
   /// 0 (default) keeps the paper's constant sigma1.
   double damping_decay_velocity{0.0};
-  /// eps [m/s] of the static model's smoothed sign tanh(v/eps). Only used by kStatic.
+  /// eps [m/s] of the smoothed sign sgn_eps(v) (forces.hpp, smoothed_sign) of the static model
+  /// and of the Coulomb-type effects.
   double static_smoothing_velocity{1e-5};
+  /// b [-] in [0, 1], the shape of the smoothed sign: 0 (default) tanh(v/eps), 1 the algebraic
+  /// v/sqrt(v^2 + eps^2), between a blend (forces.hpp, smoothed_sign).
+  double static_smoothing_shape{0.0};
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -64,7 +68,8 @@ struct FrictionParams {
     a->Visit(FD_FIELD(bristle_damping).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1 (lugre)"));
     a->Visit(FD_FIELD(viscous).unit("N*s/m").non_negative().plausible(0, 1e5).doc("sigma2, viscous coefficient"));
     a->Visit(FD_FIELD(damping_decay_velocity).unit("m/s").non_negative().plausible(0, 1.0, "mm/s").doc("vd: > 0 gives sigma1(v) = sigma1*exp(-(v/vd)^2); 0 keeps sigma1 constant"));
-    a->Visit(FD_FIELD(static_smoothing_velocity).unit("m/s").positive().plausible(1e-9, 1e-2, "mm/s").doc("eps of the static model's sign tanh(v/eps) (static only)"));
+    a->Visit(FD_FIELD(static_smoothing_velocity).unit("m/s").positive().plausible(1e-9, 1e-2, "mm/s").doc("eps of the static model's smoothed sign sgn_eps(v) (static only)"));
+    a->Visit(FD_FIELD(static_smoothing_shape).unit("-").non_negative().at_most(1).doc("b: sgn_eps(v) = (1-b)*tanh(v/eps) + b*v/sqrt(v^2+eps^2); 0 tanh, 1 algebraic (static only)"));
   }
   void validate(const std::string& prefix = "friction") const;
 };
