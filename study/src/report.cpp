@@ -391,8 +391,9 @@ std::string metric_by_value(const ReportData& d) {
     }
     md << "\n## " << cell(s.report.metric) << " against " << cell(d.params[p]) << "\n\n";
     if (rows.empty() || rows.size() > kMaxRows) {
-      md << (rows.empty() ? "No value of this key in any case.\n"
-                          : "More than 50 values (a distribution): see its plot.\n");
+      md << (d.categories[p].text && d.categories[p].more ? "More than 50 values that are not all numbers: see results.csv.\n"
+             : rows.empty()                                ? "No value of this key in any case.\n"
+                                                           : "More than 50 values (a distribution): see its plot.\n");
       continue;
     }
     md << "| " << cell(categorical ? d.params[p] : axis_label(d.params[p], ax)) << " |";

@@ -53,6 +53,16 @@ Outcome ok_with(double error_m) {
   return o;
 }
 
+// The gnuplot script write_plots writes into `dir` (before gnuplot runs: a machine without
+// gnuplot throws after it is written).
+std::string plot_script(const fs::path& dir, const ReportData& d) {
+  try {
+    write_plots(dir, "plots/", d);
+  } catch (const std::runtime_error&) {
+  }
+  return test_support::slurp(dir / "plots.gp");
+}
+
 bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 TEST(StudyOutcome, ACaseCarriesItsLoaderWarningsAndWhetherItsMoveFinished) {
@@ -134,13 +144,8 @@ TEST(StudyReport, AKeyWithTextValuesGetsATableAndAPlotByCategory) {
   EXPECT_TRUE(has(md, "| controller.switching |")) << md;
   EXPECT_TRUE(has(md, "| sgn | 2 |")) << md;
   EXPECT_TRUE(has(md, "| tanh | 1 |")) << md;
-  // The plot script (written before gnuplot runs; a machine without gnuplot throws after it).
   const fs::path dir = test_support::make_scratch("study-report-cat");
-  try {
-    write_plots(dir, "plots/", d);
-  } catch (const std::runtime_error&) {
-  }
-  const std::string gp = test_support::slurp(dir / "plots.gp");
+  const std::string gp = plot_script(dir, d);
   EXPECT_TRUE(has(gp, "set xtics (\"sgn\" 1, \"tanh\" 2)")) << gp;
   EXPECT_TRUE(has(gp, "'param_0_0.dat'")) << gp;
   // F22: the y-label is the metric's name without _m, with the unit shown.
@@ -158,12 +163,7 @@ TEST(StudyReport, ALogSweepIsPlottedOnALogAxis) {
   EXPECT_FALSE(log_axis(lin, "plant.mass", {0, 100, 1000}));     // 0 has no logarithm
   ReportData d(s);
   report_of(s, d, [](std::size_t) { return ok_with(1e-6); });
-  const fs::path dir = test_support::make_scratch("study-report-log");
-  try {
-    write_plots(dir, "plots/", d);
-  } catch (const std::runtime_error&) {
-  }
-  const std::string gp = test_support::slurp(dir / "plots.gp");
+  const std::string gp = plot_script(test_support::make_scratch("study-report-log"), d);
   EXPECT_TRUE(has(gp, "set logscale x\n")) << gp;
   EXPECT_TRUE(has(gp, "set xlabel \"plant.sensor.quantization [um]\"")) << gp;
 }
