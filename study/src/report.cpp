@@ -418,7 +418,7 @@ std::string metric_by_value(const ReportData& d) {
     } else {
       md << "\nThe median over the cases with that value and controller ("
          << (fewest == most ? std::to_string(most) : std::to_string(fewest) + " to " + std::to_string(most))
-         << " each: the other varied keys and draws take their values among them).\n";
+         << " each, over the values of the other varied keys and the draws).\n";
     }
   }
   return md.str();

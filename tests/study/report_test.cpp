@@ -124,7 +124,7 @@ TEST(StudyReport, TimeKeysAreShownInMicrosecondsOrMillisecondsWithTheirUnit) {
   EXPECT_TRUE(has(md, "| controller.computation_delay [us] |")) << md;
   for (const char* row : {"| 100 |", "| 200 |", "| 0 |"}) EXPECT_TRUE(has(md, row)) << row << "\n" << md;
   // F22: a grid of two keys has two cases per value of each: the note says so.
-  EXPECT_TRUE(has(md, "(2 each: the other varied keys")) << md;
+  EXPECT_TRUE(has(md, "(2 each, over the values of the other varied keys")) << md;
   EXPECT_FALSE(has(md, "one-key sweep")) << md;
 
   const Study t = sweep({"duration=0.01,0.5"});
