@@ -148,7 +148,14 @@ namespace {
 // key -> unit, from the tables' rows (| `key` | unit | ...).
 const std::map<std::string, std::string>& unit_map() {
   static const std::map<std::string, std::string> units = [] {
-    std::map<std::string, std::string> m;
+    // The keys the loader reads outside the params lists (scenario.cpp, parse_node; docs/scenario.md,
+    // "The scenario file"): the run's times, the controller's delay and the analysis windows.
+    std::map<std::string, std::string> m = {{"duration", "s"},
+                                            {"control_period", "s"},
+                                            {"controller.computation_delay", "s"},
+                                            {"analysis.settled_after", "s"},
+                                            {"analysis.settling_band", "m"},
+                                            {"output.every", "-"}};
     for (const auto& [name, text] : key_tables()) {
       const std::string prefix = name.rfind("controller.", 0) == 0 ? "controller" : name.rfind("reference.", 0) == 0 ? "reference" : name;
       std::size_t i = 0;

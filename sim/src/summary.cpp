@@ -422,11 +422,8 @@ nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   if (s.controller.type == ControllerType::kCascade)
     j["cascade_gains"] = {{"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
   // Issue 23: a move the run cut off, and the loader's plausibility warnings (scenario.hpp).
-  if (std::isnan(s.move_end_s)) {
-    j["move_finished"] = nullptr;  // the reference is not a move
-  } else {
-    j["move_finished"] = s.move_end_s <= s.duration;
-  }
+  const std::optional<bool> finished = move_finished(s);
+  j["move_finished"] = finished ? nlohmann::ordered_json(*finished) : nlohmann::ordered_json();  // null: not a move
   j["warnings"] = s.warnings;
   return j;
 }
@@ -441,6 +438,11 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
   // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
   // exception after the run.
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+std::optional<bool> move_finished(const Scenario& s) {
+  if (std::isnan(s.move_end_s)) return std::nullopt;
+  return s.move_end_s <= s.duration;
 }
 
 bool is_wall_clock_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }

@@ -64,6 +64,12 @@ double median(std::vector<double> v) {
 
 using Cell = ReportData::Cell;
 
+// A varied key shown by category: some of its values are not numbers, and it has at most
+// ReportData::kMaxCategories distinct values.
+bool is_categorical(const ReportData& d, std::size_t p) {
+  return d.categories[p].text && !d.categories[p].more && !d.categories[p].values.empty();
+}
+
 bool parse_number(const std::string& text, double& out) {
   char* end = nullptr;
   out = std::strtod(text.c_str(), &end);
@@ -74,7 +80,8 @@ bool parse_number(const std::string& text, double& out) {
 }  // namespace
 
 // A varied key's values in its engineering unit: the unit its params list gives
-// (sim::key_unit), scaled to mm, um, mm/s or ms where the values are that small.
+// (sim::key_unit, which knows the top-level keys too: duration, control_period, ...), scaled to
+// mm, um, mm/s, ms or us where the values are that small.
 struct AxisUnit {
   std::string unit;
   double factor{1.0};
@@ -87,10 +94,46 @@ AxisUnit axis_unit(const std::string& key, const std::vector<float>& x, std::siz
   if (unit == "m" && top > 0 && top < 1e-3) return {"um", 1e6};
   if (unit == "m" && top > 0 && top < 1.0) return {"mm", 1e3};
   if (unit == "m/s" && top > 0 && top < 1.0) return {"mm/s", 1e3};
+  if (unit == "s" && top > 0 && top < 1e-3) return {"us", 1e6};
   if (unit == "s" && top > 0 && top < 1.0) return {"ms", 1e3};
   return {unit.empty() || unit == "-" ? std::string() : unit, 1.0};
 }
 std::string axis_label(const std::string& key, const AxisUnit& u) { return u.unit.empty() ? key : key + " [" + u.unit + "]"; }
+
+std::string metric_label(const std::string& metric, const std::string& unit) {
+  std::string name = metric;
+  for (const char* suffix : {"_m", "_s", "_mps", "_mps2", "_N", "_V", "_Hz", "_A", "_W"}) {
+    const std::string sfx = suffix;
+    if (name.size() > sfx.size() && name.compare(name.size() - sfx.size(), sfx.size(), sfx) == 0) {
+      name.resize(name.size() - sfx.size());
+      break;
+    }
+  }
+  return unit.empty() ? name : name + " [" + unit + "]";
+}
+
+bool log_axis(const Study& s, const std::string& key, const std::vector<double>& values) {
+  for (const Family& f : s.families)
+    for (const GridAxis& a : f.grid)
+      if (a.log && std::find(a.keys.begin(), a.keys.end(), key) != a.keys.end()) return true;
+  double lo = INFINITY, hi = 0.0;
+  for (double v : values) {
+    if (!std::isfinite(v)) continue;
+    if (!(v > 0.0)) return false;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  return hi > 0.0 && hi > 100.0 * lo;
+}
+
+std::vector<std::string> warning_lines(const ReportData& d) {
+  std::vector<std::string> out;
+  for (const auto& [w, n] : d.warnings)
+    out.push_back(w + " (" + std::to_string(n) + " of " + std::to_string(d.cases) + " cases)");
+  if (d.cases_with_other_warnings > 0)
+    out.push_back(std::to_string(d.cases_with_other_warnings) + " cases have further warnings (the warnings column of results.csv)");
+  return out;
+}
 
 std::string csv_field(const std::string& value) {
   if (value.find_first_of(",\"\n\r") == std::string::npos) return value;
@@ -109,7 +152,7 @@ ResultsWriter::ResultsWriter(const Study& s, const fs::path& dir)
   if (!out_) throw std::runtime_error(partial_.string() + ": cannot write");
   out_ << "case,controller,family,point,draw,hash";
   for (const std::string& p : params_) out_ << ',' << csv_field(p);
-  out_ << ",ok,error";
+  out_ << ",ok,error,move_finished,warnings";
   for (const std::string& m : metrics_) out_ << ',' << csv_field(m);
   out_ << '\n';
 }
@@ -129,7 +172,11 @@ void ResultsWriter::add(std::size_t index, const CaseRecord& c) {
     const auto it = c.resolved.parameters.find(p);
     out_ << ',' << (it == c.resolved.parameters.end() ? "" : csv_field(it->second));
   }
-  out_ << ',' << (c.outcome.ok ? "true" : "false") << ',' << csv_field(c.outcome.error);
+  out_ << ',' << (c.outcome.ok ? "true" : "false") << ',' << csv_field(c.outcome.error) << ','
+       << (c.outcome.move_finished ? (*c.outcome.move_finished ? "true" : "false") : "");
+  std::string warnings;
+  for (const std::string& w : c.outcome.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+  out_ << ',' << csv_field(warnings);
   for (const std::string& m : metrics_) {
     out_ << ',';
     for (const auto& [k, v] : c.outcome.metrics)
@@ -148,11 +195,12 @@ void ResultsWriter::finish() {
 
 ReportData::ReportData(const Study& st)
     : s(st), params(varied_keys(st)), table(st.families.size(), std::vector<Cell>(st.controllers.size())),
-      worst(st.controllers.size()) {
+      worst(st.controllers.size()), categories(params.size()) {
   const auto n = static_cast<std::size_t>(st.total_cases());  // exact: no doubling of the largest vectors
   controller.reserve(n);
   shown.reserve(n);
   x.reserve(n * params.size());
+  category.reserve(n * params.size());
 }
 
 void ReportData::add(std::size_t index, const CaseRecord& c) {
@@ -174,19 +222,51 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
   }
   controller.push_back(static_cast<std::uint32_t>(c.spec.controller));
   shown.push_back(v);
-  for (const std::string& p : params) {
-    const auto it = c.resolved.parameters.find(p);
+  for (std::size_t p = 0; p < params.size(); ++p) {
+    const auto it = c.resolved.parameters.find(params[p]);
     double px = NAN;
-    if (it == c.resolved.parameters.end() || !parse_number(it->second, px)) px = NAN;
+    std::int16_t index = -1;
+    if (it != c.resolved.parameters.end()) {
+      if (!parse_number(it->second, px)) {
+        px = NAN;
+        categories[p].text = !it->second.empty() || categories[p].text;
+      }
+      Categories& cat = categories[p];
+      const auto found = std::find(cat.values.begin(), cat.values.end(), it->second);
+      if (found != cat.values.end()) {
+        index = static_cast<std::int16_t>(found - cat.values.begin());
+      } else if (cat.values.size() < kMaxCategories) {
+        index = static_cast<std::int16_t>(cat.values.size());
+        cat.values.push_back(it->second);
+      } else {
+        cat.more = true;
+      }
+    }
     x.push_back(static_cast<float>(px));
+    category.push_back(index);
   }
+  if (c.outcome.move_finished) {
+    ++moves;
+    moves_unfinished += *c.outcome.move_finished ? 0 : 1;
+  }
+  bool other = false;
+  for (const std::string& w : c.outcome.warnings) {
+    if (auto it = warnings.find(w); it != warnings.end()) {
+      ++it->second;
+    } else if (warnings.size() < kListedWarnings) {
+      warnings.emplace(w, 1);
+    } else {
+      other = true;
+    }
+  }
+  cases_with_other_warnings += other ? 1 : 0;
 }
 
 std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d) {
   const Study& s = d.s;
   fs::create_directories(dir);
   const std::size_t nc = s.controllers.size(), nf = s.families.size();
-  const std::string ylabel = output::gnuplot_string(s.report.metric + " [" + s.report.unit + "]");
+  const std::string ylabel = output::gnuplot_string(metric_label(s.report.metric, s.report.unit));
   std::ostringstream gp, md;
   gp << "set encoding utf8\nset terminal pngcairo size 1200,650 noenhanced\nset grid ytics\n"
      << "set key outside top center horizontal\nset logscale y\n";
@@ -235,14 +315,20 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
   const std::vector<std::string>& params = d.params;
   for (std::size_t p = 0; p < params.size(); ++p) {
     const AxisUnit ax = axis_unit(params[p], d.x, params.size(), p);
+    // A key whose values are not all numbers (switching: sgn, tanh): one category per value on
+    // the x-axis, at 1, 2, ... in the order given.
+    const bool categorical = is_categorical(d, p);
+    std::vector<double> xs;
     std::vector<std::string> series;
     for (std::size_t c = 0; c < nc; ++c) {
       std::ostringstream data;
       long n = 0;
       for (std::size_t i = 0; i < d.cases; ++i) {
         if (d.controller[i] != c) continue;
-        const double x = d.x[i * params.size() + p] * ax.factor, y = d.shown[i];
+        const std::int16_t k = d.category[i * params.size() + p];
+        const double x = categorical ? (k >= 0 ? k + 1.0 : NAN) : d.x[i * params.size() + p] * ax.factor, y = d.shown[i];
         if (!std::isfinite(x) || !(y > 0.0)) continue;
+        xs.push_back(x);
         data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
         ++n;
       }
@@ -255,10 +341,22 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
     if (series.empty()) continue;
     const std::string png = "param_" + std::to_string(p) + ".png";
     gp << "set output '" << png << "'\nset title " << output::gnuplot_string(s.report.metric + " against " + params[p])
-       << "\nset xlabel " << output::gnuplot_string(axis_label(params[p], ax)) << "\nset ylabel " << ylabel << "\nset xtics rotate by 0\n"
-       << limit_line << "plot ";
+       << "\nset xlabel " << output::gnuplot_string(categorical ? params[p] : axis_label(params[p], ax)) << "\nset ylabel "
+       << ylabel << "\nset xtics rotate by 0\n";
+    const bool logx = !categorical && log_axis(s, params[p], xs);
+    if (categorical) {
+      const auto& values = d.categories[p].values;
+      gp << "set xrange [0.5:" << output::number_text(static_cast<double>(values.size()) + 0.5) << "]\nset xtics (";
+      for (std::size_t k = 0; k < values.size(); ++k) gp << (k ? ", " : "") << output::gnuplot_string(values[k], 40) << ' ' << k + 1;
+      gp << ")\n";
+    } else if (logx) {
+      gp << "set logscale x\n";
+    }
+    gp << limit_line << "plot ";
     for (std::size_t i = 0; i < series.size(); ++i) gp << (i ? ", \\\n  " : "") << series[i];
     gp << '\n';
+    if (categorical) gp << "unset xtics\nset xtics\nunset xrange\nset autoscale x\n";
+    if (logx) gp << "unset logscale x\n";
     md << "![" << cell(s.report.metric) << " against " << cell(params[p]) << "](" << prefix << png << ")\n\n";
   }
   if (md.str().empty()) return "No plot: no case gave a positive " + s.report.metric + ".\n\n";
@@ -267,7 +365,8 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
 }
 
 // For every varied key with at most kMaxRows distinct values: the metric's median per value and
-// controller, the value in the key's engineering unit.
+// controller, the value in the key's engineering unit; a key with values that are not numbers
+// (switching: sgn, tanh) by its values as written, in the order given.
 std::string metric_by_value(const ReportData& d) {
   constexpr std::size_t kMaxRows = 50;
   const Study& s = d.s;
@@ -275,30 +374,52 @@ std::string metric_by_value(const ReportData& d) {
   std::ostringstream md;
   for (std::size_t p = 0; p < np; ++p) {
     const AxisUnit ax = axis_unit(d.params[p], d.x, np, p);
-    std::map<double, std::vector<std::vector<double>>> rows;  // value -> controller -> shown
+    const bool categorical = is_categorical(d, p);
+    // row -> controller -> shown; a row is a value (numeric: sorted) or a category's index.
+    std::map<double, std::vector<std::vector<double>>> rows;
+    std::map<double, std::vector<long>> counts;  // row -> controller -> cases with that value
     for (std::size_t i = 0; i < d.cases; ++i) {
-      const double x = d.x[i * np + p];
+      const std::int16_t k = d.category[i * np + p];
+      const double x = categorical ? (k >= 0 ? k : NAN) : d.x[i * np + p];
       if (!std::isfinite(x)) continue;
       auto& r = rows[x];
       r.resize(nc);
+      auto& n = counts[x];
+      n.resize(nc);
+      ++n[d.controller[i]];
       if (std::isfinite(d.shown[i])) r[d.controller[i]].push_back(d.shown[i]);
     }
     md << "\n## " << cell(s.report.metric) << " against " << cell(d.params[p]) << "\n\n";
     if (rows.empty() || rows.size() > kMaxRows) {
-      md << (rows.empty() ? "No numeric value of this key.\n" : "More than 50 values (a distribution): see its plot.\n");
+      md << (d.categories[p].text && d.categories[p].more ? "More than 50 values that are not all numbers: see results.csv.\n"
+             : rows.empty()                                ? "No value of this key in any case.\n"
+                                                           : "More than 50 values (a distribution): see its plot.\n");
       continue;
     }
-    md << "| " << cell(axis_label(d.params[p], ax)) << " |";
+    md << "| " << cell(categorical ? d.params[p] : axis_label(d.params[p], ax)) << " |";
     for (std::size_t c = 0; c < nc; ++c) md << " " << cell(s.controllers[c].name) << " [" << s.report.unit << "] |";
     md << "\n|---|";
     for (std::size_t c = 0; c < nc; ++c) md << "---|";
     md << "\n";
+    long fewest = -1, most = 0;
     for (const auto& [x, per] : rows) {
-      md << "| " << num(x * ax.factor) << " |";
-      for (std::size_t c = 0; c < nc; ++c) md << " " << num(per[c].empty() ? NAN : median(per[c])) << " |";
+      md << "| " << (categorical ? cell(d.categories[p].values[static_cast<std::size_t>(x)]) : num(x * ax.factor)) << " |";
+      for (std::size_t c = 0; c < nc; ++c) {
+        md << " " << num(per[c].empty() ? NAN : median(per[c])) << " |";
+        const long n = counts[x][c];
+        if (n == 0) continue;
+        fewest = fewest < 0 ? n : std::min(fewest, n);
+        most = std::max(most, n);
+      }
       md << "\n";
     }
-    md << "\nThe median over the cases with that value (one case each in a one-key sweep).\n";
+    if (most <= 1) {
+      md << "\nOne case per value and controller.\n";
+    } else {
+      md << "\nThe median over the cases with that value and controller ("
+         << (fewest == most ? std::to_string(most) : std::to_string(fewest) + " to " + std::to_string(most))
+         << " each, over the values of the other varied keys and the draws).\n";
+    }
   }
   return md.str();
 }
@@ -313,6 +434,16 @@ std::string report_md(const ReportData& d, const std::string& command, const std
      << d.cases << " cases (" << s.controllers.size() << " controllers x " << s.families.size() << " families), "
      << failed << " failed, " << cached << " reused from an earlier run into this folder. Every number below is "
      << "`" << s.report.metric << "` in " << unit << " (one row per case in `results.csv`).\n\n";
+  // A move cut off by `duration` has errors of part of the move only (issue 23).
+  if (d.moves_unfinished > 0)
+    md << "**" << d.moves_unfinished << " of " << d.moves << " cases did not finish their move** within `duration` "
+       << "(`move_finished` false in `results.csv`): their errors cover only the part of the move that ran.\n\n";
+  if (const std::vector<std::string> lines = warning_lines(d); !lines.empty()) {
+    md << "## Warnings\n\nThe scenario loader's warnings (an implausible value and its likely unit, a move cut off), "
+          "once each with the number of cases that have it:\n\n";
+    for (const std::string& l : lines) md << "- " << cell(l) << "\n";
+    md << "\n";
+  }
 
   md << (s.model == ModelRule::kNominal
              ? "The controllers keep the **nominal model** (`model: nominal`): a case's `plant.*` variations (except "

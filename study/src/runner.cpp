@@ -23,6 +23,8 @@ Outcome run_case(const std::string& yaml) {
     const sim::RunStats st = sim::run(s, [&builder](const sim::Record& q) { builder.add(q); });
     const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
     o.metrics = sim::summary_metrics(sum, s);
+    o.warnings = s.warnings;
+    o.move_finished = sim::move_finished(s);
     o.ok = true;
   } catch (const interrupt::Interrupted& e) {
     o.ok = false;
@@ -34,6 +36,8 @@ Outcome run_case(const std::string& yaml) {
     for (char& c : o.error)
       if (c == '\n' || c == '\r') c = ' ';
     o.metrics.clear();
+    o.warnings.clear();
+    o.move_finished.reset();
   }
   o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return o;
@@ -41,7 +45,7 @@ Outcome run_case(const std::string& yaml) {
 
 std::string outcome_json(const std::string& hash, const Outcome& o) {
   nlohmann::ordered_json j;
-  j["format"] = 1;
+  j["format"] = kOutcomeFormat;
   j["hash"] = hash;
   j["ok"] = o.ok;
   j["error"] = o.error;
@@ -55,6 +59,8 @@ std::string outcome_json(const std::string& hash, const Outcome& o) {
     }
   }
   j["metrics"] = m;
+  j["warnings"] = o.warnings;
+  j["move_finished"] = o.move_finished ? nlohmann::ordered_json(*o.move_finished) : nlohmann::ordered_json();
   j["wall_s"] = o.wall_s;
   return j.dump(1) + "\n";
 }
@@ -62,7 +68,7 @@ std::string outcome_json(const std::string& hash, const Outcome& o) {
 std::optional<Outcome> parse_outcome(const std::string& text, const std::string& hash) {
   try {
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
-    if (!j.is_object() || j.value("format", 0) != 1 || j.value("hash", std::string()) != hash) return std::nullopt;
+    if (!j.is_object() || j.value("format", 0) != kOutcomeFormat || j.value("hash", std::string()) != hash) return std::nullopt;
     Outcome o;
     o.ok = j.at("ok").get<bool>();
     o.error = j.at("error").get<std::string>();
@@ -76,6 +82,8 @@ std::optional<Outcome> parse_outcome(const std::string& text, const std::string&
       }
       o.metrics.emplace_back(it.key(), v);
     }
+    o.warnings = j.at("warnings").get<std::vector<std::string>>();
+    if (!j.at("move_finished").is_null()) o.move_finished = j.at("move_finished").get<bool>();
     o.wall_s = j.at("wall_s").get<double>();
     if (o.ok == o.metrics.empty()) return std::nullopt;
     return o;

@@ -389,6 +389,14 @@ int run_study(const Options& o, Transport* t) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
   }
+  // The loader's warnings (an implausible value with its likely unit, a move cut off by
+  // duration): once each, with the number of cases that have it, as report.md lists them.
+  if (!o.quiet) {
+    for (const std::string& w : warning_lines(report)) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    if (report.moves_unfinished > 0)
+      std::fprintf(stderr, "warning: %zu of %zu cases did not finish their move within duration (move_finished in results.csv)\n",
+                   report.moves_unfinished, report.moves);
+  }
   if (!o.quiet || report.failed > 0)
     std::fprintf(stderr, "%s: %zu cases (%zu run, %zu reused), %zu failed (see results.csv) -> %s/results.csv, report.md\n",
                  study.name.c_str(), total, ran, cached, report.failed, dir.c_str());

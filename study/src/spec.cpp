@@ -417,6 +417,7 @@ GridAxis parse_sweep(const std::string& text) {
   axis.keys = {text.substr(0, eq)};
   std::string values = text.substr(eq + 1);
   const bool log = values.rfind("log:", 0) == 0;
+  axis.log = log;
   if (log) values = values.substr(4);
   if (values.find(':') != std::string::npos) {
     std::vector<std::string> parts;
@@ -462,11 +463,25 @@ Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>&
   const fs::path p(scenario_path);
   s.name = p.stem().string() + " sweep";
   s.base_yaml = text::read_text_file<StudyError>(scenario_path, "scenario file");
+  YAML::Node root;
   try {
-    sim::load_yaml_strict(s.base_yaml);
+    root = sim::load_yaml_strict(s.base_yaml);
   } catch (const sim::ScenarioError& e) {
     throw StudyError(scenario_path + ": " + e.what());
   }
+  // A study file given to --sweep once failed on its first scenario key ("duration: missing").
+  if (const YAML::Node& map = root; map.IsMap()) {
+    std::string study_keys;
+    for (const char* k : {"base", "controllers", "families"})
+      if (map[k].IsDefined()) study_keys += (study_keys.empty() ? "" : "/") + std::string(k);
+    if (!study_keys.empty())
+      throw StudyError("--sweep takes a scenario file, not a study file (" + scenario_path + " has " + study_keys + ")");
+  }
+  for (std::size_t i = 0; i < axes.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      for (const std::string& k : axes[i].keys)
+        if (std::find(axes[j].keys.begin(), axes[j].keys.end(), k) != axes[j].keys.end())
+          throw StudyError("--sweep " + k + ": the key is swept twice (give all its values in one --sweep)");
   s.base_dir = p.parent_path().empty() ? "." : p.parent_path().string();
   s.controllers.push_back({"base", "", {}, {}});
   s.families.push_back(Family{"sweep", {}, axes, {}});

@@ -237,3 +237,48 @@ TEST(StudyCli, SweepWithoutAStudyFileReportsTheMetricAgainstEachValue) {
   }
 }
 }  // namespace
+
+namespace {
+// Review of issue 23 (F3): the loader's warnings of a sweep's cases reach the user, once per
+// distinct warning with its count, on stderr and in report.md; results.csv has move_finished.
+TEST(StudyCli, ASweepShowsItsCasesWarningsAndTheMovesThatDidNotFinish) {
+  const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
+  const fs::path out = scratch() / "warn";
+  // 10 ms: both moves (about a second) are cut off; 500 m/s is mm/s meant.
+  const ProcResult r = study(scen + " --sweep reference.max_velocity=0.2,500 --set duration=0.01 --out " + out.string() +
+                             " -j 2 --no-plots");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: reference.max_velocity: 500 m/s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mm/s? (1 of 2 cases)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: 2 of 2 cases did not finish their move"), std::string::npos) << r.err;
+  const std::string md = slurp(out / "report.md");
+  EXPECT_NE(md.find("## Warnings"), std::string::npos) << md;
+  EXPECT_NE(md.find("**2 of 2 cases did not finish their move**"), std::string::npos) << md;
+  const std::string csv = slurp(out / "results.csv");
+  EXPECT_NE(csv.find(",ok,error,move_finished,warnings,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",true,,false,\"reference"), std::string::npos) << csv;
+  // A rerun reuses the cases (format 2 files) and reports the same.
+  const ProcResult again = study(scen + " --sweep reference.max_velocity=0.2,500 --set duration=0.01 --out " +
+                                 out.string() + " -j 2 --no-plots");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.err.find("(0 run, 2 reused)"), std::string::npos) << again.err;
+  EXPECT_EQ(slurp(out / "results.csv"), csv);
+  EXPECT_NE(again.err.find("mm/s? (1 of 2 cases)"), std::string::npos) << again.err;
+}
+
+// F17: a study file given to --sweep, and one key swept twice: exit 2, one line naming it.
+TEST(StudyCli, SweepRefusesAStudyFileAndAKeySweptTwice) {
+  const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
+  const fs::path st = write_file("sweep_study.yaml", feeddrive::study::test::study_text("families: [{name: a}]\n"));
+  for (const auto& [args, expected] : std::vector<std::pair<std::string, std::string>>{
+           {st.string() + " --sweep plant.mass=1,2",
+            "--sweep takes a scenario file, not a study file (" + st.string() + " has base/families)"},
+           {scen + " --sweep plant.mass=80,100 --sweep plant.mass=1,2",
+            "--sweep plant.mass: the key is swept twice"}}) {
+    const ProcResult b = study(args + " --out " + (scratch() / "bad_sweep2").string());
+    EXPECT_EQ(b.code, 2) << args << ": " << b.err;
+    EXPECT_NE(b.err.find(expected), std::string::npos) << b.err;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+  }
+}
+}  // namespace

@@ -132,3 +132,33 @@ TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
 
 }  // namespace
 }  // namespace feeddrive::study
+
+namespace feeddrive::study {
+namespace {
+// Review of issue 23 (F17): a study file is not a scenario for --sweep, and one key swept twice
+// would silently lose the first sweep's values.
+TEST(StudySpec, SweepRefusesAStudyFileAndAKeySweptTwice) {
+  const std::string scen = test::scenarios() + "/smc_bl_jerk_limited.yaml";
+  const std::string study = std::string(FEEDDRIVE_SOURCE_DIR) + "/studies/robustness.yaml";
+  try {
+    sweep_study(study, {parse_sweep("plant.mass=1,2")});
+    ADD_FAILURE() << "a study file was taken as a scenario";
+  } catch (const StudyError& e) {
+    EXPECT_NE(std::string(e.what()).find("--sweep takes a scenario file, not a study file (" + study + " has base/"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.mass=1,2")});
+    ADD_FAILURE() << "a key swept twice was accepted";
+  } catch (const StudyError& e) {
+    EXPECT_EQ(std::string(e.what()), "--sweep plant.mass: the key is swept twice (give all its values in one --sweep)");
+  }
+  // Different keys make a grid; a log sweep is marked for the report's log axis.
+  const Study s = sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.sensor.quantization=log:1e-9:1e-6:3")});
+  EXPECT_EQ(s.total_cases(), 6);
+  EXPECT_FALSE(s.families[0].grid[0].log);
+  EXPECT_TRUE(s.families[0].grid[1].log);
+}
+}  // namespace
+}  // namespace feeddrive::study

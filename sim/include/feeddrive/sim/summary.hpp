@@ -214,5 +214,8 @@ std::vector<std::string> summary_metric_names();
 /// The drive's metrics of a run, by name, as summary_json writes them as numbers (its nulls and
 /// the wall-clock figures left out): what a study records per case, without a JSON text.
 std::vector<std::pair<std::string, double>> summary_metrics(const Summary& sum, const Scenario& s);
+/// summary.json's move_finished: whether the reference's move ends within `duration`
+/// (move_end_s <= duration); nullopt when the reference is not a move.
+std::optional<bool> move_finished(const Scenario& s);
 
 }  // namespace feeddrive::sim

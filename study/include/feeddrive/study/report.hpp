@@ -28,7 +28,9 @@ struct CaseRecord {
 };
 
 /// results.csv, one row at a time in study order: case,controller,family,point,draw,hash,
-/// <varied keys>,ok,error,<every numeric summary.json metric but the wall-clock ones>. The rows go
+/// <varied keys>,ok,error,move_finished,warnings,<every numeric summary.json metric but the
+/// wall-clock ones>. move_finished is true/false, empty where the reference is not a move or the
+/// case failed; warnings the case's loader warnings joined by "; ". The rows go
 /// to DIR/results.csv.partial as the cases finish; finish() renames it into place. Nothing of a
 /// case is kept after its row (a study has up to 10^6 cases).
 class ResultsWriter {
@@ -53,10 +55,16 @@ std::string csv_field(const std::string& value);
 
 /// What report.md and the plots need of the cases, gathered one case at a time in study order:
 /// per case a few numbers (its controller, the report metric, each varied key as a float for the
-/// plots: about 20 + 4 x keys bytes), the worst case of each controller with its parameters, and the
-/// first kListedFailures failed cases. Not the cases' scenarios or metrics.
+/// plots and as a category index, for a key with values that are not numbers such as switching:
+/// sgn, tanh: about 20 + 6 x keys bytes), the worst case of each controller with its parameters,
+/// the first kListedFailures failed cases, and the distinct loader warnings with their case
+/// counts. Not the cases' scenarios or metrics.
 struct ReportData {
   static constexpr std::size_t kListedFailures = 100;
+  /// Distinct warnings kept with their counts; the cases with others are only counted.
+  static constexpr std::size_t kListedWarnings = 50;
+  /// Categories kept per key (in order of first appearance); a key with more is a distribution.
+  static constexpr std::size_t kMaxCategories = 50;
   struct Cell {
     std::vector<double> values;
     long failed{0};    ///< cases that failed (ok = false)
@@ -86,7 +94,31 @@ struct ReportData {
   std::vector<Worst> worst;                     ///< per controller
   std::vector<Failure> failures;                ///< the first kListedFailures
   std::size_t cases{0}, failed{0}, cached{0};
+  /// Per varied key: its values in order of first appearance (at most kMaxCategories; `more`
+  /// set when there were more), and whether any of them is not a number.
+  struct Categories {
+    std::vector<std::string> values;
+    bool more{false}, text{false};
+  };
+  std::vector<Categories> categories;           ///< per varied key
+  std::vector<std::int16_t> category;           ///< per case, params.size() each: index in categories[p].values, -1 beyond
+  std::map<std::string, std::size_t> warnings;  ///< distinct loader warning -> cases with it (the first kListedWarnings)
+  std::size_t cases_with_other_warnings{0};     ///< cases with a warning beyond those kept
+  std::size_t moves{0};                         ///< cases that ran a move (move_finished true or false)
+  std::size_t moves_unfinished{0};              ///< of those, cases whose move `duration` cut off
 };
+
+/// The report metric's name as a label: without its SI suffix (_m, _s, _mps, _N, _V, _Hz ...),
+/// with the unit shown: "position_error_max_abs [um]".
+std::string metric_label(const std::string& metric, const std::string& unit);
+
+/// Whether the plot of key `key` has a logarithmic x-axis: its values were given log-spaced
+/// (--sweep KEY=log:...), or they are all > 0 and span more than two decades.
+bool log_axis(const Study& s, const std::string& key, const std::vector<double>& values);
+
+/// The warnings of a study, one line each with its count ("<warning> (N of M cases)"), as
+/// feeddrive-study prints them on stderr; empty if there are none.
+std::vector<std::string> warning_lines(const ReportData& d);
 
 /// Writes the plots into `dir` (box.png, param_<i>.png, with their .dat files and plots.gp);
 /// returns the markdown that shows them (paths relative to the study folder, under `prefix`).

@@ -17,11 +17,17 @@
 namespace feeddrive::study {
 
 /// What one case gave: its summary.json metrics (the numbers, in summary.json's order, without
-/// the wall-clock ones, which differ from run to run), or the error that stopped it.
+/// the wall-clock ones, which differ from run to run), its loader warnings and whether its move
+/// finished, or the error that stopped it.
 struct Outcome {
   bool ok{false};
   std::string error;
   std::vector<std::pair<std::string, double>> metrics;
+  /// The loader's warnings of the case's scenario (sim::Scenario::warnings: an implausible value
+  /// with its likely unit, a move cut off by `duration`), as summary.json lists them.
+  std::vector<std::string> warnings;
+  /// summary.json's move_finished: nullopt if the reference is not a move (or the case failed).
+  std::optional<bool> move_finished;
   double wall_s{0.0};  ///< time of this case (not a result: kept out of results.csv)
   bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
 };
@@ -30,6 +36,10 @@ struct Outcome {
 /// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
 /// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
 Outcome run_case(const std::string& yaml);
+
+/// The format of a case file (its "format" key). 2 (issue 23) added warnings and move_finished;
+/// a file of another format is not reused: its case runs again.
+inline constexpr int kOutcomeFormat = 2;
 
 /// The case file DIR/cases/<hash>.json: the outcome, keyed by the case's hash.
 std::string outcome_json(const std::string& hash, const Outcome& o);

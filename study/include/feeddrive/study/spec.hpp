@@ -58,6 +58,7 @@ struct GridAxis {
   std::vector<std::string> keys;
   std::vector<std::vector<std::string>> values;
   bool scale{false};
+  bool log{false};  ///< the values were given log-spaced (--sweep KEY=log:...): the report plots a log axis
 };
 
 enum class Distribution { kUniform, kNormal, kLognormal };
@@ -142,7 +143,9 @@ GridAxis parse_sweep(const std::string& text);
 
 /// A study without a study file (feeddrive-study SCENARIO --sweep ...): the scenario is the base,
 /// its controller the only one, and one family "sweep" whose grid has one axis per sweep (their
-/// Cartesian product). Validated.
+/// Cartesian product). Validated. Throws StudyError, one line, if the file is a study file (it
+/// has a study's keys: base, controllers, families) or two axes vary the same key (the later
+/// would silently replace the earlier's values).
 Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>& axes);
 
 /// Loads a study file (relative paths inside it are relative to its folder).
