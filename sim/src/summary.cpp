@@ -431,17 +431,34 @@ std::string summary_json(const Summary& m, const Scenario& s, const std::string&
 
 bool is_wall_clock_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }
 
-std::vector<std::string> summary_metric_names() {
+namespace {
+// summary.json of a run with steps whose every windowed and move metric has a value.
+nlohmann::ordered_json summary_of_a_full_run() {
   Summary m;
   m.steps = 2;
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
   m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
-  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary_json(m, Scenario{}));
+  Scenario s;
+  s.move_end_s = 0.0;  // a move: move_finished true/false, not null
+  return nlohmann::ordered_json::parse(summary_json(m, s));
+}
+}  // namespace
+
+std::vector<std::string> summary_metric_names() {
+  const nlohmann::ordered_json j = summary_of_a_full_run();
   std::vector<std::string> names;
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.value().is_number() && !is_wall_clock_metric(it.key())) names.push_back(it.key());
+  return names;
+}
+
+std::vector<std::string> summary_flag_names() {
+  const nlohmann::ordered_json j = summary_of_a_full_run();
+  std::vector<std::string> names;
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.value().is_boolean()) names.push_back(it.key());
   return names;
 }
 

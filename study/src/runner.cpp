@@ -24,6 +24,10 @@ Outcome run_case(const std::string& yaml) {
     const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(sim::summary_json(sum, s));
     for (auto it = j.begin(); it != j.end(); ++it) {
+      if (it.value().is_boolean()) {  // a verdict (sim::summary_flag_names): 1 true, 0 false
+        o.metrics.emplace_back(it.key(), it.value().get<bool>() ? 1.0 : 0.0);
+        continue;
+      }
       if (!it.value().is_number() || sim::is_wall_clock_metric(it.key())) continue;
       o.metrics.emplace_back(it.key(), it.value().get<double>());
     }

@@ -210,5 +210,10 @@ bool is_wall_clock_metric(const std::string& key);
 /// an empty window included), except the wall-clock ones, in the order written. What a study
 /// records per case and what its report.metric may name.
 std::vector<std::string> summary_metric_names();
+/// The drive's verdicts: the keys summary_json writes as true/false for a run with steps
+/// (control_chattering, control_signal_within_limits, move_finished: null for a reference that
+/// is not a move), in the order written. A study records
+/// them per case as 1 (true) or 0 (false) and report.require may name them.
+std::vector<std::string> summary_flag_names();
 
 }  // namespace feeddrive::sim

@@ -62,6 +62,8 @@ struct ReportData {
     long failed{0};    ///< cases that failed (ok = false)
     long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than settled_after)
     long total{0};
+    long passed{0};          ///< cases that pass (case_passes)
+    long verdict_failed{0};  ///< cases that ran with a required verdict false or missing
   };
   struct Worst {
     bool any{false};
@@ -87,6 +89,13 @@ struct ReportData {
   std::vector<Failure> failures;                ///< the first kListedFailures
   std::size_t cases{0}, failed{0}, cached{0};
 };
+
+/// The report's pass criterion (report.limit and report.require): the case ran, its shown metric
+/// `shown` is a number and <= limit (when a limit is given), and every required verdict is 1
+/// (true) in its metrics (a verdict the case lacks fails: an outcome of an older version).
+bool case_passes(const Study& s, const Outcome& o, double shown);
+/// Whether every verdict report.require names is 1 in the case's metrics.
+bool verdicts_hold(const Study& s, const Outcome& o);
 
 /// Writes the plots into `dir` (box.png, param_<i>.png, with their .dat files and plots.gp);
 /// returns the markdown that shows them (paths relative to the study folder, under `prefix`).
