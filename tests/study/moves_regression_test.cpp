@@ -97,9 +97,10 @@ void check(const Outcome& o, const Expect& e) {
   EXPECT_EQ(metric(o, "control_signal_within_limits"), 0.0);
 }
 
-// robust_smc (the project's recommended controller, docs/robustness.md): its worst case of
-// each move's 16 corners (a 100 nm encoder with 40 nm noise, seed 1, and 500 us of delay in
-// every one), and its worst Monte Carlo draw on two moves with encoder-noise seeds 3 and 2.
+// robust_smc (the project's recommended controller for error, docs/robustness.md; it misses the
+// direction-change limit everywhere): its worst case of each move's 24 corners (a 100 nm encoder
+// with 40 nm noise, seed 1; 500 us of delay in every one), and a Monte Carlo draw on two moves
+// with encoder-noise seeds 3 and 2.
 // Measured by `feeddrive-study studies/robustness_moves.yaml` (the figures of the docs' table).
 class RobustSmcWorstCase : public ::testing::Test {
  protected:
@@ -132,8 +133,8 @@ TEST_F(RobustSmcWorstCase, GrindingRamp) {  // mass -30 %, Fs/Fc -50 %, sigma0/s
 TEST_F(RobustSmcWorstCase, GrindingInfeed) {  // mass -30 %, Fs/Fc +50 %, sigma0/sigma1 -50 %
   check(run(*study_, "robust_smc", "grinding_infeed_corners", corner(0.7, 1.5, 0.5, 5e-4)), {0.178, 0.138, 3665, 22.3});
 }
-// Other encoder-noise sequences: the worst draw (draw 1: mass +21 %, Fs/Fc +43 %, 280 us) with
-// seed 3 on the acceleration-limited move and seed 2 on the fast S-curve.
+// Other encoder-noise sequences: draw 1 (mass +21 %, Fs/Fc +43 %, 280 us of delay) with seed 3
+// on the acceleration-limited move and seed 2 on the fast S-curve (the worst of draws 0 and 1).
 TEST_F(RobustSmcWorstCase, MonteCarloOtherNoiseSeeds) {
   check(run(*study_, "robust_smc", "accel_limited_mc", {{"plant.sensor.seed", 3}}, 1), {0.323, 0.118, 3717, 18.9});
   check(run(*study_, "robust_smc", "scurve_fast_mc", {{"plant.sensor.seed", 2}}, 1), {0.669, 0.120, 3853, 19.3});
