@@ -347,19 +347,17 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     MapReader plant = top.child("plant");
     s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
     read_plant(plant, s.plant, true);
-    // A section given with keys but off: its keys do not act (a forgotten enabled: true).
+    // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
+    // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
     const YAML::Node pn = root["plant"];
     const std::pair<const char*, bool> sections[] = {
         {"ripple", s.plant.ripple.enabled}, {"grinding", s.plant.grinding.enabled}, {"electrical", s.plant.electrical.enabled}};
     for (const auto& [name, on] : sections) {
       if (on || !pn.IsMap()) continue;
       const YAML::Node sec = pn[name];
-      if (!sec.IsMap()) continue;
-      for (const auto& kv : sec)
-        if (kv.first.IsScalar() && kv.first.Scalar() != "enabled") {
-          s.warnings.push_back(std::string("plant.") + name + ": keys given, but the section is off (enabled: false): they do not act; enabled: true?");
-          break;
-        }
+      if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
+      if (sec.size() > 0)
+        s.warnings.push_back(std::string("plant.") + name + ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
     }
   }
 

@@ -447,23 +447,54 @@ std::optional<bool> move_finished(const Scenario& s) {
 
 bool is_wall_clock_metric(const std::string& key) { return key == "wall_time_s" || key == "realtime_factor"; }
 
-std::vector<std::string> summary_metric_names() {
+namespace {
+// The summary of a run with steps whose every windowed and move metric has a value.
+Summary a_full_run() {
   Summary m;
   m.steps = 2;
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
   m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
+  return m;
+}
+// move_finished is a verdict of summary.json, but a study records it in a column of its own
+// (with the case's warnings: study/runner.hpp), not among the metrics.
+bool is_metric_verdict(const std::string& key) { return key != "move_finished"; }
+}  // namespace
+
+std::vector<std::string> summary_metric_names() {
   std::vector<std::string> names;
-  for (const auto& [key, value] : summary_metrics(m, Scenario{})) names.push_back(key);
+  for (const auto& [key, value] : summary_metrics(a_full_run(), Scenario{}))
+    if (!is_verdict(key)) names.push_back(key);
   return names;
+}
+
+std::vector<std::string> summary_flag_names() {
+  Scenario s;
+  s.move_end_s = 0.0;  // a move: move_finished true/false, not null
+  const nlohmann::ordered_json j = summary_object(a_full_run(), s);
+  std::vector<std::string> names;
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.value().is_boolean() && is_metric_verdict(it.key())) names.push_back(it.key());
+  return names;
+}
+
+bool is_verdict(const std::string& key) {
+  for (const std::string& k : summary_flag_names())
+    if (k == key) return true;
+  return false;
 }
 
 std::vector<std::pair<std::string, double>> summary_metrics(const Summary& m, const Scenario& s) {
   const nlohmann::ordered_json j = summary_object(m, s);
   std::vector<std::pair<std::string, double>> out;
-  for (auto it = j.begin(); it != j.end(); ++it)
-    if (it.value().is_number() && !is_wall_clock_metric(it.key())) out.emplace_back(it.key(), it.value().get<double>());
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it.value().is_boolean() && is_metric_verdict(it.key()))  // a verdict: 1 true, 0 false
+      out.emplace_back(it.key(), it.value().get<bool>() ? 1.0 : 0.0);
+    else if (it.value().is_number() && !is_wall_clock_metric(it.key()))
+      out.emplace_back(it.key(), it.value().get<double>());
+  }
   return out;
 }
 

@@ -70,6 +70,17 @@ bool is_categorical(const ReportData& d, std::size_t p) {
   return d.categories[p].text && !d.categories[p].more && !d.categories[p].values.empty();
 }
 
+// The pass criterion in words (report.limit and report.require).
+std::string criterion_text(const Study& s) {
+  std::string t = "A case passes when it ran";
+  if (!std::isnan(s.report.limit))
+    t += ", its " + s.report.metric + " is at most " + num(s.report.limit) + " " + s.report.unit;
+  for (std::size_t i = 0; i < s.report.require.size(); ++i)
+    t += (i == 0 ? " and " : ", ") + std::string("`") + s.report.require[i] + "`";
+  if (!s.report.require.empty()) t += s.report.require.size() == 1 ? " is true" : " are true";
+  return cell(t) + " (`report.limit`, `report.require`).";
+}
+
 bool parse_number(const std::string& text, double& out) {
   char* end = nullptr;
   out = std::strtod(text.c_str(), &end);
@@ -148,6 +159,7 @@ std::string csv_field(const std::string& value) {
 ResultsWriter::ResultsWriter(const Study& s, const fs::path& dir)
     : s_(s), partial_(dir / "results.csv.partial"), final_(dir / "results.csv"), params_(varied_keys(s)),
       metrics_(sim::summary_metric_names()) {
+  for (const std::string& f : sim::summary_flag_names()) metrics_.push_back(f);  // 1 true, 0 false
   out_.open(partial_, std::ios::binary | std::ios::trunc);
   if (!out_) throw std::runtime_error(partial_.string() + ": cannot write");
   out_ << "case,controller,family,point,draw,hash";
@@ -193,6 +205,29 @@ void ResultsWriter::finish() {
   done_ = true;
 }
 
+bool verdicts_hold(const Study& s, const Outcome& o) {
+  for (const std::string& r : s.report.require) {
+    if (r == "move_finished") {  // Outcome::move_finished: a case without a move does not pass it
+      if (!o.move_finished.value_or(false)) return false;
+      continue;
+    }
+    bool found = false;
+    for (const auto& [k, v] : o.metrics)
+      if (k == r) {
+        found = true;
+        if (v != 1.0) return false;
+      }
+    if (!found) return false;
+  }
+  return true;
+}
+
+bool case_passes(const Study& s, const Outcome& o, double shown) {
+  if (!o.ok || std::isnan(shown)) return false;
+  if (!std::isnan(s.report.limit) && shown > s.report.limit) return false;
+  return verdicts_hold(s, o);
+}
+
 ReportData::ReportData(const Study& st)
     : s(st), params(varied_keys(st)), table(st.families.size(), std::vector<Cell>(st.controllers.size())),
       worst(st.controllers.size()), categories(params.size()) {
@@ -210,6 +245,8 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
   const double v = shown_metric(s, c.outcome);
   Cell& cell_of = table[c.spec.family][c.spec.controller];
   ++cell_of.total;
+  cell_of.passed += case_passes(s, c.outcome, v) ? 1 : 0;
+  cell_of.verdict_failed += c.outcome.ok && !verdicts_hold(s, c.outcome) ? 1 : 0;
   if (!c.outcome.ok) {
     ++cell_of.failed;
     if (failures.size() < kListedFailures) failures.push_back({index, c.spec.controller, c.spec.family, c.outcome.error});
@@ -456,16 +493,19 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   md << "## Worst case per controller\n\n| controller | cases | failed | worst [" << unit << "] | family of the worst | median ["
      << unit << "] |";
   if (!std::isnan(s.report.limit)) md << " over " << num(s.report.limit) << " " << unit << " |";
-  md << "\n|---|---|---|---|---|---|" << (std::isnan(s.report.limit) ? "" : "---|") << "\n";
+  const bool criterion = s.report.has_criterion();
+  if (criterion) md << " pass |";
+  md << "\n|---|---|---|---|---|---|" << (std::isnan(s.report.limit) ? "" : "---|") << (criterion ? "---|" : "") << "\n";
   for (std::size_t c = 0; c < nc; ++c) {
     std::vector<double> all;
-    long total = 0, fail = 0, over = 0;
+    long total = 0, fail = 0, over = 0, passed = 0;
     double worst = NAN;
     std::string worst_family = "–";
     for (std::size_t f = 0; f < s.families.size(); ++f) {
       const Cell& x = t[f][c];
       total += x.total;
       fail += x.failed;
+      passed += x.passed;
       for (double v : x.values) {
         all.push_back(v);
         if (!std::isnan(s.report.limit) && v > s.report.limit) ++over;
@@ -478,10 +518,12 @@ std::string report_md(const ReportData& d, const std::string& command, const std
     md << "| " << cell(s.controllers[c].name) << " | " << total << " | " << fail << " | " << num(worst) << " | "
        << cell(worst_family) << " | " << num(median(all)) << " |";
     if (!std::isnan(s.report.limit)) md << " " << over + fail << (over + fail == 0 ? " (meets the limit in every case)" : "") << " |";
+    if (criterion) md << " " << (passed == total ? "**" : "") << passed << " of " << total << (passed == total ? "**" : "") << " |";
     md << "\n";
   }
   if (!std::isnan(s.report.limit))
     md << "\nA failed case counts as over the limit (" << num(s.report.limit) << " " << unit << ").\n";
+  if (criterion) md << "\n" << criterion_text(s) << "\n";
 
   const auto grid_table = [&](const char* title, bool worst) {
     md << "\n## " << title << "\n\n| family |";
@@ -507,6 +549,24 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   };
   grid_table(("Worst case per family [" + unit + "]").c_str(), true);
   if (!std::isnan(s.report.limit)) md << "\nBold: over " << num(s.report.limit) << " " << unit << " (or failed).\n";
+  if (criterion) {
+    md << "\n## Cases that pass per family\n\n" << criterion_text(s) << " Bold: not every case passes.\n\n| family |";
+    for (std::size_t c = 0; c < nc; ++c) md << " " << cell(s.controllers[c].name) << " |";
+    md << "\n|---|";
+    for (std::size_t c = 0; c < nc; ++c) md << "---|";
+    md << "\n";
+    for (std::size_t f = 0; f < s.families.size(); ++f) {
+      md << "| " << cell(s.families[f].name) << " |";
+      for (std::size_t c = 0; c < nc; ++c) {
+        const Cell& x = t[f][c];
+        const bool all = x.passed == x.total;
+        md << " " << (all ? "" : "**") << x.passed << " of " << x.total << (all ? "" : "**");
+        if (!s.report.require.empty() && x.verdict_failed) md << " (" << x.verdict_failed << " fail a verdict)";
+        md << " |";
+      }
+      md << "\n";
+    }
+  }
   grid_table(("Median per family [" + unit + "]").c_str(), false);
 
   // The worst case of each controller, with its parameters.

@@ -317,6 +317,21 @@ void Study::validate() const {
   }
   validate::require_positive("report.scale", report.scale);
   if (!std::isnan(report.limit)) validate::require_finite("report.limit", report.limit);
+  std::vector<std::string> flags = sim::summary_flag_names();
+  flags.push_back("move_finished");  // a column of its own (Outcome::move_finished), a verdict too
+  for (std::size_t i = 0; i < report.require.size(); ++i) {
+    const std::string& r = report.require[i];
+    const std::string where = "report.require[" + std::to_string(i) + "]";
+    if (std::find(flags.begin(), flags.end(), r) != flags.end()) {
+      if (std::find(report.require.begin(), report.require.begin() + static_cast<long>(i), r) != report.require.begin() + static_cast<long>(i))
+        fail(where, " = '" + r + "': listed twice");
+      continue;
+    }
+    std::string hint = sim::did_you_mean(r, flags);
+    if (hint.empty())
+      for (const std::string& f : flags) hint += (hint.empty() ? "; one of " : ", ") + f;
+    fail(where, " = '" + r + "': not a true/false verdict of summary.json" + hint);
+  }
 }
 
 Study parse_study(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
@@ -379,6 +394,7 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
     rep.number("scale", s.report.scale);
     rep.string("unit", s.report.unit);
     if (rep.has("limit")) rep.number("limit", s.report.limit);
+    rep.string_list("require", s.report.require);
     rep.finish();
     top.finish();
     try {

@@ -367,6 +367,15 @@ TEST(Summary, SignalFiguresAreStudyMetrics) {
     EXPECT_NE(std::find(names.begin(), names.end(), key), names.end()) << key;
 }
 
+// The true/false verdicts are what a study's report.require may name (summary_flag_names), and
+// none of them is a metric (a number).
+TEST(Summary, VerdictsAreStudyFlagsNotMetrics) {
+  const std::vector<std::string> flags = summary_flag_names();
+  EXPECT_EQ(flags, (std::vector<std::string>{"control_chattering", "control_signal_within_limits"}));
+  const std::vector<std::string> names = summary_metric_names();
+  for (const std::string& f : flags) EXPECT_EQ(std::find(names.begin(), names.end(), f), names.end()) << f;
+}
+
 // The final line names a command outside the signal limits with its figures, and says nothing
 // of a command within them.
 TEST(Summary, HeadlineFlagsASignalOutsideTheLimits) {

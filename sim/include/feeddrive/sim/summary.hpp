@@ -212,10 +212,18 @@ bool is_wall_clock_metric(const std::string& key);
 /// records per case and what its report.metric may name.
 std::vector<std::string> summary_metric_names();
 /// The drive's metrics of a run, by name, as summary_json writes them as numbers (its nulls and
-/// the wall-clock figures left out): what a study records per case, without a JSON text.
+/// the wall-clock figures left out), and its verdicts (summary_flag_names) as 1/0: what a study
+/// records per case, without a JSON text.
 std::vector<std::pair<std::string, double>> summary_metrics(const Summary& sum, const Scenario& s);
 /// summary.json's move_finished: whether the reference's move ends within `duration`
 /// (move_end_s <= duration); nullopt when the reference is not a move.
 std::optional<bool> move_finished(const Scenario& s);
+/// The drive's verdicts: the keys summary_json writes as true/false for a run with steps
+/// (control_chattering, control_signal_within_limits), in the order written; move_finished, also
+/// true/false, is recorded by a study in a column of its own. A study records
+/// them per case as 1 (true) or 0 (false) and report.require may name them.
+std::vector<std::string> summary_flag_names();
+/// Whether `key` is one of summary_flag_names().
+bool is_verdict(const std::string& key);
 
 }  // namespace feeddrive::sim

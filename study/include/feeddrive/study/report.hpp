@@ -70,6 +70,8 @@ struct ReportData {
     long failed{0};    ///< cases that failed (ok = false)
     long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than settled_after)
     long total{0};
+    long passed{0};          ///< cases that pass (case_passes)
+    long verdict_failed{0};  ///< cases that ran with a required verdict false or missing
   };
   struct Worst {
     bool any{false};
@@ -119,6 +121,13 @@ bool log_axis(const Study& s, const std::string& key, const std::vector<double>&
 /// The warnings of a study, one line each with its count ("<warning> (N of M cases)"), as
 /// feeddrive-study prints them on stderr; empty if there are none.
 std::vector<std::string> warning_lines(const ReportData& d);
+
+/// The report's pass criterion (report.limit and report.require): the case ran, its shown metric
+/// `shown` is a number and <= limit (when a limit is given), and every required verdict is 1
+/// (true) in its metrics (a verdict the case lacks fails: an outcome of an older version).
+bool case_passes(const Study& s, const Outcome& o, double shown);
+/// Whether every verdict report.require names is 1 in the case's metrics.
+bool verdicts_hold(const Study& s, const Outcome& o);
 
 /// Writes the plots into `dir` (box.png, param_<i>.png, with their .dat files and plots.gp);
 /// returns the markdown that shows them (paths relative to the study folder, under `prefix`).

@@ -17,8 +17,9 @@
 namespace feeddrive::study {
 
 /// What one case gave: its summary.json metrics (the numbers, in summary.json's order, without
-/// the wall-clock ones, which differ from run to run), its loader warnings and whether its move
-/// finished, or the error that stopped it.
+/// the wall-clock ones, which differ from run to run, and the true/false verdicts as 1/0:
+/// sim::summary_flag_names), its loader warnings and whether its move finished, or the error
+/// that stopped it.
 struct Outcome {
   bool ok{false};
   std::string error;

@@ -23,7 +23,8 @@
 //           - {keys: [plant.friction.bristle_stiffness, plant.friction.bristle_damping],
 //              distribution: lognormal, mu: 0.0, sigma: 0.1, scale: true}
 //           - {key: plant.effects.input_delay.delay_s, distribution: normal, mean: 5e-4, stddev: 2e-4, low: 0, high: 1e-3}
-//   report: {metric: position_error_max_abs_m, scale: 1.0e6, unit: um, limit: 0.8}   # optional
+//   report: {metric: position_error_max_abs_m, scale: 1.0e6, unit: um, limit: 0.8,   # optional
+//            require: [control_signal_within_limits]}
 //
 // Every key is a dotted path into the scenario YAML (docs/scenario.md), checked by the scenario
 // loader itself when the cases are resolved (cases.hpp), so a misspelt key gets the loader's
@@ -31,6 +32,7 @@
 // unknown study key, a bad distribution, an empty grid, NaN or an impossible case count throws
 // StudyError with one line naming the key and the value (feeddrive-study exits 2).
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -108,6 +110,11 @@ struct ReportParams {
   double scale{1e6};                               ///< shown value = metric * scale
   std::string unit{"um"};
   double limit{std::numeric_limits<double>::quiet_NaN()};  ///< a goal in shown units (NaN: none)
+  /// Verdicts of summary.json (sim::summary_flag_names) that must be true for a case to pass,
+  /// e.g. control_signal_within_limits. A case passes when it ran, its metric is <= limit (when
+  /// a limit is given) and every required verdict is true.
+  std::vector<std::string> require;
+  bool has_criterion() const { return !std::isnan(limit) || !require.empty(); }
 };
 
 enum class ModelRule {

@@ -1,0 +1,164 @@
+// Regression bounds of the robustness study on every move (studies/robustness_moves.yaml, issue 24
+// item 7; docs/robustness.md, "Every move, wider mismatch"): the recommended controller's worst
+// case of each move, and its control-signal figures at those corners, run from the study file
+// itself (the same resolved scenario as the study's case: same plant, encoder seed, delay and
+// nominal model), so a change to a controller, the plant or the study shows here first.
+//
+// Tolerances. Every case is deterministic (seeded encoder noise, CVODE at fixed tolerances, a
+// fixed control period): on this machine a rerun gives the same bits. The bounds are the figure
+// measured by the study plus 10 %: room for another compiler or libm moving CVODE's adaptive
+// steps (the error is a maximum over noise-driven samples, so it moves by a fraction of itself,
+// not by rounding), small enough that a real regression of the size the docs would have to
+// report (a tenth of the worst case) fails; and at least half of it (check()). The signal limits are checked as the verdict
+// itself (control_signal_within_limits) and, where the controller is known to miss one, as a
+// bound on its measured figure with the same 10 %: it must not get worse while the docs say
+// how far over the limit it is.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "feeddrive/study/cases.hpp"
+#include "feeddrive/study/runner.hpp"
+#include "feeddrive/study/spec.hpp"
+
+namespace feeddrive::study {
+namespace {
+
+const std::string kStudy = std::string(FEEDDRIVE_SOURCE_DIR) + "/studies/robustness_moves.yaml";
+
+double metric(const Outcome& o, const std::string& key) {
+  for (const auto& [k, v] : o.metrics)
+    if (k == key) return v;
+  ADD_FAILURE() << "no metric " << key;
+  return NAN;
+}
+
+// A case of the study: controller and family by name, then the variation values it must have
+// ("plant.mass" -> factor 0.7, "controller.computation_delay" -> "5.0e-4", ...).
+struct Want {
+  std::string key;
+  double factor_or_value;
+};
+
+Outcome run(const Study& s, const std::string& controller, const std::string& family, const std::vector<Want>& want,
+            long draw = -1) {
+  Resolver resolver(s);
+  for (const CaseSpec& c : expand(s)) {
+    if (s.controllers[c.controller].name != controller || s.families[c.family].name != family || c.draw != draw) continue;
+    bool match = true;
+    for (const Want& w : want) {
+      bool found = false;
+      for (const Variation& v : c.variations)
+        if (v.key == w.key) found = std::abs((v.scale ? v.factor : std::stod(v.value)) - w.factor_or_value) < 1e-12;
+      match = match && found;
+    }
+    if (!match) continue;
+    const Outcome o = run_case(resolver.resolve(c).yaml);
+    EXPECT_TRUE(o.ok) << o.error;
+    return o;
+  }
+  ADD_FAILURE() << "no case " << controller << " / " << family;
+  return {};
+}
+
+std::vector<Want> corner(double mass, double friction, double bristle, double delay) {
+  return {{"plant.mass", mass},
+          {"plant.friction.static_force", friction},
+          {"plant.friction.bristle_stiffness", bristle},
+          {"controller.computation_delay", delay}};
+}
+
+struct Expect {
+  double max_um;             // measured max |e| [um]
+  double step_rms_V;         // measured control_step_rms_V
+  double direction_changes;  // measured control_direction_changes_per_s
+  double force_hf_N;         // measured force_hf_rms_N
+};
+
+// The bounds: 10 % over each measured figure (header), the verdict exactly, and the step and
+// force figures within their limits (robust_smc meets those two everywhere in the study).
+void check(const Outcome& o, const Expect& e) {
+  EXPECT_LE(metric(o, "position_error_max_abs_m") * 1e6, 1.1 * e.max_um);
+  // And not far below it: half the measured figure means the case no longer is the study's
+  // worst case (a variation that stopped reaching the plant, a changed move) or the controller
+  // improved; either way the docs' figure is stale.
+  EXPECT_GE(metric(o, "position_error_max_abs_m") * 1e6, 0.5 * e.max_um);
+  EXPECT_LE(metric(o, "control_step_rms_V"), 1.1 * e.step_rms_V);
+  EXPECT_LE(metric(o, "control_direction_changes_per_s"), 1.1 * e.direction_changes);
+  EXPECT_LE(metric(o, "force_hf_rms_N"), 1.1 * e.force_hf_N);
+  EXPECT_LE(metric(o, "control_step_rms_V"), metric(o, "control_chatter_threshold_V")) << "step RMS within its limit";
+  EXPECT_LE(metric(o, "force_hf_rms_N"), metric(o, "force_hf_limit_N")) << "force above 1 kHz within its limit";
+  EXPECT_EQ(metric(o, "control_saturated_fraction"), 0.0);
+  // The direction-change limit (2,000 /s) is what robust_smc misses on every move: the verdict
+  // stays false until a change fixes that (then this test and the docs change together).
+  EXPECT_GT(metric(o, "control_direction_changes_per_s"), 2000.0);
+  EXPECT_EQ(metric(o, "control_signal_within_limits"), 0.0);
+}
+
+// robust_smc (the project's recommended controller for error, docs/robustness.md; it misses the
+// direction-change limit everywhere): its worst case of each move's 24 corners (a 100 nm encoder
+// with 40 nm noise, seed 1; 500 us of delay in every one), and a Monte Carlo draw on two moves
+// with encoder-noise seeds 3 and 2.
+// Measured by `feeddrive-study studies/robustness_moves.yaml` (the figures of the docs' table).
+class RobustSmcWorstCase : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { study_ = new Study(load_study(kStudy)); }
+  static void TearDownTestSuite() {
+    delete study_;
+    study_ = nullptr;
+  }
+  static Study* study_;
+};
+Study* RobustSmcWorstCase::study_ = nullptr;
+
+TEST_F(RobustSmcWorstCase, JerkLimited) {  // mass -30 %, Fs/Fc -50 %, sigma0/sigma1 +50 %
+  check(run(*study_, "robust_smc", "jerk_limited_corners", corner(0.7, 0.5, 1.5, 5e-4)), {0.269, 0.148, 4215, 23.7});
+}
+TEST_F(RobustSmcWorstCase, AccelLimited) {  // mass +50 %, Fs/Fc -50 %, sigma0/sigma1 +50 %
+  check(run(*study_, "robust_smc", "accel_limited_corners", corner(1.5, 0.5, 1.5, 5e-4)), {0.692, 0.139, 3832, 22.4});
+}
+// The sine misses 0.8 um: the reversal (docs/controllers.md, "Velocity reversals"). The bound
+// keeps it from getting worse; the docs state the 5.18 um.
+TEST_F(RobustSmcWorstCase, SineWithReversals) {  // mass +50 %, Fs/Fc -50 %, sigma0/sigma1 +50 %
+  check(run(*study_, "robust_smc", "sine_corners", corner(1.5, 0.5, 1.5, 5e-4)), {5.18, 0.149, 4427, 24.1});
+}
+TEST_F(RobustSmcWorstCase, FastScurve) {  // mass +50 %, Fs/Fc +50 %, sigma0/sigma1 -50 %: 1.13 um, over 0.8
+  check(run(*study_, "robust_smc", "scurve_fast_corners", corner(1.5, 1.5, 0.5, 5e-4)), {1.13, 0.146, 4077, 23.5});
+}
+TEST_F(RobustSmcWorstCase, GrindingRamp) {  // mass -30 %, Fs/Fc -50 %, sigma0/sigma1 -50 %
+  check(run(*study_, "robust_smc", "grinding_ramp_corners", corner(0.7, 0.5, 0.5, 5e-4)), {0.202, 0.142, 3542, 22.9});
+}
+TEST_F(RobustSmcWorstCase, GrindingInfeed) {  // mass -30 %, Fs/Fc +50 %, sigma0/sigma1 -50 %
+  check(run(*study_, "robust_smc", "grinding_infeed_corners", corner(0.7, 1.5, 0.5, 5e-4)), {0.178, 0.138, 3665, 22.3});
+}
+// Other encoder-noise sequences: draw 1 (mass +21 %, Fs/Fc +43 %, 280 us of delay) with seed 3
+// on the acceleration-limited move and seed 2 on the fast S-curve (the worst of draws 0 and 1).
+TEST_F(RobustSmcWorstCase, MonteCarloOtherNoiseSeeds) {
+  check(run(*study_, "robust_smc", "accel_limited_mc", {{"plant.sensor.seed", 3}}, 1), {0.323, 0.118, 3717, 18.9});
+  check(run(*study_, "robust_smc", "scurve_fast_mc", {{"plant.sensor.seed", 2}}, 1), {0.669, 0.120, 3853, 19.3});
+}
+
+// The cascade on the observer with the Smith predictor and the 1 kHz velocity filter: the one
+// configuration whose command meets every signal limit where it is stable. Within the limits and
+// 0.8 um on its worst stable corner of the jerk-limited move; and the corner that breaks it
+// (the plant 30 % lighter than the model with 500 us of delay: the predictor's model mass is
+// wrong by 1/0.7 and the loop, tuned as if the delay were gone, limit-cycles in saturation),
+// bounded so that a fix shows and the docs' statement is kept true.
+TEST(CascadeObserverFiltered, WithinTheSignalLimitsWhereStableAndTheCornerThatBreaksIt) {
+  const Study s = load_study(kStudy);
+  const Outcome ok = run(s, "cascade_observer_vf", "jerk_limited_corners", corner(0.7, 1.5, 0.5, 0.0));
+  EXPECT_LE(metric(ok, "position_error_max_abs_m") * 1e6, 1.1 * 0.372);  // measured 0.372 um
+  EXPECT_EQ(metric(ok, "control_signal_within_limits"), 1.0);            // 0.049 V, 1,063 /s, 9.6 N
+  EXPECT_LE(metric(ok, "control_direction_changes_per_s"), 1.1 * 1063);
+  const Outcome broken = run(s, "cascade_observer_vf", "jerk_limited_corners", corner(0.7, 1.5, 1.5, 5e-4));
+  // Measured 14.8 um with 46 % of the run in saturation: anything over 0.8 um and 1 % says "still
+  // broken"; a fix (lower gains for a mass error, or a robust predictor) fails this on purpose.
+  EXPECT_GT(metric(broken, "position_error_max_abs_m") * 1e6, 0.8);
+  EXPECT_GT(metric(broken, "control_saturated_fraction"), 0.01);
+  EXPECT_EQ(metric(broken, "control_signal_within_limits"), 0.0);
+}
+
+}  // namespace
+}  // namespace feeddrive::study
