@@ -106,6 +106,8 @@ std::vector<double> quantiles(std::vector<double> v, const std::vector<double>& 
   return out;
 }
 
+// long-function: a flat table, one entry per candidate effect (its parameters, bounds and starts);
+// splitting it would scatter the table.
 const std::vector<Spec>& specs() {
   static const std::vector<Spec> all = [] {
     std::vector<Spec> s;

@@ -347,6 +347,7 @@ std::string summary_headline(const std::string& text) {
   return line;
 }
 
+// long-function: a flat list, one line per field of summary.json in its documented order (docs/scenario.md).
 std::string summary_json(const Summary& m, const Scenario& s, const std::string& extra) {
   nlohmann::ordered_json j;
   // Metrics over an empty window are null (summary.hpp), never 0.
