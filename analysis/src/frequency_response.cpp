@@ -86,7 +86,8 @@ fields::Meta max_velocity_meta() {
   return m.meta;
 }
 
-Run run_once(const sim::Scenario& base, const Plan& p, double ref_amplitude, double force_amplitude, double v_feed) {
+Run run_once(const sim::Scenario& base, const Plan& p, double ref_amplitude, double force_amplitude, double v_feed,
+             const interrupt::StopToken& stop) {
   sim::Scenario s = base;
   const double T = s.control_period;
   s.duration = static_cast<double>(p.settle + 2 * p.n) * T;
@@ -94,6 +95,7 @@ Run run_once(const sim::Scenario& base, const Plan& p, double ref_amplitude, dou
   const ExcitationReference ref(s.plant.initial.position, v_feed, ref_amplitude, w);
   sim::Excitation ex;
   ex.reference = &ref;
+  ex.stop = stop;
   if (force_amplitude != 0.0) ex.input_force = [&](double t) { return force_amplitude * std::sin(w * t); };
   const double kf = s.plant.thrust_gain();
   Run r;
@@ -145,7 +147,7 @@ FrequencyPoint measure_point(const sim::Scenario& s, const FrequencyResponseOpti
   pt.frequency_hz = p.f;
   if (o.reference_amplitude > 0.0) {
     pt.reference_amplitude_m = std::min(o.reference_amplitude, a_lim / (w * w));
-    const Run r = run_once(s, p, pt.reference_amplitude_m, 0.0, o.feed_velocity);
+    const Run r = run_once(s, p, pt.reference_amplitude_m, 0.0, o.feed_velocity, o.stop);
     cd t[2];
     for (int b = 0; b < 2; ++b) t[b] = 1.0 - r.e[b] / r.in[b];  // X/R = (R - E)/R
     pt.closed_loop = 0.5 * (t[0] + t[1]);
@@ -156,7 +158,7 @@ FrequencyPoint measure_point(const sim::Scenario& s, const FrequencyResponseOpti
     pt.has_reference = true;
   }
   if (o.force_amplitude > 0.0) {
-    const Run r = run_once(s, p, 0.0, o.force_amplitude, o.feed_velocity);
+    const Run r = run_once(s, p, 0.0, o.force_amplitude, o.feed_velocity, o.stop);
     cd g[2], si[2], l[2];
     for (int b = 0; b < 2; ++b) {
       g[b] = -r.e[b] / r.in[b];

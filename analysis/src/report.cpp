@@ -130,7 +130,8 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
   return t.str();
 }
 
-std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r, bool plots) {
+std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r, bool plots,
+                                     const interrupt::StopToken& stop) {
   output::StagedFolder folder(out_dir, "feeddrive-sim");
   {
     output::CsvWriter csv(folder.path("frequency_response.csv"),
@@ -216,7 +217,7 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
             "unset multiplot\n";
     }
     try {
-      folder.plot(gp.str());
+      folder.plot(gp.str(), stop);
     } catch (const std::runtime_error& e) {
       plot_error = e.what();
     }

@@ -1,4 +1,5 @@
 #include "feeddrive/controller/sliding_mode.hpp"
+#include "feeddrive/controller/sliding_mode_law.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,18 +29,39 @@ void SlidingModeParams::validate(const std::string& prefix) const {
   model.validate(prefix + ".model");
 }
 
-namespace {
+namespace smc {
 
-double switching_function(const SlidingModeParams& p, double s) {
-  switch (p.switching) {
+double switching_function(Switching sw, double boundary_layer, double s) {
+  switch (sw) {
     case Switching::kSign: return (s > 0.0) - (s < 0.0);
-    case Switching::kSaturation: return std::clamp(s / p.boundary_layer, -1.0, 1.0);
-    case Switching::kTanh: return std::tanh(s / p.boundary_layer);
+    case Switching::kSaturation: return std::clamp(s / boundary_layer, -1.0, 1.0);
+    case Switching::kTanh: return std::tanh(s / boundary_layer);
   }
   return 0.0;
 }
 
-}  // namespace
+double reaching_acceleration(const SlidingModeParams& p, double ref_acceleration, double ed, double s) {
+  return (p.feedforward_acceleration ? ref_acceleration : 0.0) + p.lambda * ed +
+         p.eta * switching_function(p.switching, p.boundary_layer, s) + p.k * s;
+}
+
+double control_input(const SlidingModeParams& p, double a_cmd, const ModelForces& f, double disturbance_force) {
+  const plant::PlantParams& m = p.model;
+  const double fc = p.compensate_friction ? f.friction : 0.0;
+  const double gc = p.compensate_grinding ? f.grinding : 0.0;
+  const double cc = p.compensate_ripple ? f.cogging : 0.0;
+  const double rc = p.compensate_ripple ? f.reluctance : 0.0;
+  return (m.mass * a_cmd + fc + gc + cc + disturbance_force + f.e0) / (m.thrust_gain() * (1.0 - rc - f.e1));
+}
+
+double limit_output(const SlidingModeParams& p, double u) { return saturate(u, p.u_min, p.u_max); }
+
+double model_acceleration(const plant::PlantParams& m, const ModelForces& f, double u) {
+  const double thrust = m.thrust_gain() * u;
+  return (thrust * (1.0 - f.reluctance - f.e1) - f.cogging - f.friction - f.grinding - f.e0) / m.mass;
+}
+
+}  // namespace smc
 
 namespace {
 // The controller's model with the effects that modify a sub-model (mass_error, presliding,
@@ -69,139 +91,138 @@ bool SlidingModeController::needs_truth() const {
   return friction || grinding;
 }
 
+struct SlidingModeController::LawInput {
+  double x;
+  double v;
+  trajectory::Sample ref;
+  smc::ModelForces forces;
+};
+
+SlidingModeController::Estimate SlidingModeController::estimate_state(const plant::Measurement& meas) {
+  Estimate est{meas.x, meas.v, p_.motion_state == MotionSource::kObserver, false};
+  if (est.use_observer) motion_observer_.correct(meas.x, meas.v);
+  // Until the observer has seen a finite sample it has no estimate: use the measurement as is.
+  if (est.use_observer && motion_observer_.initialised()) {
+    est.x = motion_observer_.position();
+    est.v = motion_observer_.velocity();
+    est.observed = true;
+  }
+  return est;
+}
+
+double SlidingModeController::true_friction(double v, double z) {
+  const plant::FrictionParams& f = p_.model.friction;
+  // The bristle rate from the true z itself, not from the model's g(v) (sliding_mode.hpp).
+  const double zdot = last_true_z_ ? (z - *last_true_z_) / p_.period : plant::lugre_zdot(f, v, z);
+  if (std::isfinite(z)) last_true_z_ = z;  // a NaN sample is not kept for the next rate
+  return f.bristle_stiffness * z + plant::micro_damping(f, v) * zdot + f.viscous * v;
+}
+
+smc::ModelForces SlidingModeController::model_forces(double x, double v, const Truth* truth) {
+  const plant::PlantParams& m = p_.model;
+  smc::ModelForces f;
+  if (m.friction.model != plant::FrictionModel::kNone) {
+    if (p_.friction_state == StateSource::kTrue && m.friction.model == plant::FrictionModel::kLuGre) {
+      const double z = truth != nullptr ? truth->z : 0.0;
+      f.friction = true_friction(v, z);
+      f.z = z;
+    } else {
+      f.friction = friction_observer_.estimate(v);
+      f.z = friction_observer_.z();
+    }
+  }
+  if (m.grinding.enabled) {
+    f.grinding = p_.grinding_state == StateSource::kTrue
+                     ? plant::grinding_force(m.grinding, x, truth != nullptr ? truth->fg : 0.0)
+                     : grinding_observer_.estimate(x);
+  }
+  if (m.ripple.enabled) {
+    f.cogging = plant::cogging_force(m.ripple, x);
+    f.reluctance = plant::reluctance_factor(m.ripple, x);
+  }
+  // The model's additive effects (a fitted model, docs/fit.md), evaluated at (x^, v^).
+  if (has_extra_) {
+    f.e0 = plant::extra_force(m, x, v, 0.0);
+    f.e1 = plant::extra_force(m, x, v, 1.0) - f.e0;
+  }
+  return f;
+}
+
+SlidingModeController::LawInput SlidingModeController::predict_to_action(const Estimate& est,
+                                                                          const trajectory::Sample& ref, double t,
+                                                                          const smc::ModelForces& now) const {
+  const plant::PlantParams& m = p_.model;
+  const double a_d = motion_observer_.disturbance();
+  // With the bristle observer, its z^ is carried along the prediction too, so F^f follows the
+  // predicted velocity (the friction changes fastest at breakaway, within one delay).
+  const bool carry_friction =
+      p_.friction_state == StateSource::kObserver && m.friction.model == plant::FrictionModel::kLuGre;
+  FrictionObserver ahead = friction_observer_;
+  smc::ModelForces held = now;  // the forces at t_k, F^f carried along when carry_friction
+  LawInput in{est.x, est.v, preview(ref, p_.computation_delay), now};
+  for (const DelayLine::Piece& piece : delay_line_.pieces(t, t + p_.computation_delay)) {
+    const double tau = piece.t1 - piece.t0;
+    if (carry_friction) held.friction = ahead.estimate(in.v);
+    const double a = smc::model_acceleration(m, held, piece.u) + a_d;
+    if (carry_friction) ahead.advance(in.v, 0.0, tau);
+    in.x += in.v * tau + 0.5 * a * tau * tau;
+    in.v += a * tau;
+  }
+  if (carry_friction) in.forces.friction = ahead.estimate(in.v);  // F^f when the command acts
+  if (m.ripple.enabled) {  // the ripple where the command will act
+    in.forces.cogging = plant::cogging_force(m.ripple, in.x);
+    in.forces.reluctance = plant::reluctance_factor(m.ripple, in.x);
+  }
+  return in;
+}
+
+void SlidingModeController::advance_observers(const Estimate& est, const trajectory::Sample& ref, double t,
+                                              bool delayed, double u, const smc::ModelForces& now) {
+  // Everything held at its t_k value over [t_k, t_k + T].
+  friction_observer_.advance(est.v, ref.velocity - est.v);
+  grinding_observer_.advance(est.x, est.v);
+  if (!delayed) {
+    if (est.observed) motion_observer_.predict(smc::model_acceleration(p_.model, now, u));
+    return;
+  }
+  delay_line_.push(t, u);
+  if (est.observed) {
+    // The command acting within the period is piecewise constant (switch at t_j + d).
+    double dv = 0.0, dx = 0.0;
+    const double t_end = t + p_.period;
+    for (const DelayLine::Piece& piece : delay_line_.pieces(t, t_end)) {
+      const double tau = piece.t1 - piece.t0;
+      const double a = smc::model_acceleration(p_.model, now, piece.u);
+      dv += a * tau;
+      dx += a * tau * (0.5 * tau + (t_end - piece.t1));
+    }
+    motion_observer_.predict_increments(dv, dx);
+  }
+  delay_line_.forget_before(t + p_.period);
+}
+
 Command SlidingModeController::update(const trajectory::Sample& ref, const plant::Measurement& meas,
                                       const Truth* truth) {
   if (truth == nullptr && needs_truth())
     throw std::logic_error(
         "sliding_mode: friction_state/grinding_state = true needs the plant's true z and Fg, "
         "which this plant does not provide; use the observers");
-
-  double x = meas.x;
-  double v = meas.v;
-  // Until the observer has seen a finite sample it has no estimate: use the measurement as is.
-  const bool use_observer = p_.motion_state == MotionSource::kObserver;
-  if (use_observer) motion_observer_.correct(meas.x, meas.v);
-  if (use_observer && motion_observer_.initialised()) {
-    x = motion_observer_.position();
-    v = motion_observer_.velocity();
-  }
-
-  const plant::PlantParams& m = p_.model;
+  const Estimate est = estimate_state(meas);
+  const smc::ModelForces now = model_forces(est.x, est.v, truth);
   const bool delayed = p_.compensate_delay && p_.computation_delay > 0.0 && std::isfinite(meas.t);
-  Command cmd;
-
-  // Model forces (each opposing the thrust), Xie & Liang eq. 19.
-  double f_friction = 0.0;
-  if (m.friction.model != plant::FrictionModel::kNone) {
-    if (p_.friction_state == StateSource::kTrue && m.friction.model == plant::FrictionModel::kLuGre) {
-      // The bristle rate from the true z itself, not from the model's g(v) (sliding_mode.hpp).
-      const double z = truth != nullptr ? truth->z : 0.0;
-      const double zdot = last_true_z_ ? (z - *last_true_z_) / p_.period : plant::lugre_zdot(m.friction, v, z);
-      if (std::isfinite(z)) last_true_z_ = z;  // a NaN sample is not kept for the next rate
-      f_friction = m.friction.bristle_stiffness * z + plant::micro_damping(m.friction, v) * zdot +
-                   m.friction.viscous * v;
-      cmd.z_estimate = z;
-    } else {
-      f_friction = friction_observer_.estimate(v);
-      cmd.z_estimate = friction_observer_.z();
-    }
-  }
-  double f_grinding = 0.0;
-  if (m.grinding.enabled) {
-    f_grinding = p_.grinding_state == StateSource::kTrue
-                     ? plant::grinding_force(m.grinding, x, truth != nullptr ? truth->fg : 0.0)
-                     : grinding_observer_.estimate(x);
-  }
-  double cogging = 0.0;
-  double reluctance = 0.0;
-  if (m.ripple.enabled) {
-    cogging = plant::cogging_force(m.ripple, x);
-    reluctance = plant::reluctance_factor(m.ripple, x);
-  }
-
-  // The model's additive effects (a fitted model, docs/fit.md), affine in the thrust F:
-  // F_extra = e0 + e1*F (e1: the reluctance_ripple effect), evaluated at (x^, v^).
-  double e0 = 0.0, e1 = 0.0;
-  if (has_extra_) {
-    e0 = plant::extra_force(m, x, v, 0.0);
-    e1 = plant::extra_force(m, x, v, 1.0) - e0;
-  }
   // The state and reference the law acts on: now, or predicted to when the command acts.
-  double xc = x;
-  double vc = v;
-  trajectory::Sample r = ref;
-  const double kakf = m.thrust_gain();
-  // Model acceleration under command u with the forces held at their t_k values (d^ excluded).
-  const auto model_acceleration = [&](double u) {
-    const double thrust = kakf * u;
-    return (thrust * (1.0 - reluctance - e1) - cogging - f_friction - f_grinding - e0) / m.mass;
-  };
-  double f_friction_law = f_friction;  // F^f when the command acts
-  if (delayed && use_observer && motion_observer_.initialised()) {
-    const double a_d = motion_observer_.disturbance();
-    // With the bristle observer, its z^ is carried along the prediction too, so F^f follows the
-    // predicted velocity (the friction changes fastest at breakaway, within one delay).
-    const bool carry_friction = p_.friction_state == StateSource::kObserver &&
-                                m.friction.model == plant::FrictionModel::kLuGre;
-    FrictionObserver ahead = friction_observer_;
-    const double f_now = f_friction;
-    for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, meas.t + p_.computation_delay)) {
-      const double tau = piece.t1 - piece.t0;
-      if (carry_friction) f_friction = ahead.estimate(vc);
-      const double a = model_acceleration(piece.u) + a_d;
-      if (carry_friction) ahead.advance(vc, 0.0, tau);
-      xc += vc * tau + 0.5 * a * tau * tau;
-      vc += a * tau;
-    }
-    f_friction_law = carry_friction ? ahead.estimate(vc) : f_now;
-    f_friction = f_now;
-    r = preview(ref, p_.computation_delay);
-    if (m.ripple.enabled) {  // the ripple where the command will act
-      cogging = plant::cogging_force(m.ripple, xc);
-      reluctance = plant::reluctance_factor(m.ripple, xc);
-    }
-  }
-  const double e = r.position - xc;
-  const double ed = r.velocity - vc;
-  const double s = ed + p_.lambda * e;
-  const double a_cmd = (p_.feedforward_acceleration ? r.acceleration : 0.0) + p_.lambda * ed +
-                       p_.eta * switching_function(p_, s) + p_.k * s;
-  cmd.sliding = s;
+  const LawInput in = delayed && est.observed ? predict_to_action(est, ref, meas.t, now) : LawInput{est.x, est.v, ref, now};
 
-  const double fc = p_.compensate_friction ? f_friction_law : 0.0;
-  const double gc = p_.compensate_grinding ? f_grinding : 0.0;
-  const double cc = p_.compensate_ripple ? cogging : 0.0;
-  const double rc = p_.compensate_ripple ? reluctance : 0.0;
+  Command cmd;
+  if (now.z) cmd.z_estimate = *now.z;
+  const double ed = in.ref.velocity - in.v;
+  cmd.sliding = smc::sliding_variable(in.ref.position - in.x, ed, p_.lambda);
+  const double a_cmd = smc::reaching_acceleration(p_, in.ref.acceleration, ed, cmd.sliding);
   // Lumped disturbance of the x,v observer (0 unless motion_state = observer with d).
-  const double dc = p_.motion_state == MotionSource::kObserver ? -m.mass * motion_observer_.disturbance() : 0.0;
-  cmd.u_unsaturated = (m.mass * a_cmd + fc + gc + cc + dc + e0) / (kakf * (1.0 - rc - e1));
-  cmd.u = saturate(cmd.u_unsaturated, p_.u_min, p_.u_max);
-
-  // Advance the observers over [t_k, t_k + T] with everything held at its t_k value.
-  friction_observer_.advance(v, ref.velocity - v);
-  grinding_observer_.advance(x, v);
-  if (delayed) {
-    delay_line_.push(meas.t, cmd.u);
-    if (use_observer && motion_observer_.initialised()) {
-      // The command acting within the period is piecewise constant (switch at t_j + d).
-      if (m.ripple.enabled) {  // back to the forces at x^(t_k)
-        cogging = plant::cogging_force(m.ripple, x);
-        reluctance = plant::reluctance_factor(m.ripple, x);
-      }
-      double dv = 0.0, dx = 0.0;
-      const double t_end = meas.t + p_.period;
-      for (const DelayLine::Piece& piece : delay_line_.pieces(meas.t, t_end)) {
-        const double tau = piece.t1 - piece.t0;
-        const double a = model_acceleration(piece.u);
-        dv += a * tau;
-        dx += a * tau * (0.5 * tau + (t_end - piece.t1));
-      }
-      motion_observer_.predict_increments(dv, dx);
-    }
-    delay_line_.forget_before(meas.t + p_.period);
-  } else if (use_observer && motion_observer_.initialised()) {
-    motion_observer_.predict(model_acceleration(cmd.u));
-  }
+  const double disturbance = est.use_observer ? -p_.model.mass * motion_observer_.disturbance() : 0.0;
+  cmd.u_unsaturated = smc::control_input(p_, a_cmd, in.forces, disturbance);
+  cmd.u = smc::limit_output(p_, cmd.u_unsaturated);
+  advance_observers(est, ref, meas.t, delayed, cmd.u, now);
   return cmd;
 }
 

@@ -95,13 +95,14 @@ int main(int argc, char** argv) {
     if (csv.decimal_comma && csv.separator == ',')
       throw BadInput("--decimal-comma needs another --separator (e.g. --separator ';'): the comma cannot be both");
     output::check_output_dir(out_dir);
+    opt.stop = tool::stop_token();
     std::vector<sim::KeySetting> settings;
     for (const std::string& k : sets) settings.push_back(sim::parse_key_setting(k));
     const sim::Scenario scenario = sim::load_scenario(scenario_path, settings);
     opt.plausibility.grinding_process =
         scenario.grinding_process || std::find(ask.begin(), ask.end(), "grinding_force") != ask.end();
     if (!units.empty()) csv.units = fit::parse_units(units);
-    const fit::MeasuredData data = fit::load_data(data_path, prefix, csv);
+    const fit::MeasuredData data = fit::load_data(data_path, prefix, csv, tool::stop_token());
     // sanity before fitting: units, gaps and jumps (fit/sanity.hpp)
     fit::check_record(data, scenario.plant, scenario.control_period);
     const fit::Record rec = fit::prepare(data, opt.record);
@@ -111,7 +112,7 @@ int main(int argc, char** argv) {
     spdlog::info("{}: {} samples over {:.3g} s; model {}", data_path, data.size(), data.t.back() - data.t.front(),
                  scenario_path);
     const fit::FitResult r = fit::run_fit(rec, scenario.plant, opt, [](const std::string& s) { spdlog::info("{}", s); });
-    fit::write_outputs(out_dir, scenario_path, rec, r, !no_plots);
+    fit::write_outputs(out_dir, scenario_path, rec, r, !no_plots, tool::stop_token());
     std::printf("%-4s %-24s %14s %18s\n", "step", "model", "gap [um]", "force RMS [N]");
     std::printf("%-4d %-24s %14.4g %18.4g\n", 0, "as given", r.replay_initial.gap * 1e6, r.force_rms_initial);
     int k = 0;

@@ -152,12 +152,12 @@ MeasuredData load_csv(const std::string& path, const CsvOptions& opt) {
   }
 }
 
-MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
+MeasuredData load_lcm_log(const std::string& path, const std::string& prefix, const interrupt::StopToken& stop) {
   record::LogConversion c;
   std::vector<sim::Record> rows;
   std::string notes_tail;
   try {
-    c = record::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false);
+    c = record::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false, stop);
   } catch (const std::exception& e) {
     throw DataError(e.what());
   }
@@ -203,10 +203,11 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix) {
   return d;
 }
 
-MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt) {
+MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt,
+                       const interrupt::StopToken& stop) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  MeasuredData d = (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") ? load_lcm_log(path, prefix) : load_csv(path, opt);
+  MeasuredData d = (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") ? load_lcm_log(path, prefix, stop) : load_csv(path, opt);
   shift_time_origin(d);
   return d;
 }

@@ -27,6 +27,7 @@ struct Ctx {
   const Eigen::VectorXd* r0;  // residual of the model without the candidate (may be null)
   double x_mean;
   double offset_bound{0.0};   // |F| bound of the model-form offset (FreeSet::offset_bound)
+  interrupt::StopToken stop{};  // ends a solve within an iteration (Ctrl-C in the tool)
 };
 
 double x_mean_of(const Record& rec) {
@@ -105,6 +106,8 @@ std::vector<double> quantiles(std::vector<double> v, const std::vector<double>& 
   return out;
 }
 
+// long-function: a flat table, one entry per candidate effect (its parameters, bounds and starts);
+// splitting it would scatter the table.
 const std::vector<Spec>& specs() {
   static const std::vector<Spec> all = [] {
     std::vector<Spec> s;
@@ -389,16 +392,18 @@ Solved solve(const Record& rec, const plant::PlantParams& base, const std::vecto
   opt.logging_type = ceres::SILENT;
   opt.minimizer_progress_to_stdout = false;
   opt.num_threads = 1;
-  // Ctrl-C ends the fit within an iteration (interrupt.hpp).
+  // Ctrl-C ends the fit within an iteration (ctx.stop, interrupt.hpp).
   struct StopOnInterrupt : ceres::IterationCallback {
+    explicit StopOnInterrupt(const interrupt::StopToken& t) : token(t) {}
     ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-      return interrupt::interrupted() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+      return token.stop_requested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
     }
-  } stop;
+    const interrupt::StopToken& token;
+  } stop(ctx.stop);
   opt.callbacks.push_back(&stop);
   ceres::Solver::Summary sum;
   ceres::Solve(opt, &problem, &sum);
-  interrupt::check();
+  ctx.stop.check();
   Solved out;
   out.theta = theta;
   out.rss = 2.0 * sum.final_cost;
@@ -416,9 +421,9 @@ double bic(const Eigen::VectorXd& r, int k, long n_active) {
 }
 
 CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
-                           const Eigen::VectorXd& residual0) {
+                           const Eigen::VectorXd& residual0, const interrupt::StopToken& stop) {
   const Spec& s = spec(name);
-  const Ctx ctx{rec, model, &residual0, x_mean_of(rec)};
+  const Ctx ctx{rec, model, &residual0, x_mean_of(rec), 0.0, stop};
   const std::vector<Block> blocks{{&s, 0}};
   std::vector<Theta> starts = s.starts(ctx);
   CandidateFit out;
@@ -583,9 +588,9 @@ void start_form(const Record& rec, const plant::PlantParams& model, const std::v
 }  // namespace
 
 JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
-                     const std::vector<double>* weights, int max_iterations) {
+                     const std::vector<double>* weights, int max_iterations, const interrupt::StopToken& stop) {
   const Eigen::VectorXd r0 = force_residual(rec, model);
-  const Ctx ctx{rec, model, &r0, x_mean_of(rec), free.offset_bound};
+  const Ctx ctx{rec, model, &r0, x_mean_of(rec), free.offset_bound, stop};
   auto [blocks, theta] = joint_blocks(model, free, ctx);
   JointFit out;
   out.params = model;
@@ -609,7 +614,8 @@ JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const F
   return out;
 }
 
-std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& model, const FreeSet& free, int folds) {
+std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& model, const FreeSet& free, int folds,
+                                   const interrupt::StopToken& stop) {
   std::vector<long> active;
   for (long i = 0; i < static_cast<long>(rec.bank.tau.size()); ++i)
     if (rec.masked.empty() || !rec.masked[static_cast<std::size_t>(i)]) active.push_back(i);
@@ -621,7 +627,7 @@ std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& 
     for (long a = 0; a < n; ++a)
       if (a < lo || a >= hi) w[static_cast<std::size_t>(active[a])] = 1.0;
     // a warm start from the full fit converges in a few iterations
-    const JointFit jf = fit_jointly(rec, model, free, &w, 20);
+    const JointFit jf = fit_jointly(rec, model, free, &w, 20, stop);
     const Eigen::VectorXd r = force_residual(rec, jf.params);
     for (long a = lo; a < hi; ++a) out[static_cast<std::size_t>(f)] += r[active[a]] * r[active[a]];
   }

@@ -98,6 +98,7 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
   return "";
 }
 
+// long-function: a flat list of rules, one or two per effect, each independent of the others.
 std::string implausible(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e) {
   const std::string& n = e.name;
   const double F = env.peak_thrust;

@@ -15,7 +15,7 @@ double rms(const Eigen::VectorXd& r, long n_active) {
   return n ? std::sqrt(r.squaredNorm() / static_cast<double>(n)) : 0.0;
 }
 
-Replay replay(const Record& rec, const plant::PlantParams& model, double window) {
+Replay replay(const Record& rec, const plant::PlantParams& model, double window, const interrupt::StopToken& stop) {
   const MeasuredData& d = *rec.data;
   const long n = static_cast<long>(d.size());
   const double W = window > 0 ? window : std::max(0.1, 20.0 * rec.period);
@@ -31,7 +31,7 @@ Replay replay(const Record& rec, const plant::PlantParams& model, double window)
   long count = 0;
   long s = 0;
   while (s + 1 < n) {
-    interrupt::check();
+    stop.check();
     long e = s;
     while (e + 1 < n && d.t[e + 1] - d.t[s] <= W + 1e-12) ++e;
     if (e == s) e = s + 1;

@@ -176,7 +176,8 @@ std::string params_text(const Effect& e) {
 }  // namespace
 
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
-                   const FitResult& r, bool plots) {
+                   const FitResult& r, bool plots,
+                   const interrupt::StopToken& stop) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
   {
     const MeasuredData& d = *rec.data;
@@ -351,7 +352,7 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
               "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
               "ps 0.3 title 'residual after'\n";
       }
-      out.plot(gp.str());
+      out.plot(gp.str(), stop);
     }
   }
   out.commit();

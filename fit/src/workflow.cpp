@@ -90,7 +90,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     if (!contains(free.effects, "constant_force") && !p.effects.spring_force.enabled)
       f.offset_bound = kAsymmetryTolerance * friction_level(p);
     if (!has_coulomb_term(p) && f.offset_bound == 0.0) return p;
-    plant::PlantParams q = fit_jointly(rec, p, f, nullptr, 200).params;
+    plant::PlantParams q = fit_jointly(rec, p, f, nullptr, 200, opt.stop).params;
     try {
       q.validate();
     } catch (const std::invalid_argument&) {
@@ -102,8 +102,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   current = recalibrate(current);
   Eigen::VectorXd r = force_residual(rec, current);
   double cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
-  Replay rp = replay(rec, current, opt.replay_window);
-  out.replay_initial = replay(rec, model, opt.replay_window);
+  Replay rp = replay(rec, current, opt.replay_window, opt.stop);
+  out.replay_initial = replay(rec, model, opt.replay_window, opt.stop);
   out.force_rms_initial = rms(force_residual(rec, model), n);
   if (!std::isfinite(out.replay_initial.gap) || !std::isfinite(out.force_rms_initial)) {
     // Finite samples whose squares are not (a position outlier of 1e200 m): no finite metric.
@@ -148,7 +148,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     // Polish: the effects already in are refitted to convergence first, so that no candidate's
     // joint fit gets credit for merely finishing the optimisation of the others.
     if (!free.effects.empty()) {
-      const JointFit polished = fit_jointly(rec, current, free, nullptr, 200);
+      const JointFit polished = fit_jointly(rec, current, free, nullptr, 200, opt.stop);
       if (polished.rss < r.squaredNorm()) {
         current = polished.params;
         r = force_residual(rec, current);
@@ -177,7 +177,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         continue;
       }
       const auto t0 = std::chrono::steady_clock::now();
-      const CandidateFit single = fit_candidate(rec, current, name, r);
+      const CandidateFit single = fit_candidate(rec, current, name, r, opt.stop);
       plant::PlantParams trial = current;
       plant::set_effect(trial.effects, single.effect);
       FreeSet fs = free;
@@ -187,12 +187,12 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       fs.form = opt.fit_form && current.friction.model != plant::FrictionModel::kStatic &&
                 (name == "coulomb_friction" || name == "stribeck_friction");
       // the single fit is a good start: the joint fit converges in a few tens of iterations
-      JointFit jf = fit_jointly(rec, trial, fs, nullptr, 40);
+      JointFit jf = fit_jointly(rec, trial, fs, nullptr, 40, opt.stop);
       const Effect canon = canonical(effect_of(jf.params, name));
       if (canon.parameters != effect_of(jf.params, name).parameters) {
         plant::PlantParams p = jf.params;
         plant::set_effect(p.effects, canon);
-        const JointFit jc = fit_jointly(rec, p, fs, nullptr, 40);
+        const JointFit jc = fit_jointly(rec, p, fs, nullptr, 40, opt.stop);
         // the canonical form has two parameters fewer in effect; keep it unless the BIC says otherwise
         if (bic_of(jc.rss, fs.parameters(jc.params) - 2, n) <= bic_of(jf.rss, fs.parameters(jf.params), n)) jf = jc;
       }
@@ -245,7 +245,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
           plant::set_effect(p.effects, simple);
           fs2.effects.push_back(simple.name);
         }
-        const JointFit js = fit_jointly(rec, p, fs2, nullptr, 60);
+        const JointFit js = fit_jointly(rec, p, fs2, nullptr, 60, opt.stop);
         try {
           js.params.validate();
         } catch (const std::invalid_argument&) {
@@ -305,7 +305,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       if (it != cv_cache.end()) return it->second;
       FreeSet fs = free;
       fs.effects = c.free_effects;
-      return cv_cache[c.effect.name] = cross_validate(rec, c.joint, fs, opt.cv_folds);
+      return cv_cache[c.effect.name] = cross_validate(rec, c.joint, fs, opt.cv_folds, opt.stop);
     };
     {
       std::vector<std::size_t> close;
@@ -340,7 +340,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         c.reason = Reason::kBelowThreshold;
         continue;
       }
-      if (cv_without.empty()) cv_without = cross_validate(rec, current, free, opt.cv_folds);
+      if (cv_without.empty()) cv_without = cross_validate(rec, current, free, opt.cv_folds, opt.stop);
       const std::vector<double> cv_with = cv_of(c);
       const CvVerdict v = cv_verdict(cv_without, cv_with);
       if (!v.confirmed) {
@@ -352,7 +352,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         continue;
       }
       try {
-        rp2 = replay(rec, c.joint, opt.replay_window);
+        rp2 = replay(rec, c.joint, opt.replay_window, opt.stop);
       } catch (const std::exception& e) {  // e.g. CVODE cannot integrate the fitted model
         c.passed_over = std::string("cannot be replayed (") + e.what() + ")";
         c.reason = Reason::kInvalid;
@@ -427,7 +427,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     r = force_residual(rec, current);
     cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
     try {
-      rp = replay(rec, current, opt.replay_window);
+      rp = replay(rec, current, opt.replay_window, opt.stop);
     } catch (const std::exception&) {  // the recalibrated model cannot be replayed: keep the candidate's
       current = chosen->joint;
       r = force_residual(rec, current);
@@ -448,7 +448,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         fr.effects.erase(std::find(fr.effects.begin(), fr.effects.end(), e));
         plant::PlantParams p = current;
         plant::effect_enabled(p.effects, e) = false;
-        const JointFit jf = fit_jointly(rec, p, fr);
+        const JointFit jf = fit_jointly(rec, p, fr, nullptr, 100, opt.stop);
         const double loss = bic_of(jf.rss, fr.parameters(jf.params), n) - cur_bic;
         if (loss < least) {
           least = loss;
@@ -460,7 +460,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       Replay rp_without;
       try {
         best_without.params.validate();
-        rp_without = replay(rec, best_without.params, opt.replay_window);
+        rp_without = replay(rec, best_without.params, opt.replay_window, opt.stop);
       } catch (const std::exception&) {  // the model without it cannot be replayed: keep it
         break;
       }

@@ -40,9 +40,10 @@ int main(int argc, char** argv) {
     const auto log_bytes = std::filesystem::file_size(log_path, ec);
     const double log_steps = ec ? std::numeric_limits<double>::infinity() : static_cast<double>(log_bytes) / 64.0;
     sim::check_run_size(s, out_dir, log_steps);
-    sim::RunWriter out(out_dir, s, "feeddrive-log2csv");  // rows streamed as the log is read
+    sim::RunWriter out(out_dir, s, "feeddrive-log2csv", tool::stop_token());  // rows streamed as the log is read
     out.set_expected_steps(std::min(static_cast<double>(s.steps()), log_steps));
-    const record::LogConversion c = record::read_log(log_path, prefix, [&](const sim::Record& r) { out.add(r); });
+    const record::LogConversion c = record::read_log(log_path, prefix, [&](const sim::Record& r) { out.add(r); }, true,
+                                                         tool::stop_token());
     const record::Recorder& rec = c.recorder;
     if (out.steps() == 0)
       throw std::invalid_argument(log_path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
     sim::check_run_size(s, mopt.out_dir);
     monitor::MonitorNode node(s, opt, mopt);
     const bool ok = node.run();
-    interrupt::check();  // a Ctrl-C while the plots were drawn: the data are written, the exit says interrupted
+    opt.stop.check();  // a Ctrl-C while the plots were drawn: the data are written, the exit says interrupted
     return ok ? 0 : node.record_too_big() ? 2 : 1;
   });
 }

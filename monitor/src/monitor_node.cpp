@@ -133,7 +133,9 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   on_peer_status_back = [this](const process_status_t& m) {  // "starting" after "running": a restart?
     if (m.role == "plant" && m.state != "failed") plant_went_back(m);
   };
-  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor");
+  stop_ = opt.stop;
+  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor",
+                                          opt.stop);
   out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
 
@@ -502,7 +504,7 @@ bool MonitorNode::run() {
     // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
     // Ctrl-C stops that too; then the process exits as interrupted (128 + signal).
     progress(true);
-    interrupt::clear();
+    stop_ = stop_.renewed();
     mopt_.plots = false;
     finish(false, e.what());
     throw interrupt::Interrupted(e.signal());
@@ -725,7 +727,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
         spdlog::info("monitor: the run did not complete; {} in {} is kept, this record is in {}",
                      earlier ? "the earlier output" : "what was already there", output::shown(mopt_.out_dir), where);
     }
-    if (!out_->plot_error().empty() && !interrupt::interrupted())  // an interrupt is reported once, as such
+    if (!out_->plot_error().empty() && !stop_.stop_requested())  // an interrupt is reported once, as such
       spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
@@ -752,7 +754,7 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
 void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::vector<std::string>& names,
                                    const std::vector<Histogram>& h, bool plot) const {
   dir.write_text("latency_histogram.csv", histograms_csv(names, h));
-  if (!plot || interrupt::interrupted()) return;  // interrupted while plotting: the data still go in place
+  if (!plot || stop_.stop_requested()) return;  // interrupted while plotting: the data still go in place
   const double period_us = s_.control_period * 1e6;
   const std::string bin = std::to_string(h.front().bin_us());
   std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
@@ -769,9 +771,9 @@ void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::v
           "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
   gp += "\n";
   try {  // a view of the data: its failure (or an interrupt: the flag stays set) loses nothing
-    output::run_gnuplot(dir.dir(), gp, "latency_histogram.gp");
+    output::run_gnuplot(dir.dir(), gp, stop_, "latency_histogram.gp");
   } catch (const std::runtime_error& e) {
-    if (!interrupt::interrupted()) spdlog::warn("monitor: latency histogram not drawn ({})", e.what());
+    if (!stop_.stop_requested()) spdlog::warn("monitor: latency histogram not drawn ({})", e.what());
   }
 }
 

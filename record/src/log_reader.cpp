@@ -144,13 +144,13 @@ bool finite_reference(const reference_t& m) {
 }  // namespace
 
 LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
-                       bool need_reference) {
+                       bool need_reference, const interrupt::StopToken& stop) {
   LogParser log(path);
   const Channels ch(prefix);
   LogConversion out;
   Event ev;
   while (log.next(ev, out.events)) {
-    if (++out.events % 1024 == 0) interrupt::check();
+    if (++out.events % 1024 == 0) stop.check();
     if (ev.channel == ch.state) {
       decode_into<drive_state_t>(ev, out, [&](const drive_state_t& m, std::int64_t t) {
         if (!finite_state(m)) return void(++out.non_finite);
@@ -173,7 +173,7 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
     }
     if ((out.events & 4095) == 0) {
       out.recorder.flush(sink);  // rows leave as they complete
-      interrupt::check();        // Ctrl-C: unwind (a staged output folder is removed)
+      stop.check();              // Ctrl-C: unwind (a staged output folder is removed)
     }
   }
   out.recorder.flush_final(sink, need_reference);

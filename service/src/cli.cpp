@@ -12,6 +12,7 @@
 namespace feeddrive::service {
 
 void add_node_options(CLI::App& app, NodeOptions& opt) {
+  opt.stop = tool::stop_token();  // the process's: every run process is a tool's main
   app.add_option("--set", opt.sets, "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
       ->type_name("KEY=VALUE");
   app.add_option("--lcm-url", opt.lcm_url, "LCM URL (default: multicast, ttl=0, 4 MB receive buffer)")

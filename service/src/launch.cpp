@@ -220,7 +220,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   RefusalPipe refusal_pipe;
   std::map<pid_t, std::string> running;
   for (const auto& role : roles) {
-    if (interrupt::signal_number() != 0) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
+    if (given.stop.stop_requested()) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
       spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
                    "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
@@ -292,7 +292,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
       continue;
     }
     // Forward Ctrl-C / SIGTERM to every child once.
-    const int sig = interrupt::signal_number();
+    const int sig = given.stop.signal();
     if (sig != 0 && forwarded != sig) {
       forwarded = sig;
       for (const auto& [p, role] : running) ::kill(p, sig);
@@ -309,7 +309,7 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   }
   result.refusals = refusal_pipe.lines();
   // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
-  interrupt::check();
+  given.stop.check();
   result.exit_code = result.failed.empty() ? 0 : refused ? 2 : 1;
   return result;
 }

@@ -30,11 +30,11 @@ std::string enter_realtime(int priority) {
          "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock;
 }
 
-void sleep_until(std::int64_t target_us, std::int64_t spin_us) {
+void sleep_until(std::int64_t target_us, std::int64_t spin_us, const interrupt::StopToken& stop) {
   const std::int64_t wake = target_us - spin_us;
   if (mono_us() < wake) {
     timespec ts{static_cast<time_t>(wake / 1000000), static_cast<long>((wake % 1000000) * 1000)};
-    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !interrupt::interrupted()) {
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !stop.stop_requested()) {
     }
   }
   while (mono_us() < target_us) {
@@ -166,6 +166,12 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* sha
   });
 }
 
+Node::~Node() {
+  if (const std::int64_t n = bus_.send_errors(); n > 0)
+    spdlog::warn("{}: {} LCM message{} could not be sent (publish failed); see the warnings above", role_, n,
+                 n == 1 ? "" : "s");
+}
+
 process_status_t Node::status_message(const std::string& state, const std::string& message) const {
   process_status_t m{};
   m.utime = wall_utime();
@@ -242,7 +248,7 @@ bool is_run_role(const std::string& role) {
 }
 
 void Node::check_peers() const {
-  interrupt::check();
+  opt_.stop.check();
   if (!scenario_mismatch_.empty()) throw std::invalid_argument(scenario_mismatch_);
   for (const auto& [role, st] : peers_) {
     if (st.state != "failed" || !is_run_role(role)) continue;

@@ -257,7 +257,7 @@ void PlantNode::run_realtime() {
     if (k + 1 < steps_) {
       drive_state_t next = make_state(k + 1);
       const std::int64_t w = t0_us_ + (k + 1) * period_us;
-      sleep_until(w, options().realtime_spin_us);
+      sleep_until(w, options().realtime_spin_us, options().stop);
       const std::int64_t late = mono_us() - w;
       // An overrun: the plant itself (its timer, its integration, a descheduled virtual CPU)
       // starts the period more than the guard late. Catching up would give the controller less

@@ -59,9 +59,10 @@ int main(int argc, char** argv) {
       return s;
     });
     if (frequency_response) {
+      fr.stop = tool::stop_token();
       const auto r = analysis::measure_frequency_response(scenario, fr);
       if (!quiet) std::fputs(analysis::frequency_response_table(scenario, r).c_str(), stdout);
-      const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, !no_plots);
+      const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, !no_plots, tool::stop_token());
       if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
       // as after a run: the scenario's and the options' plausibility warnings (frequency_response.json too)
       for (const std::string& w : r.warnings) spdlog::warn("{}", w);
@@ -75,8 +76,8 @@ int main(int argc, char** argv) {
     // At run time: a model the keys make unintegrable (plant::IntegrationError) or a non-finite
     // value (check_finite_step: sim::ScenarioError), or a CSV that cannot fit (RunWriter's check
     // on its first rows: std::invalid_argument) is bad input, exit 2 (tool::report).
-    sim::RunWriter out(out_dir, scenario, "feeddrive-sim");
-    const auto stats = sim::run(scenario, [&](const sim::Record& r) { out.add(r); });
+    sim::RunWriter out(out_dir, scenario, "feeddrive-sim", tool::stop_token());
+    const auto stats = sim::run(scenario, [&](const sim::Record& r) { out.add(r); }, tool::stop_token());
     const auto summary = out.summary(stats.wall_time_s, stats.integrator);
     out.finish(summary, !no_plots);
     if (!out.plot_error().empty())

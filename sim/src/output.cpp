@@ -86,7 +86,8 @@ void check_run_size(const Scenario& s, const std::string& out_dir, double max_st
   }
 }
 
-RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool)
+RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool,
+                     const interrupt::StopToken& stop)
     : s_(s),
       folder_(out_dir, tool),
       columns_(column_indices(s)),
@@ -98,6 +99,7 @@ RunWriter::RunWriter(const std::string& out_dir, const Scenario& s, const std::s
   for (std::size_t c : columns_) header.push_back(record_columns()[c]);
   csv_ = std::make_unique<output::CsvWriter>(folder_.path("timeseries.csv"), header);
   block_.reserve(kBlockRows);
+  stop_token_ = stop;
   worker_ = std::thread([this] { work(); });
 }
 
@@ -256,7 +258,7 @@ std::filesystem::path RunWriter::finish(const Summary& sum, bool plots, const st
     // place (plot_error() says why; an interrupt still ends the writing).
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      write_plots(folder_, plot_, s_.name);
+      write_plots(folder_, plot_, s_.name, stop_token_);
     } catch (const interrupt::Interrupted& e) {
       // The interrupt flag stays set: the caller ends as interrupted once the data are in place.
       if (!keep_on_interrupt_) throw;
@@ -272,7 +274,8 @@ std::filesystem::path RunWriter::finish(const Summary& sum, bool plots, const st
   return folder_.target();
 }
 
-void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title) {
+void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title,
+                 const interrupt::StopToken& stop) {
   reduced.write_csv(dir.path("plot.csv"), curve_names());
   // Curve c of plot.csv: time in column 2c+1, value in 2c+2 (MinMaxReducer::write_csv). A panel
   // draws only the curves with samples; one with none (a run without the true state, e.g. from
@@ -324,7 +327,7 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
      << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}},
               "no friction, ripple or grinding force of the paper model in this run (forces of plant.effects are not drawn)", true);
-  dir.plot(gp.str());
+  dir.plot(gp.str(), stop);
 }
 
 }  // namespace feeddrive::sim

@@ -93,7 +93,11 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
     if (!std::isfinite(v)) fail(what, v, Source::kPlant);
 }
 
-RunStats run(const Scenario& s, const RecordSink& sink) { return run(s, sink, Excitation{}); }
+RunStats run(const Scenario& s, const RecordSink& sink, const interrupt::StopToken& stop) {
+  Excitation none;
+  none.stop = stop;
+  return run(s, sink, none);
+}
 
 RunStats run(const Scenario& s, const RecordSink& sink, const Excitation& excitation) {
   const auto wall_start = std::chrono::steady_clock::now();
@@ -105,7 +109,7 @@ RunStats run(const Scenario& s, const RecordSink& sink, const Excitation& excita
   const long n = s.steps();
 
   for (long k = 0; k < n; ++k) {
-    if ((k & 1023) == 0) interrupt::check();
+    if ((k & 1023) == 0) excitation.stop.check();
     const double t = s.time_of(k);
     const trajectory::Sample ref = reference->sample(t);
     const plant::Measurement meas = drive.measure();

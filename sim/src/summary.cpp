@@ -353,6 +353,7 @@ std::string summary_headline(const std::string& text) {
 }
 
 namespace {
+// long-function: a flat list, one line per field of summary.json in its documented order (docs/scenario.md).
 // The one assembly of the summary's fields (summary_json writes it, summary_metrics reads its
 // numbers without a text round trip).
 nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {

@@ -7,14 +7,45 @@
 // Exit codes: 0 done (failed cases are reported in results.csv), 2 bad input (study, options,
 // output folder), 1 a failure of the machine.
 #include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <optional>
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/study/session.hpp"
 #include "feeddrive/study/spec.hpp"
 #include "feeddrive/study/transport.hpp"
 #include "feeddrive/tool/main.hpp"
+#include "progress.hpp"
+
+namespace {
+
+// What run_study tells, printed: the cases of --list on stdout, the progress on stderr, the rest
+// in the one logging style (spdlog, tool::setup_logging).
+class Printer final : public feeddrive::study::Reporter {
+ public:
+  explicit Printer(bool quiet) : quiet_(quiet) {}
+  void listed(const std::string& line) override { std::printf("%s\n", line.c_str()); }
+  void started(const std::string& line) override { spdlog::info("{}", line); }
+  void progress_start(std::size_t total) override { progress_.emplace(total, 0, !quiet_); }
+  void progress_step(bool reused, bool failed) override {
+    if (reused)
+      progress_->reused();
+    else
+      progress_->step(failed);
+  }
+  void progress_end() override {
+    if (progress_) progress_->finish();
+  }
+  void warning(const std::string& line) override { spdlog::warn("{}", line); }
+
+ private:
+  bool quiet_;
+  std::optional<feeddrive::study::Progress> progress_;
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   std::string command = "feeddrive-study";
@@ -22,9 +53,8 @@ int main(int argc, char** argv) {
   std::unique_ptr<feeddrive::study::Transport> transport;
   try {
     transport = feeddrive::study::connect(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+  } catch (...) {
+    return feeddrive::tool::report(std::current_exception());
   }
   CLI::App app{"feeddrive-study: runs a study of many scenarios (grid, Monte Carlo, controllers) on all cores or MPI ranks"};
   feeddrive::study::Options o;
@@ -43,21 +73,46 @@ int main(int argc, char** argv) {
   app.add_flag("--retry-failed", o.retry_failed, "run again the cases that failed in an earlier run into DIR");
   app.add_flag("--list", o.list, "print the resolved cases and exit");
   app.add_flag("--quiet,-q", o.quiet, "no progress, print only errors");
+  // Not tool::run: every rank parses the same arguments, and only rank 0 (or the process alone)
+  // speaks; then the one mapping of every tool (tool::report).
+  const bool speaks = !transport || transport->rank() == 0;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // Every rank parses the same arguments: only rank 0 (or the process alone) speaks.
-    const int rc = (!transport || transport->rank() == 0) ? app.exit(e) : (e.get_exit_code() == 0 ? 0 : 2);
-    return rc == 0 ? 0 : 2;
+    if (!speaks) return e.get_exit_code() == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);
+    return feeddrive::tool::report(std::make_exception_ptr(feeddrive::BadInput(std::string(e.what()) + " (see --help)")));
   }
   if (o.out.empty() && !o.list) {
-    if (!transport || transport->rank() == 0) std::fprintf(stderr, "error: --out is required (except with --list)\n");
-    return 2;
+    if (!speaks) return 2;
+    return feeddrive::tool::report(std::make_exception_ptr(feeddrive::BadInput("--out is required (except with --list)")));
   }
   o.plots = !no_plots;
+  o.command = command;
+  feeddrive::tool::setup_logging("feeddrive-study", o.quiet);
   // Ctrl-C / SIGTERM: the running cases stop, the finished ones stay in DIR/cases.
   feeddrive::tool::install_interrupt_handlers();
-  o.command = command;
-  if (transport && transport->rank() != 0) return feeddrive::study::serve(*transport, o.jobs);
-  return feeddrive::study::run_study(o, transport.get());
+  o.stop = feeddrive::tool::stop_token();
+  try {
+    if (!speaks) return feeddrive::study::serve(*transport, o.jobs, o.stop);
+    Printer printer(o.quiet);
+    const feeddrive::study::StudyResult r = feeddrive::study::run_study(o, transport.get(), printer);
+    if (r.dir.empty()) return 0;  // --list
+    // The loader's warnings (an implausible value with its likely unit, a move cut off by
+    // duration): once each, with the number of cases that have it, as report.md lists them.
+    for (const std::string& w : r.warnings) spdlog::warn("{}", w);
+    if (r.moves_unfinished > 0)
+      spdlog::warn("{} of {} cases did not finish their move within duration (move_finished in results.csv)",
+                   r.moves_unfinished, r.moves);
+    const std::string line = r.name + ": " + std::to_string(r.total) + " cases (" + std::to_string(r.ran) + " run, " +
+                             std::to_string(r.reused) + " reused), " + std::to_string(r.failed) +
+                             " failed (see results.csv) -> " + r.dir + "/results.csv, report.md";
+    if (r.failed > 0)
+      spdlog::warn("{}", line);
+    else
+      spdlog::info("{}", line);
+    return 0;
+  } catch (...) {
+    return feeddrive::tool::report(std::current_exception());
+  }
 }

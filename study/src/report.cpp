@@ -299,7 +299,8 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
   cases_with_other_warnings += other ? 1 : 0;
 }
 
-std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d) {
+std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d,
+                        const interrupt::StopToken& stop) {
   const Study& s = d.s;
   fs::create_directories(dir);
   const std::size_t nc = s.controllers.size(), nf = s.families.size();
@@ -397,7 +398,7 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
     md << "![" << cell(s.report.metric) << " against " << cell(params[p]) << "](" << prefix << png << ")\n\n";
   }
   if (md.str().empty()) return "No plot: no case gave a positive " + s.report.metric + ".\n\n";
-  output::run_gnuplot(dir, gp.str());
+  output::run_gnuplot(dir, gp.str(), stop);
   return md.str();
 }
 

@@ -7,7 +7,6 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/study/cases.hpp"
@@ -88,7 +88,8 @@ namespace {
 // Worker threads running cases: the main thread hands each its index and scenario.
 class CasePool {
  public:
-  explicit CasePool(int jobs) : pool_(jobs, [this](std::size_t i) { return run_case(take(i)); }) {}
+  CasePool(int jobs, const interrupt::StopToken& stop)
+      : stop_(stop), pool_(jobs, [this](std::size_t i) { return run_case(take(i), stop_); }) {}
   void push(std::size_t i, std::string yaml) {
     {
       std::lock_guard<std::mutex> g(mu_);
@@ -108,6 +109,7 @@ class CasePool {
   }
   std::mutex mu_;
   std::map<std::size_t, std::string> yaml_;  // handed over, not yet taken by a thread
+  const interrupt::StopToken stop_;
   Pool pool_;                                // last: its threads stop before the map goes
 };
 
@@ -115,12 +117,10 @@ class CasePool {
 // second at most, and a 10^6-case study starts its first case within seconds.
 constexpr std::size_t kProbeBudget = 1000;
 
-// The exit of a Ctrl-C or SIGTERM: the message, the other ranks told, 128 + the signal.
-int interrupted_exit(Transport* t, const std::string& what) {
-  const int sig = interrupt::signal_number();
-  std::fprintf(stderr, "interrupted by %s%s\n", interrupt::signal_name(sig).c_str(), what.c_str());
+// The exit of a Ctrl-C or SIGTERM: the other ranks told, then Interrupted with what was kept.
+[[noreturn]] void throw_interrupted(Transport* t, int sig, const std::string& what) {
   if (t) t->abort(128 + sig);
-  return 128 + sig;
+  throw interrupt::Interrupted(sig, what);
 }
 
 // A case and what became of it, while it is between being handed out and its row.
@@ -129,122 +129,208 @@ struct Slot {
   bool finished{false};
 };
 
-}  // namespace
-
-int run_study(const Options& o, Transport* t) {
-  const auto start = std::chrono::steady_clock::now();
+// The study, its case count and its resolver, checked.
+struct CheckedStudy {
   Study study;
-  std::size_t total = 0;
+  std::size_t total{0};
   std::unique_ptr<Resolver> resolver;
-  fs::path dir;
-  std::unique_ptr<FolderLock> lock;
-  // Everything that can be wrong with the input, before any case runs: exit 2, and the other
-  // ranks are told to stop. The cases are made and resolved one at a time as they are handed out
-  // (a study has up to 10^6: never all at once); here only the probe cases (cases.hpp) are
-  // resolved, so the usual mistakes still stop the study before it writes anything.
+};
+
+// Everything that can be wrong with the input, before any case runs: BadInput (exit 2), and the
+// other ranks are told to stop. The cases are made and resolved one at a time as they are handed
+// out (a study has up to 10^6: never all at once); here only the probe cases (cases.hpp) are
+// resolved, so the usual mistakes still stop the study before it writes anything.
+CheckedStudy check_study(const Options& o, Transport* t) {
+  CheckedStudy c;
   try {
     if (o.sweeps.empty()) {
-      study = load_study(o.study);
+      c.study = load_study(o.study);
     } else {  // SCENARIO --sweep ...: a study without a study file
       std::vector<GridAxis> axes;
       for (const std::string& sw : o.sweeps) axes.push_back(parse_sweep(sw));
-      study = sweep_study(o.study, axes);
+      c.study = sweep_study(o.study, axes);
     }
     // --set: settings of every case, after the study's own (as if its `set` ended with them).
     for (const std::string& k : o.sets) {
       const sim::KeySetting ks = sim::parse_key_setting(k);
-      study.set.push_back({ks.key, ks.value});
+      c.study.set.push_back({ks.key, ks.value});
     }
     if (!o.list) output::check_output_dir(o.out);
-    total = case_count(study);
-    resolver = std::make_unique<Resolver>(study);
-    for (std::size_t i : probe_cases(study, kProbeBudget)) {
-      interrupt::check();
-      resolver->resolve(case_at(study, i));
+    c.total = case_count(c.study);
+    c.resolver = std::make_unique<Resolver>(c.study);
+    for (std::size_t i : probe_cases(c.study, kProbeBudget)) {
+      o.stop.check();
+      c.resolver->resolve(case_at(c.study, i));
+    }
+  } catch (const interrupt::Interrupted& e) {
+    throw_interrupted(t, e.signal(), " while checking the study; nothing written");
+  } catch (const std::exception& e) {
+    if (t) t->broadcast(2);
+    throw BadInput(e.what());
+  }
+  return c;
+}
+
+// --list: the resolved cases, one line each.
+void list_cases(const CheckedStudy& c, const interrupt::StopToken& stop, Reporter& reporter) {
+  reporter.listed(std::to_string(c.total) + " cases");
+  try {
+    for (std::size_t i = 0; i < c.total; ++i) {
+      stop.check();
+      const CaseSpec cs = case_at(c.study, i);
+      const ResolvedCase r = c.resolver->resolve(cs);
+      std::string line = std::to_string(i) + " " + r.hash.substr(0, 16) + " " + c.study.controllers[cs.controller].name +
+                         " " + c.study.families[cs.family].name;
+      for (const auto& v : cs.variations) line += " " + v.key + "=" + r.parameters.at(v.key);
+      reporter.listed(line);
     }
   } catch (const interrupt::Interrupted&) {
-    return interrupted_exit(t, " while checking the study; nothing written");
+    throw;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    if (t) t->broadcast(2);
-    return 2;
+    throw BadInput(e.what());
   }
-  if (o.list) {
-    if (t) t->broadcast(2);
-    std::printf("%zu cases\n", total);
-    try {
-      for (std::size_t i = 0; i < total; ++i) {
-        interrupt::check();
-        const CaseSpec c = case_at(study, i);
-        const ResolvedCase r = resolver->resolve(c);
-        std::string params;
-        for (const auto& v : c.variations) params += " " + v.key + "=" + r.parameters.at(v.key);
-        std::printf("%zu %s %s %s%s\n", i, r.hash.substr(0, 16).c_str(), study.controllers[c.controller].name.c_str(),
-                    study.families[c.family].name.c_str(), params.c_str());
-      }
-    } catch (const interrupt::Interrupted&) {
-      std::fflush(stdout);
-      return interrupted_exit(nullptr, "");
-    } catch (const std::exception& e) {
-      std::fflush(stdout);
-      std::fprintf(stderr, "error: %s\n", e.what());
-      return 2;
-    }
-    return 0;
-  }
+}
+
+// The output folder, made or reused, and locked: BadInput for a folder that cannot be the
+// study's (exit 2), a failure to write it (1); the other ranks are told either way.
+struct LockedFolder {
+  fs::path dir;
+  std::unique_ptr<FolderLock> lock;
+};
+LockedFolder open_folder(const std::string& out, Transport* t) {
+  LockedFolder f;
   try {
-    dir = prepare_folder(o.out);
-    lock = std::make_unique<FolderLock>(dir);
+    f.dir = prepare_folder(out);
+    f.lock = std::make_unique<FolderLock>(f.dir);
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
     if (t) t->broadcast(2);
-    return 2;
+    throw BadInput(e.what());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
     if (t) t->broadcast(1);
-    return 1;
+    throw std::runtime_error(e.what());
   }
-  if (t) t->broadcast(0);
+  return f;
+}
 
-  const int jobs = o.jobs > 0 ? o.jobs : std::max(1, available_cores() / (t ? t->local_size() : 1));
-  const int ranks = t ? t->size() : 1;
-  if (!o.quiet)
-    std::fprintf(stderr, "%s: %zu cases on %d thread%s x %d rank%s -> %s\n", study.name.c_str(), total, jobs,
-                 jobs == 1 ? "" : "s", ranks, ranks == 1 ? "" : "s", dir.c_str());
+// Streaming, in study order: case i is made (case_at), resolved and looked up in DIR/cases when
+// it is handed out; its row goes to results.csv when every earlier case has its row. At most
+// `window` cases are between being handed out and their row, so memory does not grow with the
+// study (report.md keeps a few numbers per case: ReportData).
+class CaseStream {
+ public:
+  CaseStream(const Options& o, Transport* t, const CheckedStudy& c, const fs::path& dir, int jobs, Reporter& reporter)
+      : o_(o), t_(t), c_(c), dir_(dir), jobs_(jobs), reporter_(reporter), report_(c.study),
+        window_(std::max<std::size_t>(256, 16 * static_cast<std::size_t>(jobs) *
+                                               static_cast<std::size_t>(t ? t->size() : 1))) {}
 
-  // Streaming, in study order: case i is made (case_at), resolved and looked up in DIR/cases when
-  // it is handed out; its row goes to results.csv when every earlier case has its row. At most
-  // `window` cases are between being handed out and their row, so memory does not grow with the
-  // study (report.md keeps a few numbers per case: ReportData).
-  const std::size_t workers = static_cast<std::size_t>(jobs) * static_cast<std::size_t>(ranks);
-  const std::size_t window = std::max<std::size_t>(256, 16 * workers);
-  std::map<std::size_t, Slot> slots;  // handed out, row not yet written
-  std::deque<std::size_t> ready;      // resolved, to run
-  std::deque<int> waiting;            // ranks that asked for a case while none was ready
-  std::size_t next_case = 0, next_row = 0, cached = 0, ran = 0, unresolved = 0;
-  double case_time = 0.0;
-  Progress progress(total, 0, !o.quiet);
-  ReportData report(study);
-  std::unique_ptr<ResultsWriter> results;
-  const auto finished = [&](std::size_t i, Outcome out) {
-    Slot& sl = slots.at(i);
+  // Runs every case; throws Interrupted with what was kept (the other ranks told), or a failure.
+  void run() {
+    reporter_.progress_start(c_.total);
+    try {
+      results_ = std::make_unique<ResultsWriter>(c_.study, dir_);
+      CasePool pool(jobs_, o_.stop);
+      int released = 0;  // ranks told there is no more work
+      while (next_row_ < c_.total || (t_ && released < t_->size() - 1)) {
+        if (const int sig = o_.stop.signal()) stop(pool, sig);
+        hand_out(pool, released);
+        write_rows();
+        if (pool.in_flight() > 0 || t_) {
+          if (auto r = pool.pop(std::chrono::milliseconds(t_ ? 2 : 200))) record(r->first, std::move(r->second));
+        }
+        receive_from_ranks();
+        write_rows();
+      }
+    } catch (const interrupt::Interrupted& e) {
+      reporter_.progress_end();
+      throw_interrupted(t_, e.signal(), ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
+                                           " cases finished in order; run the same command to go on");
+    } catch (const std::exception& e) {
+      if (t_) t_->abort(1);
+      throw std::runtime_error(e.what());
+    }
+    reporter_.progress_end();
+  }
+
+  ResultsWriter& results() { return *results_; }
+  const ReportData& report() const { return report_; }
+  std::size_t ran() const { return ran_; }
+  std::size_t reused() const { return cached_; }
+  std::size_t unresolved() const { return unresolved_; }
+  double case_time() const { return case_time_; }
+
+ private:
+  // Ctrl-C or SIGTERM: the running cases stop at their next poll; what finished is kept.
+  [[noreturn]] void stop(CasePool& pool, int sig) {
+    while (pool.in_flight() > 0)
+      if (auto r = pool.pop(std::chrono::milliseconds(100))) record(r->first, std::move(r->second));
+    reporter_.progress_end();
+    throw_interrupted(t_, sig, ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
+                                   " cases finished in order (and every case run is kept in " + dir_.string() +
+                                   "/cases); run the same command to go on");
+  }
+
+  // Hands out cases in order, within the window, as long as a thread or a rank can take one.
+  void hand_out(CasePool& pool, int& released) {
+    const std::size_t want = static_cast<std::size_t>(jobs_) + waiting_.size() + (t_ ? 1 : 0);
+    while (next_case_ < c_.total && next_case_ - next_row_ < window_ && ready_.size() < want && !o_.stop.stop_requested())
+      prepare_next();
+    while (pool.in_flight() < static_cast<std::size_t>(jobs_) && !ready_.empty()) {
+      pool.push(ready_.front(), slots_.at(ready_.front()).record.resolved.yaml);
+      ready_.pop_front();
+    }
+    while (t_ && !waiting_.empty() && (!ready_.empty() || next_case_ == c_.total)) {
+      const int rank = waiting_.front();
+      waiting_.pop_front();
+      if (ready_.empty()) {
+        t_->send(rank, kAssign, "");
+        ++released;
+      } else {
+        const std::size_t i = ready_.front();
+        ready_.pop_front();
+        t_->send(rank, kAssign, pack(i, slots_.at(i).record.resolved.yaml));
+      }
+    }
+  }
+
+  // The other ranks' requests and outcomes.
+  void receive_from_ranks() {
+    while (t_) {
+      auto m = t_->poll();
+      if (!m) break;
+      if (m->tag == kRequest) {
+        waiting_.push_back(m->from);
+      } else if (m->tag == kResult) {
+        auto [i, text] = unpack(m->payload);
+        if (!slots_.count(i) || slots_.at(i).finished)
+          throw std::runtime_error("rank " + std::to_string(m->from) + " sent an outcome for no case it was given");
+        auto out = parse_outcome(text, "");  // the other ranks do not hash: the index names the case
+        if (!out)
+          throw std::runtime_error("rank " + std::to_string(m->from) + " sent a malformed outcome for case " +
+                                   std::to_string(i));
+        record(i, std::move(*out));
+      }
+    }
+  }
+
+  void finished(std::size_t i, Outcome out) {
+    Slot& sl = slots_.at(i);
     sl.record.outcome = std::move(out);
     sl.finished = true;
-  };
+  }
+
   // Makes and resolves the next case: reused from DIR/cases, failed (it does not resolve), or ready.
-  const auto prepare_next = [&]() {
-    const std::size_t i = next_case++;
-    Slot& sl = slots[i];
-    CaseRecord& c = sl.record;
-    c.spec = case_at(study, i);
+  void prepare_next() {
+    const std::size_t i = next_case_++;
+    CaseRecord& c = slots_[i].record;
+    c.spec = case_at(c_.study, i);
     try {
-      c.resolved = resolver->resolve(c.spec);
+      c.resolved = c_.resolver->resolve(c.spec);
     } catch (const StudyError& e) {
       // Only a case the probes did not cover (another draw, another combination of axes) gets
       // here: a failed case in results.csv, like a run that fails (docs/study.md, Validation).
       Outcome out;
       out.error = e.what();
-      ++unresolved;
+      ++unresolved_;
       for (const Variation& v : c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
         if (!v.scale) c.resolved.parameters[v.key] = v.value;
       for (char& ch : out.error)
@@ -252,162 +338,144 @@ int run_study(const Options& o, Transport* t) {
       finished(i, std::move(out));
       return;
     }
-    const fs::path yaml = dir / "cases" / (c.resolved.hash + ".yaml");
-    const fs::path json = dir / "cases" / (c.resolved.hash + ".json");
+    const fs::path yaml = dir_ / "cases" / (c.resolved.hash + ".yaml");
+    const fs::path json = dir_ / "cases" / (c.resolved.hash + ".json");
     std::error_code ec;
     if (fs::exists(json, ec)) {
-      if (auto prev = parse_outcome(slurp(json), c.resolved.hash); prev && (prev->ok || !o.retry_failed)) {
+      if (auto prev = parse_outcome(slurp(json), c.resolved.hash); prev && (prev->ok || !o_.retry_failed)) {
         c.cached = true;
         finished(i, std::move(*prev));
         return;
       }
     }
     if (!fs::exists(yaml, ec)) output::write_file_atomically(yaml, c.resolved.yaml);
-    ready.push_back(i);
-  };
-  // Writes the rows of the finished cases at the head of the study order.
-  const auto write_rows = [&]() {
-    for (auto it = slots.begin(); it != slots.end() && it->first == next_row && it->second.finished; it = slots.erase(it)) {
-      const CaseRecord& c = it->second.record;
-      results->add(it->first, c);
-      report.add(it->first, c);
-      if (c.cached) {
-        ++cached;
-        progress.reused();
-      } else {
-        progress.step(!c.outcome.ok);
-      }
-      ++next_row;
-    }
-  };
-  const auto record = [&](std::size_t i, Outcome out) {
-    if (out.interrupted) return;  // not an outcome: the case runs again next time
-    const Slot& sl = slots.at(i);
-    case_time += out.wall_s;
-    ++ran;
-    output::write_file_atomically(dir / "cases" / (sl.record.resolved.hash + ".json"), outcome_json(sl.record.resolved.hash, out));
-    finished(i, std::move(out));
-  };
-  try {
-    results = std::make_unique<ResultsWriter>(study, dir);
-    CasePool pool(jobs);
-    int released = 0;  // ranks told there is no more work
-    while (next_row < total || (t && released < t->size() - 1)) {
-      if (interrupt::interrupted()) {
-        // Ctrl-C or SIGTERM: the running cases stop at their next poll; what finished is kept.
-        while (pool.in_flight() > 0)
-          if (auto r = pool.pop(std::chrono::milliseconds(100))) record(r->first, std::move(r->second));
-        progress.finish();
-        return interrupted_exit(t, ": " + std::to_string(next_row) + " of " + std::to_string(total) +
-                                       " cases finished in order (and every case run is kept in " + dir.string() +
-                                       "/cases); run the same command to go on");
-      }
-      // Hand out cases in order, within the window, as long as a thread or a rank can take one.
-      const std::size_t want = static_cast<std::size_t>(jobs) + waiting.size() + (t ? 1 : 0);
-      while (next_case < total && next_case - next_row < window && ready.size() < want && !interrupt::interrupted())
-        prepare_next();
-      while (pool.in_flight() < static_cast<std::size_t>(jobs) && !ready.empty()) {
-        pool.push(ready.front(), slots.at(ready.front()).record.resolved.yaml);
-        ready.pop_front();
-      }
-      while (t && !waiting.empty() && (!ready.empty() || next_case == total)) {
-        const int rank = waiting.front();
-        waiting.pop_front();
-        if (ready.empty()) {
-          t->send(rank, kAssign, "");
-          ++released;
-        } else {
-          const std::size_t i = ready.front();
-          ready.pop_front();
-          t->send(rank, kAssign, pack(i, slots.at(i).record.resolved.yaml));
-        }
-      }
-      write_rows();
-      const bool busy = pool.in_flight() > 0 || t;
-      if (busy) {
-        if (auto r = pool.pop(std::chrono::milliseconds(t ? 2 : 200))) record(r->first, std::move(r->second));
-      }
-      while (t) {
-        auto m = t->poll();
-        if (!m) break;
-        if (m->tag == kRequest) {
-          waiting.push_back(m->from);
-        } else if (m->tag == kResult) {
-          auto [i, text] = unpack(m->payload);
-          if (!slots.count(i) || slots.at(i).finished)
-            throw std::runtime_error("rank " + std::to_string(m->from) + " sent an outcome for no case it was given");
-          auto out = parse_outcome(text, "");  // the other ranks do not hash: the index names the case
-          if (!out) throw std::runtime_error("rank " + std::to_string(m->from) + " sent a malformed outcome for case " + std::to_string(i));
-          record(i, std::move(*out));
-        }
-      }
-      write_rows();
-    }
-  } catch (const interrupt::Interrupted&) {
-    progress.finish();
-    return interrupted_exit(t, ": " + std::to_string(next_row) + " of " + std::to_string(total) + " cases finished in order; run the same command to go on");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "\nerror: %s\n", e.what());
-    if (t) t->abort(1);
-    return 1;
+    ready_.push_back(i);
   }
-  progress.finish();
 
-  try {
-    results->finish();
-    std::string plots_md = "Plots skipped (--no-plots).\n\n";
-    if (o.plots) {
-      const fs::path partial = dir / ".plots.partial";
-      std::error_code ec;
-      fs::remove_all(partial, ec);
-      try {
-        plots_md = write_plots(partial, "plots/", report);
-        output::replace_folder(partial, dir / "plots");  // never a moment without plots/
-      } catch (const interrupt::Interrupted&) {
-        fs::remove_all(partial, ec);
-        throw;
-      } catch (const std::runtime_error& e) {  // a view of the results: results.csv and report.md still go
-        fs::remove_all(partial, ec);
-        std::fprintf(stderr, "warning: plots not drawn (%s); the results are in %s\n", e.what(), dir.c_str());
-        plots_md = "Plots not drawn: " + std::string(e.what()) + "\n\n";
-      }
+  // Writes the rows of the finished cases at the head of the study order.
+  void write_rows() {
+    for (auto it = slots_.begin(); it != slots_.end() && it->first == next_row_ && it->second.finished;
+         it = slots_.erase(it)) {
+      const CaseRecord& c = it->second.record;
+      results_->add(it->first, c);
+      report_.add(it->first, c);
+      if (c.cached) ++cached_;
+      reporter_.progress_step(c.cached, !c.cached && !c.outcome.ok);
+      ++next_row_;
     }
-    output::write_file_atomically(dir / "report.md", report_md(report, o.command, plots_md));
-    nlohmann::ordered_json timing;
-    timing["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    timing["cases"] = total;
-    timing["cases_run"] = ran;
-    timing["cases_reused"] = cached;
-    timing["cases_not_resolved"] = unresolved;  // failed before running: their scenario is invalid
-    timing["case_time_sum_s"] = case_time;
-    timing["threads_per_rank"] = jobs;
-    timing["ranks"] = ranks;
-    output::write_file_atomically(dir / "timing.json", timing.dump(2) + "\n");
+  }
+
+  void record(std::size_t i, Outcome out) {
+    if (out.interrupted) return;  // not an outcome: the case runs again next time
+    const Slot& sl = slots_.at(i);
+    case_time_ += out.wall_s;
+    ++ran_;
+    output::write_file_atomically(dir_ / "cases" / (sl.record.resolved.hash + ".json"),
+                                  outcome_json(sl.record.resolved.hash, out));
+    finished(i, std::move(out));
+  }
+
+  const Options& o_;
+  Transport* t_;
+  const CheckedStudy& c_;
+  const fs::path dir_;
+  const int jobs_;
+  Reporter& reporter_;
+  ReportData report_;
+  const std::size_t window_;
+  std::unique_ptr<ResultsWriter> results_;
+  std::map<std::size_t, Slot> slots_;  // handed out, row not yet written
+  std::deque<std::size_t> ready_;      // resolved, to run
+  std::deque<int> waiting_;            // ranks that asked for a case while none was ready
+  std::size_t next_case_{0}, next_row_{0}, cached_{0}, ran_{0}, unresolved_{0};
+  double case_time_{0.0};
+};
+
+// DIR/plots (replaced whole, never a moment without it); a failure to draw them is a warning:
+// results.csv and report.md still go. Returns report.md's plot section.
+std::string draw_plots(const Options& o, const fs::path& dir, const ReportData& report, Reporter& reporter) {
+  if (!o.plots) return "Plots skipped (--no-plots).\n\n";
+  const fs::path partial = dir / ".plots.partial";
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  try {
+    std::string md = write_plots(partial, "plots/", report, o.stop);
+    output::replace_folder(partial, dir / "plots");
+    return md;
   } catch (const interrupt::Interrupted&) {
-    return interrupted_exit(t, ": every case finished and is kept in " + dir.string() + "/cases; run the same command to write the report");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    fs::remove_all(partial, ec);
+    throw;
+  } catch (const std::runtime_error& e) {
+    fs::remove_all(partial, ec);
+    reporter.warning("plots not drawn (" + std::string(e.what()) + "); the results are in " + dir.string());
+    return "Plots not drawn: " + std::string(e.what()) + "\n\n";
   }
-  // The loader's warnings (an implausible value with its likely unit, a move cut off by
-  // duration): once each, with the number of cases that have it, as report.md lists them.
-  if (!o.quiet) {
-    for (const std::string& w : warning_lines(report)) std::fprintf(stderr, "warning: %s\n", w.c_str());
-    if (report.moves_unfinished > 0)
-      std::fprintf(stderr, "warning: %zu of %zu cases did not finish their move within duration (move_finished in results.csv)\n",
-                   report.moves_unfinished, report.moves);
-  }
-  if (!o.quiet || report.failed > 0)
-    std::fprintf(stderr, "%s: %zu cases (%zu run, %zu reused), %zu failed (see results.csv) -> %s/results.csv, report.md\n",
-                 study.name.c_str(), total, ran, cached, report.failed, dir.c_str());
-  return 0;
 }
 
-int serve(Transport& t, int jobs) {
+// results.csv closed, the plots, report.md and timing.json.
+void write_report(const Options& o, Transport* t, const fs::path& dir, CaseStream& cases, std::size_t total, int jobs,
+                  double wall_s, Reporter& reporter) {
+  try {
+    cases.results().finish();
+    const std::string plots_md = draw_plots(o, dir, cases.report(), reporter);
+    output::write_file_atomically(dir / "report.md", report_md(cases.report(), o.command, plots_md));
+    nlohmann::ordered_json timing;
+    timing["wall_s"] = wall_s;
+    timing["cases"] = total;
+    timing["cases_run"] = cases.ran();
+    timing["cases_reused"] = cases.reused();
+    timing["cases_not_resolved"] = cases.unresolved();  // failed before running: their scenario is invalid
+    timing["case_time_sum_s"] = cases.case_time();
+    timing["threads_per_rank"] = jobs;
+    timing["ranks"] = t ? t->size() : 1;
+    output::write_file_atomically(dir / "timing.json", timing.dump(2) + "\n");
+  } catch (const interrupt::Interrupted& e) {
+    throw_interrupted(t, e.signal(), ": every case finished and is kept in " + dir.string() +
+                                         "/cases; run the same command to write the report");
+  } catch (const std::exception& e) {
+    throw std::runtime_error(e.what());
+  }
+}
+
+}  // namespace
+
+StudyResult run_study(const Options& o, Transport* t, Reporter& reporter) {
+  const auto start = std::chrono::steady_clock::now();
+  const CheckedStudy checked = check_study(o, t);
+  StudyResult result;
+  result.name = checked.study.name;
+  result.total = checked.total;
+  if (o.list) {
+    if (t) t->broadcast(2);
+    list_cases(checked, o.stop, reporter);
+    return result;
+  }
+  const LockedFolder folder = open_folder(o.out, t);
+  if (t) t->broadcast(0);
+  const int jobs = o.jobs > 0 ? o.jobs : std::max(1, available_cores() / (t ? t->local_size() : 1));
+  const int ranks = t ? t->size() : 1;
+  reporter.started(checked.study.name + ": " + std::to_string(checked.total) + " cases on " + std::to_string(jobs) +
+                   " thread" + (jobs == 1 ? "" : "s") + " x " + std::to_string(ranks) + " rank" +
+                   (ranks == 1 ? "" : "s") + " -> " + folder.dir.string());
+  CaseStream cases(o, t, checked, folder.dir, jobs, reporter);
+  cases.run();
+  write_report(o, t, folder.dir, cases, checked.total, jobs,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), reporter);
+  result.ran = cases.ran();
+  result.reused = cases.reused();
+  result.failed = static_cast<std::size_t>(cases.report().failed);
+  result.dir = folder.dir.string();
+  result.warnings = warning_lines(cases.report());
+  result.moves = cases.report().moves;
+  result.moves_unfinished = cases.report().moves_unfinished;
+  return result;
+}
+
+int serve(Transport& t, int jobs, const interrupt::StopToken& stop) {
   const int status = t.broadcast(0);
   if (status != 0) return status;
   if (jobs <= 0) jobs = std::max(1, available_cores() / t.local_size());
-  CasePool pool(jobs);
+  CasePool pool(jobs, stop);
   bool done = false;
   while (!done || pool.in_flight() > 0) {
     if (!done && pool.in_flight() < static_cast<std::size_t>(jobs)) {

@@ -141,7 +141,7 @@ TEST(GnuplotString, RealGnuplotPrintsItAndRunsNothing) {
     script += "print " + q + "\nset title " + q + "\n";
     expected += inner(q) + "\n";
   }
-  ASSERT_NO_THROW(feeddrive::output::run_gnuplot(dir, script)) << script;
+  ASSERT_NO_THROW(feeddrive::output::run_gnuplot(dir, script, {})) << script;
   EXPECT_FALSE(fs::exists(mark)) << "a quoted text ran a command";
   EXPECT_EQ(slurp(dir / "printed.txt"), expected);
   EXPECT_FALSE(fs::exists(dir / "gnuplot.log")) << "removed on success";
@@ -151,12 +151,12 @@ TEST(GnuplotString, RealGnuplotPrintsItAndRunsNothing) {
 TEST(RunGnuplot, NoShellAndOneLineErrors) {
   // A folder name a shell would execute: gnuplot runs there all the same, and nothing else runs.
   const fs::path dir = fresh("q'; touch SHELLMARK; '");
-  ASSERT_NO_THROW(feeddrive::output::run_gnuplot(dir, "set print 'ok.txt'\nprint 1+1\n"));
+  ASSERT_NO_THROW(feeddrive::output::run_gnuplot(dir, "set print 'ok.txt'\nprint 1+1\n", {}));
   EXPECT_EQ(slurp(dir / "ok.txt"), "2\n");
   EXPECT_FALSE(fs::exists("SHELLMARK"));
   EXPECT_FALSE(fs::exists(scratch() / "SHELLMARK"));
   try {
-    feeddrive::output::run_gnuplot(dir, "print 1\nplot 'no_such_file.csv' using 1:2\n");
+    feeddrive::output::run_gnuplot(dir, "print 1\nplot 'no_such_file.csv' using 1:2\n", {});
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     const std::string w = e.what();

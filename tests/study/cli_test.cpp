@@ -181,7 +181,7 @@ TEST(StudyCli, WithoutGnuplotTheResultsAndReportAreStillWritten) {
                                   " -j 1 2> " + (scratch() / "nogp.err").string() + " > /dev/null").c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << slurp(scratch() / "nogp.err");
-  EXPECT_NE(slurp(scratch() / "nogp.err").find("warning: plots not drawn"), std::string::npos) << slurp(scratch() / "nogp.err");
+  EXPECT_NE(slurp(scratch() / "nogp.err").find("plots not drawn ("), std::string::npos) << slurp(scratch() / "nogp.err");
   EXPECT_TRUE(fs::exists(dir / "results.csv"));
   EXPECT_NE(slurp(dir / "report.md").find("Plots not drawn"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / ".plots.partial"));
@@ -248,9 +248,9 @@ TEST(StudyCli, ASweepShowsItsCasesWarningsAndTheMovesThatDidNotFinish) {
   const ProcResult r = study(scen + " --sweep reference.max_velocity=0.2,500 --set duration=0.01 --out " + out.string() +
                              " -j 2 --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("warning: reference.max_velocity: 500 m/s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[warning] reference.max_velocity: 500 m/s"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("mm/s? (1 of 2 cases)"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("warning: 2 of 2 cases did not finish their move"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("[warning] 2 of 2 cases did not finish their move"), std::string::npos) << r.err;
   const std::string md = slurp(out / "report.md");
   EXPECT_NE(md.find("## Warnings"), std::string::npos) << md;
   EXPECT_NE(md.find("**2 of 2 cases did not finish their move**"), std::string::npos) << md;

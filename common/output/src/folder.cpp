@@ -419,11 +419,12 @@ void StagedFolder::write_text(const std::string& name, const std::string& text) 
   if (!f) throw std::runtime_error(p.string() + ": write failed");
 }
 
-void StagedFolder::plot(const std::string& script) const {
+void StagedFolder::plot(const std::string& script, const interrupt::StopToken& stop) const {
   run_gnuplot(staging_,
               "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,700 noenhanced\n"
               "set grid\nset key outside right top vertical\n" +
-                  script);
+                  script,
+              stop);
 }
 
 StagedFolder::~StagedFolder() {

@@ -74,7 +74,8 @@ std::string gnuplot_string(std::string_view text, std::size_t max_bytes) {
   return out + "\"";
 }
 
-void run_gnuplot(const fs::path& dir, const std::string& script, const std::string& script_name) {
+void run_gnuplot(const fs::path& dir, const std::string& script, const interrupt::StopToken& stop,
+                 const std::string& script_name) {
   const fs::path script_path = dir / script_name, log_path = dir / "gnuplot.log";
   {
     std::ofstream gp(script_path, std::ios::binary);
@@ -99,11 +100,11 @@ void run_gnuplot(const fs::path& dir, const std::string& script, const std::stri
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
-    if (interrupt::interrupted()) {  // Ctrl-C or SIGTERM: stop gnuplot at once, then unwind
+    if (stop.stop_requested()) {  // Ctrl-C or SIGTERM: stop gnuplot at once, then unwind
       ::kill(pid, SIGKILL);
       while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
       }
-      interrupt::check();
+      stop.check();
     }
   }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

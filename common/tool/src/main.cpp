@@ -16,8 +16,15 @@
 
 namespace feeddrive::tool {
 namespace {
-extern "C" void on_signal(int sig) { interrupt::detail::g_signal = sig; }
+// The process's one stop flag: written only by on_signal, read through stop_token().
+interrupt::StopFlag g_stop;
+extern "C" void on_signal(int sig) {
+  g_stop.signal = sig;
+  g_stop.count = g_stop.count + 1;
+}
 }  // namespace
+
+interrupt::StopToken stop_token() { return interrupt::StopToken(&g_stop); }
 
 void install_interrupt_handlers() {
   struct sigaction sa {};

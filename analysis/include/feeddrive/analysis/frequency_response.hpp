@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::analysis {
@@ -67,6 +68,7 @@ struct FrequencyResponseOptions {
   int block_cycles{2};        ///< at least this many cycles per block
   double block_time{0.05};    ///< [s] at least this long per block
   int jobs{1};                ///< frequencies measured in parallel (threads)
+  interrupt::StopToken stop;  ///< polled by every run (Ctrl-C in the tool; the default never stops)
   /// Throws std::invalid_argument naming the option and its value (the tool exits 2).
   void validate(const sim::Scenario& s) const;
   /// The frequencies asked for [Hz], ascending (before they are moved to whole cycles).
@@ -134,6 +136,6 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
 /// Writes DIR/frequency_response.csv, frequency_response.json and (plots) bode_reference.png,
 /// bode_compliance.png, bode_loop.png through an output::StagedFolder. Returns the plot error ("" ok).
 std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
-                                     bool plots);
+                                     bool plots, const interrupt::StopToken& stop = {});
 
 }  // namespace feeddrive::analysis

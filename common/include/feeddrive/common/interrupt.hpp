@@ -1,24 +1,17 @@
 #pragma once
-// The one interrupt flag of every feeddrive process, as libraries read it: long loops poll it
-// (interrupted(), check()) and unwind, so destructors run: a staged output folder is removed
-// (output::StagedFolder), a child gnuplot is stopped (output::run_gnuplot). Libraries only read
-// it; what sets it (the SIGINT and SIGTERM handlers) is installed by the process, in
-// feeddrive::tool (tool::install_interrupt_handlers, common/tool/), which also reports it.
+// How a library learns that it should stop (Ctrl-C, SIGTERM): through a StopToken its caller hands
+// in, never a global. Long loops poll it (stop_requested(), check()) and unwind, so destructors
+// run: a staged output folder is removed (output::StagedFolder), a child gnuplot is stopped
+// (output::run_gnuplot). The flag itself, and the SIGINT/SIGTERM handlers that set it, live in one
+// place, feeddrive::tool (common/tool/src/main.cpp): only a tool's main installs them
+// (tool::install_interrupt_handlers) and hands the process's token (tool::stop_token()) to the
+// libraries; tool::report turns the Interrupted a library threw into the exit 128 + signal.
 
 #include <csignal>
 #include <stdexcept>
 #include <string>
 
 namespace feeddrive::interrupt {
-
-namespace detail {
-/// Written only by the process's signal handler (tool::install_interrupt_handlers).
-inline volatile std::sig_atomic_t g_signal = 0;
-}  // namespace detail
-
-/// The signal that interrupted the process, or 0.
-inline int signal_number() { return detail::g_signal; }
-inline bool interrupted() { return detail::g_signal != 0; }
 
 /// "SIGINT", "SIGTERM" or "signal N".
 inline std::string signal_name(int sig) {
@@ -27,10 +20,12 @@ inline std::string signal_name(int sig) {
   return "signal " + std::to_string(sig);
 }
 
-/// Thrown by a loop that saw the flag; the tools exit 128 + signal.
+/// Thrown by a loop that saw the flag; the tools exit 128 + signal. detail completes the one line
+/// the tool prints ("interrupted by SIGINT" + detail, e.g. "; nothing written").
 class Interrupted : public std::runtime_error {
  public:
-  explicit Interrupted(int sig) : std::runtime_error("interrupted by " + signal_name(sig)), sig_(sig) {}
+  explicit Interrupted(int sig, const std::string& detail = "")
+      : std::runtime_error("interrupted by " + signal_name(sig) + detail), sig_(sig) {}
   int signal() const { return sig_; }
   int exit_code() const { return 128 + sig_; }
 
@@ -38,14 +33,40 @@ class Interrupted : public std::runtime_error {
   int sig_;
 };
 
-/// Throws Interrupted if a signal came.
-inline void check() {
-  if (const int s = detail::g_signal; s != 0) throw Interrupted(s);
-}
+/// The flag a StopToken reads: the signal that asked to stop (0: none) and how many came. Written
+/// only by the process's signal handler (tool::install_interrupt_handlers) or by a test.
+struct StopFlag {
+  volatile std::sig_atomic_t signal{0};
+  volatile std::sig_atomic_t count{0};
+};
 
-/// Forgets the signal: for a tool that, once interrupted, still finishes a short job it must not
-/// lose (the monitor writing the steps it recorded); a second signal then stops that too.
-inline void clear() { detail::g_signal = 0; }
+/// A read-only view of a StopFlag: what a library polls. A default-made token never stops (a
+/// library used without a tool, a unit test); tools hand in tool::stop_token().
+class StopToken {
+ public:
+  StopToken() = default;
+  /// A token that sees every signal that came to the flag.
+  explicit StopToken(const StopFlag* flag) : flag_(flag) {}
+  /// The signal that asked to stop, or 0.
+  int signal() const { return flag_ != nullptr && flag_->count != seen_ ? static_cast<int>(flag_->signal) : 0; }
+  bool stop_requested() const { return signal() != 0; }
+  /// Throws Interrupted if a stop was asked for.
+  void check() const {
+    if (const int s = signal(); s != 0) throw Interrupted(s);
+  }
+  /// A token on the same flag that ignores the signals that came so far: for a job that, once
+  /// interrupted, still finishes a short task it must not lose (the monitor writing the steps it
+  /// recorded); a second signal then stops that too.
+  StopToken renewed() const {
+    StopToken t(flag_);
+    t.seen_ = flag_ != nullptr ? flag_->count : 0;
+    return t;
+  }
+
+ private:
+  const StopFlag* flag_{nullptr};
+  std::sig_atomic_t seen_{0};
+};
 
 /// Set (to "1") by feeddrive-launch for the processes it starts: the launcher reports the
 /// interrupt once, its children stay silent about it.

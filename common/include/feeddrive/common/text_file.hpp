@@ -1,6 +1,5 @@
 #pragma once
-// The one reader of small text files (scenario and study YAML): bounded in size and
-// interruptible, so a wrong path (/dev/zero, a log, a disk image) is refused in one line instead
+// The one reader of small text files (scenario and study YAML): bounded in size, so a wrong path (/dev/zero, a log, a disk image) is refused in one line instead
 // of filling the memory. Header-only.
 
 #include <fcntl.h>
@@ -13,7 +12,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::text {
 
@@ -47,8 +45,8 @@ int open_regular_file(const std::string& path, const std::string& what) {
   return fd;
 }
 
-/// The bytes of the file `path`, read in 64 kB chunks (Ctrl-C is polled between them: it throws
-/// interrupt::Interrupted). Throws Error("PATH: cannot read the WHAT"), Error("PATH: the WHAT is
+/// The bytes of the file `path`, read in 64 kB chunks (a regular file of at most max_bytes, 1 MB by
+/// default: read in milliseconds, so Ctrl-C is seen by the caller's next poll). Throws Error("PATH: cannot read the WHAT"), Error("PATH: the WHAT is
 /// a FIFO, not a regular file") or Error("PATH: the WHAT is larger than ... bytes ..."), one
 /// line; Error is the caller's exception type (ScenarioError, StudyError), constructible from a
 /// std::string. Never blocks in open().
@@ -59,8 +57,6 @@ std::string read_text_file(const std::string& path, const std::string& what, std
   static constexpr std::size_t kChunk = 1 << 16;
   char buf[kChunk];
   for (;;) {
-    if (interrupt::interrupted()) ::close(fd);
-    interrupt::check();
     const ssize_t n = ::read(fd, buf, kChunk);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {

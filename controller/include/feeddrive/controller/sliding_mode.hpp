@@ -56,6 +56,10 @@
 
 namespace feeddrive::controller {
 
+namespace smc {
+struct ModelForces;  // sliding_mode_law.hpp
+}  // namespace smc
+
 enum class Switching { kSign, kSaturation, kTanh };
 inline const std::vector<std::pair<Switching, const char*>>& enum_names(Switching) {
   static const std::vector<std::pair<Switching, const char*>> n = {{Switching::kSign, "sgn"}, {Switching::kSaturation, "sat"}, {Switching::kTanh, "tanh"}};
@@ -141,6 +145,34 @@ class SlidingModeController final : public Controller {
   std::string name() const override { return "sliding_mode"; }
 
  private:
+  /// The state the law starts from: the measurement, or the x,v observer's estimate once it has one.
+  struct Estimate {
+    double x;
+    double v;
+    bool use_observer;  ///< motion_state = observer
+    bool observed;      ///< x, v are the observer's (it has seen a finite sample)
+  };
+  /// What the law acts on: the state, the reference and the model forces, at t_k or predicted to
+  /// t_k + d (compensate_delay).
+  struct LawInput;  // sliding_mode.cpp
+  /// Corrects the x,v observer with the sample (motion_state = observer) and returns the estimate.
+  Estimate estimate_state(const plant::Measurement& meas);
+  /// F^f from the plant's true z (friction_state = true): sigma0*z + sigma1(v)*zdot^ + sigma2*v
+  /// with zdot^_k = (z_k - z_{k-1})/T (see above); keeps z for the next rate.
+  double true_friction(double v, double z);
+  /// The model forces of eq. 19 at (x, v): friction and grinding from the truth or the observers,
+  /// the ripple, and the model's additive effects.
+  smc::ModelForces model_forces(double x, double v, const Truth* truth);
+  /// The Smith predictor (see above): the state predicted from (x^, v^) over [t_k, t_k + d] through
+  /// the commands already issued, the reference previewed to t_k + d, the ripple (and with the
+  /// bristle observer F^f) at the predicted state.
+  LawInput predict_to_action(const Estimate& est, const trajectory::Sample& ref, double t,
+                             const smc::ModelForces& now) const;
+  /// Advances the force observers over [t_k, t_k + T] and predicts the x,v observer with the
+  /// command u (with compensate_delay: with the commands that act within the period).
+  void advance_observers(const Estimate& est, const trajectory::Sample& ref, double t, bool delayed, double u,
+                         const smc::ModelForces& now);
+
   SlidingModeParams p_;  ///< with the model's modifying effects folded in
   bool has_extra_;       ///< the model has additive effects (compensated with the others)
   FrictionObserver friction_observer_;

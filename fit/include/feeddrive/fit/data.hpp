@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/errors.hpp"
 
 namespace feeddrive::fit {
@@ -85,11 +86,12 @@ MeasuredData load_csv(const std::string& path, const CsvOptions& opt = {});
 /// in the next state, and one whose reference was lost costs only the optional xd column; both
 /// are noted. A lost state is a gap the fit cannot bridge: DataError naming how many steps are
 /// missing and where. Throws DataError.
-MeasuredData load_lcm_log(const std::string& path, const std::string& prefix);
+MeasuredData load_lcm_log(const std::string& path, const std::string& prefix, const interrupt::StopToken& stop = {});
 /// Loads by extension: .lcm / .lcmlog / .log -> LCM log, anything else -> CSV. Time stamps are
 /// shifted to start at 0 (time_offset): epoch time stamps (t ~ 1e9 s) would leave the
 /// integrator a step size below the resolution of t.
-MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt = {});
+MeasuredData load_data(const std::string& path, const std::string& prefix, const CsvOptions& opt = {},
+                       const interrupt::StopToken& stop = {});
 
 /// Subtracts t[0] from every time stamp (adds it to time_offset, with a note). Throws DataError
 /// if two time stamps become equal.

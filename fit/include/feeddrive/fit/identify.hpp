@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/model.hpp"
 #include "feeddrive/plant/effects.hpp"
 #include "feeddrive/plant/params.hpp"
@@ -64,7 +65,7 @@ double bic(const Eigen::VectorXd& r, int k, long n_active = 0);
 /// least squares from the candidate's starts; `residual0` is force_residual(rec, model). The
 /// start of the joint fit.
 CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
-                           const Eigen::VectorXd& residual0);
+                           const Eigen::VectorXd& residual0, const interrupt::StopToken& stop = {});
 
 /// What a joint fit refits: the named effects (enabled in the model) and, if `form` and the model
 /// has a Coulomb-type term (static friction, coulomb_friction or stribeck_friction), the
@@ -89,14 +90,15 @@ struct JointFit {
 /// Refits every free parameter of `model` jointly (Ceres, Levenberg-Marquardt) starting from its
 /// values. `weights` (0 or 1 per filter point, nullptr: all 1) leaves points out of the fit.
 JointFit fit_jointly(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
-                     const std::vector<double>* weights = nullptr, int max_iterations = 100);
+                     const std::vector<double>* weights = nullptr, int max_iterations = 100,
+                     const interrupt::StopToken& stop = {});
 
 /// Out-of-sample evidence: the active filter points are cut into `folds` contiguous blocks of
 /// time; for each block the free parameters are refitted on the other blocks (warm start from
 /// `model`) and the squared residual on the block itself is summed. Returns the per-block sums
 /// [N^2] (with nothing free: the model's residual per block).
 std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& model, const FreeSet& free,
-                                   int folds = 5);
+                                   int folds = 5, const interrupt::StopToken& stop = {});
 
 /// The canonical form of a fitted effect: a cogging ripple whose fundamental is below a tenth
 /// of its third harmonic is the ripple of a third of the pitch (its "third harmonic" is its

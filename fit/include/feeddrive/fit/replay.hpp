@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/model.hpp"
 #include "feeddrive/plant/params.hpp"
 
@@ -24,7 +25,8 @@ struct Replay {
 };
 
 /// window: W [s]; 0 picks 0.1 s (at least 20 samples).
-Replay replay(const Record& rec, const plant::PlantParams& model, double window = 0.0);
+Replay replay(const Record& rec, const plant::PlantParams& model, double window = 0.0,
+              const interrupt::StopToken& stop = {});
 
 /// RMS of a residual vector over n_active points (0: all).
 double rms(const Eigen::VectorXd& r, long n_active = 0);

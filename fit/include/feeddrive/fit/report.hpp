@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/workflow.hpp"
 
 namespace feeddrive::fit {
@@ -20,6 +21,6 @@ std::string findings_json(const FitResult& r, const MeasuredData* data = nullptr
 /// check --out before the work with output::check_output_dir). Throws std::invalid_argument if
 /// out_dir must not be replaced, std::runtime_error if writing fails; a previous output is kept.
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
-                   const FitResult& r, bool plots);
+                   const FitResult& r, bool plots, const interrupt::StopToken& stop = {});
 
 }  // namespace feeddrive::fit

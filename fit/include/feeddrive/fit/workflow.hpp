@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/identify.hpp"
 #include "feeddrive/fit/model.hpp"
 #include "feeddrive/fit/plausibility.hpp"
@@ -35,6 +36,7 @@ struct FitOptions {
   double min_gap_reduction{0.05};   ///< the replay gap must shrink by at least this fraction
   double replay_window{0.0};        ///< W [s] of the replay (0: default)
   double stamp_error{0.0};          ///< sigma_t [s] of the record's time stamps, for the noise floor (verdict.hpp)
+  interrupt::StopToken stop;        ///< polled by the replays and solves (Ctrl-C in the tool; the default never stops)
   RecordOptions record;
 };
 

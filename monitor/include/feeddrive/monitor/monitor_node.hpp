@@ -96,6 +96,9 @@ class MonitorNode : public service::Node {
   bool too_big_{false};
   record::Recorder rec_;
   std::unique_ptr<sim::RunWriter> out_;
+  /// options().stop, renewed once the first interrupt is handled (the record is still written; a
+  /// second signal stops that too).
+  interrupt::StopToken stop_;
   std::string open_error_;  // why out_ could not be opened
   std::int64_t start_us_{0};
   std::int64_t last_row_us_{0};

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/record/recorder.hpp"
 
 namespace feeddrive::record {
@@ -27,8 +28,9 @@ std::string describe_cut(const LogConversion& c);
 /// non-finite value is dropped and counted. A last event cut short by the end of the file (a
 /// logger killed or out of disk) ends the log: its bytes are counted (cut_bytes), the steps it
 /// leaves incomplete are a gap. Throws std::invalid_argument naming the file when it cannot be
-/// opened or an event is corrupt (with the event number and byte offset).
+/// opened or an event is corrupt (with the event number and byte offset); interrupt::Interrupted
+/// when `stop` asks to stop (polled every 1024 events; the default never stops).
 LogConversion read_log(const std::string& path, const std::string& prefix, const sim::RecordSink& sink,
-                       bool need_reference = true);
+                       bool need_reference = true, const interrupt::StopToken& stop = {});
 
 }  // namespace feeddrive::record

@@ -147,6 +147,9 @@ class Bus {
   void count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why);
   /// Messages of another run (Admit::kRun subscriptions, and count_foreign()).
   std::int64_t foreign() const { return foreign_; }
+  /// Publish calls that failed (each logged, at most once a second); read at the end of a run
+  /// (~Node reports a non-zero count).
+  std::int64_t send_errors() const { return send_errors_; }
   /// With a key: messages without a valid mac.
   std::int64_t unauthenticated() const { return unauthenticated_; }
   const std::string& url() const { return url_; }

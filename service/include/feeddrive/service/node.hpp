@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/resend_request_t.hpp"
 #include "feeddrive/service/bus.hpp"
@@ -43,6 +44,9 @@ struct NodeOptions {
   /// gave a median 767 plant overruns and 75 misses of 15,000, with 30 us 156 and 56).
   std::int64_t realtime_spin_us{30};
   bool quiet{false};
+  /// Polled by the protocol loops (Ctrl-C, SIGTERM): add_node_options sets the process's token
+  /// (tool::stop_token()); the default never stops.
+  interrupt::StopToken stop;
   /// The run's identity (docs/security.md); 0: not given. Then the plant draws one and every
   /// other process takes it from the plant's first fresh heartbeat.
   std::int64_t run_id{0};
@@ -78,7 +82,8 @@ class Node {
   /// receives through this liblcm instance instead of opening opt.lcm_url (Bus: in-process
   /// tests over one memq:// instance); nullptr in the processes.
   Node(std::string role, const NodeOptions& opt, Receive receive = Receive::kDirect, lcm_t* shared_lcm = nullptr);
-  virtual ~Node() = default;
+  /// Reports the LCM publish calls that failed during the process's life (a warning; none: silent).
+  virtual ~Node();
 
   const std::string& role() const { return role_; }
   Bus& bus() { return bus_; }
@@ -176,7 +181,7 @@ std::string enter_realtime(int priority);
 
 /// Sleeps until monotonic time `target_us` [us]: an absolute clock_nanosleep to spin_us before
 /// it, then a busy wait (the wake-up latency of a timer is tens of us on a virtual machine).
-void sleep_until(std::int64_t target_us, std::int64_t spin_us);
+void sleep_until(std::int64_t target_us, std::int64_t spin_us, const interrupt::StopToken& stop);
 
 /// "2", "0.5", "30": a duration in seconds for messages (shortest exact form, %g).
 std::string seconds_text(double s);

@@ -54,7 +54,9 @@ class RunWriter {
   /// Creates the staged folder (marked as written by `tool`) and starts timeseries.csv.
   /// Throws std::invalid_argument if out_dir must not be replaced, std::runtime_error if it
   /// cannot be written.
-  RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool);
+  /// `stop` ends the plots (interrupt::Interrupted, see keep_data_on_interrupt).
+  RunWriter(const std::string& out_dir, const Scenario& s, const std::string& tool,
+            const interrupt::StopToken& stop = {});
   ~RunWriter();
 
   static constexpr std::size_t kBlockRows = 4096;
@@ -106,6 +108,7 @@ class RunWriter {
   long every_;
   double expected_steps_;
   bool keep_on_interrupt_{false};
+  interrupt::StopToken stop_token_;
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;
   double plot_seconds_{0.0};
@@ -136,6 +139,7 @@ class RunWriter {
 /// Plots position+error, velocity error, control and forces into the staged folder (position.png,
 /// velocity_error.png, control.png, forces.png, plots.gp) from its reduced plot data plot.csv.
 /// `title` is any text (it goes through output::gnuplot_string). Throws on failure.
-void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title);
+void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& reduced, const std::string& title,
+                 const interrupt::StopToken& stop);
 
 }  // namespace feeddrive::sim

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/plant/cvode_integrator.hpp"
 #include "feeddrive/plant/dynamics.hpp"
@@ -91,10 +92,10 @@ struct RunStats {
   plant::CvodeIntegrator::Stats integrator;
 };
 
-/// Runs a scenario in-process, handing every record to `sink` in step order. Polls the
-/// interrupt flag (feeddrive/common/interrupt.hpp) every 1024 steps and throws
-/// interrupt::Interrupted after Ctrl-C or SIGTERM.
-RunStats run(const Scenario& s, const RecordSink& sink);
+/// Runs a scenario in-process, handing every record to `sink` in step order. Polls `stop`
+/// (feeddrive/common/interrupt.hpp) every 1024 steps and throws interrupt::Interrupted when it
+/// asks to stop (Ctrl-C or SIGTERM in a tool; the default never stops).
+RunStats run(const Scenario& s, const RecordSink& sink, const interrupt::StopToken& stop = {});
 
 /// An excitation of the closed loop (the frequency response, analysis/frequency_response.hpp):
 ///  * reference: replaces the scenario's reference (nullptr: the scenario's);
@@ -105,6 +106,7 @@ RunStats run(const Scenario& s, const RecordSink& sink);
 struct Excitation {
   const trajectory::Trajectory* reference{nullptr};
   std::function<double(double t)> input_force;
+  interrupt::StopToken stop;  ///< polled as by run(s, sink, stop)
 };
 RunStats run(const Scenario& s, const RecordSink& sink, const Excitation& excitation);
 

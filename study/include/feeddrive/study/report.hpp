@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/study/cases.hpp"
 #include "feeddrive/study/runner.hpp"
 #include "feeddrive/study/spec.hpp"
@@ -131,7 +132,8 @@ bool verdicts_hold(const Study& s, const Outcome& o);
 
 /// Writes the plots into `dir` (box.png, param_<i>.png, with their .dat files and plots.gp);
 /// returns the markdown that shows them (paths relative to the study folder, under `prefix`).
-std::string write_plots(const std::filesystem::path& dir, const std::string& prefix, const ReportData& d);
+std::string write_plots(const std::filesystem::path& dir, const std::string& prefix, const ReportData& d,
+                        const interrupt::StopToken& stop = {});
 
 /// report.md: counts, the verdict against report.limit, worst and median per family and
 /// controller, the worst case of each controller with its parameters, the failed cases, and the

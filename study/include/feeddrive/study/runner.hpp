@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::study {
 
 /// What one case gave: its summary.json metrics (the numbers, in summary.json's order, without
@@ -36,7 +38,7 @@ struct Outcome {
 /// Loads the resolved scenario YAML, runs it in-process (sim::run, streamed into the online
 /// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
 /// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
-Outcome run_case(const std::string& yaml);
+Outcome run_case(const std::string& yaml, const interrupt::StopToken& stop = {});
 
 /// The format of a case file (its "format" key). 2 (issue 23) added warnings and move_finished;
 /// a file of another format is not reused: its case runs again.
@@ -75,25 +77,5 @@ class Pool {
   bool stop_{false};
   std::vector<std::thread> workers_;
 };
-
-/// Progress on stderr: a bar with the count, percentage and ETA, redrawn in place on a terminal;
-/// on anything else (a log file, CI) a plain line at most every 10 s and at the end.
-class Progress {
- public:
-  Progress(std::size_t total, std::size_t already_done, bool enabled);
-  void step(bool failed);
-  /// A case finished in an earlier run (no time spent on it here).
-  void reused() { ++done_; }
-  void finish();
-
- private:
-  void draw(bool final_line);
-  std::size_t total_, done_, ran_{0}, failed_{0};
-  bool enabled_, tty_;
-  std::chrono::steady_clock::time_point start_, last_;
-};
-
-/// "1h02m", "3m05s", "12s".
-std::string format_duration(double seconds);
 
 }  // namespace feeddrive::study

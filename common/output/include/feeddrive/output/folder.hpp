@@ -28,6 +28,8 @@
 #include <filesystem>
 #include <string>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::output {
 
 inline constexpr const char* kMarkerFile = ".feeddrive-output";
@@ -105,7 +107,7 @@ class StagedFolder {
   /// Runs a gnuplot script in dir() (run_gnuplot) after the preamble every feeddrive plot shares:
   /// UTF-8, comma-separated data, 1000x700 PNG (cairo, no enhanced text), grid, key to the right of the plot
   /// (clear of the title above it).
-  void plot(const std::string& script) const;
+  void plot(const std::string& script, const interrupt::StopToken& stop) const;
   /// The final folder (absolute, normalised).
   const std::filesystem::path& target() const { return target_; }
 

@@ -13,6 +13,8 @@
 #include <string>
 #include <string_view>
 
+#include "feeddrive/common/interrupt.hpp"
+
 namespace feeddrive::output {
 
 /// `text` as a gnuplot double-quoted string literal that can only ever be text. Kept: ASCII
@@ -27,8 +29,9 @@ std::string gnuplot_string(std::string_view text, std::size_t max_bytes = 200);
 
 /// Writes `script` to dir/script_name and runs `gnuplot script_name` in `dir` (fork and exec, no
 /// shell; output to dir/gnuplot.log, removed on success). script_name is a fixed name chosen by
-/// the caller, never the user's. Throws std::runtime_error with gnuplot's last message on failure.
-void run_gnuplot(const std::filesystem::path& dir, const std::string& script,
+/// the caller, never the user's. Throws std::runtime_error with gnuplot's last message on failure;
+/// when `stop` asks to stop (Ctrl-C), kills gnuplot and throws interrupt::Interrupted.
+void run_gnuplot(const std::filesystem::path& dir, const std::string& script, const interrupt::StopToken& stop,
                  const std::string& script_name = "plots.gp");
 
 }  // namespace feeddrive::output

@@ -25,6 +25,10 @@ namespace feeddrive::tool {
 /// their start is kept pending, not lost).
 void install_interrupt_handlers();
 
+/// The process's stop token, set by those handlers: what a tool hands to the libraries it calls
+/// (feeddrive/common/interrupt.hpp). Without the handlers installed it never stops.
+interrupt::StopToken stop_token();
+
 /// The end of an interrupted tool (docs/scenario.md, "Exit codes and Ctrl-C"): prints the one
 /// line "error: interrupted by SIGINT<detail>" (unless started by feeddrive-launch:
 /// interrupt::kQuietEnv) and returns the exit code 128 + signal.
