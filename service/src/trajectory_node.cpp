@@ -84,6 +84,13 @@ void TrajectoryNode::run() {
     // Another role's failure first: it names the culprit (a stalled controller makes the plant
     // fail, and then the plant's heartbeat stops too; our own timeout would blame the plant).
     check_peers();
+    // The plant has finished the run and no end-of-run state reached us: a controller that
+    // answers without references let the plant run ahead of a late trajectory. The run is over;
+    // linger() still answers the monitor's requests for the blocks it lacks.
+    if (const process_status_t* p = peer("plant"); p != nullptr && p->state == "done" && p->seq >= s_.steps() - 1) {
+      end_ = true;
+      break;
+    }
     const std::int64_t waited = mono_us() - last_progress_us_;
     const bool plant_waits = highest_state_ >= 0 && peer_alive("plant", 0.5) && waited <= 3 * us(limit);
     if (waited > us(limit) && !plant_waits)
