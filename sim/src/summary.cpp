@@ -465,9 +465,10 @@ bool is_metric_verdict(const std::string& key) { return key != "move_finished"; 
 }  // namespace
 
 std::vector<std::string> summary_metric_names() {
+  const nlohmann::ordered_json j = summary_object(a_full_run(), Scenario{});
   std::vector<std::string> names;
-  for (const auto& [key, value] : summary_metrics(a_full_run(), Scenario{}))
-    if (!is_verdict(key)) names.push_back(key);
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.value().is_number() && !is_wall_clock_metric(it.key())) names.push_back(it.key());
   return names;
 }
 
@@ -479,12 +480,6 @@ std::vector<std::string> summary_flag_names() {
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.value().is_boolean() && is_metric_verdict(it.key())) names.push_back(it.key());
   return names;
-}
-
-bool is_verdict(const std::string& key) {
-  for (const std::string& k : summary_flag_names())
-    if (k == key) return true;
-  return false;
 }
 
 std::vector<std::pair<std::string, double>> summary_metrics(const Summary& m, const Scenario& s) {

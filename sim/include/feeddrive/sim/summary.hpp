@@ -223,7 +223,5 @@ std::optional<bool> move_finished(const Scenario& s);
 /// true/false, is recorded by a study in a column of its own. A study records
 /// them per case as 1 (true) or 0 (false) and report.require may name them.
 std::vector<std::string> summary_flag_names();
-/// Whether `key` is one of summary_flag_names().
-bool is_verdict(const std::string& key);
 
 }  // namespace feeddrive::sim
