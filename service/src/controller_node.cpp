@@ -30,8 +30,18 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
     // controller's stall. With another publisher's command k (forged, or a second controller)
     // this controller still answers step k, and the plant or the monitor names the conflict.
     // In real time states go out every period whether answered or not: a lost one is a gap.
+    // The first state heard, though, may be beyond step 0 with nothing seen before it: this
+    // controller subscribed late, after another publisher had answered the earlier states (a
+    // forger without --key, a second controller). That is not the plant's error: this
+    // controller answers the state it has, and the plant or the monitor names the conflict.
     answered_by_others_.erase(answered_by_others_.begin(), answered_by_others_.lower_bound(next_seq_));
-    if (!options().realtime && m.seq > next_seq_ && !answered_by_others_.count(next_seq_))
+    if (!heard_state_ && m.seq > next_seq_)
+      spdlog::warn("controller: the first state heard is {}: states {}..{} went by before this controller "
+                   "listened, answered by another publisher",
+                   m.seq, next_seq_, m.seq - 1);
+    const bool late_join = !heard_state_;
+    heard_state_ = true;
+    if (!options().realtime && !late_join && m.seq > next_seq_ && !answered_by_others_.count(next_seq_))
       throw RunFailure("protocol error of the plant: it published state " + std::to_string(m.seq) + " while step " +
                        std::to_string(next_seq_) + " has no command yet (a skipped or out-of-order step number; "
                        "docs/external-plant.md)");

@@ -5,6 +5,7 @@
 // (plant::Plant behind a Bus) and a scripted trajectory answer inside the controller's poll.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <set>
 #include <vector>
@@ -238,6 +239,39 @@ TEST_F(ControllerProtocol, ASkippedStepIsThePlantsProtocolError) {
   });
   const std::string what = run_to_failure(plant);
   EXPECT_EQ(what.rfind("protocol error of the plant: it published state 4 while step 3 has no command yet", 0), 0u) << what;
+}
+
+// A controller that subscribes late (CI, stop 28: the launcher's controller was slower to start
+// than a forger without --key, which answered states 0..10 first): the first state it hears is
+// beyond step 0 with no command of another publisher seen. It joined late; that is not the
+// plant's skipped step. It answers the state it has, and its commands go on from there.
+TEST_F(ControllerProtocol, ALateJoinerAnswersTheFirstStateItHearsAndDoesNotBlameThePlant) {
+  auto forger = peer(memq);
+  Plant plant(memq, s);
+  std::int64_t forged = 0;
+  forger->subscribe<drive_state_t>(kCh.state, [&](const drive_state_t& m, std::int64_t) {
+    if (m.end_of_run || m.seq >= 5 || m.seq < forged) return;
+    control_command_t c{};
+    c.seq = m.seq;
+    c.t = m.t;
+    c.u = c.u_unsaturated = 0.5;
+    c.sliding = c.z_estimate = std::nan("");
+    forger->publish(kCh.command, c);
+    forged = m.seq + 1;
+  });
+  plant.start();
+  ASSERT_TRUE(poll_until(*forger, [&] { return plant.sent.count(5) == 1; })) << "the forger drove states 0..4";
+  make_node();                 // subscribes now: states 0..5 and commands 0..4 went by
+  Trajectory traj(memq, s);    // after the node, which would miss references sent before it
+  plant.bus->publish(kCh.state, plant.sent.at(5));  // the plant's re-publication of the unanswered state
+  const std::string what = failure_of([&] { node_->run(); });
+  EXPECT_EQ(what, "") << "a late join taken for the plant's error";
+  std::set<std::int64_t> answered;
+  for (const control_command_t& c : plant.commands)
+    if (c.u != 0.5 || c.seq >= 5) answered.insert(c.seq);
+  ASSERT_FALSE(answered.empty());
+  EXPECT_EQ(*answered.begin(), 5) << "the node's first answer is the first state it heard";
+  EXPECT_EQ(*answered.rbegin(), kSteps - 1) << "and it answered to the end";
 }
 
 // A plant of another run publishing its own state 0 first: counted as foreign, not answered, not

@@ -39,6 +39,8 @@ class ControllerNode : public Node {
   /// Steps >= next_seq_ for which a command of another publisher was seen on the command channel
   /// (a forged or stray answer: the plant may then move on without this controller's command).
   std::set<std::int64_t> answered_by_others_;
+  /// A state of this run was heard: from then on a state beyond next_seq_ is a skip, not a late join.
+  bool heard_state_{false};
   std::int64_t last_progress_us_{0};
   bool end_{false};
 };
