@@ -22,9 +22,7 @@ namespace {
 
 using namespace feeddrive;
 
-std::string scenario_path(const char* name) {
-  return std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/" + name;
-}
+std::string scenario_path(const char* name) { return std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/" + name; }
 
 // One control period (reference, measurement, controller, CVODE advance with restart), cycling
 // through the scenario's run so every phase is sampled. The plant and controller are rebuilt
@@ -87,10 +85,14 @@ void jerk_limited_run(benchmark::State& state, const char* file) {
   state.counters["periods"] = static_cast<double>(s.steps());
 }
 // The paper's configuration: hard sgn at 20 us (75,000 periods for 1.5 s).
-void BM_JerkLimitedRun_PaperHardSgn20us(benchmark::State& state) { jerk_limited_run(state, "paper/smc_jerk_limited.yaml"); }
+void BM_JerkLimitedRun_PaperHardSgn20us(benchmark::State& state) {
+  jerk_limited_run(state, "paper/smc_jerk_limited.yaml");
+}
 BENCHMARK(BM_JerkLimitedRun_PaperHardSgn20us)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 // The beyond-the-paper configuration at 10 kHz (observers, 50 nm encoder).
-void BM_JerkLimitedRun_Beyond10kHz(benchmark::State& state) { jerk_limited_run(state, "paper/beyond_jerk_limited.yaml"); }
+void BM_JerkLimitedRun_Beyond10kHz(benchmark::State& state) {
+  jerk_limited_run(state, "paper/beyond_jerk_limited.yaml");
+}
 BENCHMARK(BM_JerkLimitedRun_Beyond10kHz)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace

@@ -44,7 +44,10 @@ typedef struct {
   double t0, x0, v0, a0, j0;
 } Data;
 
-static double g_of(double v) { const double r = v / kVs; return kFc + (kFs - kFc) * exp(-r * r); }
+static double g_of(double v) {
+  const double r = v / kVs;
+  return kFc + (kFs - kFc) * exp(-r * r);
+}
 
 /* f_v and z' of the physical state. */
 static void physics(double v, double z, double u, double* vdot, double* zdot) {
@@ -83,8 +86,7 @@ static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user) {
   return isfinite(o[1]) && isfinite(o[2]) ? 0 : 1;
 }
 
-static int jac(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J, void* user, N_Vector t1, N_Vector t2,
-               N_Vector t3) {
+static int jac(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J, void* user, N_Vector t1, N_Vector t2, N_Vector t3) {
   (void)fy, (void)t1, (void)t2, (void)t3;
   const Data* d = (const Data*)user;
   const double* s = N_VGetArrayPointer(y);

@@ -29,11 +29,13 @@ int main(int argc, char** argv) {
   const int shards = argc > 4 ? std::atoi(argv[4]) : 1;
   const double duration = argc > 5 ? std::atof(argv[5]) : 10.0;
   const std::string mix = argc > 6 ? argv[6] : "standard";
-  if (n < 1 || shards < 1 || shard < 0 || shard >= shards || !(duration > 0) || (mix != "standard" && mix != "issue20")) {
+  if (n < 1 || shards < 1 || shard < 0 || shard >= shards || !(duration > 0) ||
+      (mix != "standard" && mix != "issue20")) {
     std::fprintf(stderr, "usage: fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [standard|issue20]\n");
     return 2;
   }
-  std::vector<fdgen::CaseSpec> cases = mix == "issue20" ? fdgen::issue20_cases(n, seed) : fdgen::standard_cases(n, seed);
+  std::vector<fdgen::CaseSpec> cases =
+      mix == "issue20" ? fdgen::issue20_cases(n, seed) : fdgen::standard_cases(n, seed);
   std::set<std::size_t> only;
   if (const char* o = std::getenv("FD_SWEEP_ONLY")) {
     std::stringstream ss(o);
@@ -49,11 +51,12 @@ int main(int argc, char** argv) {
     try {
       const sweep::Outcome o = sweep::run_case(cases[i]);
       std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\t%s\t%s\t%d\t%d\t%d\t%.4g\t%.4g\t%.4g\t%.4g\t%s\t%s\t%.3g\t%d\n",
-                  static_cast<unsigned long long>(o.spec.seed), sweep::names(o.hidden).c_str(), sweep::names(o.named).c_str(),
-                  o.right ? 1 : 0, o.spurious ? 1 : 0, o.seconds, o.parameter_miss.empty() ? "-" : o.parameter_miss.c_str(),
-                  o.description.c_str(), o.verdict.c_str(), o.category.c_str(), o.false_all_clear ? 1 : 0,
-                  o.above_floor_all_clear ? 1 : 0, o.suggestion ? 1 : 0, o.gap_final * 1e6, o.gap_floor * 1e6, o.force_final,
-                  o.force_floor, sweep::names(o.tentative).c_str(), sweep::names(o.tie_partners).c_str(), o.periods, o.nothing_there ? 1 : 0);
+                  static_cast<unsigned long long>(o.spec.seed), sweep::names(o.hidden).c_str(),
+                  sweep::names(o.named).c_str(), o.right ? 1 : 0, o.spurious ? 1 : 0, o.seconds,
+                  o.parameter_miss.empty() ? "-" : o.parameter_miss.c_str(), o.description.c_str(), o.verdict.c_str(),
+                  o.category.c_str(), o.false_all_clear ? 1 : 0, o.above_floor_all_clear ? 1 : 0, o.suggestion ? 1 : 0,
+                  o.gap_final * 1e6, o.gap_floor * 1e6, o.force_final, o.force_floor, sweep::names(o.tentative).c_str(),
+                  sweep::names(o.tie_partners).c_str(), o.periods, o.nothing_there ? 1 : 0);
     } catch (const std::exception& e) {
       std::string why = e.what();
       for (char& c : why)

@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
   app.add_option("mode", mode)->required()->check(CLI::IsMember({"server", "client", "listen"}));
   app.add_option("--seconds", seconds, "listen: how long");
   app.add_flag("--batched", batched, "listen: read the group in batches instead of with liblcm's receive thread");
-  app.add_flag("--liblcm", liblcm, "server/client: receive with liblcm's receive thread (Receive::kEvent) instead of the direct socket");
+  app.add_flag("--liblcm", liblcm,
+               "server/client: receive with liblcm's receive thread (Receive::kEvent) instead of the direct socket");
   app.add_option("--lcm-url", url);
   app.add_option("--prefix", prefix);
   app.add_option("--count", count);

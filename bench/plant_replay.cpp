@@ -41,11 +41,13 @@ int main(int argc, char** argv) {
       }
       const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-      const double cpu = static_cast<double>(c1.tv_sec - c0.tv_sec) + 1e-9 * static_cast<double>(c1.tv_nsec - c0.tv_nsec);
+      const double cpu =
+          static_cast<double>(c1.tv_sec - c0.tv_sec) + 1e-9 * static_cast<double>(c1.tv_nsec - c0.tv_nsec);
       const auto st = drive.integrator_stats();
       const auto x = drive.state();
-      std::printf("plant seconds %.6f periods %zu steps %ld rhs %ld jac %ld x %.12g v %.12g z %.12g check %.6g cpu %.6f\n",
-                  sec, u.size(), st.steps, st.rhs_evals, st.jac_evals, x.x, x.v, x.z, check, cpu);
+      std::printf(
+          "plant seconds %.6f periods %zu steps %ld rhs %ld jac %ld x %.12g v %.12g z %.12g check %.6g cpu %.6f\n", sec,
+          u.size(), st.steps, st.rhs_evals, st.jac_evals, x.x, x.v, x.z, check, cpu);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -53,9 +53,10 @@ int main(int argc, char** argv) {
     if (gap > worst) worst = gap;
   }
   const double periods = seconds * 1e4;  // 100-us periods of a 10 kHz loop in the same time
-  printf("%s, CPU 0, %.2f s: gaps > 10 us %ld, > 20 us %ld, > 40 us %ld (%.2f %% of 100-us periods), > 100 us %ld; "
-         "largest %.1f us\n",
-         fifo ? "SCHED_FIFO 80" : "normal scheduling", seconds, over10, over20, over40, 100.0 * over40 / periods,
-         over100, worst / 1e3);
+  printf(
+      "%s, CPU 0, %.2f s: gaps > 10 us %ld, > 20 us %ld, > 40 us %ld (%.2f %% of 100-us periods), > 100 us %ld; "
+      "largest %.1f us\n",
+      fifo ? "SCHED_FIFO 80" : "normal scheduling", seconds, over10, over20, over40, 100.0 * over40 / periods, over100,
+      worst / 1e3);
   return 0;
 }

@@ -63,7 +63,8 @@ Segment dwell(double t0, double x0, double T) {
 Segment cosine(double t0, double x0, double A, double f, int periods) {
   const double w = 2 * kPi * f;
   return {t0, t0 + periods / f, [=](double t, double& x, double& v, double& a) {
-            x = x0 + 0.5 * A * (1 - std::cos(w * t)), v = 0.5 * A * w * std::sin(w * t), a = 0.5 * A * w * w * std::cos(w * t);
+            x = x0 + 0.5 * A * (1 - std::cos(w * t)), v = 0.5 * A * w * std::sin(w * t),
+            a = 0.5 * A * w * w * std::cos(w * t);
           }};
 }
 
@@ -150,19 +151,19 @@ struct Truth {
   // form deviations
   double vt{1e-5}, asym{0.0}, delta{2.0};
   // hidden effects
-  double F0{0};                                        // constant
-  double hc{0};                                        // coulomb
-  double hv{0};                                        // viscous
+  double F0{0};  // constant
+  double hc{0};  // coulomb
+  double hv{0};  // viscous
   bool strib{false};
-  double sFs{0}, sFc{0}, svs{1e-3};                    // stribeck
+  double sFs{0}, sFc{0}, svs{1e-3};  // stribeck
   bool pres{false};
-  double sig0{0}, sig1{0};                             // presliding
-  double cp{0}, ca{0}, cphi{0}, cb{0}, cphi3{0};       // cogging
-  double rp{0}, rA{0}, rphi{0};                        // reluctance
+  double sig0{0}, sig1{0};                        // presliding
+  double cp{0}, ca{0}, cphi{0}, cb{0}, cphi3{0};  // cogging
+  double rp{0}, rA{0}, rphi{0};                   // reluctance
   bool grind{false};
-  double C{0}, ke{0}, xc{0};                           // grinding
-  double k{0}, xr{0};                                  // spring
-  double delay{0};                                     // input delay
+  double C{0}, ke{0}, xc{0};  // grinding
+  double k{0}, xr{0};         // spring
+  double delay{0};            // input delay
 };
 
 double sgn_t(const Truth& T, double v) { return v / std::sqrt(v * v + T.vt * T.vt); }
@@ -245,9 +246,9 @@ std::string num(double v) {
 }  // namespace
 
 const std::vector<std::string>& vocabulary() {
-  static const std::vector<std::string> v{"constant_force", "coulomb_friction", "viscous_friction", "stribeck_friction",
-                                          "presliding",     "cogging_ripple",   "reluctance_ripple", "grinding_force",
-                                          "spring_force",   "mass_error",       "input_delay"};
+  static const std::vector<std::string> v{
+      "constant_force",    "coulomb_friction", "viscous_friction", "stribeck_friction", "presliding", "cogging_ripple",
+      "reluctance_ripple", "grinding_force",   "spring_force",     "mass_error",        "input_delay"};
   return v;
 }
 
@@ -265,15 +266,17 @@ Generated generate(const CaseSpec& spec) {
   for (const auto& h : spec.hidden)
     if (std::find(vocabulary().begin(), vocabulary().end(), h) == vocabulary().end())
       throw std::invalid_argument("drivegen: unknown effect '" + h + "'");
-  const auto hidden = [&](const char* n) { return std::find(spec.hidden.begin(), spec.hidden.end(), n) != spec.hidden.end(); };
+  const auto hidden = [&](const char* n) {
+    return std::find(spec.hidden.begin(), spec.hidden.end(), n) != spec.hidden.end();
+  };
   Rng r{std::mt19937_64(spec.seed * 0x9E3779B97F4A7C15ULL + 12345)};
   Generated out;
   Truth T;
   const double m_nom = r.u(40.0, 120.0);
   T.m = m_nom;
   // position-dependent effects need travel: at least three ripple pitches, a contact passed often
-  const bool positional = hidden("cogging_ripple") || hidden("reluctance_ripple") || hidden("spring_force") ||
-                          hidden("grinding_force");
+  const bool positional =
+      hidden("cogging_ripple") || hidden("reluctance_ripple") || hidden("spring_force") || hidden("grinding_force");
   double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
   const double Ts = 1.0 / spec.sample_rate;
   T.base_static = hidden("presliding") || r.coin(0.5);
@@ -303,7 +306,8 @@ Generated generate(const CaseSpec& spec) {
   if (hidden("stribeck_friction")) {
     T.strib = true;
     T.sFc = r.u(5, 20), T.sFs = T.sFc + r.u(5, 20), T.svs = r.u(1e-3, 10e-3);
-    out.truth.push_back({"stribeck_friction", {{"static_N", T.sFs}, {"coulomb_N", T.sFc}, {"stribeck_velocity_mps", T.svs}}});
+    out.truth.push_back(
+        {"stribeck_friction", {{"static_N", T.sFs}, {"coulomb_N", T.sFc}, {"stribeck_velocity_mps", T.svs}}});
   }
   if (hidden("presliding")) {
     T.pres = true;
@@ -315,20 +319,26 @@ Generated generate(const CaseSpec& spec) {
     T.cp = r.u(0.01, std::min(0.04, travel / 3)), T.ca = r.u(2, 10), T.cphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.cp = travel / spec.ripple_periods;
     T.cb = T.ca * r.u(0, 0.4), T.cphi3 = r.u(-kPi, kPi);
-    out.truth.push_back({"cogging_ripple", {{"pitch_m", T.cp}, {"amplitude_N", T.ca}, {"phase_rad", T.cphi},
-                                            {"third_harmonic_N", T.cb}, {"third_phase_rad", T.cphi3}}});
+    out.truth.push_back({"cogging_ripple",
+                         {{"pitch_m", T.cp},
+                          {"amplitude_N", T.ca},
+                          {"phase_rad", T.cphi},
+                          {"third_harmonic_N", T.cb},
+                          {"third_phase_rad", T.cphi3}}});
   }
   if (hidden("reluctance_ripple")) {
     T.rp = r.u(0.01, std::min(0.04, travel / 3)), T.rA = r.u(0.03, 0.08), T.rphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.rp = travel / spec.ripple_periods;
-    out.truth.push_back({"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
+    out.truth.push_back(
+        {"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
   }
   if (hidden("grinding_force")) {
     T.grind = true;
     T.xc = r.u(0.2, 0.8) * travel;
     T.C = r.u(20, 100) / v_typ;
     T.ke = T.C / r.u(2e-3, 50e-3);
-    out.truth.push_back({"grinding_force", {{"gain_Ns_per_m", T.C}, {"stiffness_N_per_m", T.ke}, {"contact_position_m", T.xc}}});
+    out.truth.push_back(
+        {"grinding_force", {{"gain_Ns_per_m", T.C}, {"stiffness_N_per_m", T.ke}, {"contact_position_m", T.xc}}});
   }
   if (hidden("spring_force")) {
     T.k = r.u(200, 2000), T.xr = r.u(0.0, 1.0) * travel;
@@ -355,8 +365,8 @@ Generated generate(const CaseSpec& spec) {
   const double wv = 4 * w, wp = w;
   const double q = r.u(50e-9, 200e-9), noise = r.u(0.0, 20e-9);
   const double jitter = 0.02 * Ts;
-  const Reference ref = spec.one_direction ? make_forward_reference(r, spec.duration, travel)
-                                           : make_reference(r, spec.duration, travel);
+  const Reference ref =
+      spec.one_direction ? make_forward_reference(r, spec.duration, travel) : make_reference(r, spec.duration, travel);
   // closed loop
   const long N = static_cast<long>(std::lround(spec.duration * spec.sample_rate)) + 1;
   std::vector<double> t_true(static_cast<std::size_t>(N));
@@ -364,10 +374,10 @@ Generated generate(const CaseSpec& spec) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   double y[4] = {0.0, 0.0, 0.0, 0.0};
   double integ = 0.0, e_prev = 0.0, d_filt = 0.0, x_prev = 0.0, v_filt = 0.0;
-  double pending = 0.0;                          // computed, waiting one sample
+  double pending = 0.0;  // computed, waiting one sample
   std::vector<double> applied(static_cast<std::size_t>(N), 0.0);
   const double F_max = 1500.0;
-  const double tf = 1.0 / (5.0 * w);             // derivative / velocity filter time constant
+  const double tf = 1.0 / (5.0 * w);  // derivative / velocity filter time constant
   for (long k = 0; k < N; ++k) {
     const double tk = t_true[k];
     const double dt = k > 0 ? tk - t_true[k - 1] : Ts;
@@ -432,8 +442,7 @@ Generated generate(const CaseSpec& spec) {
   if (T.base_static)
     yaml << "  friction: {model: static, static_force: " << num(T.Fs) << ", coulomb_force: " << num(T.Fc)
          << ", stribeck_velocity: " << num(T.vs) << ", stribeck_exponent: 2, viscous: " << num(T.s2) << "}\n";
-  else
-    yaml << "  friction: {model: none}\n";
+  else yaml << "  friction: {model: none}\n";
   if (grinding) yaml << "  grinding: {enabled: false}\n";
   // the encoder is known to its engineer: the fit's noise floor comes from it
   yaml << "  sensor: {quantization: " << num(q) << ", noise_stddev: " << num(noise) << "}\n";
@@ -442,17 +451,27 @@ Generated generate(const CaseSpec& spec) {
   long saturated = 0;
   for (double f : out.force_N) saturated += std::abs(f) >= F_max ? 1 : 0;
   out.knobs = {{"saturated_fraction", static_cast<double>(saturated) / static_cast<double>(N)},
-               {"mass_nominal_kg", m_nom},    {"travel_m", travel},          {"controller", pid ? 0.0 : 1.0},
-               {"bandwidth_hz", bw},          {"feedforward", ff ? 1.0 : 0.0}, {"command_delay_samples", cmd_delay},
-               {"quantization_m", q},         {"noise_m", noise},            {"jitter_s", jitter},
+               {"mass_nominal_kg", m_nom},
+               {"travel_m", travel},
+               {"controller", pid ? 0.0 : 1.0},
+               {"bandwidth_hz", bw},
+               {"feedforward", ff ? 1.0 : 0.0},
+               {"command_delay_samples", cmd_delay},
+               {"quantization_m", q},
+               {"noise_m", noise},
+               {"jitter_s", jitter},
                {"stamp_error_s", kStampError / std::sqrt(3.0)},
-               {"coulomb_transition_mps", T.vt}, {"asymmetry", T.asym},      {"stribeck_exponent", T.delta},
+               {"coulomb_transition_mps", T.vt},
+               {"asymmetry", T.asym},
+               {"stribeck_exponent", T.delta},
                {"base_static_friction", T.base_static ? 1.0 : 0.0}};
   char b[512];
   std::snprintf(b, sizeof b,
-                "%s: m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm%s, %s friction, vt=%.0f um/s, asym %.3f, %.1f %% saturated",
-                spec.category.c_str(), m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "", cmd_delay ? " +1-sample delay" : "",
-                q * 1e9, travel * 1e3, spec.one_direction ? " one direction" : "", T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
+                "%s: m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm%s, %s friction, vt=%.0f um/s, asym %.3f, %.1f "
+                "%% saturated",
+                spec.category.c_str(), m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "",
+                cmd_delay ? " +1-sample delay" : "", q * 1e9, travel * 1e3, spec.one_direction ? " one direction" : "",
+                T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
                 100.0 * static_cast<double>(saturated) / static_cast<double>(N));
   out.description = b;
   return out;
@@ -514,7 +533,8 @@ std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed) {
   for (int k = 0; k < per; ++k)
     for (const auto& e : v) out.push_back({0, {e}});
   while (static_cast<int>(out.size()) < n) {
-    const std::string a = v[static_cast<std::size_t>(r.u(0, v.size()))], b = v[static_cast<std::size_t>(r.u(0, v.size()))];
+    const std::string a = v[static_cast<std::size_t>(r.u(0, v.size()))],
+                      b = v[static_cast<std::size_t>(r.u(0, v.size()))];
     if (a == b) continue;
     const std::set<std::string> p{a, b};
     if (p.count("coulomb_friction") && p.count("stribeck_friction")) continue;

@@ -55,12 +55,13 @@ struct CaseSpec {
 };
 
 struct Generated {
-  std::vector<double> t, x, force_N, xd;  ///< recorded stamps [s], quantized position [m], applied thrust [N], reference [m]
-  std::string scenario_yaml;              ///< the model the fit starts from (the known drive, no hidden effect)
-  std::vector<Effect> truth;              ///< the hidden effects, in the vocabulary's parametrisation
-  std::map<std::string, double> knobs;    ///< everything else that was drawn
-  std::string description;                ///< one line
-  std::string csv() const;                ///< "t,x,force_N,xd" with %.17g
+  std::vector<double> t, x, force_N,
+      xd;                     ///< recorded stamps [s], quantized position [m], applied thrust [N], reference [m]
+  std::string scenario_yaml;  ///< the model the fit starts from (the known drive, no hidden effect)
+  std::vector<Effect> truth;  ///< the hidden effects, in the vocabulary's parametrisation
+  std::map<std::string, double> knobs;  ///< everything else that was drawn
+  std::string description;              ///< one line
+  std::string csv() const;              ///< "t,x,force_N,xd" with %.17g
 };
 
 Generated generate(const CaseSpec& spec);

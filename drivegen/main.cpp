@@ -12,7 +12,9 @@
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] [bw=HZ]\n");
+    std::fprintf(stderr,
+                 "usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] "
+                 "[bw=HZ]\n");
     return 2;
   }
   fdgen::CaseSpec spec;
@@ -27,7 +29,8 @@ int main(int argc, char** argv) {
   for (int a = 5; a < argc; ++a) {
     const std::string w = argv[a];
     if (w == "grinding") spec.grinding_process = true;
-    if (w == "noform") spec.form_deviation = false;  // the model's friction form: no transition, asymmetry or exponent change
+    if (w == "noform")
+      spec.form_deviation = false;  // the model's friction form: no transition, asymmetry or exponent change
     if (w == "onedir") spec.one_direction = true;
     if (w.rfind("periods=", 0) == 0) spec.ripple_periods = std::atof(w.c_str() + 8);
     if (w.rfind("bw=", 0) == 0) spec.bandwidth_hz = std::atof(w.c_str() + 3);

@@ -23,21 +23,21 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "drivegen.hpp"
 #include "feeddrive/fit/data.hpp"
 #include "feeddrive/fit/sanity.hpp"
 #include "feeddrive/fit/verdict.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/sim/scenario.hpp"
-#include "drivegen.hpp"
 
 namespace feeddrive::fit::sweep {
 
@@ -45,19 +45,19 @@ struct Outcome {
   fdgen::CaseSpec spec;
   std::string description;
   std::set<std::string> hidden, named;
-  bool right{false};            ///< named set == hidden set, parameters within tolerance
-  bool spurious{false};         ///< something named that is not hidden
-  std::string parameter_miss;   ///< first parameter out of tolerance, if any
-  double seconds{0.0};          ///< wall time of the fit
+  bool right{false};           ///< named set == hidden set, parameters within tolerance
+  bool spurious{false};        ///< something named that is not hidden
+  std::string parameter_miss;  ///< first parameter out of tolerance, if any
+  double seconds{0.0};         ///< wall time of the fit
   std::string conclusion;
-  std::string verdict;          ///< explained, no_discrepancy, unexplained
+  std::string verdict;  ///< explained, no_discrepancy, unexplained
   std::set<std::string> tentative, tie_partners;
-  bool suggestion{false};       ///< an unexplained verdict says what would settle it
-  bool false_all_clear{false};  ///< explained/no discrepancy with a hidden effect not named (strict)
-  bool nothing_there{false};    ///< "no discrepancy" (or nothing named) on a record with a hidden effect
+  bool suggestion{false};             ///< an unexplained verdict says what would settle it
+  bool false_all_clear{false};        ///< explained/no discrepancy with a hidden effect not named (strict)
+  bool nothing_there{false};          ///< "no discrepancy" (or nothing named) on a record with a hidden effect
   bool above_floor_all_clear{false};  ///< explained/no discrepancy above the floor (never, by the rule)
   double gap_final{0.0}, gap_floor{0.0}, force_final{0.0}, force_floor{0.0};
-  double periods{0.0};          ///< travelled range / hidden ripple pitch (0: no ripple)
+  double periods{0.0};  ///< travelled range / hidden ripple pitch (0: no ripple)
   std::string category;
 };
 
@@ -139,8 +139,9 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
     const auto sp = t.find(" or "), end = t.find(" (");
     if (sp != std::string::npos && end != std::string::npos) o.tie_partners.insert(t.substr(sp + 4, end - sp - 4));
   }
-  for (const auto& u : r.unexplained) o.suggestion = o.suggestion || u.find("to settle it") != std::string::npos ||
-                                                     u.find("--max-effects") != std::string::npos;
+  for (const auto& u : r.unexplained)
+    o.suggestion =
+        o.suggestion || u.find("to settle it") != std::string::npos || u.find("--max-effects") != std::string::npos;
   const double range = *std::max_element(g.x.begin(), g.x.end()) - *std::min_element(g.x.begin(), g.x.end());
   for (const char* rip : {"cogging_ripple", "reluctance_ripple"})
     if (truth.count(rip)) o.periods = range / truth[rip]["pitch_m"];

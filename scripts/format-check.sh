@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checks that every C and C++ file of the repository is formatted by .clang-format (exit 1 and the
-# files that are not). Not yet in scripts/test.sh: the tree is formatted once first (issue 22,
-# point 5), then CI runs this. With file arguments, checks only those.
+# files that are not). scripts/test.sh (CI) runs it. With file arguments, checks
+# only those.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format > /dev/null || { echo "format-check: clang-format is not installed" >&2; exit 2; }

@@ -4,9 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
-#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -100,20 +100,24 @@ Run run_once(const sim::Scenario& base, const Plan& p, double ref_amplitude, dou
   const double kf = s.plant.thrust_gain();
   Run r;
   long k = 0;
-  sim::run(s, [&](const sim::Record& q) {
-    const long j = k++ - p.settle;
-    if (j < 0) return;
-    const int b = j < p.n ? 0 : 1;
-    const cd rot = std::polar(1.0, -w * q.t);  // t_k = k*T exactly (Scenario::time_of)
-    const double e = q.xd - q.x;
-    const double input = force_amplitude != 0.0 ? force_amplitude * std::sin(w * q.t) : ref_amplitude * std::sin(w * q.t);
-    r.e[b] += e * rot;
-    r.fc[b] += kf * q.u * rot;
-    r.in[b] += input * rot;
-    r.se[b] += e;
-    r.see[b] += e * e;
-    if (q.u != q.u_unsaturated) ++r.saturated;
-  }, ex);
+  sim::run(
+      s,
+      [&](const sim::Record& q) {
+        const long j = k++ - p.settle;
+        if (j < 0) return;
+        const int b = j < p.n ? 0 : 1;
+        const cd rot = std::polar(1.0, -w * q.t);  // t_k = k*T exactly (Scenario::time_of)
+        const double e = q.xd - q.x;
+        const double input =
+            force_amplitude != 0.0 ? force_amplitude * std::sin(w * q.t) : ref_amplitude * std::sin(w * q.t);
+        r.e[b] += e * rot;
+        r.fc[b] += kf * q.u * rot;
+        r.in[b] += input * rot;
+        r.se[b] += e;
+        r.see[b] += e * e;
+        if (q.u != q.u_unsaturated) ++r.saturated;
+      },
+      ex);
   const double scale = 2.0 / static_cast<double>(p.n);
   for (int b = 0; b < 2; ++b) {
     r.e[b] *= scale;
@@ -222,8 +226,9 @@ void FrequencyResponseOptions::validate(const sim::Scenario& s) const {
     throw std::invalid_argument(option + " " + validate::format_number(v) + ": " + why);
   };
   if (s.controller.type == sim::ControllerType::kOpenLoop)
-    throw std::invalid_argument("controller.type open_loop: no feedback loop to measure (the frequency response needs a "
-                                "closed loop: sliding_mode, cascade or plugin)");
+    throw std::invalid_argument(
+        "controller.type open_loop: no feedback loop to measure (the frequency response needs a "
+        "closed loop: sliding_mode, cascade or plugin)");
   const double nyquist = 0.5 / s.control_period;
   const std::string below = "below Nyquist " + validate::format_number(nyquist) + " Hz";
   for (double f : frequencies)
@@ -234,16 +239,22 @@ void FrequencyResponseOptions::validate(const sim::Scenario& s) const {
       bad("--fr-to", f_max, "must be above --fr-from and " + below);
     if (points < 1 || points > 1000) bad("--fr-points", points, "must be 1 to 1000");
   }
-  if (!(reference_amplitude >= 0.0) || !std::isfinite(reference_amplitude)) bad("--fr-amplitude", reference_amplitude, "must be >= 0 [m]");
-  if (!(force_amplitude >= 0.0) || !std::isfinite(force_amplitude)) bad("--fr-force", force_amplitude, "must be >= 0 [N]");
-  if (reference_amplitude == 0.0 && force_amplitude == 0.0) bad("--fr-amplitude", 0.0, "and --fr-force 0: nothing to measure");
-  if (!(acceleration_limit >= 0.0) || !std::isfinite(acceleration_limit)) bad("--fr-acceleration", acceleration_limit, "must be >= 0 [m/s^2]");
+  if (!(reference_amplitude >= 0.0) || !std::isfinite(reference_amplitude))
+    bad("--fr-amplitude", reference_amplitude, "must be >= 0 [m]");
+  if (!(force_amplitude >= 0.0) || !std::isfinite(force_amplitude))
+    bad("--fr-force", force_amplitude, "must be >= 0 [N]");
+  if (reference_amplitude == 0.0 && force_amplitude == 0.0)
+    bad("--fr-amplitude", 0.0, "and --fr-force 0: nothing to measure");
+  if (!(acceleration_limit >= 0.0) || !std::isfinite(acceleration_limit))
+    bad("--fr-acceleration", acceleration_limit, "must be >= 0 [m/s^2]");
   // the hard bound of reference.max_velocity (trajectory.hpp), with its likely unit
   const fields::Meta vmax = max_velocity_meta();
   if (!std::isfinite(feed_velocity) || std::abs(feed_velocity) > vmax.max)
     bad("--fr-velocity", feed_velocity,
-        "must be within +-" + validate::format_number(vmax.max) + " m/s, as reference.max_velocity (" + vmax.hint_high + "?)");
-  if (!(settle_cycles >= 0.0) || !(settle_time >= 0.0) || !std::isfinite(settle_time)) bad("--fr-settle", settle_time, "must be >= 0 and finite [s]");
+        "must be within +-" + validate::format_number(vmax.max) + " m/s, as reference.max_velocity (" + vmax.hint_high +
+            "?)");
+  if (!(settle_cycles >= 0.0) || !(settle_time >= 0.0) || !std::isfinite(settle_time))
+    bad("--fr-settle", settle_time, "must be >= 0 and finite [s]");
   if (block_cycles < 1) bad("block_cycles", block_cycles, "must be >= 1");
   if (jobs < 1 || jobs > 256) bad("--jobs", jobs, "must be 1 to 256");
   // A frequency moved to whole cycles (M/(N T)) must stay below Nyquist: on it, sin(pi k) = 0.
@@ -258,10 +269,11 @@ void FrequencyResponseOptions::validate(const sim::Scenario& s) const {
   if (const double n = total_steps(s); !(n <= sim::kMaxSteps)) {
     char buf[320];
     const std::vector<double> fs = requested(s);
-    std::snprintf(buf, sizeof buf,
-                  "frequency response: %.3g steps (%zu frequencies from %.4g Hz, --fr-settle %.4g s); a run has at most %.3g "
-                  "steps (docs/scenario.md, Limits): a higher lowest frequency or a shorter --fr-settle",
-                  n, fs.size(), fs.front(), settle_time, sim::kMaxSteps);
+    std::snprintf(
+        buf, sizeof buf,
+        "frequency response: %.3g steps (%zu frequencies from %.4g Hz, --fr-settle %.4g s); a run has at most %.3g "
+        "steps (docs/scenario.md, Limits): a higher lowest frequency or a shorter --fr-settle",
+        n, fs.size(), fs.front(), settle_time, sim::kMaxSteps);
     throw std::invalid_argument(buf);
   }
 }
@@ -280,7 +292,8 @@ FrequencyResponse measure_frequency_response(const sim::Scenario& s, const Frequ
                              : 0.25 * 0.5 * sim::controller_output_range(s) * s.plant.thrust_gain() / s.plant.mass;
   r.points.resize(fs.size());
   // A plugin may keep state of its own: one at a time.
-  const int jobs = s.controller.type == sim::ControllerType::kPlugin ? 1 : std::min<int>(o.jobs, static_cast<int>(fs.size()));
+  const int jobs =
+      s.controller.type == sim::ControllerType::kPlugin ? 1 : std::min<int>(o.jobs, static_cast<int>(fs.size()));
   std::atomic<std::size_t> next{0};
   std::exception_ptr error;
   std::mutex m;
@@ -352,15 +365,18 @@ void compute_figures(FrequencyResponse& r) {
   if (!ref.empty() && std::isnan(r.bandwidth_hz)) r.bandwidth_outside = db(ref.front()->closed_loop) < kBw ? -1 : 1;
   for (const FrequencyPoint* q : dist) {
     const double ms = std::abs(q->sensitivity), k = q->stiffness_N_per_um();
-    if (std::isnan(r.sensitivity_peak) || ms > r.sensitivity_peak) r.sensitivity_peak = ms, r.sensitivity_peak_hz = q->frequency_hz;
-    if (std::isnan(r.min_stiffness_N_per_um) || k < r.min_stiffness_N_per_um) r.min_stiffness_N_per_um = k, r.min_stiffness_hz = q->frequency_hz;
+    if (std::isnan(r.sensitivity_peak) || ms > r.sensitivity_peak)
+      r.sensitivity_peak = ms, r.sensitivity_peak_hz = q->frequency_hz;
+    if (std::isnan(r.min_stiffness_N_per_um) || k < r.min_stiffness_N_per_um)
+      r.min_stiffness_N_per_um = k, r.min_stiffness_hz = q->frequency_hz;
   }
   // phase of L unwrapped from the lowest frequency, started in (-360, 0]
   std::vector<cd> loop;
   for (const FrequencyPoint* q : dist) loop.push_back(q->loop);
   const std::vector<double> phase = unwrapped_phase_deg(loop, true);
   const auto f_at = [&](std::size_t i, double a) {
-    return std::exp(std::log(dist[i - 1]->frequency_hz) + a * (std::log(dist[i]->frequency_hz) - std::log(dist[i - 1]->frequency_hz)));
+    return std::exp(std::log(dist[i - 1]->frequency_hz) +
+                    a * (std::log(dist[i]->frequency_hz) - std::log(dist[i - 1]->frequency_hz)));
   };
   for (std::size_t i = 1; i < dist.size(); ++i) {
     const double g0 = db(dist[i - 1]->loop), g1 = db(dist[i]->loop);
@@ -387,7 +403,8 @@ void compute_figures(FrequencyResponse& r) {
     const double gm = -(db(dist[i - 1]->loop) + a * (db(dist[i]->loop) - db(dist[i - 1]->loop)));
     const double f = f_at(i, a);
     if (f < r.crossover_hz) {
-      if (std::isnan(r.lower_gain_margin_db) || gm > r.lower_gain_margin_db) r.lower_gain_margin_db = gm, r.lower_phase_crossover_hz = f;
+      if (std::isnan(r.lower_gain_margin_db) || gm > r.lower_gain_margin_db)
+        r.lower_gain_margin_db = gm, r.lower_phase_crossover_hz = f;
     } else if (k1 < k0) {
       r.gain_margin_db = gm, r.phase_crossover_hz = f;
       break;

@@ -20,7 +20,8 @@ void CascadeParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".computation_delay", computation_delay);
   require_non_negative(prefix + ".velocity_filter_cutoff", velocity_filter_cutoff);
   if (motion_state == MotionSource::kObserver && !(disturbance_observer_bandwidth > 0.0))
-    throw std::invalid_argument(prefix + ".motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
+    throw std::invalid_argument(prefix +
+                                ".motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
   require_positive(prefix + ".model.mass", mass);
   require_positive(prefix + ".model.thrust_gain", thrust_gain);
   if (friction_feedforward) friction.validate(prefix + ".model.friction");
@@ -32,15 +33,16 @@ void apply_tuning(CascadeParams& p, bool differenced_velocity) {
   if (p.tuning != CascadeTuning::kRule) return;
   const bool observer = p.motion_state == MotionSource::kObserver;
   const double delay = observer && p.compensate_delay ? 0.0 : p.computation_delay;
-  const double lag = p.velocity_filter_cutoff > 0.0 ? 1.0 / (2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff) : 0.0;
+  const double lag =
+      p.velocity_filter_cutoff > 0.0 ? 1.0 / (2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff) : 0.0;
   const CascadeGains g = cascade_tuning(p.period, delay, differenced_velocity && !observer, p.bandwidth_scale, lag);
   p.kp = g.kp;
   p.kv = g.kv;
   p.ki = g.ki;
 }
 
-CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
-                            double scale, double extra_lag) {
+CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity, double scale,
+                            double extra_lag) {
   const double tau = computation_delay + 0.5 * period + (differenced_velocity ? 0.5 * period : 0.0) + extra_lag;
   const double pi = 3.14159265358979323846;
   const double wv = scale * (pi / 4.0 - std::atan(0.25)) / tau;
@@ -51,8 +53,8 @@ CascadeGains cascade_tuning(double period, double computation_delay, bool differ
 CascadeController::CascadeController(const CascadeParams& p)
     : p_((p.validate("controller"), p)),
       friction_ff_(p.friction, p.period, 0.0),
-      observer_(p.disturbance_observer_bandwidth > 0.0 ? p.disturbance_observer_bandwidth : 1.0,
-                p.period, true, p.quantization),
+      observer_(p.disturbance_observer_bandwidth > 0.0 ? p.disturbance_observer_bandwidth : 1.0, p.period, true,
+                p.quantization),
       delay_line_(p.compensate_delay ? p.computation_delay : 0.0, 1e-9 * p.period),
       velocity_filter_gain_(p.velocity_filter_cutoff > 0.0
                                 ? -std::expm1(-2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff * p.period)
@@ -104,8 +106,7 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
   const double v_cmd = p_.velocity_feedforward * ref.velocity + p_.kp * (ref.position - x);
   const double ev = v_cmd - v;
   const double force =
-      p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ahead.acceleration - d_hat) +
-      f_ff;
+      p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ahead.acceleration - d_hat) + f_ff;
   Command cmd;
   cmd.u_unsaturated = force / p_.thrust_gain;
   cmd.u = saturate(cmd.u_unsaturated, p_.u_min, p_.u_max);

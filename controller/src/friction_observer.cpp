@@ -32,8 +32,7 @@ void FrictionObserver::advance(double v, double velocity_error, double dt) {
   }
 }
 
-GrindingObserver::GrindingObserver(const plant::GrindingParams& p, double period)
-    : p_(p), period_(period) {}
+GrindingObserver::GrindingObserver(const plant::GrindingParams& p, double period) : p_(p), period_(period) {}
 
 double GrindingObserver::estimate(double x) const { return plant::grinding_force(p_, x, fg_); }
 

@@ -27,7 +27,8 @@ void OpenLoopParams::validate(const std::string& prefix) const {
       require_finite(row + ".t", table_t[i]);
       require_finite(row + value, table_value[i]);
       if (i > 0 && !(table_t[i] > table_t[i - 1]))
-        fail(row + ".t", table_t[i], "must be greater than the previous t = " + validate::format_number(table_t[i - 1]));
+        fail(row + ".t", table_t[i],
+             "must be greater than the previous t = " + validate::format_number(table_t[i - 1]));
     }
   }
 }
@@ -48,8 +49,7 @@ double OpenLoopSource::force(double t) const {
   const double tau = t - p_.start_time;
   switch (p_.kind) {
     case OpenLoopKind::kStep: return p_.offset + p_.amplitude;
-    case OpenLoopKind::kSine:
-      return p_.offset + p_.amplitude * std::sin(2.0 * M_PI * p_.frequency * tau + p_.phase);
+    case OpenLoopKind::kSine: return p_.offset + p_.amplitude * std::sin(2.0 * M_PI * p_.frequency * tau + p_.phase);
     case OpenLoopKind::kRamp: {
       double f = p_.rate * tau;
       if (p_.amplitude > 0.0) f = std::clamp(f, -p_.amplitude, p_.amplitude);

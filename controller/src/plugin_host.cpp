@@ -24,7 +24,8 @@ std::string message_of(const char* buf) {
 
 void PluginParams::validate(const std::string& prefix) const {
   using namespace detail;
-  if (library.empty()) throw std::invalid_argument(prefix + ".library = '': needs the path of the plugin's shared library");
+  if (library.empty())
+    throw std::invalid_argument(prefix + ".library = '': needs the path of the plugin's shared library");
   require_positive(prefix + ".period", period);
   require_range(prefix, u_min, u_max);
   require_non_negative(prefix + ".computation_delay", computation_delay);
@@ -48,10 +49,12 @@ std::shared_ptr<const PluginLibrary> PluginLibrary::open(const std::string& path
     dlerror();
     void* s = dlsym(lib->handle_, name);
     if (s == nullptr)
-      throw PluginError(where + "missing symbol " + name + " (plugin.h: a plugin exports all five functions with C linkage)");
+      throw PluginError(where + "missing symbol " + name +
+                        " (plugin.h: a plugin exports all five functions with C linkage)");
     return s;
   };
-  const auto version = reinterpret_cast<feeddrive_controller_abi_version_fn>(symbol("feeddrive_controller_abi_version"));
+  const auto version =
+      reinterpret_cast<feeddrive_controller_abi_version_fn>(symbol("feeddrive_controller_abi_version"));
   lib->create = reinterpret_cast<feeddrive_controller_create_fn>(symbol("feeddrive_controller_create"));
   lib->update = reinterpret_cast<feeddrive_controller_update_fn>(symbol("feeddrive_controller_update"));
   lib->reset = reinterpret_cast<feeddrive_controller_reset_fn>(symbol("feeddrive_controller_reset"));

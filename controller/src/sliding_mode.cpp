@@ -25,7 +25,8 @@ void SlidingModeParams::validate(const std::string& prefix) const {
   require_positive(prefix + ".period", period);
   require_non_negative(prefix + ".computation_delay", computation_delay);
   if (compensate_delay && motion_state != MotionSource::kObserver)
-    throw std::invalid_argument(prefix + ".compensate_delay = true: needs motion_state: observer (the model predictor)");
+    throw std::invalid_argument(prefix +
+                                ".compensate_delay = true: needs motion_state: observer (the model predictor)");
   model.validate(prefix + ".model");
 }
 
@@ -86,8 +87,7 @@ SlidingModeController::SlidingModeController(const SlidingModeParams& given)
 bool SlidingModeController::needs_truth() const {
   const bool friction = p_.compensate_friction && p_.friction_state == StateSource::kTrue &&
                         p_.model.friction.model == plant::FrictionModel::kLuGre;
-  const bool grinding = p_.compensate_grinding && p_.grinding_state == StateSource::kTrue &&
-                        p_.model.grinding.enabled;
+  const bool grinding = p_.compensate_grinding && p_.grinding_state == StateSource::kTrue && p_.model.grinding.enabled;
   return friction || grinding;
 }
 
@@ -149,8 +149,8 @@ smc::ModelForces SlidingModeController::model_forces(double x, double v, const T
 }
 
 SlidingModeController::LawInput SlidingModeController::predict_to_action(const Estimate& est,
-                                                                          const trajectory::Sample& ref, double t,
-                                                                          const smc::ModelForces& now) const {
+                                                                         const trajectory::Sample& ref, double t,
+                                                                         const smc::ModelForces& now) const {
   const plant::PlantParams& m = p_.model;
   const double a_d = motion_observer_.disturbance();
   // With the bristle observer, its z^ is carried along the prediction too, so F^f follows the
@@ -169,7 +169,7 @@ SlidingModeController::LawInput SlidingModeController::predict_to_action(const E
     in.v += a * tau;
   }
   if (carry_friction) in.forces.friction = ahead.estimate(in.v);  // F^f when the command acts
-  if (m.ripple.enabled) {  // the ripple where the command will act
+  if (m.ripple.enabled) {                                         // the ripple where the command will act
     in.forces.cogging = plant::cogging_force(m.ripple, in.x);
     in.forces.reluctance = plant::reluctance_factor(m.ripple, in.x);
   }
@@ -211,7 +211,8 @@ Command SlidingModeController::update(const trajectory::Sample& ref, const plant
   const smc::ModelForces now = model_forces(est.x, est.v, truth);
   const bool delayed = p_.compensate_delay && p_.computation_delay > 0.0 && std::isfinite(meas.t);
   // The state and reference the law acts on: now, or predicted to when the command acts.
-  const LawInput in = delayed && est.observed ? predict_to_action(est, ref, meas.t, now) : LawInput{est.x, est.v, ref, now};
+  const LawInput in =
+      delayed && est.observed ? predict_to_action(est, ref, meas.t, now) : LawInput{est.x, est.v, ref, now};
 
   Command cmd;
   if (now.z) cmd.z_estimate = *now.z;

@@ -42,7 +42,7 @@
 #define KEEP 4096          /* states kept for resend requests */
 #define V_COULOMB 1e-4     /* m/s: the smoothing velocity of this drive's Coulomb friction */
 
-static lcm_t *lc;
+static lcm_t* lc;
 static char ch_state[80], ch_cmd[80], ch_status[80], ch_resend[80], ch_info[80];
 static unsigned char key[4096];
 static int key_len; /* 0: unsigned run */
@@ -72,13 +72,13 @@ static double now(void) {
     (msg)->run_id = run_id;                                                                  \
     (msg)->mac_size = 0;                                                                     \
     (msg)->mac = NULL;                                                                       \
-    int n_ = type##_encode(buf_, 0, (int)sizeof buf_ - 32, (msg));                          \
+    int n_ = type##_encode(buf_, 0, (int)sizeof buf_ - 32, (msg));                           \
     if (n_ > 0 && key_len > 0) n_ = (int)fd_sign(key, key_len, (channel), buf_, (size_t)n_); \
     if (n_ > 0) lcm_publish(lc, (channel), buf_, (unsigned)n_);                              \
   } while (0)
 
 /* A received message: verified (with a key) before it is decoded; 0 when it is to be dropped. */
-static int admit(const lcm_recv_buf_t *rb, const char *channel) {
+static int admit(const lcm_recv_buf_t* rb, const char* channel) {
   if (key_len > 0 && !fd_verify(key, key_len, channel, rb->data, rb->data_size)) {
     ++unauthenticated;
     return 0;
@@ -88,7 +88,7 @@ static int admit(const lcm_recv_buf_t *rb, const char *channel) {
 
 /* A random number in 1 .. 2^53 - 1 (exact in a double). */
 static int64_t draw53(void) {
-  FILE *r = fopen("/dev/urandom", "rb");
+  FILE* r = fopen("/dev/urandom", "rb");
   uint64_t b = 0;
   while (b == 0 && r && fread(&b, sizeof b, 1, r) == 1) b &= (UINT64_C(1) << 53) - 1;
   if (r) fclose(r);
@@ -106,7 +106,7 @@ static int64_t keyed_run_id(int64_t r, int64_t n) {
   return (int64_t)(1 + splitmix64((uint64_t)r ^ splitmix64((uint64_t)n)) % ((UINT64_C(1) << 53) - 1));
 }
 
-static void heartbeat(const char *state, const char *message) {
+static void heartbeat(const char* state, const char* message) {
   struct timespec w;
   clock_gettime(CLOCK_REALTIME, &w);
   feeddrive_process_status_t m;
@@ -114,8 +114,8 @@ static void heartbeat(const char *state, const char *message) {
   m.utime = (int64_t)w.tv_sec * 1000000 + w.tv_nsec / 1000;
   m.run_nonce = run_nonce;
   m.role = "plant";
-  m.state = (char *)state;
-  m.message = (char *)message;
+  m.state = (char*)state;
+  m.message = (char*)message;
   m.seq = seq;
   m.acked_seq = -1;
   m.resends = resends;
@@ -125,21 +125,30 @@ static void heartbeat(const char *state, const char *message) {
   PUBLISH(feeddrive_process_status_t, ch_status, &m);
 }
 
-static void on_info(const lcm_recv_buf_t *rb, const char *ch, void *u) {
+static void on_info(const lcm_recv_buf_t* rb, const char* ch, void* u) {
   (void)u;
   if (have_info || !admit(rb, ch)) return;
   feeddrive_run_info_t m;
-  if (feeddrive_run_info_t_decode(rb->data, 0, rb->data_size, &m) < 0) { ++invalid; return; }
-  if (m.run_id != run_id) { feeddrive_run_info_t_decode_cleanup(&m); return; } /* another run's */
+  if (feeddrive_run_info_t_decode(rb->data, 0, rb->data_size, &m) < 0) {
+    ++invalid;
+    return;
+  }
+  if (m.run_id != run_id) {
+    feeddrive_run_info_t_decode_cleanup(&m);
+    return;
+  }         /* another run's */
   info = m; /* kept for the whole run: no decode_cleanup */
   have_info = 1;
 }
 
-static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *u) {
+static void on_status(const lcm_recv_buf_t* rb, const char* ch, void* u) {
   (void)u;
   if (!admit(rb, ch)) return;
   feeddrive_process_status_t m;
-  if (feeddrive_process_status_t_decode(rb->data, 0, rb->data_size, &m) < 0) { ++invalid; return; }
+  if (feeddrive_process_status_t_decode(rb->data, 0, rb->data_size, &m) < 0) {
+    ++invalid;
+    return;
+  }
   if (m.run_id == run_id && strcmp(m.role, "plant") != 0) {
     const int run_role = !strcmp(m.role, "controller") || !strcmp(m.role, "trajectory") || !strcmp(m.role, "monitor");
     if (run_role && !strcmp(m.state, "failed") && !failure[0])
@@ -153,11 +162,14 @@ static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *u) {
   feeddrive_process_status_t_decode_cleanup(&m);
 }
 
-static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *u) {
+static void on_command(const lcm_recv_buf_t* rb, const char* ch, void* u) {
   (void)u;
   if (!admit(rb, ch)) return;
   feeddrive_control_command_t m;
-  if (feeddrive_control_command_t_decode(rb->data, 0, rb->data_size, &m) < 0) { ++invalid; return; }
+  if (feeddrive_control_command_t_decode(rb->data, 0, rb->data_size, &m) < 0) {
+    ++invalid;
+    return;
+  }
   if (m.run_id == run_id && (!have_cmd || m.seq > cmd.seq)) { /* repeats and older ones: ignored */
     cmd = m;
     cmd.mac = NULL;
@@ -167,11 +179,14 @@ static void on_command(const lcm_recv_buf_t *rb, const char *ch, void *u) {
   feeddrive_control_command_t_decode_cleanup(&m);
 }
 
-static void on_resend(const lcm_recv_buf_t *rb, const char *ch, void *u) {
+static void on_resend(const lcm_recv_buf_t* rb, const char* ch, void* u) {
   (void)u;
   if (!admit(rb, ch)) return;
   feeddrive_resend_request_t r;
-  if (feeddrive_resend_request_t_decode(rb->data, 0, rb->data_size, &r) < 0) { ++invalid; return; }
+  if (feeddrive_resend_request_t_decode(rb->data, 0, rb->data_size, &r) < 0) {
+    ++invalid;
+    return;
+  }
   if (r.run_id == run_id && !strcmp(r.channel, ch_state) && r.seq >= 0 && kept[r.seq % KEEP].seq == r.seq &&
       kept[r.seq % KEEP].steps > 0) {
     PUBLISH(feeddrive_drive_state_t, ch_state, &kept[r.seq % KEEP]);
@@ -208,7 +223,7 @@ static void integrate(double u, double T) {
 
 /* Builds and publishes state k; u_prev is what was applied during step k-1. */
 static void publish_state(int64_t k, double u_prev, int safe) {
-  feeddrive_drive_state_t *m = &kept[k % KEEP];
+  feeddrive_drive_state_t* m = &kept[k % KEEP];
   memset(m, 0, sizeof *m);
   const double T = info.control_period;
   const double xm = q > 0 ? q * round(x / q) : x;
@@ -234,18 +249,24 @@ static void publish_state(int64_t k, double u_prev, int safe) {
 
 /* The command for a step, as the plant admits it: NaN/inf -> 0 V (or the last good one), |u| clipped. */
 static double admit_u(double u, double fallback) {
-  if (!isfinite(u)) { ++rejected; return fallback; }
-  if (fabs(u) > info.input_limit) { ++rejected; return u > 0 ? info.input_limit : -info.input_limit; }
+  if (!isfinite(u)) {
+    ++rejected;
+    return fallback;
+  }
+  if (fabs(u) > info.input_limit) {
+    ++rejected;
+    return u > 0 ? info.input_limit : -info.input_limit;
+  }
   return u;
 }
 
-static int fail(const char *message) {
+static int fail(const char* message) {
   for (int i = 0; i < 3; ++i) heartbeat("failed", message);
   fprintf(stderr, "drive_adapter: %s\n", message);
   return 1;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   const char *url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304", *prefix = "FD", *key_file = NULL;
   long long skip_at = -1, exit_at = -1;
   run_id = 0;
@@ -256,14 +277,23 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--run-id")) run_id = atoll(argv[i + 1]);
     else if (!strcmp(argv[i], "--skip-at")) skip_at = atoll(argv[i + 1]);
     else if (!strcmp(argv[i], "--exit-at")) exit_at = atoll(argv[i + 1]);
-    else { fprintf(stderr, "drive_adapter: unknown option %s\n", argv[i]); return 2; }
+    else {
+      fprintf(stderr, "drive_adapter: unknown option %s\n", argv[i]);
+      return 2;
+    }
   }
   if (key_file) {
-    FILE *f = fopen(key_file, "rb");
-    if (!f) { fprintf(stderr, "drive_adapter: --key %s: cannot open it\n", key_file); return 2; }
+    FILE* f = fopen(key_file, "rb");
+    if (!f) {
+      fprintf(stderr, "drive_adapter: --key %s: cannot open it\n", key_file);
+      return 2;
+    }
     key_len = (int)fread(key, 1, sizeof key, f);
     fclose(f);
-    if (key_len < 16) { fprintf(stderr, "drive_adapter: --key %s: fewer than 16 bytes\n", key_file); return 2; }
+    if (key_len < 16) {
+      fprintf(stderr, "drive_adapter: --key %s: fewer than 16 bytes\n", key_file);
+      return 2;
+    }
   }
   /* Step 1: a run id of its own (the launcher's --run-id if given), 53 bits, never 0. With a
    * key, a fresh nonce N binds it to this run: the run id on the wire is keyed_run_id(R, N). */
@@ -278,7 +308,10 @@ int main(int argc, char **argv) {
   snprintf(ch_resend, sizeof ch_resend, "%s_RESEND", prefix);
   snprintf(ch_info, sizeof ch_info, "%s_INFO", prefix);
   lc = lcm_create(url);
-  if (!lc) { fprintf(stderr, "drive_adapter: cannot open LCM at %s\n", url); return 1; }
+  if (!lc) {
+    fprintf(stderr, "drive_adapter: cannot open LCM at %s\n", url);
+    return 1;
+  }
   lcm_subscribe(lc, ch_info, on_info, NULL);
   lcm_subscribe(lc, ch_status, on_status, NULL);
   lcm_subscribe(lc, ch_cmd, on_command, NULL);
@@ -290,7 +323,10 @@ int main(int argc, char **argv) {
   for (const double start = now(); !have_info;) {
     handle(0.01);
     const double t = now();
-    if (t - last_beat >= 0.1) { heartbeat("starting", ""); last_beat = t; }
+    if (t - last_beat >= 0.1) {
+      heartbeat("starting", "");
+      last_beat = t;
+    }
     if (monitor_seen && t - last_ask >= 0.1) {
       feeddrive_resend_request_t r;
       memset(&r, 0, sizeof r);
@@ -300,7 +336,8 @@ int main(int argc, char **argv) {
       PUBLISH(feeddrive_resend_request_t, ch_resend, &r);
       last_ask = t;
     }
-    if (t - start > 30.0) return fail("no run_info_t from the monitor within 30 s (is feeddrive-launch running with --external plant?)");
+    if (t - start > 30.0)
+      return fail("no run_info_t from the monitor within 30 s (is feeddrive-launch running with --external plant?)");
   }
   if (info.contract_version != CONTRACT_VERSION) {
     char m[200];
@@ -313,10 +350,11 @@ int main(int argc, char **argv) {
   x = info.initial_position;
   v = info.initial_velocity;
   q = info.sensor_quantization > 0 ? info.sensor_quantization : 1e-7;
-  fprintf(stderr, "drive_adapter: run %lld, %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V, b = %g N*s/m, "
-          "Fc = %g N, q = %g m, x0 = %g m, scenario sha256 %.12s...\n", (long long)run_id, info.scenario, info.mode, T,
-          (long long)info.steps, info.mass, info.thrust_gain, info.viscous, info.coulomb_force, q,
-          info.initial_position, info.scenario_hash);
+  fprintf(stderr,
+          "drive_adapter: run %lld, %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V, b = %g N*s/m, "
+          "Fc = %g N, q = %g m, x0 = %g m, scenario sha256 %.12s...\n",
+          (long long)run_id, info.scenario, info.mode, T, (long long)info.steps, info.mass, info.thrust_gain,
+          info.viscous, info.coulomb_force, q, info.initial_position, info.scenario_hash);
 
   /* Step 3: the steps. */
   double u_prev = 0.0, last_good = 0.0, t0 = 0.0;
@@ -328,7 +366,10 @@ int main(int argc, char **argv) {
       handle(resend);
       if (failure[0]) return fail(failure);
       if (now() - w0 > step_timeout) return fail("no acknowledgement from the monitor within the step timeout");
-      if (now() - last_beat >= 0.1) { heartbeat("running", ""); last_beat = now(); }
+      if (now() - last_beat >= 0.1) {
+        heartbeat("running", "");
+        last_beat = now();
+      }
     }
     const int64_t published = (k == skip_at) ? k + 1 : k; /* test hook: a skipped step number */
     if (!realtime || k == 0) {
@@ -341,8 +382,15 @@ int main(int argc, char **argv) {
         handle(resend);
         const double t = now();
         if (failure[0]) return fail(failure);
-        if (t - last_sent >= resend) { PUBLISH(feeddrive_drive_state_t, ch_state, &kept[published % KEEP]); ++resends; last_sent = t; }
-        if (t - last_beat >= 0.1) { heartbeat("running", ""); last_beat = t; }
+        if (t - last_sent >= resend) {
+          PUBLISH(feeddrive_drive_state_t, ch_state, &kept[published % KEEP]);
+          ++resends;
+          last_sent = t;
+        }
+        if (t - last_beat >= 0.1) {
+          heartbeat("running", "");
+          last_beat = t;
+        }
         if (t - since > limit) {
           char m[200];
           snprintf(m, sizeof m, "no command from the controller for step %lld within %g s", (long long)k, limit);
@@ -359,7 +407,10 @@ int main(int argc, char **argv) {
       const double deadline = w + T - fmin(T / 5, 25e-6);
       while ((!have_cmd || cmd.seq < k) && now() < deadline) handle(deadline - now());
       if (failure[0]) return fail(failure);
-      if (now() - last_beat >= 0.1) { heartbeat("running", ""); last_beat = now(); }
+      if (now() - last_beat >= 0.1) {
+        heartbeat("running", "");
+        last_beat = now();
+      }
     }
     /* The command of step k (real time: the newest that came on time, else the last good one). */
     double u;

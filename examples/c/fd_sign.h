@@ -21,8 +21,8 @@
 #include <string.h>
 
 /* The mac of `channel` and the `body_size` bytes of `body` into out[32]. 0 on failure. */
-static inline int fd_mac(const unsigned char *key, int key_len, const char *channel, const unsigned char *body,
-                         size_t body_size, unsigned char *out) {
+static inline int fd_mac(const unsigned char* key, int key_len, const char* channel, const unsigned char* body,
+                         size_t body_size, unsigned char* out) {
   unsigned char in[4096];
   const size_t clen = strlen(channel);
   if (clen + 1 + body_size > sizeof in) return 0; /* feeddrive messages are < 1 KB */
@@ -33,7 +33,7 @@ static inline int fd_mac(const unsigned char *key, int key_len, const char *chan
 
 /* buf[0, n): a message encoded with mac_size = 0, and 32 more bytes of room. Writes mac_size = 32
  * and the mac; returns the signed size (n + 32), or 0 on failure. */
-static inline size_t fd_sign(const unsigned char *key, int key_len, const char *channel, unsigned char *buf, size_t n) {
+static inline size_t fd_sign(const unsigned char* key, int key_len, const char* channel, unsigned char* buf, size_t n) {
   if (n < 10 || buf[n - 2] != 0 || buf[n - 1] != 0) return 0; /* not an unsigned encoding */
   const size_t body = n - 2;
   buf[body] = 0;
@@ -42,7 +42,7 @@ static inline size_t fd_sign(const unsigned char *key, int key_len, const char *
 }
 
 /* 1 if data[0, n) ends with mac_size = 32 and the right mac for `channel`, else 0. */
-static inline int fd_verify(const unsigned char *key, int key_len, const char *channel, const unsigned char *data,
+static inline int fd_verify(const unsigned char* key, int key_len, const char* channel, const unsigned char* data,
                             size_t n) {
   unsigned char expect[32];
   if (n < 42 || data[n - 34] != 0 || data[n - 33] != 32) return 0;

@@ -9,8 +9,8 @@
 // second) and stamp its run_id on everything published; heartbeat
 // every 100 ms; stop at the end-of-run state, linger until the monitor is done; fail (exit 1,
 // one line, status "failed") when another role fails or nothing comes for 5 s (30 s at the start).
-#include <lcm/lcm-cpp.hpp>
 #include <poll.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -19,8 +19,8 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/controller/sliding_mode.hpp"
@@ -34,11 +34,10 @@ namespace fd = feeddrive;
 
 namespace {
 
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 // The controller of the run, from its self-description: the drive's nominal model and limits,

@@ -91,8 +91,8 @@ static int read_number(const feeddrive_parameter* p, double* out, char* error, s
   return 1;
 }
 
-FD_EXPORT void* feeddrive_controller_create(const feeddrive_run_info* info, const feeddrive_parameter* params,
-                                            size_t n, char* error, size_t size) {
+FD_EXPORT void* feeddrive_controller_create(const feeddrive_run_info* info, const feeddrive_parameter* params, size_t n,
+                                            char* error, size_t size) {
   if (info->size != sizeof(feeddrive_run_info)) {
     set_error(error, size, "run info of a different layout%s%s (rebuild against this feeddrive)", "", "");
     return NULL;
@@ -152,7 +152,8 @@ FD_EXPORT int feeddrive_controller_update(void* self, const feeddrive_input* in,
   const feeddrive_model* m = &c->info.model;
   const int lugre = m->friction_model == FEEDDRIVE_FRICTION_LUGRE;
   if (!in->has_truth && (lugre || m->grinding_enabled)) {
-    set_error(error, size, "this law uses the plant's true z and Fg%s%s, which this host does not send (hardware)", "", "");
+    set_error(error, size, "this law uses the plant's true z and Fg%s%s, which this host does not send (hardware)", "",
+              "");
     return 1;
   }
   const double x = in->x, v = in->v;
@@ -182,7 +183,8 @@ FD_EXPORT int feeddrive_controller_update(void* self, const feeddrive_input* in,
   /* The built-in law's terms in its order; the observer disturbance and the model's additive
    * effects are 0 here (+ 0.0 keeps the sum's bits the same). */
   const double dc = 0.0, e0 = 0.0, e1 = 0.0;
-  out->u_unsaturated = (m->mass * a_cmd + f_friction + f_grinding + cog + dc + e0) / (m->thrust_gain * (1.0 - rel - e1));
+  out->u_unsaturated =
+      (m->mass * a_cmd + f_friction + f_grinding + cog + dc + e0) / (m->thrust_gain * (1.0 - rel - e1));
   const double u = out->u_unsaturated;
   out->u = isnan(u) ? 0.0 : u < c->info.u_min ? c->info.u_min : (c->info.u_max < u ? c->info.u_max : u);
   return 0;

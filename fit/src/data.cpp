@@ -28,8 +28,8 @@ void validate(const MeasuredData& d) {
       (!d.v.empty() && d.v.size() != n))
     throw DataError(d.source + ": columns of different lengths");
   if (n < kMinSamples)
-    throw DataError(d.source + ": " + std::to_string(n) + " samples: too few (at least " +
-                    std::to_string(kMinSamples) + ")");
+    throw DataError(d.source + ": " + std::to_string(n) + " samples: too few (at least " + std::to_string(kMinSamples) +
+                    ")");
   for (std::size_t k = 0; k < n; ++k) {
     const auto bad = [&](const char* col, double v) {
       throw DataError(d.source + ": sample " + std::to_string(k) + ", column " + col + ": " + std::to_string(v) +
@@ -63,11 +63,16 @@ Units parse_units(const std::string& spec) {
     const auto eq = item.find('=');
     const std::string role = item.substr(0, eq), unit = eq == std::string::npos ? "" : item.substr(eq + 1);
     const auto bad = [&](const std::string& why) {
-      throw DataError("--units '" + csv::shown(item) + "': " + why +
-                      " (ROLE=UNIT with t: s, ms, us; x, xd: m, mm, um, nm; force: N, kN, mN; u: V, mV; any: counts:SCALE)");
+      throw DataError(
+          "--units '" + csv::shown(item) + "': " + why +
+          " (ROLE=UNIT with t: s, ms, us; x, xd: m, mm, um, nm; force: N, kN, mN; u: V, mV; any: counts:SCALE)");
     };
-    double* target = role == "t" ? &u.t : role == "x" ? &u.x : role == "xd" ? &u.xd : role == "force" ? &u.force
-                   : role == "u" ? &u.u : nullptr;
+    double* target = role == "t"       ? &u.t
+                     : role == "x"     ? &u.x
+                     : role == "xd"    ? &u.xd
+                     : role == "force" ? &u.force
+                     : role == "u"     ? &u.u
+                                       : nullptr;
     if (!target) bad("unknown role '" + csv::shown(role) + "'");
     if (unit.empty()) bad("no unit");
     static const std::map<std::string, std::map<std::string, double>> table{
@@ -80,7 +85,8 @@ Units parse_units(const std::string& spec) {
       const std::string sc = unit.substr(7);
       char* end = nullptr;
       const double v = std::strtod(sc.c_str(), &end);
-      if (sc.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0)) bad("the scale of counts must be a positive number");
+      if (sc.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0))
+        bad("the scale of counts must be a positive number");
       *target = v;
       continue;
     }
@@ -157,7 +163,8 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix, co
   std::vector<sim::Record> rows;
   std::string notes_tail;
   try {
-    c = record::read_log(path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false, stop);
+    c = record::read_log(
+        path, prefix, [&](const sim::Record& r) { rows.push_back(r); }, /*need_reference=*/false, stop);
   } catch (const std::exception& e) {
     throw DataError(e.what());
   }
@@ -174,8 +181,8 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix, co
     gaps.pop_back();
   }
   if (!gaps.empty())
-    throw DataError(path + ": " + record::describe_gaps(gaps) + " of " +
-                    std::to_string(c.recorder.steps()) + "; the fit needs every state (position and applied input); " +
+    throw DataError(path + ": " + record::describe_gaps(gaps) + " of " + std::to_string(c.recorder.steps()) +
+                    "; the fit needs every state (position and applied input); " +
                     "feeddrive-log2csv writes the complete steps");
   MeasuredData d;
   d.source = path;
@@ -194,9 +201,11 @@ MeasuredData load_lcm_log(const std::string& path, const std::string& prefix, co
     d.notes.push_back("some reference messages are missing from the log: the record has no xd column");
   }
   if (const auto n = c.recorder.commandless_rows(); n > 0)
-    d.notes.push_back(std::to_string(n) + " of " + std::to_string(rows.size()) +
-                      " steps have no command in the log: their input is the one the plant applied (from its next state)");
-  if (c.non_finite > 0) d.notes.push_back(std::to_string(c.non_finite) + " messages with a non-finite value were dropped");
+    d.notes.push_back(
+        std::to_string(n) + " of " + std::to_string(rows.size()) +
+        " steps have no command in the log: their input is the one the plant applied (from its next state)");
+  if (c.non_finite > 0)
+    d.notes.push_back(std::to_string(c.non_finite) + " messages with a non-finite value were dropped");
   if (c.cut_bytes > 0) d.notes.push_back(record::describe_cut(c));
   if (!notes_tail.empty()) d.notes.push_back(notes_tail);
   validate(d);
@@ -207,7 +216,8 @@ MeasuredData load_data(const std::string& path, const std::string& prefix, const
                        const interrupt::StopToken& stop) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  MeasuredData d = (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") ? load_lcm_log(path, prefix, stop) : load_csv(path, opt);
+  MeasuredData d =
+      (ext == ".lcm" || ext == ".lcmlog" || ext == ".log") ? load_lcm_log(path, prefix, stop) : load_csv(path, opt);
   shift_time_origin(d);
   return d;
 }

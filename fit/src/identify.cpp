@@ -26,7 +26,7 @@ struct Ctx {
   const plant::PlantParams& model;
   const Eigen::VectorXd* r0;  // residual of the model without the candidate (may be null)
   double x_mean;
-  double offset_bound{0.0};   // |F| bound of the model-form offset (FreeSet::offset_bound)
+  double offset_bound{0.0};     // |F| bound of the model-form offset (FreeSet::offset_bound)
   interrupt::StopToken stop{};  // ends a solve within an iteration (Ctrl-C in the tool)
 };
 
@@ -153,13 +153,16 @@ const std::vector<Spec>& specs() {
       sp.name = "presliding";
       sp.dim = 2;  // ln sigma0, sigma1
       sp.to_effect = [](const Theta& t, const Ctx&) {
-        return Effect{"presliding", {{"bristle_stiffness_N_per_m", std::exp(t[0])}, {"bristle_damping_Ns_per_m", t[1]}}};
+        return Effect{"presliding",
+                      {{"bristle_stiffness_N_per_m", std::exp(t[0])}, {"bristle_damping_Ns_per_m", t[1]}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
-        return Theta{std::log(e.parameters.at("bristle_stiffness_N_per_m")), e.parameters.at("bristle_damping_Ns_per_m")};
+        return Theta{std::log(e.parameters.at("bristle_stiffness_N_per_m")),
+                     e.parameters.at("bristle_damping_Ns_per_m")};
       };
       sp.starts = [](const Ctx& c) {
-        const double s1 = c.model.friction.model == plant::FrictionModel::kLuGre ? c.model.friction.bristle_damping : 0.0;
+        const double s1 =
+            c.model.friction.model == plant::FrictionModel::kLuGre ? c.model.friction.bristle_damping : 0.0;
         std::vector<Theta> out;
         for (double s0 : {1e5, 1e6, 1e7, 1e8}) out.push_back({std::log(s0), s1});
         return out;
@@ -193,9 +196,7 @@ const std::vector<Spec>& specs() {
       };
       // A ripple of pitch p is also "the third harmonic of pitch 3p": when the fit lands on the
       // latter, the fundamental-only form at p is the same force with the physical pitch.
-      sp.alternatives = [](const Theta& t) {
-        return std::vector<Theta>{{t[0] - std::log(3.0), t[3], t[4], 0.0, 0.0}};
-      };
+      sp.alternatives = [](const Theta& t) { return std::vector<Theta>{{t[0] - std::log(3.0), t[3], t[4], 0.0, 0.0}}; };
       s.push_back(sp);
     }
     {
@@ -226,9 +227,9 @@ const std::vector<Spec>& specs() {
       sp.dim = 3;  // ln C, ln ke, contact position (scanned, held by Ceres)
       sp.fixed = {2};
       sp.to_effect = [](const Theta& t, const Ctx&) {
-        return Effect{"grinding_force", {{"gain_Ns_per_m", std::exp(t[0])},
-                                         {"stiffness_N_per_m", std::exp(t[1])},
-                                         {"contact_position_m", t[2]}}};
+        return Effect{
+            "grinding_force",
+            {{"gain_Ns_per_m", std::exp(t[0])}, {"stiffness_N_per_m", std::exp(t[1])}, {"contact_position_m", t[2]}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
         const auto& p = e.parameters;
@@ -517,7 +518,8 @@ int FreeSet::parameters(const plant::PlantParams& model) const {
 namespace {
 
 // The blocks and start vector of a joint fit of `free` on `model`.
-std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& model, const FreeSet& free, const Ctx& ctx) {
+std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& model, const FreeSet& free,
+                                                  const Ctx& ctx) {
   std::vector<Block> blocks;
   Theta theta;
   for (const std::string& name : free.effects) {
@@ -634,7 +636,8 @@ std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& 
   return out;
 }
 
-std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec, const plant::PlantParams& fitted,
+std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec,
+                                                                          const plant::PlantParams& fitted,
                                                                           const std::vector<std::string>& effects) {
   std::map<std::string, std::map<std::string, double>> out;
   std::vector<std::pair<std::string, std::string>> keys;
@@ -683,7 +686,8 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
   for (long c = 0; c < k; ++c) {
     const auto& [name, key] = keys[static_cast<std::size_t>(c)];
     const double var = s2 * d[c] * d[c] * P(c, c);
-    out[name][key] = d[c] > 0 && var > 0 && std::isfinite(var) ? 1.96 * std::sqrt(var) : std::numeric_limits<double>::quiet_NaN();
+    out[name][key] =
+        d[c] > 0 && var > 0 && std::isfinite(var) ? 1.96 * std::sqrt(var) : std::numeric_limits<double>::quiet_NaN();
   }
   return out;
 }
@@ -742,7 +746,8 @@ std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, 
     const double d = rec.period;
     const Eigen::VectorXd ahead = apply_delayed(b, rec.data->t, rec.input, -d);
     const Eigen::VectorXd behind = apply_delayed(b, rec.data->t, rec.input, d);
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = (ahead[static_cast<long>(i)] - behind[static_cast<long>(i)]) / (2 * d);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = (ahead[static_cast<long>(i)] - behind[static_cast<long>(i)]) / (2 * d);
     return {"input rate [input unit/s]", out};
   }
   return {"t [s]", b.tau};

@@ -15,16 +15,17 @@ Record prepare(const MeasuredData& d, const RecordOptions& opt) {
   r.data = &d;
   r.cache = std::make_shared<Record::Cache>();
   r.period = d.median_period();
-  const int M = opt.motion_half_window > 0
-                    ? opt.motion_half_window
-                    : std::max(3, static_cast<int>(std::lround(2e-3 / r.period)));
+  const int M =
+      opt.motion_half_window > 0 ? opt.motion_half_window : std::max(3, static_cast<int>(std::lround(2e-3 / r.period)));
   const double L = opt.filter_half_width > 0 ? opt.filter_half_width : std::max(0.01, 10.0 * r.period);
   // A filter window must hold samples: one shorter than two sample periods averages nothing
   // (the force is the raw second difference) and makes a bank of one window per sample.
   if (opt.filter_half_width > 0 && opt.filter_half_width < 2.0 * r.period) {
     char why[200];
-    std::snprintf(why, sizeof why, ": --filter-half-width %.3g s is shorter than 2 sample periods (%.3g s) of the record; "
-                  "use at least %.3g s, or 0 for the default", opt.filter_half_width, r.period, 2.0 * r.period);
+    std::snprintf(why, sizeof why,
+                  ": --filter-half-width %.3g s is shorter than 2 sample periods (%.3g s) of the record; "
+                  "use at least %.3g s, or 0 for the default",
+                  opt.filter_half_width, r.period, 2.0 * r.period);
     throw DataError(d.source + why);
   }
   if (d.size() < static_cast<std::size_t>(2 * M + 1))
@@ -51,9 +52,11 @@ Record prepare(const MeasuredData& d, const RecordOptions& opt) {
     for (long j = std::max(0L, k - 2 * M - 1); j < std::min(n, k + 2 * M + 2); ++j)
       if (std::abs(d.x[static_cast<std::size_t>(j)]) > std::abs(d.x[static_cast<std::size_t>(worst)])) worst = j;
     char why[240];
-    std::snprintf(why, sizeof why, ": the velocity or acceleration estimated from the position is beyond 1e150 near t = %.6g s "
+    std::snprintf(why, sizeof why,
+                  ": the velocity or acceleration estimated from the position is beyond 1e150 near t = %.6g s "
                   "(position %.6g m at t = %.6g s): is the position column in metres and free of outliers?",
-                  d.t[static_cast<std::size_t>(k)], d.x[static_cast<std::size_t>(worst)], d.t[static_cast<std::size_t>(worst)]);
+                  d.t[static_cast<std::size_t>(k)], d.x[static_cast<std::size_t>(worst)],
+                  d.t[static_cast<std::size_t>(worst)]);
     throw DataError(d.source + why);
   }
   r.input.resize(static_cast<long>(d.size()) - 1);
@@ -158,7 +161,7 @@ void internal_force(const Record& r, const plant::PlantParams& pe, int part, Eig
     const double hs = h / S;
     double fsum = 0.0;
     for (int q = 0; q < S; ++q) {
-      const double sq = (q + 0.5) / S;  // sub-step midpoint in [0, 1]
+      const double sq = (q + 0.5) / S;                          // sub-step midpoint in [0, 1]
       const auto par = [sq](double y0, double ym, double y1) {  // parabola through (0,y0), (1/2,ym), (1,y1)
         return y0 * (2 * sq - 1) * (sq - 1) + ym * 4 * sq * (1 - sq) + y1 * sq * (2 * sq - 1);
       };

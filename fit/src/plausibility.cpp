@@ -31,9 +31,7 @@ double friction_level(const plant::PlantParams& m) {
   return c;
 }
 
-double Envelope::min_pitch() const {
-  return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width});
-}
+double Envelope::min_pitch() const { return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width}); }
 
 Envelope envelope(const Record& rec, const plant::PlantParams& model) {
   Envelope e;
@@ -80,9 +78,10 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
     if (model.friction.model == plant::FrictionModel::kNone)
       return "the model has no friction (friction.model: none) whose presliding regime could be missing";
     if (env.stick_phases + env.reversals < 3)
-      return fmt("the data has too few stick phases or reversals to show presliding (%.0f stick phases below %.3g mm/s, "
-                 "%.0f reversals)",
-                 env.stick_phases, env.stick_velocity * 1e3, env.reversals);
+      return fmt(
+          "the data has too few stick phases or reversals to show presliding (%.0f stick phases below %.3g mm/s, "
+          "%.0f reversals)",
+          env.stick_phases, env.stick_velocity * 1e3, env.reversals);
   }
   if ((name == "cogging_ripple" || name == "reluctance_ripple") && env.min_pitch() > env.max_pitch())
     return fmt("the travel (%.3g mm) spans no two periods of the shortest pitch the data resolves (%.3g mm)",
@@ -115,9 +114,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     // from that.
     const double level = friction_level(model);
     if (level > 0 && std::abs(par(e, "force_N")) < kAsymmetry * level)
-      return fmt("force %.3g N is within a %.0f %% direction asymmetry of the %.4g N Coulomb friction, from which "
-                 "moving data cannot tell it",
-                 std::abs(par(e, "force_N")), 100 * kAsymmetry, level);
+      return fmt(
+          "force %.3g N is within a %.0f %% direction asymmetry of the %.4g N Coulomb friction, from which "
+          "moving data cannot tell it",
+          std::abs(par(e, "force_N")), 100 * kAsymmetry, level);
   }
   if (n == "coulomb_friction" && par(e, "coulomb_N") > F) return above("Coulomb level", par(e, "coulomb_N"));
   if (n == "viscous_friction" && par(e, "viscous_Ns_per_m") * env.v_max > F)
@@ -125,9 +125,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
   if (n == "stribeck_friction") {
     if (par(e, "static_N") > F) return above("static level", par(e, "static_N"));
     if (par(e, "static_N") - par(e, "coulomb_N") < 0.05 * par(e, "coulomb_N"))
-      return fmt("no Stribeck hump: the static level %.4g N is within 5 %% of the Coulomb level %.4g N (that is Coulomb "
-                 "friction)",
-                 par(e, "static_N"), par(e, "coulomb_N"));
+      return fmt(
+          "no Stribeck hump: the static level %.4g N is within 5 %% of the Coulomb level %.4g N (that is Coulomb "
+          "friction)",
+          par(e, "static_N"), par(e, "coulomb_N"));
     const double vs = par(e, "stribeck_velocity_mps");
     if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
       return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
@@ -169,9 +170,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
       return above("spring force over the travel", par(e, "stiffness_N_per_m") * env.travel);
     const double level = friction_level(model);
     if (level > 0 && par(e, "stiffness_N_per_m") * env.travel < kAsymmetry * level)
-      return fmt("its force changes by only %.3g N over the travel, within a %.0f %% direction asymmetry of the "
-                 "%.4g N Coulomb friction: a constant force in disguise",
-                 par(e, "stiffness_N_per_m") * env.travel, 100 * kAsymmetry, level);
+      return fmt(
+          "its force changes by only %.3g N over the travel, within a %.0f %% direction asymmetry of the "
+          "%.4g N Coulomb friction: a constant force in disguise",
+          par(e, "stiffness_N_per_m") * env.travel, 100 * kAsymmetry, level);
   }
   if (n == "mass_error") {
     const double m = par(e, "mass_kg");

@@ -48,8 +48,8 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
   std::string shown_path = scenario_path;  // a comment: one line, whatever the path holds
   for (char& c : shown_path)
     if (c == '\n' || c == '\r') c = '?';
-  return std::string("# feeddrive-fit: ") + shown_path + " plus the fitted effects under plant.effects\n" +
-         em.c_str() + "\n";
+  return std::string("# feeddrive-fit: ") + shown_path + " plus the fitted effects under plant.effects\n" + em.c_str() +
+         "\n";
 }
 
 namespace {
@@ -63,8 +63,12 @@ nlohmann::json params_json(const Effect& e) {
 nlohmann::json bins_json(const std::vector<Bin>& bins) {
   nlohmann::json a = nlohmann::json::array();
   for (const Bin& b : bins)
-    a.push_back({{"bin", b.label}, {"points", b.points}, {"force_rms_N", b.force_rms}, {"share", b.share},
-                 {"concentration", b.concentration}, {"gap_m", b.gap}});
+    a.push_back({{"bin", b.label},
+                 {"points", b.points},
+                 {"force_rms_N", b.force_rms},
+                 {"share", b.share},
+                 {"concentration", b.concentration},
+                 {"gap_m", b.gap}});
   return a;
 }
 
@@ -73,7 +77,9 @@ nlohmann::json bins_json(const std::vector<Bin>& bins) {
 std::string findings_json(const FitResult& r, const MeasuredData* data) {
   nlohmann::json j;
   if (data != nullptr)
-    j["data"] = {{"source", data->source}, {"samples", data->size()}, {"time_offset_s", data->time_offset},
+    j["data"] = {{"source", data->source},
+                 {"samples", data->size()},
+                 {"time_offset_s", data->time_offset},
                  {"notes", data->notes}};
   j["gap_initial"] = r.replay_initial.gap;
   j["gap_final"] = r.replay_final.gap;
@@ -92,7 +98,8 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
     }
     nlohmann::json ci = nlohmann::json::object();
     if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
-      for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
+      for (const auto& [k, v] : it->second)
+        ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
     const auto tent = r.tentative.find(final.name);
     nlohmann::json e = {{"name", final.name},
                         {"parameters", params_json(final)},
@@ -108,10 +115,16 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   }
   j["verdict"] = verdict_name(r.verdict);
   j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
-  j["noise_floor"] = {{"gap_m", r.floor.gap}, {"force_rms_N", r.floor.force}, {"quantization_m", r.floor.quantization},
-                      {"noise_m", r.floor.noise}, {"position_sigma_m", r.floor.position}, {"factor", kFloorFactor},
-                      {"from_scenario", r.floor.from_scenario}, {"source", r.floor.source},
-                      {"force_noise_N", r.floor.force_noise}, {"force_discretisation_N", r.floor.force_discretisation},
+  j["noise_floor"] = {{"gap_m", r.floor.gap},
+                      {"force_rms_N", r.floor.force},
+                      {"quantization_m", r.floor.quantization},
+                      {"noise_m", r.floor.noise},
+                      {"position_sigma_m", r.floor.position},
+                      {"factor", kFloorFactor},
+                      {"from_scenario", r.floor.from_scenario},
+                      {"source", r.floor.source},
+                      {"force_noise_N", r.floor.force_noise},
+                      {"force_discretisation_N", r.floor.force_discretisation},
                       {"stamp_error_s", r.floor.stamp_error}};
   j["unexplained"] = r.unexplained;
   j["ties"] = r.ties;
@@ -122,26 +135,42 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
                      {"coulomb_transition_shape_final", r.shape_final},
                      {"fitted", r.smoothing_fitted}};
   const Envelope& env = r.envelope;
-  j["record"] = {{"travel_m", env.travel}, {"peak_speed_mps", env.v_max}, {"peak_thrust_N", env.peak_thrust},
-                 {"ripple_pitch_range_m", {env.min_pitch(), env.max_pitch()}}, {"stick_phases", env.stick_phases}, {"reversals", env.reversals},
+  j["record"] = {{"travel_m", env.travel},
+                 {"peak_speed_mps", env.v_max},
+                 {"peak_thrust_N", env.peak_thrust},
+                 {"ripple_pitch_range_m", {env.min_pitch(), env.max_pitch()}},
+                 {"stick_phases", env.stick_phases},
+                 {"reversals", env.reversals},
                  {"stick_fraction", env.stick_fraction}};
   nlohmann::json steps = nlohmann::json::array();
   for (const StepResult& st : r.steps) {
     nlohmann::json rk = nlohmann::json::array();
     for (const CandidateFit& c : st.ranking)
-      rk.push_back({{"name", c.effect.name}, {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
-                    {"parameters", params_json(c.effect)}, {"k", c.parameters}, {"rss_N2", c.rss},
-                    {"passed_over", c.passed_over}, {"tentative", c.tentative}, {"swap", c.swap},
+      rk.push_back({{"name", c.effect.name},
+                    {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
+                    {"parameters", params_json(c.effect)},
+                    {"k", c.parameters},
+                    {"rss_N2", c.rss},
+                    {"passed_over", c.passed_over},
+                    {"tentative", c.tentative},
+                    {"swap", c.swap},
                     {"fit_seconds", c.seconds}});
-    steps.push_back({{"accepted", st.accepted}, {"verdict", st.verdict}, {"ranking", rk}, {"removed", st.removed},
-                     {"swap", st.swap}, {"caveat", st.caveat}, {"ties", st.ties},
-                     {"cross_validation", {{"held_out_sq_residual_without_N2", st.cv_without},
-                                           {"held_out_sq_residual_with_N2", st.cv_with}}},
-                     {"localisation", {{"summary", st.localisation.summary},
-                                       {"time", bins_json(st.localisation.time)},
-                                       {"velocity", bins_json(st.localisation.velocity)},
-                                       {"acceleration", bins_json(st.localisation.acceleration)},
-                                       {"position", bins_json(st.localisation.position)}}}});
+    steps.push_back(
+        {{"accepted", st.accepted},
+         {"verdict", st.verdict},
+         {"ranking", rk},
+         {"removed", st.removed},
+         {"swap", st.swap},
+         {"caveat", st.caveat},
+         {"ties", st.ties},
+         {"cross_validation",
+          {{"held_out_sq_residual_without_N2", st.cv_without}, {"held_out_sq_residual_with_N2", st.cv_with}}},
+         {"localisation",
+          {{"summary", st.localisation.summary},
+           {"time", bins_json(st.localisation.time)},
+           {"velocity", bins_json(st.localisation.velocity)},
+           {"acceleration", bins_json(st.localisation.acceleration)},
+           {"position", bins_json(st.localisation.position)}}}});
   }
   j["steps"] = steps;
   // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
@@ -153,7 +182,8 @@ namespace {
 
 std::string table(const std::vector<Bin>& bins) {
   std::ostringstream s;
-  s << "| bin | points | force RMS [N] | share of residual | concentration | replay gap [um] |\n|---|---|---|---|---|---|\n";
+  s << "| bin | points | force RMS [N] | share of residual | concentration | replay gap [um] "
+       "|\n|---|---|---|---|---|---|\n";
   char buf[256];
   for (const Bin& b : bins) {
     std::snprintf(buf, sizeof buf, "| %s | %ld | %.3g | %.1f %% | %.2f | %.3g |\n", b.label.c_str(), b.points,
@@ -175,9 +205,8 @@ std::string params_text(const Effect& e) {
 
 }  // namespace
 
-void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
-                   const FitResult& r, bool plots,
-                   const interrupt::StopToken& stop) {
+void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
+                   bool plots, const interrupt::StopToken& stop) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
   {
     const MeasuredData& d = *rec.data;
@@ -185,7 +214,8 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
     // data behind the plots
     {
-      output::CsvWriter f(out.path("replay.csv"), {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
+      output::CsvWriter f(out.path("replay.csv"),
+                          {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
       for (std::size_t k = 0; k < d.size(); ++k)
         f.row({d.t[k], d.x[k], r.replay_initial.x_sim[k], r.replay_final.x_sim[k], r.replay_initial.error[k],
                r.replay_final.error[k]});
@@ -209,7 +239,8 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       for (std::size_t i = 0; i < xs.size(); ++i) {
         const long li = static_cast<long>(i);
         // r = -filtered F_extra: the effect's own filtered force is -(r_after - r_before)
-        f.row({xs[i], -st.residual_before[li], -(st.residual_before[li] - st.residual_after[li]), -st.residual_after[li]});
+        f.row({xs[i], -st.residual_before[li], -(st.residual_before[li] - st.residual_after[li]),
+               -st.residual_after[li]});
       }
       f.close();
     }
@@ -243,12 +274,13 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
     if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
     {
       char a[160], b[200];
-      std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ", r.floor.gap * 1e6,
-                    r.floor.force, r.floor.position * 1e9);
-      std::snprintf(b, sizeof b,
-                    "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
-                    "most %.0fx the floor.\n\n",
-                    r.floor.force_noise, r.floor.force_discretisation, kFloorFactor);
+      std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ",
+                    r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9);
+      std::snprintf(
+          b, sizeof b,
+          "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
+          "most %.0fx the floor.\n\n",
+          r.floor.force_noise, r.floor.force_discretisation, kFloorFactor);
       md << a << r.floor.source << b;
     }
     if (!r.unexplained.empty()) {
@@ -278,11 +310,12 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
     }
     if (r.smoothing_fitted) {
-      std::snprintf(buf, sizeof buf,
-                    "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
-                    "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
-                    "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
-                    r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
+      std::snprintf(
+          buf, sizeof buf,
+          "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
+          "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
+          "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
+          r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
       md << buf;
     }
     {
@@ -318,9 +351,11 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
         md << buf << params_text(st.ranking[i].effect) << " | " << st.ranking[i].passed_over << " |\n";
       }
       md << "\nWhere the residual was (before this step):\n\n"
-         << "Velocity regimes\n\n" << table(st.localisation.velocity) << "\nAcceleration phases\n\n"
-         << table(st.localisation.acceleration) << "\nPosition\n\n" << table(st.localisation.position)
-         << "\nTime\n\n" << table(st.localisation.time);
+         << "Velocity regimes\n\n"
+         << table(st.localisation.velocity) << "\nAcceleration phases\n\n"
+         << table(st.localisation.acceleration) << "\nPosition\n\n"
+         << table(st.localisation.position) << "\nTime\n\n"
+         << table(st.localisation.time);
       if (st.accepted && plots) {
         ++k;
         md << "\n![residual against the regressor of " << st.effect.name << "](effect" << k << ".png)\n";
@@ -333,7 +368,8 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
             "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
          << "plot 'replay.csv' every ::1 using 1:($2*1e3) with lines lw 2 title 'measured', '' every ::1 using "
-            "1:($3*1e3) with lines title 'model as given', '' every ::1 using 1:($4*1e3) with lines title 'fitted model'\n"
+            "1:($3*1e3) with lines title 'model as given', '' every ::1 using 1:($4*1e3) with lines title 'fitted "
+            "model'\n"
          << "set ylabel 'x_sim - x [um]'\nplot 'replay.csv' every ::1 using 1:($5*1e6) with lines title 'model as "
             "given', '' every ::1 using 1:($6*1e6) with lines title 'fitted model'\nunset multiplot\n";
       gp << "set output 'gap.png'\nset title 'replay gap after each step'\nset xlabel 'step'\nset ylabel 'gap [um]'\n"

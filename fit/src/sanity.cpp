@@ -28,7 +28,8 @@ std::string hint(const std::string& role, double factor) {
 std::string unit_name(const std::string& role, double factor) {
   const auto near = [&](double f) { return std::abs(std::log10(factor / f)) < 0.01; };
   if (role == "t") return near(1) ? "s" : near(1e-3) ? "ms" : near(1e-6) ? "us" : "";
-  if (role == "x" || role == "xd") return near(1) ? "m" : near(1e-3) ? "mm" : near(1e-6) ? "um" : near(1e-9) ? "nm" : "";
+  if (role == "x" || role == "xd")
+    return near(1) ? "m" : near(1e-3) ? "mm" : near(1e-6) ? "um" : near(1e-9) ? "nm" : "";
   if (role == "force") return near(1) ? "N" : near(1e3) ? "kN" : near(1e-3) ? "mN" : "";
   if (role == "u") return near(1) ? "V" : near(1e-3) ? "mV" : "";
   return "";
@@ -44,10 +45,12 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
     if (d.t[k] - d.t[k - 1] > d.t[worst] - d.t[worst - 1]) worst = k;
   const double gap = d.t[worst] - d.t[worst - 1];
   if (gap > kMaxGap * T)
-    throw DataError(d.where(worst) + ": column '" + d.time_name + "': the time jumps by " + fmt("%.6g s (%.3g sample periods of %.3g s) from t = %.9g", gap, gap / T, T, d.t[worst - 1] + d.time_offset) +
-                    fmt(" to %.9g s: a gap, or two recordings joined; the fit needs one continuous recording: split the "
-                        "file there and fit each part",
-                        d.t[worst] + d.time_offset));
+    throw DataError(
+        d.where(worst) + ": column '" + d.time_name + "': the time jumps by " +
+        fmt("%.6g s (%.3g sample periods of %.3g s) from t = %.9g", gap, gap / T, T, d.t[worst - 1] + d.time_offset) +
+        fmt(" to %.9g s: a gap, or two recordings joined; the fit needs one continuous recording: split the "
+            "file there and fit each part",
+            d.t[worst] + d.time_offset));
   // 2. the time scale against the control period
   if (control_period > 0 && T > 0) {
     const int k = thousands(T / control_period);
@@ -55,8 +58,9 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
       const double factor = d.time_factor * std::pow(1000.0, -k);
       const std::string h = hint("t", factor);
       if (!h.empty())
-        throw DataError(d.source + ": column '" + d.time_name + "'" +
-                        fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
+        throw DataError(
+            d.source + ": column '" + d.time_name + "'" +
+            fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
     }
   }
   // 3. the position scale: travel and speed a feed drive can have
@@ -77,11 +81,12 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
     int k = 0;
     while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
     const std::string h = hint("x", d.position_factor * std::pow(1e-3, k));
-    throw DataError(d.source + ": column '" + d.position_name + "'" +
-                    fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
-                        "%.3g m, %.3g m/s)",
-                        travel, v99, kMaxTravel, kMaxSpeed) +
-                    (h.empty() ? ": is the position in metres?" : h));
+    throw DataError(
+        d.source + ": column '" + d.position_name + "'" +
+        fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
+            "%.3g m, %.3g m/s)",
+            travel, v99, kMaxTravel, kMaxSpeed) +
+        (h.empty() ? ": is the position in metres?" : h));
   }
   // 4. discontinuities in position: an acceleration no thrust of this drive gives, and beyond the
   // sensor's own second difference (a quantum and three noise deviations per step, 50-fold)
@@ -123,10 +128,11 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
     for (std::size_t k = std::max<std::size_t>(jump, 1) - 0; k <= jump + 1 && k + 1 < n; ++k) {
       const double off = std::abs(d.x[k] - 0.5 * (d.x[k - 1] + d.x[k + 1]));
       if (std::abs(d.x[k + 1] - d.x[k - 1]) < 0.1 * off)
-        throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
-                        fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
-                            "column in metres and free of outliers?",
-                            d.x[k], d.t[k] + d.time_offset, off));
+        throw DataError(
+            d.where(k) + ": column '" + d.position_name + "'" +
+            fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
+                "column in metres and free of outliers?",
+                d.x[k], d.t[k] + d.time_offset, off));
     }
     // the step of the jump is the larger of the two around sample `jump`
     const std::size_t k = std::abs(d.x[jump + 1] - d.x[jump]) > std::abs(d.x[jump] - d.x[jump - 1]) ? jump + 1 : jump;

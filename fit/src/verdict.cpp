@@ -23,9 +23,10 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
     for (std::size_t k = 1; k < d.size(); ++k)
       if (d.x[k] != d.x[k - 1]) q = std::min(q, std::abs(d.x[k] - d.x[k - 1]));
     f.quantization = std::isfinite(q) ? q : 0.0;
-    f.source = fmt("the scenario gives no sensor (plant.sensor): q = %.3g nm is the record's smallest position step, "
-                   "noise unknown (taken as 0): give plant.sensor for a floor you can trust",
-                   f.quantization * 1e9);
+    f.source =
+        fmt("the scenario gives no sensor (plant.sensor): q = %.3g nm is the record's smallest position step, "
+            "noise unknown (taken as 0): give plant.sensor for a floor you can trust",
+            f.quantization * 1e9);
   } else {
     f.source = fmt("plant.sensor: quantization %.3g nm, noise %.3g nm", f.quantization * 1e9, f.noise * 1e9);
   }
@@ -158,42 +159,51 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
   if (n == "cogging_ripple" || n == "reluctance_ripple") {
     const double p = par(c.effect, "pitch_m");
     if (p > 0 && p > env.max_pitch())
-      return fmt("a force periodic in position, pitch about %.3g mm, seen over %.2g periods: record a travel of at least 3 "
-                 "periods (%.3g mm)",
-                 p * 1e3, env.travel / p, 3 * p * 1e3);
+      return fmt(
+          "a force periodic in position, pitch about %.3g mm, seen over %.2g periods: record a travel of at least 3 "
+          "periods (%.3g mm)",
+          p * 1e3, env.travel / p, 3 * p * 1e3);
     if (p > 0 && p < env.min_pitch())
-      return fmt("a force periodic in position, pitch about %.3g mm, faster than the filter resolves at %.3g mm/s: record "
-                 "the moves at most %.3g mm/s (or at a higher sample rate)",
-                 p * 1e3, env.v_max * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
+      return fmt(
+          "a force periodic in position, pitch about %.3g mm, faster than the filter resolves at %.3g mm/s: record "
+          "the moves at most %.3g mm/s (or at a higher sample rate)",
+          p * 1e3, env.v_max * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
     if (why == Reason::kPrerequisite)
-      return fmt("a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "
-                 "pitch you suspect",
-                 env.travel * 1e3);
-    return fmt("a force periodic in position (pitch about %.3g mm): record more travel over the same range, e.g. a "
-               "record of %.3g s with full-travel moves at several speeds",
-               p * 1e3, longer);
+      return fmt(
+          "a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "
+          "pitch you suspect",
+          env.travel * 1e3);
+    return fmt(
+        "a force periodic in position (pitch about %.3g mm): record more travel over the same range, e.g. a "
+        "record of %.3g s with full-travel moves at several speeds",
+        p * 1e3, longer);
   }
   if (why == Reason::kPrerequisite && n == "presliding")
     return "friction at the reversals: record at least 3 reversals or stick phases (short back-and-forth moves)";
   if (why == Reason::kPrerequisite && n == "grinding_force")
-    return "a grinding force: describe the grinding process (plant.grinding) or ask for it with --effects grinding_force";
+    return "a grinding force: describe the grinding process (plant.grinding) or ask for it with --effects "
+           "grinding_force";
   if (why == Reason::kPrerequisite) return "";
   if (n == "constant_force" || n == "coulomb_friction")
-    return fmt("a force that depends on the direction of motion or not: record moves in both directions (reversals), "
-               "%.3g s or more",
-               longer);
+    return fmt(
+        "a force that depends on the direction of motion or not: record moves in both directions (reversals), "
+        "%.3g s or more",
+        longer);
   if (n == "viscous_friction" || n == "stribeck_friction")
-    return fmt("a friction that depends on speed: record moves at several constant speeds (from %.3g to %.3g mm/s), "
-               "%.3g s or more",
-               0.05 * env.v_max * 1e3, env.v_max * 1e3, longer);
+    return fmt(
+        "a friction that depends on speed: record moves at several constant speeds (from %.3g to %.3g mm/s), "
+        "%.3g s or more",
+        0.05 * env.v_max * 1e3, env.v_max * 1e3, longer);
   if (n == "mass_error" || n == "input_delay")
-    return fmt("a force proportional to the acceleration or a delay: record stronger and faster changes of the thrust "
-               "(short accelerations), %.3g s or more",
-               longer);
+    return fmt(
+        "a force proportional to the acceleration or a delay: record stronger and faster changes of the thrust "
+        "(short accelerations), %.3g s or more",
+        longer);
   if (n == "spring_force" || n == "grinding_force")
-    return fmt("a force that depends on position: record a longer travel than %.3g mm, passing the range several "
-               "times",
-               env.travel * 1e3);
+    return fmt(
+        "a force that depends on position: record a longer travel than %.3g mm, passing the range several "
+        "times",
+        env.travel * 1e3);
   if (n == "presliding") return "friction at the reversals: record more short reversals and stick phases";
   return fmt("record a longer record (%.3g s) with the same moves", longer);
 }
@@ -208,8 +218,7 @@ std::string what_would_separate(const std::string& a, const std::string& b) {
     return "moves at different speeds: a friction that grows with speed separates from one that does not";
   if (has("spring_force") || has("cogging_ripple") || has("reluctance_ripple") || has("grinding_force"))
     return "a longer travel: forces that depend on position differ over more of it";
-  if (has("mass_error") || has("input_delay"))
-    return "different accelerations (short, strong moves and slow ones)";
+  if (has("mass_error") || has("input_delay")) return "different accelerations (short, strong moves and slow ones)";
   return "a record with reversals, a longer travel and moves at different speeds";
 }
 

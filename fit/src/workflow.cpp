@@ -59,9 +59,10 @@ void check_options(const Record& rec, const FitOptions& opt) {
   // A replay window must hold more samples than the two its start-state correction fits
   // (offset and slope): a window of 2 or 3 samples replays any model with a gap of 0.
   if (opt.replay_window > 0 && opt.replay_window < 10.0 * rec.period)
-    throw DataError(rec.data->source + fmt(": --replay-window %.3g s spans fewer than 10 sample periods (%.3g s) of the "
-                                           "record; use at least %.3g s, or 0 for the default",
-                                           opt.replay_window, rec.period, 10.0 * rec.period));
+    throw DataError(rec.data->source +
+                    fmt(": --replay-window %.3g s spans fewer than 10 sample periods (%.3g s) of the "
+                        "record; use at least %.3g s, or 0 for the default",
+                        opt.replay_window, rec.period, 10.0 * rec.period));
 }
 
 FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const FitOptions& opt, const Log& log) {
@@ -111,12 +112,14 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     std::size_t worst = 0;
     for (std::size_t k = 0; k < d.size(); ++k)
       if (std::abs(d.x[k]) > std::abs(d.x[worst])) worst = k;
-    throw DataError(d.source + fmt(": the replay gap or the force residual of the model is not finite on this record (its "
-                                   "largest position is %.6g m at t = %.6g s): is the position column in metres and free of "
-                                   "outliers?",
-                                   d.x[worst], d.t[worst]));
+    throw DataError(d.source +
+                    fmt(": the replay gap or the force residual of the model is not finite on this record (its "
+                        "largest position is %.6g m at t = %.6g s): is the position column in metres and free of "
+                        "outliers?",
+                        d.x[worst], d.t[worst]));
   }
-  say("initial model: gap " + fmt("%.4g um, force residual RMS %.4g N", out.replay_initial.gap * 1e6, out.force_rms_initial));
+  say("initial model: gap " +
+      fmt("%.4g um, force residual RMS %.4g N", out.replay_initial.gap * 1e6, out.force_rms_initial));
   std::vector<std::string> added;  // in the order found; removed ones are taken out
   // A ripple whose fitted pitch fails a resolvability limit only by its uncertainty: the caveat
   // (named as tentative: docs/fit.md, "Tentative effects").
@@ -253,7 +256,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
           c.reason = Reason::kImplausible;
           break;
         }
-        c.swap = swap_from + (simple.name == swap_from ? " (its fundamental vanished: its harmonic)" : "") + " -> " + simple.name;
+        c.swap = swap_from + (simple.name == swap_from ? " (its fundamental vanished: its harmonic)" : "") + " -> " +
+                 simple.name;
         jf = js;
         fs = fs2;
       }
@@ -284,9 +288,11 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
         const double top = st.ranking[eligible.front()].score;
         std::size_t pick = eligible.front();
         for (std::size_t i : eligible)
-          if (st.ranking[i].score >= top - kParsimony && st.ranking[i].parameters < st.ranking[pick].parameters) pick = i;
+          if (st.ranking[i].score >= top - kParsimony && st.ranking[i].parameters < st.ranking[pick].parameters)
+            pick = i;
         const auto first = st.ranking.begin() + static_cast<long>(eligible.front());
-        std::rotate(first, st.ranking.begin() + static_cast<long>(pick), st.ranking.begin() + static_cast<long>(pick) + 1);
+        std::rotate(first, st.ranking.begin() + static_cast<long>(pick),
+                    st.ranking.begin() + static_cast<long>(pick) + 1);
       }
     }
     // 2. the best eligible candidate that is significant, confirmed out of sample and by the replay
@@ -344,9 +350,10 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       const std::vector<double> cv_with = cv_of(c);
       const CvVerdict v = cv_verdict(cv_without, cv_with);
       if (!v.confirmed) {
-        c.passed_over = fmt("not confirmed out of sample: held-out squared residual %.4g -> %.4g N^2 "
-                            "(mean reduction per block %.3g, standard error %.3g)",
-                            total(cv_without), total(cv_with), v.mean, v.se);
+        c.passed_over =
+            fmt("not confirmed out of sample: held-out squared residual %.4g -> %.4g N^2 "
+                "(mean reduction per block %.3g, standard error %.3g)",
+                total(cv_without), total(cv_with), v.mean, v.se);
         c.reason = Reason::kNotConfirmed;
         why_not += (why_not.empty() ? "" : "; ") + c.effect.name + " " + c.passed_over;
         continue;
@@ -400,12 +407,14 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       const Eigen::VectorXd d0 = r - force_residual(rec, chosen->joint);
       for (const CandidateFit& o : st.ranking) {
         if (&o == chosen || !(o.score >= opt.score_threshold)) continue;
-        if (o.reason != Reason::kNone && o.reason != Reason::kNotConfirmed && o.reason != Reason::kNoGapReduction) continue;
+        if (o.reason != Reason::kNone && o.reason != Reason::kNotConfirmed && o.reason != Reason::kNoGapReduction)
+          continue;
         const Eigen::VectorXd d1 = r - force_residual(rec, o.joint);
         const double cosine = d0.dot(d1) / std::max(d0.norm() * d1.norm(), 1e-300);
         if (std::abs(chosen->score - o.score) <= opt.score_threshold || std::abs(cosine) >= 0.98) {
           st.ties.push_back(o.effect.name);
-          st.tie_notes.push_back(fmt("%.4g", o.score) + " against " + fmt("%.4g", chosen->score) + fmt(", fitted forces collinear to %.3f", cosine));
+          st.tie_notes.push_back(fmt("%.4g", o.score) + " against " + fmt("%.4g", chosen->score) +
+                                 fmt(", fitted forces collinear to %.3f", cosine));
         }
       }
     }
@@ -434,7 +443,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
       cur_bic = bic_of(r.squaredNorm(), free.parameters(current), n);
       rp = rp2;
     }
-    st.verdict = "added " + name + fmt(" (score %.4g): gap %.4g -> %.4g um", st.score, st.gap_before * 1e6, rp.gap * 1e6);
+    st.verdict =
+        "added " + name + fmt(" (score %.4g): gap %.4g -> %.4g um", st.score, st.gap_before * 1e6, rp.gap * 1e6);
     if (!why_not.empty()) st.verdict += " (passed over: " + why_not + ")";
     say(st.verdict);
     // 3. backward: remove the earlier effect that costs least, while it costs less than the threshold
@@ -504,8 +514,9 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     if (!st.accepted || !contains(added, st.effect.name)) continue;
     for (std::size_t i = 0; i < st.ties.size(); ++i) {
       if (contains(added, st.ties[i])) continue;
-      out.ties.push_back(st.effect.name + " or " + st.ties[i] + " (scores " + st.tie_notes[i] +
-                         "): the record cannot separate them; what would: " + what_would_separate(st.effect.name, st.ties[i]));
+      out.ties.push_back(
+          st.effect.name + " or " + st.ties[i] + " (scores " + st.tie_notes[i] +
+          "): the record cannot separate them; what would: " + what_would_separate(st.effect.name, st.ties[i]));
     }
   }
   // The verdict against the sensor's noise floor (verdict.hpp).
@@ -523,15 +534,18 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     out.conclusion = "explained: found " + std::to_string(added.size()) + " effect(s):";
     for (const auto& e : added) out.conclusion += " " + e + (out.tentative.count(e) ? " (tentative)" : "");
     out.conclusion += fmt("; gap %.4g -> %.4g um, force residual %.4g N RMS, within ", out.replay_initial.gap * 1e6,
-                          gap_final * 1e6, force_final) + floor_text;
+                          gap_final * 1e6, force_final) +
+                      floor_text;
   } else {
     out.verdict = Verdict::kUnexplained;
-    out.conclusion = "unexplained discrepancy: " + fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6,
-                                                       force_final) + floor_text;
+    out.conclusion = "unexplained discrepancy: " +
+                     fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) +
+                     floor_text;
     if (!added.empty()) {
       out.conclusion += "; named:";
       for (const auto& e : added) out.conclusion += " " + e + (out.tentative.count(e) ? " (tentative)" : "");
-      out.conclusion += fmt(" (gap %.4g -> %.4g um), and the rest is not named", out.replay_initial.gap * 1e6, gap_final * 1e6);
+      out.conclusion +=
+          fmt(" (gap %.4g -> %.4g um), and the rest is not named", out.replay_initial.gap * 1e6, gap_final * 1e6);
     } else {
       out.conclusion += "; no candidate could be named with confidence";
     }
@@ -539,7 +553,8 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     out.unexplained.push_back("where: " + out.final_localisation.summary);
     const StepResult* last = out.steps.empty() ? nullptr : &out.steps.back();
     if (!last || last->accepted) {
-      out.unexplained.push_back(fmt("the search stopped at --max-effects %.0f: allow more effects to go on", opt.max_effects));
+      out.unexplained.push_back(
+          fmt("the search stopped at --max-effects %.0f: allow more effects to go on", opt.max_effects));
     } else {
       int shown = 0;
       for (const CandidateFit& c : last->ranking) {
@@ -577,20 +592,24 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
           if (b.points >= 3 && (!where || b.concentration > where->concentration)) where = &b;
         const std::string regime = where ? where->label : std::string("the record");
         out.unexplained.push_back(
-            "no candidate of the vocabulary reduces the residual: an effect outside the vocabulary (e.g. the form of the "
-            "friction's transition), or a sensor noisier than plant.sensor says (" + out.floor.source +
-            "); to settle it: record more of the regime where the rest concentrates (" + regime +
-            ": e.g. slow reversals and creeping moves for friction at low speed), and measure the sensor at rest for its "
+            "no candidate of the vocabulary reduces the residual: an effect outside the vocabulary (e.g. the form of "
+            "the "
+            "friction's transition), or a sensor noisier than plant.sensor says (" +
+            out.floor.source + "); to settle it: record more of the regime where the rest concentrates (" + regime +
+            ": e.g. slow reversals and creeping moves for friction at low speed), and measure the sensor at rest for "
+            "its "
             "noise");
       }
     }
     if (!out.floor.from_scenario) out.unexplained.push_back("noise floor: " + out.floor.source);
   }
   if (out.asymmetry_offset != 0.0)
-    out.conclusion += fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
+    out.conclusion +=
+        fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
   if (out.smoothing_fitted)
-    out.conclusion += fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
-                          out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
+    out.conclusion +=
+        fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
+            out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
   say(out.conclusion);
   return out;
 }

@@ -4,8 +4,8 @@
 // are missing are reported in one warning line and in summary.json ("log": missing_steps, gaps).
 // Exit 2 (one line) for a log that cannot be read, is corrupt (the event's byte offset), or holds
 // no complete step.
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <filesystem>
@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
   bool plots = false, quiet = false;
   app.add_option("log", log_path, "LCM log file written by lcm-logger")->required();
   app.add_option("--scenario,-s", scenario_path, "the run's scenario YAML (control period, name)")->required();
-  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")
+      ->required();
   app.add_option("--prefix", prefix, "channel prefix of the run")->capture_default_str();
   app.add_flag("--plots", plots, "also draw the PNG plots");
   app.add_flag("--quiet,-q", quiet, "log only warnings and errors");
@@ -42,8 +43,8 @@ int main(int argc, char** argv) {
     sim::check_run_size(s, out_dir, log_steps);
     sim::RunWriter out(out_dir, s, "feeddrive-log2csv", tool::stop_token());  // rows streamed as the log is read
     out.set_expected_steps(std::min(static_cast<double>(s.steps()), log_steps));
-    const record::LogConversion c = record::read_log(log_path, prefix, [&](const sim::Record& r) { out.add(r); }, true,
-                                                         tool::stop_token());
+    const record::LogConversion c = record::read_log(
+        log_path, prefix, [&](const sim::Record& r) { out.add(r); }, true, tool::stop_token());
     const record::Recorder& rec = c.recorder;
     if (out.steps() == 0)
       throw std::invalid_argument(log_path + ": no complete step on channels " + prefix + "_STATE/_REF/_CMD (" +
@@ -65,9 +66,10 @@ int main(int argc, char** argv) {
     out.finish(out.summary(0.0, {}), plots, j.dump());
     if (!out.plot_error().empty())
       spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
-    spdlog::info("{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
-                 log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
-                 out_dir);
+    spdlog::info(
+        "{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
+        log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,
+        out_dir);
     if (c.cut_bytes > 0) spdlog::warn("{}: {}", log_path, record::describe_cut(c));
     if (!rec.gaps().empty())
       spdlog::warn("{}: {} of {} steps; the {} complete steps are in {}", log_path, record::describe_gaps(rec.gaps()),

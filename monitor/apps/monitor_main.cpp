@@ -1,24 +1,27 @@
 // feeddrive-monitor: records a run from its LCM channels into DIR/{timeseries.csv, summary.json,
 // *.png} (feeddrive-sim's format plus lockstep statistics). Wiring only: scenario -> MonitorNode.
-#include "feeddrive/record/lcm_log.hpp"
+#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
 #include "feeddrive/output/folder.hpp"
-#include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
-  CLI::App app{"feeddrive-monitor: records every step of a run, prints progress, writes the results "
-               "(docs/lcm-contract.md)",
-               "feeddrive-monitor"};
+  CLI::App app{
+      "feeddrive-monitor: records every step of a run, prints progress, writes the results "
+      "(docs/lcm-contract.md)",
+      "feeddrive-monitor"};
   std::string scenario_path;
   service::NodeOptions opt;
   monitor::MonitorOptions mopt;
   bool no_plots = false;
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", mopt.out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
+  app.add_option("--out,-o", mopt.out_dir,
+                 "output folder (written atomically; replaces only an earlier feeddrive output)")
+      ->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--attach", mopt.attach,
                "join a running system or an lcm-logplayer playback: record from the first state seen, "
@@ -29,9 +32,10 @@ int main(int argc, char** argv) {
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
     mopt.plots = !no_plots;
-    const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    const service::RunScenario rs =
+        service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
     const sim::Scenario& s = rs.scenario;
-    opt.scenario_hash = rs.sha256;  // run_info_t.scenario_hash: of the bytes read here
+    opt.scenario_hash = rs.sha256;           // run_info_t.scenario_hash: of the bytes read here
     output::check_output_dir(mopt.out_dir);  // before the run
     output::check_outside(mopt.lcm_log, "--lcm-log", mopt.out_dir);
     output::check_output_file(mopt.lcm_log, "--lcm-log", record::kLcmLogMagic);

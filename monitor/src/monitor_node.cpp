@@ -1,24 +1,24 @@
-#include "feeddrive/wire.hpp"
-#include "feeddrive/service/loggers.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
+#include "feeddrive/service/loggers.hpp"
+#include "feeddrive/wire.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
 #include "feeddrive/reference_block_t.hpp"
-#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/service/contract.hpp"
 #include "feeddrive/service/translate.hpp"
 #include "feeddrive/sim/output.hpp"
@@ -46,7 +46,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     last_state_us_ = mono_us();
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     last_admitted_us_["plant"] = last_state_us_;
-    if (m.previous.seq >= 0) applied_[static_cast<std::uint64_t>(m.previous.seq) % applied_.size()] = {m.previous.seq, m.previous.u};
+    if (m.previous.seq >= 0)
+      applied_[static_cast<std::uint64_t>(m.previous.seq) % applied_.size()] = {m.previous.seq, m.previous.u};
     if (command_conflict_ && !command_conflict_->applied_known && m.previous.seq == command_conflict_->step) {
       command_conflict_->applied_known = true;  // what the plant applied over the conflicted step
       command_conflict_->applied_u = m.previous.u;
@@ -68,7 +69,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     if (!source_process_.count(sent.sender) && source_process_.size() < 16) {
       const auto colon = sent.sender.rfind(':');
       source_process_[sent.sender] =
-          colon == std::string::npos ? "" : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
+          colon == std::string::npos ? ""
+                                     : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
     }
     try {
       if (!admit(command_ledger_, channels().command, m.seq, m)) return;
@@ -94,7 +96,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   });
   if (!mopt_.lcm_log.empty()) {
     if (!bus().batched())
-      throw std::invalid_argument("--lcm-log " + mopt_.lcm_log + ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
+      throw std::invalid_argument("--lcm-log " + mopt_.lcm_log +
+                                  ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
                                   opt.lcm_url);
     output::check_outside(mopt_.lcm_log, "--lcm-log", mopt_.out_dir);
     log_ = std::make_unique<record::LcmLogWriter>(mopt_.lcm_log);
@@ -124,7 +127,9 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   }
   service::BusEvents ev;
   ev.foreign = [this](const std::string& ch, std::int64_t id, const std::string& r) { on_foreign(ch, id, r); };
-  ev.unauthenticated = [this](const std::string& ch, const std::uint8_t* d, std::size_t n) { on_unauthenticated(ch, d, n); };
+  ev.unauthenticated = [this](const std::string& ch, const std::uint8_t* d, std::size_t n) {
+    on_unauthenticated(ch, d, n);
+  };
   ev.undecodable = [this](const std::string& ch, const std::uint8_t* d, std::size_t n, const std::string& why) {
     on_undecodable(ch, d, n, why);
   };
@@ -134,8 +139,8 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
     if (m.role == "plant" && m.state != "failed") plant_went_back(m);
   };
   stop_ = opt.stop;
-  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_, mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor",
-                                          opt.stop);
+  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_,
+                                          mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor", opt.stop);
   out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
 
@@ -154,7 +159,8 @@ void MonitorNode::fail_for(const std::string& role, const std::string& why, bool
   // Filled: its heartbeat within the last second, or its own valid messages (at the start of a
   // run an attacker's first messages can come before the role's first heartbeat reaches us).
   const auto admitted = last_admitted_us_.find(role);
-  const bool filled = peer_alive(role, 1.0) || (admitted != last_admitted_us_.end() && mono_us() - admitted->second < 1000000);
+  const bool filled =
+      peer_alive(role, 1.0) || (admitted != last_admitted_us_.end() && mono_us() - admitted->second < 1000000);
   if (unless_role_alive && filled) return;
   if (service::is_run_role(role) && !mopt_.attach && failure_.empty()) failure_ = why;
 }
@@ -177,17 +183,20 @@ void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, co
   // A plant of another run while this run's plant is silent: the drive restarted (it drew a new
   // run id). A restarted plant cannot rejoin (docs/external-plant.md, "Restarts").
   if (who_role == "plant" && plant_seq_seen_ >= 0 && !peer_alive("plant", 0.3)) {
-    const std::string why = "the plant restarted: a plant with a new run id " + std::to_string(run_id) +
-                            " appeared on " + channel + " after this run's plant (run id " + std::to_string(bus().run_id()) +
-                            ") went silent after state " + std::to_string(rec_.highest_state()) +
-                            "; a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
+    const std::string why =
+        "the plant restarted: a plant with a new run id " + std::to_string(run_id) + " appeared on " + channel +
+        " after this run's plant (run id " + std::to_string(bus().run_id()) + ") went silent after state " +
+        std::to_string(rec_.highest_state()) +
+        "; a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts)";
     spdlog::error("{}: {}", role(), why);
     fail_for("plant", why, false);  // its own test above: silent for 0.3 s
     return;
   }
-  spdlog::warn("{}: {} of another run (run id {}; this run {}) publishes on {}: a second run on this group, a participant "
-               "given the wrong --run-id, or a replayed log; its messages are ignored (give one run another --prefix or "
-               "--lcm-url: docs/security.md)", role(), who, run_id, bus().run_id(), channel);
+  spdlog::warn(
+      "{}: {} of another run (run id {}; this run {}) publishes on {}: a second run on this group, a participant "
+      "given the wrong --run-id, or a replayed log; its messages are ignored (give one run another --prefix or "
+      "--lcm-url: docs/security.md)",
+      role(), who, run_id, bus().run_id(), channel);
 }
 
 void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint8_t* d, std::size_t n) {
@@ -200,10 +209,12 @@ void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint
   const std::int64_t now = mono_us();
   const std::int64_t first = first_unauthenticated_us_.emplace(key, now).first->second;
   const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
-  const std::string why = who + (unsigned_msg ? " publishes unsigned messages on " : " publishes messages with a mac that does not verify on ") +
-                          channel + ", but this run is authenticated with --key " + options().key_file +
-                          (unsigned_msg ? ": give it the same key" : ": another key, or forged; give it the same key") +
-                          " (docs/security.md)";
+  const std::string why =
+      who +
+      (unsigned_msg ? " publishes unsigned messages on " : " publishes messages with a mac that does not verify on ") +
+      channel + ", but this run is authenticated with --key " + options().key_file +
+      (unsigned_msg ? ": give it the same key" : ": another key, or forged; give it the same key") +
+      " (docs/security.md)";
   // This monitor's own role is never someone else's to fill: such a message is forged. Named
   // once, counted, never a reason to end the run.
   if (who_role == role()) {
@@ -222,7 +233,8 @@ void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint
   if (channel == channels().status && count >= 3 && now - first >= 1000000) fail_for(who_role, why);
 }
 
-void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n, const std::string& why_invalid) {
+void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t* d, std::size_t n,
+                                 const std::string& why_invalid) {
   if (const auto older = service::older_contract(channels(), channel, d, n)) {
     const std::string key = "older " + channel + " " + older->role + " " + std::to_string(older->version);
     if (named_[key]++ > 0) return;
@@ -233,8 +245,10 @@ void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t*
   }
   const std::string key = "undecodable " + channel;
   if (named_[key]++ == 0)
-    spdlog::warn("{}: dropped a message on {} that is not valid: {} ({} bytes; counted in invalid_messages, further "
-                 "ones on this channel silently)", role(), channel, why_invalid, n);
+    spdlog::warn(
+        "{}: dropped a message on {} that is not valid: {} ({} bytes; counted in invalid_messages, further "
+        "ones on this channel silently)",
+        role(), channel, why_invalid, n);
 }
 
 void MonitorNode::check_peer_status(const process_status_t& m) {
@@ -242,8 +256,9 @@ void MonitorNode::check_peer_status(const process_status_t& m) {
     const std::string key = "version " + m.role + " " + std::to_string(m.contract_version);
     if (named_[key]++ == 0 && m.contract_version == 0) {
       // Built from these types but never set: it decodes, so it may well work; named, not failed.
-      spdlog::warn("{}: the {} sends contract_version 0 in its heartbeat: set it to {} (docs/lcm-contract.md, Versions)",
-                   role(), m.role, service::kContractVersion);
+      spdlog::warn(
+          "{}: the {} sends contract_version 0 in its heartbeat: set it to {} (docs/lcm-contract.md, Versions)", role(),
+          m.role, service::kContractVersion);
     } else if (named_[key] == 1) {
       const std::string why = "the " + m.role + " speaks contract version " + std::to_string(m.contract_version) +
                               "; this run speaks " + std::to_string(service::kContractVersion) +
@@ -292,15 +307,17 @@ void MonitorNode::plant_went_back(const process_status_t& m) {
   if (plant_step_implausible(m.seq)) return;
   if (!options().key_file.empty()) {
     if (named_["plant heartbeat back"]++ == 0)
-      spdlog::warn("{}: a signed heartbeat of the plant went back (step {} '{}' after step {}): a replay of this run's "
-                   "own heartbeats (a restarted plant would have drawn a new nonce); ignored",
-                   role(), m.seq, m.state, plant_seq_seen_);
+      spdlog::warn(
+          "{}: a signed heartbeat of the plant went back (step {} '{}' after step {}): a replay of this run's "
+          "own heartbeats (a restarted plant would have drawn a new nonce); ignored",
+          role(), m.seq, m.state, plant_seq_seen_);
     return;
   }
-  const std::string why = "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) +
-                          " to " + std::to_string(m.seq) + " (" + m.state +
-                          "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts). "
-                          "Without --key a forged heartbeat looks the same (docs/security.md)";
+  const std::string why =
+      "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) + " to " +
+      std::to_string(m.seq) + " (" + m.state +
+      "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts). "
+      "Without --key a forged heartbeat looks the same (docs/security.md)";
   if (named_["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
   fail_for("plant", why, false);
 }
@@ -311,7 +328,8 @@ void MonitorNode::plant_went_back(const process_status_t& m) {
 void MonitorNode::on_state_timing(const drive_state_t& m, std::int64_t t) {
   if (m.end_of_run || m.seq <= timing_pruned_ || state_recv_.count(m.seq)) return;
   state_recv_[m.seq] = t;
-  if (options().realtime && m.seq >= 1) hist_late_.add(static_cast<double>(m.start_late_us));  // state 0: the start handshake
+  if (options().realtime && m.seq >= 1)
+    hist_late_.add(static_cast<double>(m.start_late_us));  // state 0: the start handshake
   if (const auto c = cmd_recv_.find(m.seq - 1); c != cmd_recv_.end() && t >= c->second)
     hist_cs_.add(static_cast<double>(t - c->second));
   prune_timing(m.seq);
@@ -353,7 +371,9 @@ void MonitorNode::request_missing() {
   // kPerRound messages of each kind a round, not one.
   constexpr std::size_t kPerRound = 64;
   for (const record::Missing& m : rec_.missing_until(rec_.highest_state(), kPerRound)) {
-    const std::string& channel = m.what == "state" ? channels().state : m.what == "reference" ? channels().reference : channels().command;
+    const std::string& channel = m.what == "state"       ? channels().state
+                                 : m.what == "reference" ? channels().reference
+                                                         : channels().command;
     request_resend(channel, m.seq);
     ++lost_;
   }
@@ -366,16 +386,19 @@ bool MonitorNode::attached_stalled(std::int64_t now, double limit) {
     // still be completed is recorded, the rest is a gap.
     rec_.flush_final(sink);
     if (!rec_.end_seen())
-      throw service::RunFailure("no message on " + channels().state + " for " + service::seconds_text(limit) + " s after step " +
-                                std::to_string(rec_.highest_state()) + ": the run stopped before its end");
+      throw service::RunFailure("no message on " + channels().state + " for " + service::seconds_text(limit) +
+                                " s after step " + std::to_string(rec_.highest_state()) +
+                                ": the run stopped before its end");
     return true;
   }
   // States still come in: a step asked for this often and this long is not kept any more.
-  if (asking_seq_ == rec_.next() && asking_requests_ >= kLostAfterRequests && now - asking_since_us_ >= us(kLostAfter_s)) {
+  if (asking_seq_ == rec_.next() && asking_requests_ >= kLostAfterRequests &&
+      now - asking_since_us_ >= us(kLostAfter_s)) {
     const std::size_t gaps = rec_.gaps().size();
     if (rec_.skip_lost(sink) > 0 || rec_.gaps().size() != gaps) last_row_us_ = now;
     if (rec_.gaps().size() != gaps && !options().quiet)
-      spdlog::warn("{}: {} (not re-sent after {} requests)", role(), record::describe_gaps({rec_.gaps().back()}), asking_requests_);
+      spdlog::warn("{}: {} (not re-sent after {} requests)", role(), record::describe_gaps({rec_.gaps().back()}),
+                   asking_requests_);
   }
   return rec_.complete();
 }
@@ -390,8 +413,9 @@ void MonitorNode::progress(bool force) {
   const sim::Record& last = out_->last();
   const double err = out_->steps() == 0 ? 0.0 : (last.xd - (std::isnan(last.x) ? last.x_measured : last.x));
   std::fprintf(stderr, "\r[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um   ",
-               static_cast<long long>(rec_.next()), static_cast<long long>(rec_.steps() < 0 ? s_.steps() : rec_.steps()),
-               sim_t, wall > 0 ? sim_t / wall : 0.0, err * 1e6);
+               static_cast<long long>(rec_.next()),
+               static_cast<long long>(rec_.steps() < 0 ? s_.steps() : rec_.steps()), sim_t,
+               wall > 0 ? sim_t / wall : 0.0, err * 1e6);
   if (force) std::fprintf(stderr, "\n");
 }
 
@@ -446,14 +470,16 @@ bool MonitorNode::run() {
       if (rec_.complete()) break;
       request_missing();
       check_peers();
-      const double limit = rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
+      const double limit =
+          rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
       if (mopt_.attach && rec_.highest_state() >= 0 && now - last_row_us_ > us(kLostAfter_s)) {
         if (attached_stalled(now, limit)) break;
         continue;
       }
       if (now - last_row_us_ > us(limit)) {
         if (mopt_.attach && rec_.highest_state() < 0)
-          throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) + " s");
+          throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) +
+                                    " s");
         // A role whose heartbeat still comes is waiting on another and runs its own timeout: it
         // will name the culprit (check_peers above), as the trajectory and the controller do. So
         // wait for it (at most three timeouts), then name only the roles that went silent.
@@ -468,19 +494,19 @@ bool MonitorNode::run() {
           if (!peer_alive(m.role, 0.5)) silent += (silent.empty() ? "" : ", ") + what;
         }
         const std::string& who = silent.empty() ? all : silent;
-        throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " + service::seconds_text(limit) +
-                                  " s: no " + who);
+        throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " +
+                                  service::seconds_text(limit) + " s: no " + who);
       }
     }
   } catch (const service::RunFailure& e) {
     failure = e.what();
     // A command conflict: wait (at most 0.5 s) for the state that says which command the plant
     // applied, so that the step is recorded and the summary can name it.
-    for (const std::int64_t until = mono_us() + 500000; command_conflict_ && !command_conflict_->applied_known && mono_us() < until;) {
+    for (const std::int64_t until = mono_us() + 500000;
+         command_conflict_ && !command_conflict_->applied_known && mono_us() < until;) {
       try {
         bus().poll(std::chrono::microseconds(20000));
-      } catch (const std::exception&) {
-      }
+      } catch (const std::exception&) {}
     }
     if (const std::string a = applied_command_text(); !a.empty()) failure += "; " + a;
     // The record reaches the last step completed before the failure: the batch that failed was
@@ -537,14 +563,17 @@ std::string MonitorNode::applied_command_text() const {
   const CommandConflict& c = *command_conflict_;
   const auto from = [](const SentCommand& s) { return s.sender.empty() ? std::string("an unknown sender") : s.sender; };
   if (!c.applied_known)
-    return "the plant's state after step " + std::to_string(c.step) + " did not come (it stopped on the conflict before "
-           "applying either command, or that state was lost): u = " + service::seconds_text(c.first.u) + " V from " + from(c.first) + " or u = " +
-           service::seconds_text(c.second.u) + " V from " + from(c.second);
+    return "the plant's state after step " + std::to_string(c.step) +
+           " did not come (it stopped on the conflict before "
+           "applying either command, or that state was lost): u = " +
+           service::seconds_text(c.first.u) + " V from " + from(c.first) +
+           " or u = " + service::seconds_text(c.second.u) + " V from " + from(c.second);
   const bool first = std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
   const SentCommand& a = first ? c.first : c.second;
   const SentCommand& o = first ? c.second : c.first;
-  return "the plant applied u = " + service::seconds_text(a.u) + " V from " + from(a) + " at step " + std::to_string(c.step) +
-         " (the other command, u = " + service::seconds_text(o.u) + " V, came from " + from(o) + "; the step is in the record)";
+  return "the plant applied u = " + service::seconds_text(a.u) + " V from " + from(a) + " at step " +
+         std::to_string(c.step) + " (the other command, u = " + service::seconds_text(o.u) + " V, came from " +
+         from(o) + "; the step is in the record)";
 }
 
 bool MonitorNode::finish(bool completed, const std::string& failure) {
@@ -557,7 +586,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     write_error = e.what();
   }
 
-  std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(), invalid_total = bus().invalid();
+  std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(),
+               invalid_total = bus().invalid();
   // Foreign, conflicting and unauthenticated messages: the most any one process saw (each
   // process hears the same bus; the monitor hears every channel, the others fewer).
   std::int64_t foreign = bus().foreign(), conflicts_seen = conflicts, unauthenticated = bus().unauthenticated();
@@ -615,7 +645,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   // The monitor hears every channel of the run: its own count per channel says where they came
   // ("" : datagrams without LCM's framing). invalid_messages adds the other processes' counts.
   l["invalid_messages_by_channel"] = nlohmann::ordered_json::object();
-  for (const auto& [ch, n] : bus().invalid_by_channel()) l["invalid_messages_by_channel"][ch.empty() ? "(not LCM)" : ch] = n;
+  for (const auto& [ch, n] : bus().invalid_by_channel())
+    l["invalid_messages_by_channel"][ch.empty() ? "(not LCM)" : ch] = n;
   l["rejected_commands"] = rec_.rejected_commands();
   l["deadline_misses"] = rec_.missed_deadlines();
   l["plant_overruns"] = rec_.plant_overruns();
@@ -631,8 +662,10 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     j["first"] = {{"u", c.first.u}, {"sender", c.first.sender}};
     j["second"] = {{"u", c.second.u}, {"sender", c.second.sender}};
     if (c.applied_known) {
-      const bool first = std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
-      j["applied"] = {{"u", c.applied_u}, {"sender", (first ? c.first : c.second).sender}, {"which", first ? "first" : "second"}};
+      const bool first =
+          std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
+      j["applied"] = {
+          {"u", c.applied_u}, {"sender", (first ? c.first : c.second).sender}, {"which", first ? "first" : "second"}};
     } else {
       j["applied"] = nullptr;
     }
@@ -642,7 +675,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   if (mopt_.attach) {  // an observer records across what it could not get (the run's monitor never does)
     l["missing_steps"] = rec_.missing_steps();
     l["gaps"] = nlohmann::ordered_json::array();
-    for (const record::Gap& g : rec_.gaps()) l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
+    for (const record::Gap& g : rec_.gaps())
+      l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
   }
   l["steps_per_second"] = rec_.steps_per_second();
   {
@@ -666,18 +700,23 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     // records without loss (service::kStockLoggerSteps): the run cannot know what it dropped.
     const double run_rate = wall_time_s > 0 ? static_cast<double>(sum.steps) / wall_time_s : 0.0;
     const double peak = std::max(peak_rate_, run_rate);
-    const bool too_fast = !loggers_.empty() && peak > service::stock_logger_pace(loggers_) * 1.02;  // 2 %: the window's clock
+    const bool too_fast =
+        !loggers_.empty() && peak > service::stock_logger_pace(loggers_) * 1.02;  // 2 %: the window's clock
     auto& sl = l["stock_loggers"];
     sl["seen"] = nlohmann::ordered_json::array();
     for (const service::StockLogger& g : loggers_) sl["seen"].push_back({{"name", g.name}, {"pid", g.pid}});
-    sl["max_rate"] = options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
+    sl["max_rate"] =
+        options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
     sl["peak_steps_per_second"] = peak;
-    sl["records_without_loss_up_to"] = loggers_.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(service::stock_logger_pace(loggers_));
+    sl["records_without_loss_up_to"] = loggers_.empty() ? nlohmann::ordered_json(nullptr)
+                                                        : nlohmann::ordered_json(service::stock_logger_pace(loggers_));
     sl["faster_than_it_records"] = too_fast;
     if (too_fast)
-      spdlog::warn("{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
-                   "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
-                   role(), peak, service::describe(loggers_), service::stock_logger_pace(loggers_), service::stock_logger_pace(loggers_));
+      spdlog::warn(
+          "{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
+          "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
+          role(), peak, service::describe(loggers_), service::stock_logger_pace(loggers_),
+          service::stock_logger_pace(loggers_));
   }
   const auto hop = [&](const char* name, const stats::StreamingQuantile& v) {
     l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.count()}};
@@ -700,7 +739,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     auto& h = l["latency_histogram_us"];
     h["bin_us"] = hist_sc_.bin_us();
     for (std::size_t i = 0; i < hists.size(); ++i)
-      h[hist_names[i]] = {{"counts", hists[i].counts()}, {"overflow", hists[i].overflow()}, {"samples", hists[i].samples()}};
+      h[hist_names[i]] = {
+          {"counts", hists[i].counts()}, {"overflow", hists[i].overflow()}, {"samples", hists[i].samples()}};
   }
   for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
     for (const char* q : {"p50", "p99", "p1"})
@@ -719,8 +759,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     const bool earlier = output::is_feeddrive_output(target);
     if (!completed && !earlier) ::rmdir(target.c_str());
     const std::filesystem::path dest = out_->finish(
-        sum, mopt_.plots, j.dump(), [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); },
-        completed);
+        sum, mopt_.plots, j.dump(),
+        [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); }, completed);
     if (!completed && dest != target) {
       where = dest.string();
       if (!options().quiet)  // an interrupt's one line stays one line with -q
@@ -744,7 +784,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     announce_failure(why);
   }
   if (!rec_.gaps().empty())
-    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), record::describe_gaps(rec_.gaps()), sum.steps, where);
+    spdlog::warn("{}: {}; the {} complete steps are in {}", role(), record::describe_gaps(rec_.gaps()), sum.steps,
+                 where);
   if (!options().quiet)
     spdlog::info("monitor: {} steps recorded{} -> {}", sum.steps,
                  completed ? "" : " (stopped at step " + std::to_string(rec_.next()) + ": " + why + ")", where);
@@ -757,18 +798,22 @@ void MonitorNode::write_histograms(const output::StagedFolder& dir, const std::v
   if (!plot || stop_.stop_requested()) return;  // interrupted while plotting: the data still go in place
   const double period_us = s_.control_period * 1e6;
   const std::string bin = std::to_string(h.front().bin_us());
-  std::string gp = "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
-                   "set output 'latency_histogram.png'\nset grid\nset logscale y\nset yrange [0.5:*]\n"
-                   "set style fill transparent solid 0.4\nset boxwidth " + bin + "\n"
-                   "set xlabel 'latency [us] (bins of T/20 up to 2T; later ones in summary.json as overflow)'\n"
-                   "set ylabel 'steps'\nset title " +
-                   output::gnuplot_string(s_.name + (options().realtime ? " (real time)" : " (lockstep)")) + "\n";
+  std::string gp =
+      "set encoding utf8\nset datafile separator ','\nset terminal pngcairo size 1000,600 noenhanced\n"
+      "set output 'latency_histogram.png'\nset grid\nset logscale y\nset yrange [0.5:*]\n"
+      "set style fill transparent solid 0.4\nset boxwidth " +
+      bin +
+      "\n"
+      "set xlabel 'latency [us] (bins of T/20 up to 2T; later ones in summary.json as overflow)'\n"
+      "set ylabel 'steps'\nset title " +
+      output::gnuplot_string(s_.name + (options().realtime ? " (real time)" : " (lockstep)")) + "\n";
   gp += "set arrow from " + std::to_string(period_us) + ",graph 0 to " + std::to_string(period_us) +
         ",graph 1 nohead dt 2\nset label 'T' at " + std::to_string(period_us) + ",graph 0.95\n";
   gp += "plot ";
   for (std::size_t i = 0; i < names.size(); ++i)
-    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" + std::to_string(h.front().bin_us() / 2) +
-          "):" + std::to_string(i + 2) + " with boxes title " + output::gnuplot_string(names[i]);
+    gp += std::string(i ? ", " : "") + "'latency_histogram.csv' every ::1 using ($1+" +
+          std::to_string(h.front().bin_us() / 2) + "):" + std::to_string(i + 2) + " with boxes title " +
+          output::gnuplot_string(names[i]);
   gp += "\n";
   try {  // a view of the data: its failure (or an interrupt: the flag stays set) loses nothing
     output::run_gnuplot(dir.dir(), gp, stop_, "latency_histogram.gp");

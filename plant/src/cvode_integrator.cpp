@@ -73,8 +73,7 @@ int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data) {
 }
 
 // CVLsJacFn: dense analytic Jacobian df/dy (dynamics.hpp).
-int jac(sunrealtype t, N_Vector y, N_Vector /*fy*/, SUNMatrix J, void* user_data, N_Vector,
-        N_Vector, N_Vector) {
+int jac(sunrealtype t, N_Vector y, N_Vector /*fy*/, SUNMatrix J, void* user_data, N_Vector, N_Vector, N_Vector) {
   const auto* ud = static_cast<const UserData*>(user_data);
   const Jacobian a = jacobian(*ud->params, state_of(t, y, *ud), ud->u);
   for (int r = 0; r < ud->n; ++r)
@@ -130,8 +129,7 @@ CvodeIntegrator::CvodeIntegrator(const PlantParams& params, double t0, const Sta
     if (active[i]) m.user.index[m.user.n++] = i;
   const int n = m.user.n;
   const IntegratorParams& ip = params.integrator;
-  const StateVector atol_full{ip.atol_position, ip.atol_velocity, ip.atol_bristle, ip.atol_grinding,
-                              ip.atol_current};
+  const StateVector atol_full{ip.atol_position, ip.atol_velocity, ip.atol_bristle, ip.atol_grinding, ip.atol_current};
 
   check_flag(SUNContext_Create(nullptr, &m.ctx), "SUNContext_Create");
   m.y = check_ptr(N_VNew_Serial(n, m.ctx), "N_VNew_Serial");
@@ -149,7 +147,8 @@ CvodeIntegrator::CvodeIntegrator(const PlantParams& params, double t0, const Sta
   check_flag(CVodeSetLinearSolver(m.mem, m.LS, m.A), "CVodeSetLinearSolver");
   check_flag(CVodeSetJacFn(m.mem, jac), "CVodeSetJacFn");
   check_flag(CVodeSetMaxNumSteps(m.mem, ip.max_steps), "CVodeSetMaxNumSteps");
-  CVodeSetErrHandlerFn(m.mem, [](int, const char*, const char*, char*, void*) {}, nullptr);
+  CVodeSetErrHandlerFn(
+      m.mem, [](int, const char*, const char*, char*, void*) {}, nullptr);
 }
 
 CvodeIntegrator::~CvodeIntegrator() = default;
@@ -201,8 +200,8 @@ void CvodeIntegrator::advance(double u, double t_next) {
   m.accumulate();
   if (flag < 0)
     throw IntegrationError("CVODE: CVode failed with flag " + std::to_string(flag) + " (" +
-                             CVodeGetReturnFlagName(flag) + ") at t = " + validate::format_number(t_reached) +
-                             " with u = " + validate::format_number(u) + "; " + m.given.fastest_time_scales());
+                           CVodeGetReturnFlagName(flag) + ") at t = " + validate::format_number(t_reached) +
+                           " with u = " + validate::format_number(u) + "; " + m.given.fastest_time_scales());
   y_ = state_of(t_next, m.y, ud).to_vector();
   t_ = t_next;  // exactly the boundary (CV_TSTOP_RETURN stops there)
 }

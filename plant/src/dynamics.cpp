@@ -31,10 +31,9 @@ StateVector derivative_of(const PlantParams& p, bool extra, const State& s, doub
   d[kV] = (f.thrust - f.friction - f.ripple - f.grinding - f.extra) / p.mass;
   d[kZ] = p.friction.model == FrictionModel::kLuGre ? lugre_zdot(p.friction, s.v, s.z) : 0.0;
   d[kFg] = grinding_rate(p.grinding, s.x, s.v, s.fg);
-  d[kI] = p.electrical.enabled
-              ? (p.amplifier_gain * u - p.electrical.resistance * s.i - p.electrical.back_emf * s.v) /
-                    p.electrical.inductance
-              : 0.0;
+  d[kI] = p.electrical.enabled ? (p.amplifier_gain * u - p.electrical.resistance * s.i - p.electrical.back_emf * s.v) /
+                                     p.electrical.inductance
+                               : 0.0;
   return d;
 }
 
@@ -84,8 +83,7 @@ Jacobian jacobian_of(const PlantParams& p, bool extra, const State& s, double u)
 }
 
 std::array<bool, kStateSize> active_of(const PlantParams& p) {
-  return {true, true, p.friction.model == FrictionModel::kLuGre, p.grinding.enabled,
-          p.electrical.enabled};
+  return {true, true, p.friction.model == FrictionModel::kLuGre, p.grinding.enabled, p.electrical.enabled};
 }
 
 // Calls f(effective params, has_extra_force) on p, copying p only when an effect folds into it.

@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <functional>
-#include <type_traits>
 #include <stdexcept>
+#include <type_traits>
 
 #include "feeddrive/plant/forces.hpp"
 
@@ -85,7 +85,8 @@ ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v
   if (fx.stribeck_friction.enabled) {
     // d/dv [sgn_eps(v)*g(v)] = sgn_eps'(v)*g(v) + sgn_eps(v)*g'(v)
     const FrictionParams curve = stribeck_curve(p);
-    g.dv += smoothed_sign_derivative(p.friction, v) * stribeck(curve, v) + smoothed_sign(p.friction, v) * stribeck_derivative(curve, v);
+    g.dv += smoothed_sign_derivative(p.friction, v) * stribeck(curve, v) +
+            smoothed_sign(p.friction, v) * stribeck_derivative(curve, v);
   }
   if (fx.cogging_ripple.enabled) {
     const CoggingRippleEffect& c = fx.cogging_ripple;
@@ -131,7 +132,8 @@ class EffectFields {
 // The effects: their names and parameter names, or the effect named `name` in an EffectsParams.
 class EffectList {
  public:
-  explicit EffectList(const std::string* name = nullptr, const std::string* param = nullptr) : name_(name), param_(param) {}
+  explicit EffectList(const std::string* name = nullptr, const std::string* param = nullptr)
+      : name_(name), param_(param) {}
   template <typename T>
   void Visit(const fields::Field<T>& f) {
     EffectFields inner(name_ && *name_ == f.meta.name ? param_ : nullptr);
@@ -200,7 +202,8 @@ std::vector<NamedEffect> enabled_effects(const EffectsParams& e) {
   for (const std::string& name : effect_names()) {
     if (!effect_enabled(copy, name)) continue;
     NamedEffect ne{name, {}};
-    for (const std::string& param : effect_parameter_names(name)) ne.parameters[param] = effect_parameter(copy, name, param);
+    for (const std::string& param : effect_parameter_names(name))
+      ne.parameters[param] = effect_parameter(copy, name, param);
     out.push_back(ne);
   }
   return out;

@@ -26,8 +26,8 @@ double stribeck_derivative(const FrictionParams& p, double v) {
   if (v == 0.0) return 0.0;  // exact for d > 1; the one-sided limit is used for d <= 1
   const double r = std::abs(v / p.stribeck_velocity);
   const double d = p.stribeck_exponent;
-  return -(p.static_force - p.coulomb_force) * std::exp(-power(r, d)) * d * power(r, d - 1.0) *
-         sgn(v) / p.stribeck_velocity;
+  return -(p.static_force - p.coulomb_force) * std::exp(-power(r, d)) * d * power(r, d - 1.0) * sgn(v) /
+         p.stribeck_velocity;
 }
 
 double micro_damping(const FrictionParams& p, double v) {
@@ -65,10 +65,8 @@ double friction_force(const FrictionParams& p, double v, double z) {
   switch (p.model) {
     case FrictionModel::kLuGre:
       return p.bristle_stiffness * z + micro_damping(p, v) * lugre_zdot(p, v, z) + p.viscous * v;
-    case FrictionModel::kStatic:
-      return stribeck(p, v) * smoothed_sign(p, v) + p.viscous * v;
-    case FrictionModel::kNone:
-      return 0.0;
+    case FrictionModel::kStatic: return stribeck(p, v) * smoothed_sign(p, v) + p.viscous * v;
+    case FrictionModel::kNone: return 0.0;
   }
   return 0.0;
 }
@@ -91,11 +89,11 @@ FrictionJacobian friction_jacobian(const FrictionParams& p, double v, double z) 
       break;
     }
     case FrictionModel::kStatic: {
-      J.dF_dv = stribeck_derivative(p, v) * smoothed_sign(p, v) + stribeck(p, v) * smoothed_sign_derivative(p, v) + p.viscous;
+      J.dF_dv =
+          stribeck_derivative(p, v) * smoothed_sign(p, v) + stribeck(p, v) * smoothed_sign_derivative(p, v) + p.viscous;
       break;
     }
-    case FrictionModel::kNone:
-      break;
+    case FrictionModel::kNone: break;
   }
   return J;
 }

@@ -36,8 +36,7 @@ void FrictionParams::validate(const std::string& prefix) const {
   } else {
     fields::check_fields(*this, prefix, {"bristle_stiffness", "bristle_damping"});
   }
-  if (static_force < coulomb_force)
-    fail(prefix + ".static_force", static_force, "must be >= coulomb_force");
+  if (static_force < coulomb_force) fail(prefix + ".static_force", static_force, "must be >= coulomb_force");
 }
 
 // A section that is off is checked as well: a key written in it must be valid even while it does
@@ -50,24 +49,17 @@ void RippleParams::validate(const std::string& prefix) const {
          "|reluctance_amplitude| + |reluctance_third| must be < 1");
 }
 
-double GrindingParams::damping() const {
-  return dullness * M_PI * workpiece_diameter * wheel_width;
-}
+double GrindingParams::damping() const { return dullness * M_PI * workpiece_diameter * wheel_width; }
 double GrindingParams::time_constant() const { return damping() / stiffness; }
 
-void GrindingParams::validate(const std::string& prefix) const {
-  fields::check_fields(*this, prefix);
-}
+void GrindingParams::validate(const std::string& prefix) const { fields::check_fields(*this, prefix); }
 
-void ElectricalParams::validate(const std::string& prefix) const {
-  fields::check_fields(*this, prefix);
-}
+void ElectricalParams::validate(const std::string& prefix) const { fields::check_fields(*this, prefix); }
 
 bool EffectsParams::any() const {
-  return constant_force.enabled || coulomb_friction.enabled || viscous_friction.enabled ||
-         stribeck_friction.enabled || presliding.enabled || cogging_ripple.enabled ||
-         reluctance_ripple.enabled || grinding_force.enabled || spring_force.enabled ||
-         mass_error.enabled || input_delay.enabled;
+  return constant_force.enabled || coulomb_friction.enabled || viscous_friction.enabled || stribeck_friction.enabled ||
+         presliding.enabled || cogging_ripple.enabled || reluctance_ripple.enabled || grinding_force.enabled ||
+         spring_force.enabled || mass_error.enabled || input_delay.enabled;
 }
 
 namespace {
@@ -100,11 +92,13 @@ void SensorParams::validate(const std::string& prefix) const {
   // Beyond the list's bounds the measurement overflows (a 1e308 noise gave inf measurements) or
   // rounds to nothing: a step of 1 pm is far below any encoder's, 1 m of noise far above any drive's.
   fields::check_fields(*this, prefix);
-  if (quantization > 0.0 && quantization < 1e-12) fail(prefix + ".quantization", quantization, "must be 0 or >= 1e-12 m");
+  if (quantization > 0.0 && quantization < 1e-12)
+    fail(prefix + ".quantization", quantization, "must be 0 or >= 1e-12 m");
   // An encoder measures position only: with quantization or noise the velocity a drive sees is
   // formed from the counts, never the true velocity (issue 10: honest velocity estimation).
   if (velocity == VelocityMeasurement::kTrue && !ideal())
-    throw std::invalid_argument(prefix + ".velocity = 'true': an encoder with quantization or noise "
+    throw std::invalid_argument(prefix +
+                                ".velocity = 'true': an encoder with quantization or noise "
                                 "measures position only; use difference (or auto)");
 }
 
@@ -155,20 +149,21 @@ std::string PlantParams::fastest_time_scales(std::size_t n) const {
                  "plant.friction.bristle_stiffness = " + format_number(friction.bristle_stiffness) + " with " + m,
                  "presliding oscillation"});
     s.push_back({friction.bristle_damping / mass,
-                 "plant.friction.bristle_damping = " + format_number(friction.bristle_damping) + " with " + m, "bristle damping"});
+                 "plant.friction.bristle_damping = " + format_number(friction.bristle_damping) + " with " + m,
+                 "bristle damping"});
   }
   if (friction.model != FrictionModel::kNone && friction.viscous > 0)
     s.push_back({friction.viscous / mass, "plant.friction.viscous = " + format_number(friction.viscous) + " with " + m,
                  "viscous damping"});
   if (grinding.enabled)
     s.push_back({1.0 / grinding.time_constant(),
-                 "plant.grinding.stiffness = " + format_number(grinding.stiffness) + ", dullness = " +
-                     format_number(grinding.dullness),
+                 "plant.grinding.stiffness = " + format_number(grinding.stiffness) +
+                     ", dullness = " + format_number(grinding.dullness),
                  "grinding force lag"});
   if (electrical.enabled)
     s.push_back({electrical.resistance / electrical.inductance,
-                 "plant.electrical.resistance = " + format_number(electrical.resistance) + ", inductance = " +
-                     format_number(electrical.inductance),
+                 "plant.electrical.resistance = " + format_number(electrical.resistance) +
+                     ", inductance = " + format_number(electrical.inductance),
                  "current loop"});
   if (effects.presliding.enabled)
     s.push_back({std::sqrt(effects.presliding.bristle_stiffness_N_per_m / mass),
@@ -177,8 +172,8 @@ std::string PlantParams::fastest_time_scales(std::size_t n) const {
                  "presliding oscillation"});
   if (effects.spring_force.enabled)
     s.push_back({std::sqrt(effects.spring_force.stiffness_N_per_m / mass),
-                 "plant.effects.spring_force.stiffness_N_per_m = " + format_number(effects.spring_force.stiffness_N_per_m) +
-                     " with " + m,
+                 "plant.effects.spring_force.stiffness_N_per_m = " +
+                     format_number(effects.spring_force.stiffness_N_per_m) + " with " + m,
                  "spring oscillation"});
   if (effects.viscous_friction.enabled)
     s.push_back({effects.viscous_friction.viscous_Ns_per_m / mass,

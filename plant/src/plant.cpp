@@ -3,8 +3,7 @@
 namespace feeddrive::plant {
 namespace {
 StateVector initial_vector(const PlantParams& p) {
-  return State{p.initial.position, p.initial.velocity, p.initial.bristle, p.initial.grinding,
-               p.initial.current}
+  return State{p.initial.position, p.initial.velocity, p.initial.bristle, p.initial.grinding, p.initial.current}
       .to_vector();
 }
 }  // namespace

@@ -9,9 +9,9 @@
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/text_file.hpp"
+#include "feeddrive/record/channels.hpp"
 #include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/reference_block_t.hpp"
-#include "feeddrive/record/channels.hpp"
 #include "feeddrive/wire.hpp"
 
 namespace feeddrive::record {
@@ -26,7 +26,7 @@ struct Event {
   std::vector<std::uint8_t> data;
 };
 
-constexpr std::int32_t kMaxChannel = 4096;        // far above LCM's 63-character channel limit
+constexpr std::int32_t kMaxChannel = 4096;           // far above LCM's 63-character channel limit
 constexpr std::int32_t kMaxData = 64 * 1024 * 1024;  // our messages are < 1 KB
 
 class LogParser {
@@ -34,7 +34,8 @@ class LogParser {
   static void check_regular(const std::string& path) {
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
-      throw std::invalid_argument(path + ": the LCM log is " + text::non_regular_kind(st.st_mode) + ", not a regular file");
+      throw std::invalid_argument(path + ": the LCM log is " + text::non_regular_kind(st.st_mode) +
+                                  ", not a regular file");
   }
 
  public:
@@ -57,7 +58,8 @@ class LogParser {
       std::uint8_t start[4] = {0, 0, 0, 0};
       in_.read(reinterpret_cast<char*>(start), std::min<std::int64_t>(left, 4));
       const std::uint8_t sync[4] = {0xED, 0xA1, 0xDA, 0x01};
-      if (!std::equal(start, start + std::min<std::int64_t>(left, 4), sync)) corrupt(events_so_far, "truncated event header");
+      if (!std::equal(start, start + std::min<std::int64_t>(left, 4), sync))
+        corrupt(events_so_far, "truncated event header");
       return cut(left);
     }
     in_.read(reinterpret_cast<char*>(h), sizeof h);
@@ -137,8 +139,8 @@ bool finite_state(const drive_state_t& m) {
 }
 
 bool finite_reference(const reference_t& m) {
-  return std::isfinite(m.t) && std::isfinite(m.position) && std::isfinite(m.velocity) && std::isfinite(m.acceleration) &&
-         std::isfinite(m.jerk) && m.seq >= 0;
+  return std::isfinite(m.t) && std::isfinite(m.position) && std::isfinite(m.velocity) &&
+         std::isfinite(m.acceleration) && std::isfinite(m.jerk) && m.seq >= 0;
 }
 
 }  // namespace
@@ -167,7 +169,8 @@ LogConversion read_log(const std::string& path, const std::string& prefix, const
         }
       });
     } else if (ev.channel == ch.command) {
-      decode_into<control_command_t>(ev, out, [&](const control_command_t& m, std::int64_t t) { out.recorder.on_command(m, t); });
+      decode_into<control_command_t>(
+          ev, out, [&](const control_command_t& m, std::int64_t t) { out.recorder.on_command(m, t); });
     } else {
       ++out.foreign_events;
     }

@@ -45,7 +45,8 @@ void Recorder::on_reference(const reference_t& m, std::int64_t recv_us) {
   refs_[m.seq] = {m, recv_us};
   if (first_ref_seq_ < 0 || (whole_log_ && m.seq < first_ref_seq_)) first_ref_seq_ = m.seq;
   maybe_start();
-  if (const auto s = states_.find(m.seq); s != states_.end()) lead_.add(static_cast<double>(s->second.recv_us - recv_us));
+  if (const auto s = states_.find(m.seq); s != states_.end())
+    lead_.add(static_cast<double>(s->second.recv_us - recv_us));
 }
 
 void Recorder::on_command(const control_command_t& m, std::int64_t recv_us) {
@@ -168,7 +169,8 @@ Recorder::Advance Recorder::advance(const sim::RecordSink& sink, bool need_refer
   const auto c = cmds_.find(next_);
   const bool have_ref = r != refs_.end();
   if (s != states_.end() && s1 != states_.end() && (have_ref || !need_reference)) {
-    add_row(s->second, have_ref ? &r->second.msg : nullptr, c == cmds_.end() ? nullptr : &c->second.msg, s1->second.msg, sink);
+    add_row(s->second, have_ref ? &r->second.msg : nullptr, c == cmds_.end() ? nullptr : &c->second.msg, s1->second.msg,
+            sink);
     states_.erase(s);
     if (have_ref) refs_.erase(r);
     if (c != cmds_.end()) cmds_.erase(c);
@@ -211,7 +213,8 @@ std::string describe_gaps(const std::vector<Gap>& gaps, std::size_t max_listed) 
   std::string out = std::to_string(total) + (total == 1 ? " step" : " steps") + " missing:";
   for (std::size_t i = 0; i < gaps.size() && i < max_listed; ++i) {
     const Gap& g = gaps[i];
-    out += (i ? ", " : " ") + std::to_string(g.first) + (g.last > g.first ? "-" + std::to_string(g.last) : "") + " (" + g.why + ")";
+    out += (i ? ", " : " ") + std::to_string(g.first) + (g.last > g.first ? "-" + std::to_string(g.last) : "") + " (" +
+           g.why + ")";
   }
   if (gaps.size() > max_listed) out += " and " + std::to_string(gaps.size() - max_listed) + " more gaps";
   return out;
@@ -243,14 +246,16 @@ std::vector<Missing> Recorder::missing_until(std::int64_t upto, std::size_t per_
       out.push_back({"reference", "trajectory", k}), ++refs;
       last_block = k / 16;
     }
-    if (commands < per_kind && k < upto && !realtime && !cmds_.count(k)) out.push_back({"command", "controller", k}), ++commands;
+    if (commands < per_kind && k < upto && !realtime && !cmds_.count(k))
+      out.push_back({"command", "controller", k}), ++commands;
   }
   return out;
 }
 
 double Recorder::steps_per_second() const {
   if (first_state_seq_ < 0 || highest_state_ <= first_state_seq_ || last_state_us_ <= first_state_us_) return 0.0;
-  return static_cast<double>(highest_state_ - first_state_seq_) / (static_cast<double>(last_state_us_ - first_state_us_) * 1e-6);
+  return static_cast<double>(highest_state_ - first_state_seq_) /
+         (static_cast<double>(last_state_us_ - first_state_us_) * 1e-6);
 }
 
 }  // namespace feeddrive::record

@@ -7,9 +7,10 @@
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
-  CLI::App app{"feeddrive-controller: answers <prefix>_STATE with <prefix>_CMD using <prefix>_REF "
-               "(docs/lcm-contract.md)",
-               "feeddrive-controller"};
+  CLI::App app{
+      "feeddrive-controller: answers <prefix>_STATE with <prefix>_CMD using <prefix>_REF "
+      "(docs/lcm-contract.md)",
+      "feeddrive-controller"};
   std::string scenario_path;
   std::string plugin;
   service::NodeOptions opt;
@@ -17,7 +18,8 @@ int main(int argc, char** argv) {
   app.add_option("--plugin", plugin, "host the controller plugin (shared library) at PATH (docs/plugins.md)");
   service::add_node_options(app, opt);
   return service::run_process(app, argc, argv, opt, [&] {
-    const service::RunScenario rs = service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
+    const service::RunScenario rs =
+        service::load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
     // Checked against the monitor's run_info_t, except for a --plugin host: its scenario gives the
     // plugin's parameters and may be another file than the run's (docs/plugins.md).
     if (plugin.empty()) opt.scenario_hash = rs.sha256;

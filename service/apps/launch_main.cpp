@@ -8,9 +8,9 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 
-#include "feeddrive/record/lcm_log.hpp"
-#include "feeddrive/output/folder.hpp"
 #include "feeddrive/common/text_file.hpp"
+#include "feeddrive/output/folder.hpp"
+#include "feeddrive/record/lcm_log.hpp"
 #include "feeddrive/service/cli.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/launch.hpp"
@@ -19,15 +19,18 @@
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
-  CLI::App app{"feeddrive-launch: runs SCENARIO as four lockstep LCM processes and writes DIR "
-               "(timeseries.csv, summary.json, plots)",
-               "feeddrive-launch"};
+  CLI::App app{
+      "feeddrive-launch: runs SCENARIO as four lockstep LCM processes and writes DIR "
+      "(timeseries.csv, summary.json, plots)",
+      "feeddrive-launch"};
   service::LaunchOptions lo;
   service::NodeOptions opt;
   std::vector<std::string> external;
   bool no_plots = false;
   app.add_option("scenario", lo.scenario, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", lo.out_dir, "output folder (written atomically by the monitor; replaces only an earlier feeddrive output)")->required();
+  app.add_option("--out,-o", lo.out_dir,
+                 "output folder (written atomically by the monitor; replaces only an earlier feeddrive output)")
+      ->required();
   app.add_option("--external", external, "leave ROLE (controller, plant or trajectory) to a process you start")
       ->type_name("ROLE");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
@@ -35,7 +38,9 @@ int main(int argc, char** argv) {
                  "the monitor also writes every message of the run to FILE in the standard LCM log format "
                  "(instead of the stock lcm-logger, which halves a lockstep run's speed)");
   std::string cpus;
-  app.add_option("--cpus", cpus, "pin every process to these CPUs, e.g. 0 or 0,1 (a lockstep chain runs fastest on one core where cross-core wake-ups are slow)")
+  app.add_option("--cpus", cpus,
+                 "pin every process to these CPUs, e.g. 0 or 0,1 (a lockstep chain runs fastest on one core where "
+                 "cross-core wake-ups are slow)")
       ->type_name("LIST");
   std::string off_path_cpus;
   app.add_option("--off-path-cpus", off_path_cpus,
@@ -53,13 +58,14 @@ int main(int argc, char** argv) {
     // its copy hashes the same (one run, one scenario).
     const service::RunScenario rs = service::load_run_scenario(lo.scenario, opt);
     const sim::Scenario& s = rs.scenario;
-    opt.scenario_hash = rs.sha256;  // --scenario-hash, run_info_t.scenario_hash
+    opt.scenario_hash = rs.sha256;                          // --scenario-hash, run_info_t.scenario_hash
     const auto out = output::check_output_dir(lo.out_dir);  // and these, before any process starts
     output::check_outside(lo.lcm_log, "--lcm-log", lo.out_dir);
     output::check_output_file(lo.lcm_log, "--lcm-log", record::kLcmLogMagic);
     if (!opt.key_file.empty()) service::read_key_file(opt.key_file);
     sim::check_run_size(s, lo.out_dir);
-    spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url, opt.prefix);
+    spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url,
+                 opt.prefix);
     // The monitor's marker before the run: a successful run leaves a new one (a new file).
     const auto marker_id = [&] {
       struct stat st {};
@@ -73,8 +79,10 @@ int main(int argc, char** argv) {
     if (r.refusals.empty())
       for (const auto& f : r.failed) spdlog::error("failed: {}", f);
     if (!r.partial_record.empty())
-      spdlog::error("the monitor was killed: its record up to then (it goes to the file every second: the last "
-                    "second's rows may be missing; no summary.json) is in {}", r.partial_record);
+      spdlog::error(
+          "the monitor was killed: its record up to then (it goes to the file every second: the last "
+          "second's rows may be missing; no summary.json) is in {}",
+          r.partial_record);
     // A failed run's record is where the monitor said (DIR, or DIR.incomplete-N beside an
     // earlier output): DIR's summary may be the earlier run's, so it is not shown as this one's.
     if (r.exit_code != 0) return r.exit_code;

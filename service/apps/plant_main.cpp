@@ -5,8 +5,9 @@
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
-  CLI::App app{"feeddrive-plant: the simulated linear-motor feed drive, publishing <prefix>_STATE and "
-               "applying <prefix>_CMD (docs/lcm-contract.md)",
-               "feeddrive-plant"};
+  CLI::App app{
+      "feeddrive-plant: the simulated linear-motor feed drive, publishing <prefix>_STATE and "
+      "applying <prefix>_CMD (docs/lcm-contract.md)",
+      "feeddrive-plant"};
   return service::run_scenario_node<service::PlantNode>(app, argc, argv);
 }

@@ -13,22 +13,22 @@ namespace feeddrive::service {
 std::string default_lcm_url() { return "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304"; }
 
 std::int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
 std::int64_t mono_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
 Bus::Bus(const std::string& url, Receive receive, lcm_t* shared)
-    : url_(url), shared_(shared != nullptr), lcm_(shared != nullptr ? lcm::LCM(shared) : lcm::LCM(url)), receive_(receive) {
+    : url_(url),
+      shared_(shared != nullptr),
+      lcm_(shared != nullptr ? lcm::LCM(shared) : lcm::LCM(url)),
+      receive_(receive) {
   if (!lcm_.good())
-    throw std::runtime_error("cannot open LCM at '" + url +
-                             "' (is there a multicast route? see docs/lcm-contract.md)");
+    throw std::runtime_error("cannot open LCM at '" + url + "' (is there a multicast route? see docs/lcm-contract.md)");
   // Direct and batched: liblcm only publishes (it opens its receive socket and thread on the
   // first subscribe or handle, which then never come); our reader takes the group's datagrams.
   if (receive != Receive::kEvent && !shared_)
@@ -54,8 +54,10 @@ void Bus::count_foreign(const std::string& channel, std::int64_t run_id, const s
   ++foreign_;
   if (events_.foreign) events_.foreign(channel, run_id, role);
   else if (reports_ && log_due(last_foreign_log_us_))
-    spdlog::warn("ignored a message of another run (run id {}, this run {}) on {}: {} so far (a second run on this "
-                 "group, or a replayed log)", run_id, run_id_, channel, foreign_);
+    spdlog::warn(
+        "ignored a message of another run (run id {}, this run {}) on {}: {} so far (a second run on this "
+        "group, or a replayed log)",
+        run_id, run_id_, channel, foreign_);
 }
 
 bool Bus::publish_raw(const std::string& channel, const std::uint8_t* data, std::size_t size) {
@@ -70,7 +72,8 @@ bool Bus::sent(int rc, const std::string& channel) {
   return false;
 }
 
-void Bus::count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size, const std::string& why) {
+void Bus::count_invalid(const std::string& channel, const std::uint8_t* data, std::size_t size,
+                        const std::string& why) {
   ++invalid_;
   ++invalid_by_channel_[channel];
   if (events_.undecodable) events_.undecodable(channel, data, size, why);
@@ -117,14 +120,15 @@ bool Bus::poll(std::chrono::microseconds timeout) {
 
 std::size_t Bus::drain() {
   std::string channel;
-  const std::size_t n = reader_->drain([&](std::string_view ch, const std::uint8_t* d, std::size_t size, std::int64_t utime) {
-    if (tap_) tap_(ch, d, size, utime);
-    channel.assign(ch);
-    const auto it = batched_subs_.find(channel);
-    if (it == batched_subs_.end()) return;
-    lcm::ReceiveBuffer rbuf{const_cast<std::uint8_t*>(d), static_cast<std::uint32_t>(size), utime};
-    for (Raw* r : it->second) r->handle(&rbuf, channel);
-  });
+  const std::size_t n =
+      reader_->drain([&](std::string_view ch, const std::uint8_t* d, std::size_t size, std::int64_t utime) {
+        if (tap_) tap_(ch, d, size, utime);
+        channel.assign(ch);
+        const auto it = batched_subs_.find(channel);
+        if (it == batched_subs_.end()) return;
+        lcm::ReceiveBuffer rbuf{const_cast<std::uint8_t*>(d), static_cast<std::uint32_t>(size), utime};
+        for (Raw* r : it->second) r->handle(&rbuf, channel);
+      });
   rethrow_handler_error();
   return n;
 }
@@ -132,7 +136,9 @@ std::size_t Bus::drain() {
 bool Bus::poll_batched(std::chrono::microseconds timeout) {
   // Sleep first, never on the socket: datagrams queue meanwhile without waking anyone.
   const std::int64_t wait_us = std::max<std::int64_t>(std::min(timeout, kBatchInterval).count(), 0);
-  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+  struct timespec ts {
+    static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)
+  };
   ::nanosleep(&ts, nullptr);  // EINTR (a signal): drain what is there and return
   return drain() > 0;
 }
@@ -140,8 +146,12 @@ bool Bus::poll_batched(std::chrono::microseconds timeout) {
 bool Bus::poll_direct(std::chrono::microseconds timeout) {
   // One wait on the socket (returns at once when something is queued), then take everything.
   const std::int64_t wait_us = std::max<std::int64_t>(timeout.count(), 0);
-  struct pollfd p{reader_->fd(), POLLIN, 0};
-  struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+  struct pollfd p {
+    reader_->fd(), POLLIN, 0
+  };
+  struct timespec ts {
+    static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)
+  };
   const int r = ::ppoll(&p, 1, &ts, nullptr);
   if (r < 0 && errno != EINTR) throw std::runtime_error("poll on the LCM socket failed");
   return r > 0 && drain() > 0;
@@ -153,9 +163,13 @@ bool Bus::poll_event(std::chrono::microseconds timeout) {
   const std::int64_t deadline = mono_us() + timeout.count();
   for (;;) {
     const std::int64_t left = deadline - mono_us();
-    struct pollfd p{fd, POLLIN, 0};
+    struct pollfd p {
+      fd, POLLIN, 0
+    };
     const std::int64_t wait_us = handled ? 0 : std::max<std::int64_t>(left, 0);
-    struct timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+    struct timespec ts {
+      static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)
+    };
     const int r = ::ppoll(&p, 1, &ts, nullptr);
     if (r < 0) {
       if (errno == EINTR) return handled;

@@ -6,14 +6,15 @@
 #include <limits>
 
 #include "feeddrive/common/interrupt.hpp"
-#include "feeddrive/tool/main.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/tool/main.hpp"
 
 namespace feeddrive::service {
 
 void add_node_options(CLI::App& app, NodeOptions& opt) {
   opt.stop = tool::stop_token();  // the process's: every run process is a tool's main
-  app.add_option("--set", opt.sets, "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
+  app.add_option("--set", opt.sets,
+                 "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
       ->type_name("KEY=VALUE");
   app.add_option("--lcm-url", opt.lcm_url, "LCM URL (default: multicast, ttl=0, 4 MB receive buffer)")
       ->capture_default_str();
@@ -48,7 +49,8 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
   app.add_option("--scenario-hash", opt.scenario_hash,
-                 "hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash; feeddrive-launch passes it)")
+                 "hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash; feeddrive-launch "
+                 "passes it)")
       ->type_name("HEX");
   app.add_option("--key", opt.key_file,
                  "authenticate every message with HMAC-SHA256 and this key file (mode 0600; docs/security.md)")
@@ -86,15 +88,17 @@ RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {
     wt.push_back(w.t);
     wx.push_back(w.x);
   }
-  if (r.scenario.reference.type == sim::ReferenceType::kWaypoints) add_table("waypoints", r.scenario.reference.waypoints_file, wt, wx);
+  if (r.scenario.reference.type == sim::ReferenceType::kWaypoints)
+    add_table("waypoints", r.scenario.reference.waypoints_file, wt, wx);
   if (r.scenario.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
     add_table("open_loop", r.scenario.controller.open_loop_file, r.scenario.controller.open_loop.table_t,
               r.scenario.controller.open_loop.table_value);
   r.sha256 = sha256_hex(text);
   if (!opt.scenario_hash.empty() && opt.scenario_hash != r.sha256)
-    throw std::invalid_argument(path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
-                                "..., the launcher read " + opt.scenario_hash.substr(0, 12) +
-                                "...): the file, or a table it names, changed while the run started; one run, one scenario: launch again");
+    throw std::invalid_argument(
+        path + ": not the scenario this run started with (sha256 " + r.sha256.substr(0, 12) +
+        "..., the launcher read " + opt.scenario_hash.substr(0, 12) +
+        "...): the file, or a table it names, changed while the run started; one run, one scenario: launch again");
   return r;
 }
 

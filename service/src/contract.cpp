@@ -74,10 +74,10 @@ std::optional<OlderSender> older_contract(const Channels& ch, std::string_view c
 
 std::string describe_older(const OlderSender& s, std::string_view channel) {
   const std::string who = s.role.empty() ? "a participant" : "the " + s.role;
-  return who + " speaks contract version " + std::to_string(s.version) + " (a " + s.type + " on " + std::string(channel) +
-         "); this run speaks " + std::to_string(kContractVersion) +
-         ": rebuild it with this feeddrive's lcmtypes/" + (s.version < 2 ? " and stamp run_info_t.run_id on every message" : "") +
-         " (docs/lcm-contract.md, Versions)";
+  return who + " speaks contract version " + std::to_string(s.version) + " (a " + s.type + " on " +
+         std::string(channel) + "); this run speaks " + std::to_string(kContractVersion) +
+         ": rebuild it with this feeddrive's lcmtypes/" +
+         (s.version < 2 ? " and stamp run_info_t.run_id on every message" : "") + " (docs/lcm-contract.md, Versions)";
 }
 
 }  // namespace feeddrive::service

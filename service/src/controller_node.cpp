@@ -7,7 +7,9 @@
 namespace feeddrive::service {
 
 ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const NodeOptions& opt, lcm_t* shared_lcm)
-    : Node("controller", opt, Receive::kDirect, shared_lcm), controller_(std::move(c)), commands_(bus(), channels().command) {
+    : Node("controller", opt, Receive::kDirect, shared_lcm),
+      controller_(std::move(c)),
+      commands_(bus(), channels().command) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {
@@ -36,14 +38,16 @@ ControllerNode::ControllerNode(std::unique_ptr<controller::Controller> c, const 
     // controller answers the state it has, and the plant or the monitor names the conflict.
     answered_by_others_.erase(answered_by_others_.begin(), answered_by_others_.lower_bound(next_seq_));
     if (!heard_state_ && m.seq > next_seq_)
-      spdlog::warn("controller: the first state heard is {}: states {}..{} went by before this controller "
-                   "listened, answered by another publisher",
-                   m.seq, next_seq_, m.seq - 1);
+      spdlog::warn(
+          "controller: the first state heard is {}: states {}..{} went by before this controller "
+          "listened, answered by another publisher",
+          m.seq, next_seq_, m.seq - 1);
     const bool late_join = !heard_state_;
     heard_state_ = true;
     if (!options().realtime && !late_join && m.seq > next_seq_ && !answered_by_others_.count(next_seq_))
       throw RunFailure("protocol error of the plant: it published state " + std::to_string(m.seq) + " while step " +
-                       std::to_string(next_seq_) + " has no command yet (a skipped or out-of-order step number; "
+                       std::to_string(next_seq_) +
+                       " has no command yet (a skipped or out-of-order step number; "
                        "docs/external-plant.md)");
     // Waiting for a reference since the first unanswered state, not the newest: in real-time
     // mode a newer state replaces the pending one every period, and a request timed from the
@@ -81,8 +85,9 @@ void ControllerNode::try_answer() {
   pending_.reset();
   const controller::Truth truth = to_truth(st.truth);
   if (controller_->needs_truth() && !st.truth.valid)
-    throw RunFailure("the controller is configured with friction_state/grinding_state = true, but the plant "
-                     "sends no truth (hardware); use the observers");
+    throw RunFailure(
+        "the controller is configured with friction_state/grinding_state = true, but the plant "
+        "sends no truth (hardware); use the observers");
   const controller::Command c =
       controller_->update(to_sample(it->second), to_measurement(st), st.truth.valid ? &truth : nullptr);
   commands_.publish(st.seq, to_message(st.seq, st.t, c));
@@ -119,12 +124,12 @@ void ControllerNode::run() {
     const double limit = next_seq_ == 0 ? options().start_timeout_s : options().step_timeout_s;
     // As in the trajectory: a plant that still sends its heartbeat waits for another role and
     // will name it; never wait longer than three timeouts, though.
-    const bool plant_waits = !pending_ && next_seq_ > 0 && peer_alive("plant", 0.5) &&
-                             now - last_progress_us_ <= 3 * us(limit);
+    const bool plant_waits =
+        !pending_ && next_seq_ > 0 && peer_alive("plant", 0.5) && now - last_progress_us_ <= 3 * us(limit);
     if (now - last_progress_us_ > us(limit) && !plant_waits) {
       if (pending_)
-        throw RunFailure("no reference from the trajectory for step " + std::to_string(pending_->seq) +
-                         " within " + seconds_text(limit) + " s");
+        throw RunFailure("no reference from the trajectory for step " + std::to_string(pending_->seq) + " within " +
+                         seconds_text(limit) + " s");
       throw RunFailure("no state from the plant for step " + std::to_string(next_seq_) + " within " +
                        seconds_text(limit) + " s");
     }

@@ -113,7 +113,8 @@ std::uint64_t splitmix64(std::uint64_t x) {
 std::int64_t keyed_run_id(std::int64_t run_id, std::int64_t nonce) {
   if (nonce == 0) return run_id;
   const std::uint64_t m = (std::uint64_t{1} << 53) - 1;
-  const std::uint64_t h = splitmix64(static_cast<std::uint64_t>(run_id) ^ splitmix64(static_cast<std::uint64_t>(nonce)));
+  const std::uint64_t h =
+      splitmix64(static_cast<std::uint64_t>(run_id) ^ splitmix64(static_cast<std::uint64_t>(nonce)));
   return static_cast<std::int64_t>(1 + h % m);
 }
 
@@ -157,7 +158,8 @@ std::string read_key_file(const std::string& path) {
     if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
       throw std::invalid_argument(where + "not a regular file (" + text::non_regular_kind(st.st_mode) + ")");
     if (st.st_uid != ::geteuid())
-      throw std::invalid_argument(where + "owned by another user (uid " + std::to_string(st.st_uid) + "); a key must be its user's own");
+      throw std::invalid_argument(where + "owned by another user (uid " + std::to_string(st.st_uid) +
+                                  "); a key must be its user's own");
     if ((st.st_mode & 077) != 0) {
       char mode[8];
       std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
@@ -185,7 +187,8 @@ MessageAuth::MessageAuth(const std::string& key) {
   mac_alg_ = EVP_MAC_fetch(nullptr, "HMAC", nullptr);
   ctx_ = mac_alg_ ? EVP_MAC_CTX_new(mac_alg_) : nullptr;
   char digest[] = "SHA256";
-  const OSSL_PARAM params[] = {OSSL_PARAM_construct_utf8_string(OSSL_MAC_PARAM_DIGEST, digest, 0), OSSL_PARAM_construct_end()};
+  const OSSL_PARAM params[] = {OSSL_PARAM_construct_utf8_string(OSSL_MAC_PARAM_DIGEST, digest, 0),
+                               OSSL_PARAM_construct_end()};
   if (ctx_ == nullptr ||
       EVP_MAC_init(ctx_, reinterpret_cast<const unsigned char*>(key.data()), key.size(), params) != 1) {
     EVP_MAC_CTX_free(ctx_);

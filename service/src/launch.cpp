@@ -1,13 +1,13 @@
 #include "feeddrive/service/launch.hpp"
 
-#include <sched.h>
-#include <algorithm>
 #include <fcntl.h>
-#include <sys/prctl.h>
+#include <sched.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 
 #include <cerrno>
 #include <cstdlib>
@@ -15,13 +15,13 @@
 #include <map>
 #include <optional>
 
-#include "feeddrive/output/folder.hpp"
+#include <stdexcept>
 #include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/output/folder.hpp"
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/service/bus.hpp"
 #include "feeddrive/service/integrity.hpp"
 #include "feeddrive/service/loggers.hpp"
-#include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
 
@@ -35,14 +35,15 @@ std::string fmt_double(double v) {
 }
 
 std::vector<std::string> common_args(const NodeOptions& opt) {
-  std::vector<std::string> a = {"--lcm-url", opt.lcm_url, "--prefix", opt.prefix,
-                                "--start-timeout", fmt_double(opt.start_timeout_s),
-                                "--step-timeout", fmt_double(opt.step_timeout_s),
-                                "--resend-interval", fmt_double(opt.resend_interval_s),
-                                "--monitor-window", std::to_string(opt.monitor_window),
-                                "--linger", fmt_double(opt.linger_s),
+  std::vector<std::string> a = {"--lcm-url",          opt.lcm_url,
+                                "--prefix",           opt.prefix,
+                                "--start-timeout",    fmt_double(opt.start_timeout_s),
+                                "--step-timeout",     fmt_double(opt.step_timeout_s),
+                                "--resend-interval",  fmt_double(opt.resend_interval_s),
+                                "--monitor-window",   std::to_string(opt.monitor_window),
+                                "--linger",           fmt_double(opt.linger_s),
                                 "--max-bad-commands", std::to_string(opt.max_bad_commands),
-                                "--spin-us", std::to_string(opt.realtime_spin_us)};
+                                "--spin-us",          std::to_string(opt.realtime_spin_us)};
   if (opt.realtime) a.push_back("--realtime");
   if (opt.max_rate > 0) a.insert(a.end(), {"--max-rate", fmt_double(opt.max_rate)});
   if (opt.run_id != 0) a.insert(a.end(), {"--run-id", std::to_string(opt.run_id)});
@@ -76,7 +77,8 @@ class RefusalPipe {
   std::vector<std::string> lines() {
     std::string text;
     char buf[4096];
-    for (ssize_t n; read_ >= 0 && (n = ::read(read_, buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
+    for (ssize_t n; read_ >= 0 && (n = ::read(read_, buf, sizeof buf)) > 0;)
+      text.append(buf, static_cast<std::size_t>(n));
     std::vector<std::string> out;
     std::size_t start = 0;
     while (start < text.size()) {
@@ -135,9 +137,7 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
 
 }  // namespace
 
-std::string executable_dir() {
-  return std::filesystem::read_symlink("/proc/self/exe").parent_path().string();
-}
+std::string executable_dir() { return std::filesystem::read_symlink("/proc/self/exe").parent_path().string(); }
 
 std::vector<int> parse_cpu_list(const std::string& text, const std::string& option) {
   cpu_set_t allowed;
@@ -167,20 +167,24 @@ void check_group_free(const NodeOptions& opt, double listen_s) {
       ch.status,
       [&](const process_status_t& m, std::int64_t) {
         if (holder.empty() && m.role == "plant")
-          holder = "run id " + std::to_string(m.run_id) + ", its plant " + m.state + " at step " + std::to_string(m.seq);
+          holder =
+              "run id " + std::to_string(m.run_id) + ", its plant " + m.state + " at step " + std::to_string(m.seq);
       },
       Admit::kAnyRun);
   probe.subscribe<drive_state_t>(
       ch.state,
       [&](const drive_state_t& m, std::int64_t) {
-        if (holder.empty()) holder = "run id " + std::to_string(m.run_id) + ", its plant at step " + std::to_string(m.seq);
+        if (holder.empty())
+          holder = "run id " + std::to_string(m.run_id) + ", its plant at step " + std::to_string(m.seq);
       },
       Admit::kAnyRun);
   const std::int64_t end = mono_us() + us(listen_s);
-  while (holder.empty() && mono_us() < end) probe.poll(std::chrono::microseconds(std::max<std::int64_t>(end - mono_us(), 1)));
+  while (holder.empty() && mono_us() < end)
+    probe.poll(std::chrono::microseconds(std::max<std::int64_t>(end - mono_us(), 1)));
   if (holder.empty()) return;
   const std::optional<UdpmAddress> a = parse_udpm_url(opt.lcm_url);
-  const std::string other_port = a ? "udpm://" + a->group + ":" + std::to_string(a->port + 1) + "?ttl=0" : "another URL";
+  const std::string other_port =
+      a ? "udpm://" + a->group + ":" + std::to_string(a->port + 1) + "?ttl=0" : "another URL";
   throw std::invalid_argument("another run holds " + opt.prefix + "_* on " + opt.lcm_url + " (" + holder +
                               "): give this one another --prefix (e.g. --prefix " + opt.prefix +
                               "2) or --lcm-url (e.g. '" + other_port + "'), and the same to its external processes");
@@ -201,7 +205,8 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     if (opt.run_id == 0) opt.run_id = draw_run_id();
     // With a key, a fresh nonce binds the run id on the wire to this run (docs/security.md).
     if (!opt.key_file.empty() && opt.run_nonce == 0) opt.run_nonce = draw_run_id();
-    spdlog::info("run id {}{}", opt.run_id, opt.key_file.empty() ? "" : " (messages authenticated with " + opt.key_file + ")");
+    spdlog::info("run id {}{}", opt.run_id,
+                 opt.key_file.empty() ? "" : " (messages authenticated with " + opt.key_file + ")");
   } else if (opt.run_id == 0) {
     spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
   }
@@ -211,9 +216,11 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     const std::vector<StockLogger> loggers = stock_loggers_on(opt.lcm_url);
     if (!loggers.empty()) {
       opt.max_rate = stock_logger_pace(loggers);
-      spdlog::info("{} on the bus: the run is paced to {:g} steps/s, which it records without loss{} (--max-rate N to "
-                   "choose, --max-rate 0 for none; docs/lcm-contract.md)", describe(loggers), opt.max_rate,
-                   opt.max_rate < kStockLoggerSteps ? "; at real-time priority (chrt -f 20) it keeps up with 1000" : "");
+      spdlog::info(
+          "{} on the bus: the run is paced to {:g} steps/s, which it records without loss{} (--max-rate N to "
+          "choose, --max-rate 0 for none; docs/lcm-contract.md)",
+          describe(loggers), opt.max_rate,
+          opt.max_rate < kStockLoggerSteps ? "; at real-time priority (chrt -f 20) it keeps up with 1000" : "");
     }
   }
 
@@ -222,15 +229,17 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   for (const auto& role : roles) {
     if (given.stop.stop_requested()) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
     if (lo.external.count(role)) {
-      spdlog::info("{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
-                   "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
-                   "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
-                   "(docs/external-{}.md)",
-                   role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
-                   opt.key_file.empty() ? "" : " --key " + opt.key_file,
-                   opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
-                   opt.scenario_hash, opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s), seconds_text(opt.step_timeout_s),
-                   seconds_text(opt.resend_interval_s), opt.monitor_window, role == "plant" ? "plant" : "controllers");
+      spdlog::info(
+          "{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
+          "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
+          "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
+          "(docs/external-{}.md)",
+          role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
+          opt.key_file.empty() ? "" : " --key " + opt.key_file,
+          opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
+          opt.scenario_hash, opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s),
+          seconds_text(opt.step_timeout_s), seconds_text(opt.resend_interval_s), opt.monitor_window,
+          role == "plant" ? "plant" : "controllers");
       continue;
     }
     std::vector<std::string> args = {lo.scenario};

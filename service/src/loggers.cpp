@@ -112,7 +112,8 @@ std::string local_process_on_udp_port(int port) {
 std::string describe(const std::vector<StockLogger>& loggers) {
   std::string s;
   for (const StockLogger& l : loggers)
-    s += (s.empty() ? "" : ", ") + l.name + " (pid " + std::to_string(l.pid) + (l.realtime ? ", real-time priority)" : ", normal priority)");
+    s += (s.empty() ? "" : ", ") + l.name + " (pid " + std::to_string(l.pid) +
+         (l.realtime ? ", real-time priority)" : ", normal priority)");
   return s;
 }
 

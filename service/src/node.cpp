@@ -1,5 +1,5 @@
-#include "feeddrive/wire.hpp"
 #include "feeddrive/service/node.hpp"
+#include "feeddrive/wire.hpp"
 
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -12,17 +12,18 @@
 #include <ctime>
 #include <stdexcept>
 
+#include <cstdio>
+#include <cstdlib>
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/run_info_t.hpp"
 #include "feeddrive/service/contract.hpp"
-#include <cstdio>
-#include <cstdlib>
 
 namespace feeddrive::service {
 std::string enter_realtime(int priority) {
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-  const std::string lock = locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
+  const std::string lock =
+      locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
   sched_param sp{};
   sp.sched_priority = priority;
   if (::sched_setscheduler(0, SCHED_FIFO, &sp) == 0) return "SCHED_FIFO " + std::to_string(priority) + ", " + lock;
@@ -34,11 +35,9 @@ void sleep_until(std::int64_t target_us, std::int64_t spin_us, const interrupt::
   const std::int64_t wake = target_us - spin_us;
   if (mono_us() < wake) {
     timespec ts{static_cast<time_t>(wake / 1000000), static_cast<long>((wake % 1000000) * 1000)};
-    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !stop.stop_requested()) {
-    }
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !stop.stop_requested()) {}
   }
-  while (mono_us() < target_us) {
-  }
+  while (mono_us() < target_us) {}
 }
 
 std::string seconds_text(double s) {
@@ -76,9 +75,10 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* sha
           if (m.role != "plant" || std::llabs(m.utime - wall_utime()) > 5000000) return;
           if (keyed && m.run_nonce == 0) {
             if (!warned_no_nonce_)
-              spdlog::error("{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
-                            "contract's version 3 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
-                            role_);
+              spdlog::error(
+                  "{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
+                  "contract's version 3 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
+                  role_);
             warned_no_nonce_ = true;
             return;
           }
@@ -118,7 +118,8 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* sha
         // forge any step (docs/security.md: detected, not prevented), and the newest one wins.
         const bool seq_back = keyed && tracked && m.state == it->second.state && m.seq < it->second.seq;
         if (implausible || seq_back ||
-            (tracked && (rank(m.state) < rank(it->second.state) || (a_monitor && m.acked_seq < it->second.acked_seq)))) {
+            (tracked &&
+             (rank(m.state) < rank(it->second.state) || (a_monitor && m.acked_seq < it->second.acked_seq)))) {
           const std::string was = tracked ? it->second.state : std::string("-");
           const std::int64_t was_acked = tracked ? it->second.acked_seq : -1;
           {
@@ -127,14 +128,16 @@ Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* sha
             if (now - last_conflict_log_us_ > 1000000) {
               last_conflict_log_us_ = now;
               if (implausible)
-                spdlog::warn("{}: conflict on {}: a heartbeat of the {} acknowledges step {}, beyond this {}'s step {}; "
-                             "forged or replayed; ignored, {} conflicts so far", role_, ch_.status, m.role, m.acked_seq,
-                             role_, seq_, conflicts);
+                spdlog::warn(
+                    "{}: conflict on {}: a heartbeat of the {} acknowledges step {}, beyond this {}'s step {}; "
+                    "forged or replayed; ignored, {} conflicts so far",
+                    role_, ch_.status, m.role, m.acked_seq, role_, seq_, conflicts);
               else
-                spdlog::warn("{}: conflict on {}: a heartbeat of the {} goes back ('{}' at step {} after its own '{}' at "
-                             "step {}, acknowledged step {} after {}; forged or replayed; ignored, {} conflicts so far)",
-                             role_, ch_.status, m.role, m.state, m.seq, was, tracked ? it->second.seq : -1, m.acked_seq,
-                             was_acked, conflicts);
+                spdlog::warn(
+                    "{}: conflict on {}: a heartbeat of the {} goes back ('{}' at step {} after its own '{}' at "
+                    "step {}, acknowledged step {} after {}; forged or replayed; ignored, {} conflicts so far)",
+                    role_, ch_.status, m.role, m.state, m.seq, was, tracked ? it->second.seq : -1, m.acked_seq,
+                    was_acked, conflicts);
             }
             if (!implausible && on_peer_status_back) on_peer_status_back(m);
             return;
@@ -231,7 +234,8 @@ void Node::wait_for_run() {
 bool Node::on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff) {
   ++conflicts;
   const std::string what = "conflict on " + channel + " step " + std::to_string(seq) + ": two different " + type +
-                           " for one step (" + diff + " differ); another publisher on the bus, or a stale step number (an answer to "
+                           " for one step (" + diff +
+                           " differ); another publisher on the bus, or a stale step number (an answer to "
                            "state k carrying seq < k)? (docs/security.md)";
   if (opt_.on_conflict == ConflictPolicy::kFail) throw RunFailure(what);
   // keep-first: every conflict is counted; the log names the first ten, then one a second.
@@ -269,8 +273,7 @@ const process_status_t* Node::peer(const std::string& role) const {
 bool Node::peer_alive(const std::string& role, double seconds) const {
   const process_status_t* p = peer(role);
   const auto seen = peer_seen_us_.find(role);
-  return p != nullptr && seen != peer_seen_us_.end() && p->state != "failed" &&
-         mono_us() - seen->second <= us(seconds);
+  return p != nullptr && seen != peer_seen_us_.end() && p->state != "failed" && mono_us() - seen->second <= us(seconds);
 }
 
 bool Node::monitor_done() const {

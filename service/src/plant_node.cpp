@@ -153,13 +153,15 @@ void PlantNode::run_lockstep() {
       heartbeat();
       bus().poll(std::chrono::microseconds(std::max<std::int64_t>(resend_us - (mono_us() - last_sent), 1)));
     }
-    if (command_->seq > k) throw RunFailure("the controller answered step " + std::to_string(command_->seq) +
-                                            " while the plant is at step " + std::to_string(k));
+    if (command_->seq > k)
+      throw RunFailure("the controller answered step " + std::to_string(command_->seq) +
+                       " while the plant is at step " + std::to_string(k));
     const plant::AdmittedCommand a = plant::admit_command(command_->u, s_.plant.input_limit, 0.0);
     if (a.status != plant::CommandStatus::kApplied) {
       ++rejected_;
-      spdlog::warn("plant: command {} for step {} {}", command_->u, k,
-                   a.status == plant::CommandStatus::kRejected ? "rejected, 0 V applied" : "clipped to the input limit");
+      spdlog::warn(
+          "plant: command {} for step {} {}", command_->u, k,
+          a.status == plant::CommandStatus::kRejected ? "rejected, 0 V applied" : "clipped to the input limit");
     }
     apply(k, a.u);
     heartbeat();
@@ -174,8 +176,9 @@ bool PlantNode::take_commands(std::int64_t k, double t_end) {
   for (const auto& [c, recv_us] : arrived_) {
     if (c.seq <= newest_seq_) continue;  // a repeat (counted by the handler), or older than one acting
     newest_seq_ = c.seq;
-    if (c.seq > k) throw RunFailure("the controller answered step " + std::to_string(c.seq) +
-                                    " while the plant is at step " + std::to_string(k));
+    if (c.seq > k)
+      throw RunFailure("the controller answered step " + std::to_string(c.seq) + " while the plant is at step " +
+                       std::to_string(k));
     const bool on_time = c.seq == k;
     const plant::AdmittedCommand a = plant::admit_command(c.u, s_.plant.input_limit, last_good_u_);
     if (a.status != plant::CommandStatus::kApplied) ++rejected_;
@@ -219,7 +222,8 @@ void PlantNode::run_realtime() {
       last_sent = mono_us();
     }
     if (mono_us() - hs_start > us(options().start_timeout_s))
-      throw RunFailure("no command from the controller for step 0 within " + seconds_text(options().start_timeout_s) + " s");
+      throw RunFailure("no command from the controller for step 0 within " + seconds_text(options().start_timeout_s) +
+                       " s");
     check_peers();
     heartbeat();
     bus().poll(std::chrono::microseconds(us(options().resend_interval_s)));

@@ -7,7 +7,10 @@
 namespace feeddrive::service {
 
 TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt, lcm_t* shared_lcm)
-    : Node("trajectory", opt, Receive::kBatched, shared_lcm), s_(s), reference_(sim::make_reference(s)), blocks_(bus(), channels().reference) {
+    : Node("trajectory", opt, Receive::kBatched, shared_lcm),
+      s_(s),
+      reference_(sim::make_reference(s)),
+      blocks_(bus(), channels().reference) {
   bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t now) {
     if (!admit(state_ledger_, channels().state, m.seq, m)) return;
     if (m.end_of_run) {
@@ -56,7 +59,8 @@ void TrajectoryNode::send_block(std::int64_t b, bool resend) {
 }
 
 void TrajectoryNode::send_ahead(std::int64_t k) {
-  for (; next_block_ <= (k + kLead) / kBlock && next_block_ * kBlock < s_.steps(); ++next_block_) send_block(next_block_, false);
+  for (; next_block_ <= (k + kLead) / kBlock && next_block_ * kBlock < s_.steps(); ++next_block_)
+    send_block(next_block_, false);
 }
 
 void TrajectoryNode::run() {

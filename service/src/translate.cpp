@@ -1,5 +1,5 @@
-#include "feeddrive/wire.hpp"
 #include "feeddrive/service/translate.hpp"
+#include "feeddrive/wire.hpp"
 
 #include <limits>
 

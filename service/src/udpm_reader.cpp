@@ -18,7 +18,7 @@ constexpr std::uint32_t kMagicLong = 0x4c433033;   // "LC03"
 constexpr std::size_t kShortHeader = 8;
 constexpr std::size_t kLongHeader = 20;
 constexpr std::size_t kMaxDatagram = 65536;
-constexpr std::size_t kBatch = 16;                       // datagrams per recvmmsg call
+constexpr std::size_t kBatch = 16;  // datagrams per recvmmsg call
 // Fragmented messages: feeddrive's own are all below 2 kB (wire_check.hpp's kMaxEncoded) and never
 // fragmented, so a fragmented one is another application's or forged. At most kMaxPartial of at
 // most kMaxPayload bytes are kept while their fragments come: 8 MB per process, whatever is sent.
@@ -197,8 +197,8 @@ std::string UdpmReader::current_source() const {
   const auto addr = static_cast<std::uint32_t>(current_ >> 16);  // network byte order, as in sin_addr
   const auto* b = reinterpret_cast<const unsigned char*>(&addr);
   const auto port = static_cast<std::uint16_t>(current_ & 0xFFFF);
-  return std::to_string(b[0]) + "." + std::to_string(b[1]) + "." + std::to_string(b[2]) + "." + std::to_string(b[3]) + ":" +
-         std::to_string(ntohs(port));
+  return std::to_string(b[0]) + "." + std::to_string(b[1]) + "." + std::to_string(b[2]) + "." + std::to_string(b[3]) +
+         ":" + std::to_string(ntohs(port));
 }
 
 std::size_t UdpmReader::drain(const MessageSink& sink) {

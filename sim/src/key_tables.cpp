@@ -61,7 +61,8 @@ class DocArchive {
     } else if constexpr (std::is_same_v<T, bool>) {
       rows_->push_back({key, "–", v ? "true" : "false", "true, false", "–", m.doc});
     } else if constexpr (fields::is_named_enum<T>::value) {
-      rows_->push_back({key, "–", std::string("`") + fields::enum_name(v) + "`", fields::enum_choices<T>(), "–", m.doc});
+      rows_->push_back(
+          {key, "–", std::string("`") + fields::enum_name(v) + "`", fields::enum_choices<T>(), "–", m.doc});
     } else if constexpr (fields::is_serializable<T>::value) {
       if (*m.doc) rows_->push_back({key, "map", "", "", "", m.doc});
       DocArchive child(key, rows_);
@@ -92,8 +93,8 @@ std::string table(S obj, const std::string& prefix = "") {
       "| Key | Unit | Default | Valid (else exit 2) | Plausible for a linear feed drive (else a warning) | Meaning |\n"
       "|---|---|---|---|---|---|\n";
   for (const Row& r : rows)
-    t += "| `" + r.key + "` | " + r.unit + " | " + r.def + " | " + r.valid + " | " + r.plausible + " | " + escape(r.meaning) +
-         " |\n";
+    t += "| `" + r.key + "` | " + r.unit + " | " + r.def + " | " + r.valid + " | " + r.plausible + " | " +
+         escape(r.meaning) + " |\n";
   return t;
 }
 
@@ -157,7 +158,9 @@ const std::map<std::string, std::string>& unit_map() {
                                             {"analysis.settling_band", "m"},
                                             {"output.every", "-"}};
     for (const auto& [name, text] : key_tables()) {
-      const std::string prefix = name.rfind("controller.", 0) == 0 ? "controller" : name.rfind("reference.", 0) == 0 ? "reference" : name;
+      const std::string prefix = name.rfind("controller.", 0) == 0  ? "controller"
+                                 : name.rfind("reference.", 0) == 0 ? "reference"
+                                                                    : name;
       std::size_t i = 0;
       while ((i = text.find("\n| `", i)) != std::string::npos) {
         const std::size_t b = i + 4, e = text.find('`', b);
@@ -182,7 +185,9 @@ std::string key_unit(const std::string& key) {
 std::vector<std::string> listed_keys() {
   std::vector<std::string> out;
   for (const auto& [name, text] : key_tables()) {
-    const std::string prefix = name.rfind("controller.", 0) == 0 ? "controller" : name.rfind("reference.", 0) == 0 ? "reference" : name;
+    const std::string prefix = name.rfind("controller.", 0) == 0  ? "controller"
+                               : name.rfind("reference.", 0) == 0 ? "reference"
+                                                                  : name;
     collect_keys(text, [&](const std::string& k) { out.push_back(prefix + "." + k); });
   }
   return out;

@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   using namespace feeddrive;
   CLI::App app{"feeddrive-keys: the scenario key tables of docs/scenario.md, from the params structs"};
   std::string check, write;
-  app.add_option("--check", check, "a Markdown file whose marked tables must equal the generated ones (exit 1 otherwise)");
+  app.add_option("--check", check,
+                 "a Markdown file whose marked tables must equal the generated ones (exit 1 otherwise)");
   app.add_option("--write", write, "a Markdown file whose marked tables are rewritten");
   tool::Options opt;
   opt.name = "feeddrive-keys";
@@ -37,7 +38,8 @@ int main(int argc, char** argv) {
     const std::string generated = tool::input_step([&] { return sim::with_key_tables(doc); });
     if (!check.empty()) {
       if (generated == doc) return kExitOk;
-      throw std::runtime_error(path + ": the key tables differ from the params structs' lists; run feeddrive-keys --write " + path);
+      throw std::runtime_error(
+          path + ": the key tables differ from the params structs' lists; run feeddrive-keys --write " + path);
     }
     std::ofstream out(path);
     out << generated;

@@ -27,22 +27,31 @@ int main(int argc, char** argv) {
   bool no_plots = false, quiet = false;
   std::vector<std::string> sets;
   app.add_option("scenario", scenario_path, "scenario YAML file (docs/scenario.md)")->required();
-  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")->required();
+  app.add_option("--out,-o", out_dir, "output folder (written atomically; replaces only an earlier feeddrive output)")
+      ->required();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
-  app.add_option("--set", sets, "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
+  app.add_option("--set", sets,
+                 "KEY=VALUE: set a scenario key (dotted, e.g. plant.mass=110) as if the file said so; repeatable")
       ->type_name("KEY=VALUE");
   app.add_flag("--quiet,-q", quiet, "print only errors");
   bool frequency_response = false;
   analysis::FrequencyResponseOptions fr;
-  app.add_flag("--frequency-response", frequency_response, "measure the closed loop's frequency response (docs/analysis.md)");
-  app.add_option("--fr-frequencies", fr.frequencies, "frequencies [Hz] (default: --fr-points log-spaced)")->delimiter(',');
+  app.add_flag("--frequency-response", frequency_response,
+               "measure the closed loop's frequency response (docs/analysis.md)");
+  app.add_option("--fr-frequencies", fr.frequencies, "frequencies [Hz] (default: --fr-points log-spaced)")
+      ->delimiter(',');
   app.add_option("--fr-from", fr.f_min, "lowest frequency [Hz]")->capture_default_str();
   app.add_option("--fr-to", fr.f_max, "highest frequency [Hz] (0: 0.4/control_period)")->capture_default_str();
   app.add_option("--fr-points", fr.points, "number of frequencies")->capture_default_str();
-  app.add_option("--fr-amplitude", fr.reference_amplitude, "reference sine amplitude [m] (0: no reference run)")->capture_default_str();
-  app.add_option("--fr-acceleration", fr.acceleration_limit, "reference acceleration limit [m/s^2] (0: a quarter of the force range / mass)")->capture_default_str();
-  app.add_option("--fr-force", fr.force_amplitude, "disturbance force amplitude [N] (0: no disturbance run)")->capture_default_str();
-  app.add_option("--fr-velocity", fr.feed_velocity, "constant feed velocity under the excitation [m/s]")->capture_default_str();
+  app.add_option("--fr-amplitude", fr.reference_amplitude, "reference sine amplitude [m] (0: no reference run)")
+      ->capture_default_str();
+  app.add_option("--fr-acceleration", fr.acceleration_limit,
+                 "reference acceleration limit [m/s^2] (0: a quarter of the force range / mass)")
+      ->capture_default_str();
+  app.add_option("--fr-force", fr.force_amplitude, "disturbance force amplitude [N] (0: no disturbance run)")
+      ->capture_default_str();
+  app.add_option("--fr-velocity", fr.feed_velocity, "constant feed velocity under the excitation [m/s]")
+      ->capture_default_str();
   app.add_option("--fr-settle", fr.settle_time, "least settling time dropped per frequency [s]")->capture_default_str();
   app.add_option("--jobs,-j", fr.jobs, "frequencies measured in parallel")->capture_default_str();
   tool::Options opt{"feeddrive-sim", &quiet, [&] { return "; nothing written to " + output::shown(out_dir); }};
@@ -52,18 +61,18 @@ int main(int argc, char** argv) {
       for (const std::string& k : sets) settings.push_back(sim::parse_key_setting(k));
       sim::Scenario s = sim::load_scenario(scenario_path, settings);
       output::check_output_dir(out_dir);  // before any work
-      if (frequency_response)
-        fr.validate(s);
-      else
-        sim::check_run_size(s, out_dir);
+      if (frequency_response) fr.validate(s);
+      else sim::check_run_size(s, out_dir);
       return s;
     });
     if (frequency_response) {
       fr.stop = tool::stop_token();
       const auto r = analysis::measure_frequency_response(scenario, fr);
       if (!quiet) std::fputs(analysis::frequency_response_table(scenario, r).c_str(), stdout);
-      const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, !no_plots, tool::stop_token());
-      if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
+      const std::string plot_error =
+          analysis::write_frequency_response(out_dir, scenario, r, !no_plots, tool::stop_token());
+      if (!plot_error.empty())
+        spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
       // as after a run: the scenario's and the options' plausibility warnings (frequency_response.json too)
       for (const std::string& w : r.warnings) spdlog::warn("{}", w);
       spdlog::info("{} frequencies in {:.1f} s -> {}", r.points.size(), r.wall_time_s, out_dir);
@@ -77,13 +86,13 @@ int main(int argc, char** argv) {
     // value (check_finite_step: sim::ScenarioError), or a CSV that cannot fit (RunWriter's check
     // on its first rows: std::invalid_argument) is bad input, exit 2 (tool::report).
     sim::RunWriter out(out_dir, scenario, "feeddrive-sim", tool::stop_token());
-    const auto stats = sim::run(scenario, [&](const sim::Record& r) { out.add(r); }, tool::stop_token());
+    const auto stats = sim::run(
+        scenario, [&](const sim::Record& r) { out.add(r); }, tool::stop_token());
     const auto summary = out.summary(stats.wall_time_s, stats.integrator);
     out.finish(summary, !no_plots);
     if (!out.plot_error().empty())
       spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
-    else if (!no_plots)
-      spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
+    else if (!no_plots) spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
     // After the run (a run that then fails says only why, in one line): the values that load but
     // are implausible for a linear feed drive, and a move the run cut off (summary.json too).
     for (const std::string& w : scenario.warnings) spdlog::warn("{}", w);

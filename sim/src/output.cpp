@@ -31,8 +31,8 @@ std::string size_text(double bytes) {
 // x_measured and e_m = xd - x_measured are drawn where the true state is missing (hardware).
 enum Curve { kXd, kX, kE, kEv, kU, kFriction, kRipple, kGrinding, kXm, kEm, kCurves };
 const std::vector<std::string>& curve_names() {
-  static const std::vector<std::string> n = {"xd", "x", "e", "e_v", "u", "f_friction", "f_ripple", "f_grinding",
-                                             "x_measured", "e_measured"};
+  static const std::vector<std::string> n = {"xd",         "x",        "e",          "e_v",        "u",
+                                             "f_friction", "f_ripple", "f_grinding", "x_measured", "e_measured"};
   return n;
 }
 void curve_values(const Record& r, double* y) {
@@ -69,7 +69,8 @@ double plot_end(const Scenario& s) { return std::max(1.0, static_cast<double>(s.
 }  // namespace
 
 void check_run_size(const Scenario& s, const std::string& out_dir, double max_steps) {
-  const double rows = std::ceil(std::min(static_cast<double>(s.steps()), max_steps) / static_cast<double>(s.output.every));
+  const double rows =
+      std::ceil(std::min(static_cast<double>(s.steps()), max_steps) / static_cast<double>(s.output.every));
   const double cols = static_cast<double>(s.output.columns.empty() ? kRecordColumns : s.output.columns.size());
   const double least = rows * cols * 2.0;
   fs::path up = fs::absolute(output::normalise(out_dir));
@@ -79,10 +80,11 @@ void check_run_size(const Scenario& s, const std::string& out_dir, double max_st
   if (::statvfs(up.c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
   const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
   if (least > free_bytes) {
-    throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv needs at least " +
-                                size_text(least) + " (" + validate::format_number(rows) + " rows x " +
-                                validate::format_number(cols) + " columns x 2 bytes), only " + size_text(free_bytes) +
-                                " free in " + up.string() + "; record fewer rows (output.every) or columns (output.columns)");
+    throw std::invalid_argument(
+        "duration, control_period, output.every, output.columns: timeseries.csv needs at least " + size_text(least) +
+        " (" + validate::format_number(rows) + " rows x " + validate::format_number(cols) +
+        " columns x 2 bytes), only " + size_text(free_bytes) + " free in " + up.string() +
+        "; record fewer rows (output.every) or columns (output.columns)");
   }
 }
 
@@ -227,12 +229,12 @@ void RunWriter::check_projected_size() const {
   if (::statvfs(folder_.dir().c_str(), &st) != 0) return;  // unknown: the write itself reports a full disk
   const double free_bytes = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
   if (to_come > free_bytes) {
-    throw std::invalid_argument("duration, control_period, output.every, output.columns: timeseries.csv would take about " +
-                                size_text(to_come + static_cast<double>(csv_->bytes())) + " (" + validate::format_number(rows_total) +
-                                " rows of " + validate::format_number(std::round(per_row)) + " bytes, measured on the first " +
-                                std::to_string(kProjectAfterRows) + "), only " + size_text(free_bytes) + " free in " +
-                                folder_.target().parent_path().string() +
-                                "; record fewer rows (output.every) or columns (output.columns)");
+    throw std::invalid_argument(
+        "duration, control_period, output.every, output.columns: timeseries.csv would take about " +
+        size_text(to_come + static_cast<double>(csv_->bytes())) + " (" + validate::format_number(rows_total) +
+        " rows of " + validate::format_number(std::round(per_row)) + " bytes, measured on the first " +
+        std::to_string(kProjectAfterRows) + "), only " + size_text(free_bytes) + " free in " +
+        folder_.target().parent_path().string() + "; record fewer rows (output.every) or columns (output.columns)");
   }
 }
 
@@ -304,7 +306,9 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
         << ") with lines " << l.style << "title '" << l.title << "'";
       first = false;
     }
-    if (first) return "set label 1 '" + std::string(none) + "' at graph 0.5,0.5 center\nplot [0:1][0:1] NaN notitle\nunset label 1\n";
+    if (first)
+      return "set label 1 '" + std::string(none) +
+             "' at graph 0.5,0.5 center\nplot [0:1][0:1] NaN notitle\nunset label 1\n";
     return p.str() + "\n";
   };
   // Fixed data file name, the title through the one escaping rule (feeddrive/output/gnuplot.hpp).
@@ -323,10 +327,13 @@ void write_plots(const output::StagedFolder& dir, const output::MinMaxReducer& r
      << "unset multiplot\n";
   gp << "set output 'velocity_error.png'\nset title " << t << "\nset ylabel 'velocity error v_d - v [um/s]'\n"
      << panel({{kEv, "*1e6", "", "e_v"}}, "no true velocity: no error to draw");
-  gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n" << panel({{kU, "", "", "u"}}, "no command recorded");
+  gp << "set output 'control.png'\nset ylabel 'control input u [V]'\n"
+     << panel({{kU, "", "", "u"}}, "no command recorded");
   gp << "set output 'forces.png'\nset ylabel 'force [N]'\n"
      << panel({{kFriction, "", "", "friction"}, {kRipple, "", "", "ripple"}, {kGrinding, "", "", "grinding"}},
-              "no friction, ripple or grinding force of the paper model in this run (forces of plant.effects are not drawn)", true);
+              "no friction, ripple or grinding force of the paper model in this run (forces of plant.effects are not "
+              "drawn)",
+              true);
   dir.plot(gp.str(), stop);
 }
 

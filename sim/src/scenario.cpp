@@ -66,7 +66,9 @@ void read_ripple(MapReader& r, plant::RippleParams& p) {
     try {
       p = plant::RippleParams::of(fields::enum_from_name<plant::RipplePreset>(preset));
     } catch (const std::invalid_argument& e) {
-      if (scalar) r.fail("ripple", " = '" + preset + "': expected a map of keys, or one of " + fields::enum_choices<plant::RipplePreset>());
+      if (scalar)
+        r.fail("ripple",
+               " = '" + preset + "': expected a map of keys, or one of " + fields::enum_choices<plant::RipplePreset>());
       m.fail("preset", " = '" + preset + "': " + e.what());
     }
   }
@@ -85,8 +87,9 @@ void read_plant(MapReader r, PlantParams& p, bool with_effects) {
     p.effects.Serialize(&a);
     e.finish();
   } else if (r.has("effects")) {
-    r.fail("effects", ": only the sliding_mode controller's model takes effects (e.g. those "
-                      "feeddrive-fit found); the cascade uses the model's mass and friction only");
+    r.fail("effects",
+           ": only the sliding_mode controller's model takes effects (e.g. those "
+           "feeddrive-fit found); the cascade uses the model's mass and friction only");
   }
   r.finish();
 }
@@ -180,8 +183,7 @@ void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir
     case ReferenceType::kRamp: read_fields(r, c.ramp); break;
     case ReferenceType::kWaypoints:
       c.waypoints_file = r.required_string("file");
-      if (fs::path(c.waypoints_file).is_relative())
-        c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
+      if (fs::path(c.waypoints_file).is_relative()) c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
       r.record("file", c.waypoints_file, true);
       break;
   }
@@ -224,7 +226,9 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
   const long n = s.steps();
   const long samples = std::min<long>(n + 1, 100000);
   const auto step_at = [&](long i) {
-    return samples <= 1 ? 0L : static_cast<long>(static_cast<double>(i) * static_cast<double>(n) / static_cast<double>(samples - 1));
+    return samples <= 1
+               ? 0L
+               : static_cast<long>(static_cast<double>(i) * static_cast<double>(n) / static_cast<double>(samples - 1));
   };
   const auto section = [&](const char* key) {
     YAML::Emitter e;
@@ -235,8 +239,8 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
     return text.size() > 200 ? text.substr(0, 200) + "..." : text;
   };
   const auto fail = [&](const std::string& what, double v, double t, const char* key, const char* gives) {
-    throw ScenarioError(std::string(key) + ": " + what + " = " + validate::format_number(v) + " at t = " +
-                        validate::format_number(t) + " s: " + key + " " + section(key) + " " + gives);
+    throw ScenarioError(std::string(key) + ": " + what + " = " + validate::format_number(v) +
+                        " at t = " + validate::format_number(t) + " s: " + key + " " + section(key) + " " + gives);
   };
   if (s.reference.type != ReferenceType::kNone) {
     const auto ref = make_reference(s);
@@ -246,7 +250,8 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
       const std::pair<const char*, double> fields[] = {
           {"position", q.position}, {"velocity", q.velocity}, {"acceleration", q.acceleration}, {"jerk", q.jerk}};
       for (const auto& [what, v] : fields)
-        if (!std::isfinite(v)) fail(std::string("the reference's ") + what, v, t, "reference", "gives no finite trajectory");
+        if (!std::isfinite(v))
+          fail(std::string("the reference's ") + what, v, t, "reference", "gives no finite trajectory");
     }
   }
   if (s.controller.type == ControllerType::kOpenLoop) {
@@ -275,8 +280,12 @@ void find_warnings(Scenario& s) {
   const auto add = [&w](const std::vector<std::string>& more) { w.insert(w.end(), more.begin(), more.end()); };
   {
     fields::PlausibilityArchive top("", &w);
-    top.Visit(fields::field("control_period", s.control_period).unit("s").plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period"));
-    top.Visit(fields::field("controller.computation_delay", s.controller.computation_delay).unit("s").plausible(0, 0.01, "ms", "", "a servo drive's delay"));
+    top.Visit(fields::field("control_period", s.control_period)
+                  .unit("s")
+                  .plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period"));
+    top.Visit(fields::field("controller.computation_delay", s.controller.computation_delay)
+                  .unit("s")
+                  .plausible(0, 0.01, "ms", "", "a servo drive's delay"));
   }
   add(fields::plausibility(s.plant, "plant"));  // sections that are off too: their keys were written
   const auto warned = [&w](const std::string& key, std::size_t from) {
@@ -311,20 +320,24 @@ void find_warnings(Scenario& s) {
       if (t == ReferenceType::kSCurve) start = s.reference.scurve.start_time;
       if (t == ReferenceType::kStep) start = s.reference.step.step_time;
       const char* hint = warned("reference.distance", 0) ? "a distance in mm?"
-                         : start >= s.duration     ? (t == ReferenceType::kStep ? "a step_time in ms?" : "a start_time in ms?")
-                                                   : "a longer duration?";
+                         : start >= s.duration
+                             ? (t == ReferenceType::kStep ? "a step_time in ms?" : "a start_time in ms?")
+                             : "a longer duration?";
       char buf[240];
-      std::snprintf(buf, sizeof buf,
-                    "reference: the move ends at t = %.4g s, after duration = %.4g s: the run cuts it off (summary.json "
-                    "move_finished: false); %s",
-                    s.move_end_s, s.duration, hint);
+      std::snprintf(
+          buf, sizeof buf,
+          "reference: the move ends at t = %.4g s, after duration = %.4g s: the run cuts it off (summary.json "
+          "move_finished: false); %s",
+          s.move_end_s, s.duration, hint);
       w.push_back(buf);
     }
   }
 }
 
 Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
-  if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
+  if (!root.IsMap())
+    throw ScenarioError(
+        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   MapReader top(root, "", resolved);
   Scenario s;
   top.string("name", s.name);
@@ -334,14 +347,13 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   top.number("duration", s.duration);
   top.number("control_period", s.control_period);
   if (!(s.duration > 0.0)) top.fail("duration", " = " + root["duration"].Scalar() + ": must be > 0");
-  if (!(s.control_period > 0.0))
-    top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
+  if (!(s.control_period > 0.0)) top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
   if (s.control_period > s.duration)
     top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
   if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
-    throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " + root["control_period"].Scalar() +
-                        ": " + steps_text(n) + " steps; a run has at most " + validate::format_number(kMaxSteps) +
-                        " steps (docs/scenario.md, Limits)");
+    throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " +
+                        root["control_period"].Scalar() + ": " + steps_text(n) + " steps; a run has at most " +
+                        validate::format_number(kMaxSteps) + " steps (docs/scenario.md, Limits)");
 
   {
     MapReader plant = top.child("plant");
@@ -350,14 +362,17 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
     // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
     const YAML::Node pn = root["plant"];
-    const std::pair<const char*, bool> sections[] = {
-        {"ripple", s.plant.ripple.enabled}, {"grinding", s.plant.grinding.enabled}, {"electrical", s.plant.electrical.enabled}};
+    const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
+                                                     {"grinding", s.plant.grinding.enabled},
+                                                     {"electrical", s.plant.electrical.enabled}};
     for (const auto& [name, on] : sections) {
       if (on || !pn.IsMap()) continue;
       const YAML::Node sec = pn[name];
       if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
       if (sec.size() > 0)
-        s.warnings.push_back(std::string("plant.") + name + ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
+        s.warnings.push_back(
+            std::string("plant.") + name +
+            ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
     }
   }
 
@@ -380,7 +395,8 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     s.controller.cascade.period = s.control_period;
     s.controller.cascade.computation_delay = s.controller.computation_delay;
     if (!(s.controller.cascade.bandwidth_scale > 0.0))  // before the rule divides by it
-      c.fail("bandwidth_scale", " = " + validate::format_number(s.controller.cascade.bandwidth_scale) + ": must be > 0");
+      c.fail("bandwidth_scale",
+             " = " + validate::format_number(s.controller.cascade.bandwidth_scale) + ": must be > 0");
     controller::apply_tuning(s.controller.cascade, model.sensor.differenced_velocity());
   } else if (type == "open_loop") {
     s.controller.type = ControllerType::kOpenLoop;
@@ -424,11 +440,14 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   a.finish();
   top.finish();
   if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
-  if (s.analysis.settling_band < 0.0) a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) + ": must be >= 0 (0: 2 % of the move's distance)");
+  if (s.analysis.settling_band < 0.0)
+    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
+                                ": must be >= 0 (0: 2 % of the move's distance)");
 
   // Component validation: each validate() names its key and value; tables come from the files.
   try {
-    if (s.reference.type == ReferenceType::kWaypoints) s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
+    if (s.reference.type == ReferenceType::kWaypoints)
+      s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
     if (s.controller.type == ControllerType::kOpenLoop && s.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
       read_open_loop_file(s.controller.open_loop_file, s.controller.open_loop);
     s.plant.validate("plant");
@@ -646,8 +665,7 @@ std::unique_ptr<trajectory::Trajectory> make_reference(const Scenario& s) {
     case ReferenceType::kAccelLimited: return trajectory::make_accel_limited(c.accel_limited);
     case ReferenceType::kSCurve: return trajectory::make_scurve(c.scurve);
     case ReferenceType::kRamp: return trajectory::make_ramp(c.ramp);
-    case ReferenceType::kWaypoints:
-      return trajectory::make_waypoints(c.waypoints);
+    case ReferenceType::kWaypoints: return trajectory::make_waypoints(c.waypoints);
   }
   return nullptr;
 }
@@ -656,12 +674,9 @@ std::unique_ptr<controller::Controller> make_controller(const Scenario& s) {
   switch (s.controller.type) {
     case ControllerType::kSlidingMode:
       return std::make_unique<controller::SlidingModeController>(s.controller.sliding_mode);
-    case ControllerType::kCascade:
-      return std::make_unique<controller::CascadeController>(s.controller.cascade);
-    case ControllerType::kOpenLoop:
-      return std::make_unique<controller::OpenLoopSource>(s.controller.open_loop);
-    case ControllerType::kPlugin:
-      return std::make_unique<controller::PluginController>(s.controller.plugin);
+    case ControllerType::kCascade: return std::make_unique<controller::CascadeController>(s.controller.cascade);
+    case ControllerType::kOpenLoop: return std::make_unique<controller::OpenLoopSource>(s.controller.open_loop);
+    case ControllerType::kPlugin: return std::make_unique<controller::PluginController>(s.controller.plugin);
   }
   return nullptr;
 }

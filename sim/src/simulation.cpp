@@ -65,8 +65,8 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
     static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop", "plugin"};
     switch (src) {
       case Source::kController:
-        return std::string("from the controller (controller.type = ") + kControllers[static_cast<int>(s.controller.type)] +
-               "; its gains or model make it diverge)";
+        return std::string("from the controller (controller.type = ") +
+               kControllers[static_cast<int>(s.controller.type)] + "; its gains or model make it diverge)";
       case Source::kReference: return "from the reference (the reference section)";
       case Source::kSensor:
         return "from the sensor (plant.sensor.quantization = " + validate::format_number(s.plant.sensor.quantization) +
@@ -86,9 +86,15 @@ void check_finite_step(const Scenario& s, long k, const Record& r, double comman
   const std::pair<const char*, double> meas[] = {{"x_measured", r.x_measured}, {"v_measured", r.v_measured}};
   for (const auto& [what, v] : meas)
     if (!std::isfinite(v)) fail(what, v, Source::kSensor);
-  const std::pair<const char*, double> state[] = {{"x", r.x}, {"v", r.v}, {"z", r.z}, {"fg", r.fg}, {"i", r.i},
-                                                  {"f_thrust", r.f_thrust}, {"f_friction", r.f_friction},
-                                                  {"f_ripple", r.f_ripple}, {"f_grinding", r.f_grinding}};
+  const std::pair<const char*, double> state[] = {{"x", r.x},
+                                                  {"v", r.v},
+                                                  {"z", r.z},
+                                                  {"fg", r.fg},
+                                                  {"i", r.i},
+                                                  {"f_thrust", r.f_thrust},
+                                                  {"f_friction", r.f_friction},
+                                                  {"f_ripple", r.f_ripple},
+                                                  {"f_grinding", r.f_grinding}};
   for (const auto& [what, v] : state)
     if (!std::isfinite(v)) fail(what, v, Source::kPlant);
 }

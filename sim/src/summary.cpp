@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <utility>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 namespace feeddrive::sim {
 
@@ -246,7 +246,8 @@ void SummaryBuilder::finish_move(Summary& m) const {
   }
   if (n_during_ > 0) {
     m.position_error_max_abs_during_move_m = max_during_;
-    m.position_error_rms_during_move_m = static_cast<double>(std::sqrt(se_during_ / static_cast<long double>(n_during_)));
+    m.position_error_rms_during_move_m =
+        static_cast<double>(std::sqrt(se_during_ / static_cast<long double>(n_during_)));
   }
   if (n_after_ > 0) m.position_error_max_abs_after_move_m = max_after_;
 }
@@ -261,13 +262,14 @@ void SummaryBuilder::finish_signal(Summary& m) const {
   const SignalLimits& l = kSignalLimits;
   // Every limit that has a value must hold (a run of one step has no step-to-step change; a
   // rate without content above f_c has no HF figure: those limits are not checked).
-  m.control_signal_within_limits =
-      !(m.control_step_rms_V > l.step_rms_deltas * chatter_delta_) &&
-      m.control_direction_changes_per_s <= l.direction_changes_per_s &&
-      m.control_saturated_fraction <= l.saturated_fraction && !(m.force_hf_rms_N > m.force_hf_limit_N);
+  m.control_signal_within_limits = !(m.control_step_rms_V > l.step_rms_deltas * chatter_delta_) &&
+                                   m.control_direction_changes_per_s <= l.direction_changes_per_s &&
+                                   m.control_saturated_fraction <= l.saturated_fraction &&
+                                   !(m.force_hf_rms_N > m.force_hf_limit_N);
 }
 
-Summary SummaryBuilder::summary(double wall_time_s, const std::optional<plant::CvodeIntegrator::Stats>& integrator) const {
+Summary SummaryBuilder::summary(double wall_time_s,
+                                const std::optional<plant::CvodeIntegrator::Stats>& integrator) const {
   Summary m = m_;
   m.steps = n_;
   m.sim_time_s = static_cast<double>(n_) * control_period_;
@@ -295,11 +297,13 @@ Summary SummaryBuilder::summary(double wall_time_s, const std::optional<plant::C
   // rank floor(0.95 n) of the n finite values |e| (and |e_m|)
   const auto p95 = [](const stats::StreamingQuantile& q, double& out) {
     if (q.count() == 0) return;
-    out = q.value_at_rank(std::min<std::uint64_t>(q.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(q.count()))));
+    out = q.value_at_rank(
+        std::min<std::uint64_t>(q.count() - 1, static_cast<std::uint64_t>(0.95 * static_cast<double>(q.count()))));
   };
   p95(abs_e_, m.position_error_p95_abs_m);
   p95(abs_em_, m.measured_position_error_p95_abs_m);
-  m.measured_position_error_rms_m = n_em_ > 0 ? static_cast<double>(std::sqrt(sem_ / static_cast<long double>(n_em_))) : kNone;
+  m.measured_position_error_rms_m =
+      n_em_ > 0 ? static_cast<double>(std::sqrt(sem_ / static_cast<long double>(n_em_))) : kNone;
   if (n_em_ == 0) m.measured_position_error_max_abs_m = m.measured_position_error_p95_abs_m = kNone;
   if (n_e_ == 0) m.position_error_max_abs_m = m.position_error_p95_abs_m = kNone;
   if (n_e_settled_ == 0) m.position_error_max_abs_settled_m = kNone;
@@ -330,9 +334,10 @@ std::string summary_headline(const std::string& text) {
   };
   // The true-state error where the plant has one, else the measured one (a hardware plant).
   const bool truth = j.contains("position_error_max_abs_m") && j["position_error_max_abs_m"].is_number();
-  std::string line = truth ? "max |e| = " + num("position_error_max_abs_m") + " m, rms e = " + num("position_error_rms_m") + " m"
-                           : "max |e_m| = " + num("measured_position_error_max_abs_m") + " m, rms e_m = " +
-                                 num("measured_position_error_rms_m") + " m (measured: x_d - x_measured)";
+  std::string line =
+      truth ? "max |e| = " + num("position_error_max_abs_m") + " m, rms e = " + num("position_error_rms_m") + " m"
+            : "max |e_m| = " + num("measured_position_error_max_abs_m") +
+                  " m, rms e_m = " + num("measured_position_error_rms_m") + " m (measured: x_d - x_measured)";
   line += ", u in [" + num("control_min") + ", " + num("control_max") + "] V";
   if (j.contains("settling_time_s") && j["settling_time_s"].is_number())
     line += ", settles to " + num("settling_band_m") + " m in " + num("settling_time_s") + " s";
@@ -342,12 +347,14 @@ std::string summary_headline(const std::string& text) {
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
   if (j.contains("move_finished") && j["move_finished"] == false) line += ", MOVE CUT OFF at the end of the run";
   if (j.value("control_chattering", false))
-    line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") + " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
+    line += ", CONTROL CHATTERS (" + num("control_reversals_per_s") +
+            " reversals/s of steps >= " + num("control_chatter_threshold_V") + " V)";
   if (j.contains("control_signal_within_limits") && j["control_signal_within_limits"] == false)
     line += ", CONTROL SIGNAL OUTSIDE LIMITS (step rms " + num("control_step_rms_V") + " V, " +
             num("control_direction_changes_per_s") + " direction changes/s, " + num("force_hf_rms_N") +
             " N above 1 kHz, saturated " + num("control_saturated_fraction") + ")";
-  if (j.contains("controller_model") && (j["controller_model"] == "plant" || j["controller_model"] == "plant_without_effects"))
+  if (j.contains("controller_model") &&
+      (j["controller_model"] == "plant" || j["controller_model"] == "plant_without_effects"))
     line += ", model = " + j["controller_model"].get<std::string>();
   return line;
 }
@@ -360,7 +367,9 @@ nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   nlohmann::ordered_json j;
   // Metrics over an empty window are null (summary.hpp), never 0.
   const auto val = [&](double v) { return m.steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
-  const auto settled = [&](double v) { return m.settled_steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  const auto settled = [&](double v) {
+    return m.settled_steps > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+  };
   j["scenario"] = s.name;
   j["scenario_path"] = s.path;
   j["control_period_s"] = s.control_period;
@@ -375,9 +384,12 @@ nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   j["measured_position_error_rms_m"] = val(m.measured_position_error_rms_m);
   j["measured_position_error_p95_abs_m"] = val(m.measured_position_error_p95_abs_m);
   // Which error the headline figure is (launcher line, plots): the true state's where it exists.
-  j["error_source"] = m.steps == 0 ? nlohmann::ordered_json() : nlohmann::ordered_json(std::isnan(m.position_error_max_abs_m) ? "measured" : "true_state");
+  j["error_source"] = m.steps == 0
+                          ? nlohmann::ordered_json()
+                          : nlohmann::ordered_json(std::isnan(m.position_error_max_abs_m) ? "measured" : "true_state");
   j["velocity_error_max_abs_mps"] = val(m.velocity_error_max_abs_mps);
-  j["velocity_error_max_abs_after_first_mps"] = m.steps > 1 ? nlohmann::ordered_json(m.velocity_error_max_abs_after_first_mps) : nlohmann::ordered_json();
+  j["velocity_error_max_abs_after_first_mps"] =
+      m.steps > 1 ? nlohmann::ordered_json(m.velocity_error_max_abs_after_first_mps) : nlohmann::ordered_json();
   j["velocity_error_rms_mps"] = val(m.velocity_error_rms_mps);
   j["settled_after_s"] = m.settled_after_s;
   j["position_error_max_abs_settled_m"] = settled(m.position_error_max_abs_settled_m);
@@ -394,13 +406,17 @@ nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   j["max_position_m"] = val(m.max_position_m);
   j["min_position_m"] = val(m.min_position_m);
   // The plant's CVODE counts where it ran in this process; null where it ran elsewhere (never 0).
-  const auto counted = [&](long v) { return m.integrator_known ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  const auto counted = [&](long v) {
+    return m.integrator_known ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+  };
   j["integrator_steps"] = counted(m.integrator_steps);
   j["integrator_rhs_evals"] = counted(m.integrator_rhs_evals);
   j["integrator_jac_evals"] = counted(m.integrator_jac_evals);
   j["integrator_error_test_fails"] = counted(m.integrator_error_test_fails);
   // Move and step metrics (summary.hpp): null where they do not apply.
-  const auto opt = [&](double v) { return m.steps > 0 && std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  const auto opt = [&](double v) {
+    return m.steps > 0 && std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+  };
   for (const auto& [key, field] : kMoveFields) j[key] = opt(m.*field);
   // Chatter (summary.hpp): reversals of the command's steps larger than the threshold.
   j["control_chatter_threshold_V"] = m.control_chatter_threshold_V;
@@ -414,14 +430,16 @@ nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s) {
   j["force_hf_corner_Hz"] = m.force_hf_corner_Hz;
   j["force_hf_rms_N"] = opt(m.force_hf_rms_N);
   j["force_hf_limit_N"] = m.force_hf_limit_N;
-  j["control_signal_within_limits"] = m.steps > 0 ? nlohmann::ordered_json(m.control_signal_within_limits) : nlohmann::ordered_json();
+  j["control_signal_within_limits"] =
+      m.steps > 0 ? nlohmann::ordered_json(m.control_signal_within_limits) : nlohmann::ordered_json();
   // Whose parameters the controller's model holds: "plant" means every result is a
   // perfect-model result (docs/scenario.md).
   const std::string model = controller_model_source(s);
   j["controller_model"] = model.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(model);
   // The gains a cascade runs with (tuning: rule chooses them: docs/controllers.md).
   if (s.controller.type == ControllerType::kCascade)
-    j["cascade_gains"] = {{"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
+    j["cascade_gains"] = {
+        {"kp", s.controller.cascade.kp}, {"kv", s.controller.cascade.kv}, {"ki", s.controller.cascade.ki}};
   // Issue 23: a move the run cut off, and the loader's plausibility warnings (scenario.hpp).
   const std::optional<bool> finished = move_finished(s);
   j["move_finished"] = finished ? nlohmann::ordered_json(*finished) : nlohmann::ordered_json();  // null: not a move
@@ -456,7 +474,7 @@ Summary a_full_run() {
   m.settled_steps = 2;  // every windowed metric a number, not null (the after-first ones need 2 steps)
   m.integrator_known = true;
   for (const auto& [key, field] : kMoveFields) m.*field = 0.0;  // numbers for a move
-  m.control_step_rms_V = m.force_hf_rms_N = 0.0;                 // and for a rate above 2 kHz
+  m.control_step_rms_V = m.force_hf_rms_N = 0.0;                // and for a rate above 2 kHz
   return m;
 }
 // move_finished is a verdict of summary.json, but a study records it in a column of its own

@@ -10,10 +10,10 @@
 #include <sstream>
 #include <string_view>
 
-#include "feeddrive/common/validate.hpp"
-#include "feeddrive/sim/scenario.hpp"
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/parser.h>
+#include "feeddrive/common/validate.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::sim {
 namespace {
@@ -28,16 +28,11 @@ std::string describe(const YAML::Node& n) {
 bool parse_double(const std::string& text, double& out) {
   // YAML 1.2 core schema spellings of the special values.
   static const std::pair<const char*, double> kSpecial[] = {
-      {".inf", std::numeric_limits<double>::infinity()},
-      {".Inf", std::numeric_limits<double>::infinity()},
-      {".INF", std::numeric_limits<double>::infinity()},
-      {"+.inf", std::numeric_limits<double>::infinity()},
-      {"-.inf", -std::numeric_limits<double>::infinity()},
-      {"-.Inf", -std::numeric_limits<double>::infinity()},
-      {"-.INF", -std::numeric_limits<double>::infinity()},
-      {".nan", std::numeric_limits<double>::quiet_NaN()},
-      {".NaN", std::numeric_limits<double>::quiet_NaN()},
-      {".NAN", std::numeric_limits<double>::quiet_NaN()}};
+      {".inf", std::numeric_limits<double>::infinity()},   {".Inf", std::numeric_limits<double>::infinity()},
+      {".INF", std::numeric_limits<double>::infinity()},   {"+.inf", std::numeric_limits<double>::infinity()},
+      {"-.inf", -std::numeric_limits<double>::infinity()}, {"-.Inf", -std::numeric_limits<double>::infinity()},
+      {"-.INF", -std::numeric_limits<double>::infinity()}, {".nan", std::numeric_limits<double>::quiet_NaN()},
+      {".NaN", std::numeric_limits<double>::quiet_NaN()},  {".NAN", std::numeric_limits<double>::quiet_NaN()}};
   for (const auto& [s, v] : kSpecial)
     if (text == s) {
       out = v;
@@ -78,7 +73,8 @@ OpenQuote find_multiline_quote(const std::string& text) {
       const char c = l[k];
       if (c == '#' && (k == 0 || l[k - 1] == ' ' || l[k - 1] == '\t')) break;
       const bool after_space = k > 0 && (l[k - 1] == ' ' || l[k - 1] == '\t');
-      const bool value_start = k == first || (after_space && std::string_view(":-?,[{").find(prev_token) != std::string_view::npos) ||
+      const bool value_start = k == first ||
+                               (after_space && std::string_view(":-?,[{").find(prev_token) != std::string_view::npos) ||
                                std::string_view("[{,").find(prev_token) != std::string_view::npos;
       if ((c == '"' || c == '\'') && value_start) {
         // Scan to the closing quote, possibly over lines.
@@ -132,7 +128,8 @@ void check_duplicate_keys(const YAML::Node& n, const std::string& path, long& bu
   if (n.IsMap()) {
     std::map<std::string, long> seen;
     for (const auto& kv : n) {
-      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "(a " + std::string(kv.first.IsMap() ? "map" : "list") + ")";
+      const std::string key =
+          kv.first.IsScalar() ? kv.first.Scalar() : "(a " + std::string(kv.first.IsMap() ? "map" : "list") + ")";
       const std::string key_path = path.empty() ? key : path + "." + key;
       const long line = kv.first.Mark().line + 1;
       const auto [it, fresh] = seen.emplace(key, line);
@@ -145,7 +142,6 @@ void check_duplicate_keys(const YAML::Node& n, const std::string& path, long& bu
     for (std::size_t k = 0; k < n.size(); ++k) check_duplicate_keys(n[k], path + "[" + std::to_string(k) + "]", budget);
   }
 }
-
 
 // The parser's events of the first document, checked before any node is built: yaml-cpp 0.7 makes
 // an alias the same node as its anchor, so an alias inside its own anchor ("&f {inner: *f}") is a
@@ -164,21 +160,25 @@ class ConstructCheck : public YAML::EventHandler {
     begin_node();
     for (const Frame& f : stack_)
       if (f.anchor == anchor && anchor != YAML::NullAnchor)
-        throw ScenarioError(where(mark) + path() + ": recursive YAML alias *" + name(anchor) + " inside its own anchor &" +
-                            name(anchor) + " (line " + std::to_string(f.line) + "): not supported (an alias may only repeat a finished node)");
+        throw ScenarioError(where(mark) + path() + ": recursive YAML alias *" + name(anchor) +
+                            " inside its own anchor &" + name(anchor) + " (line " + std::to_string(f.line) +
+                            "): not supported (an alias may only repeat a finished node)");
     end_node("", false);
   }
   void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t, const std::string& value) override {
     begin_node();
     if (value == "<<" && tag == "?" && !stack_.empty() && stack_.back().map && stack_.back().expect_key)
-      throw ScenarioError(where(mark) + path() + (path().empty() ? "" : ".") + "<<: YAML merge key (<<) not supported: write the keys out");
+      throw ScenarioError(where(mark) + path() + (path().empty() ? "" : ".") +
+                          "<<: YAML merge key (<<) not supported: write the keys out");
     end_node(value, true);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
     open(mark, anchor, false);
   }
   void OnSequenceEnd() override { close(); }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
     open(mark, anchor, true);
   }
   void OnMapEnd() override { close(); }
@@ -254,8 +254,9 @@ YAML::Node load_yaml_strict(const std::string& text) {
   if (q.line > 0 && q.closed_on == 0)
     throw ScenarioError("line " + std::to_string(q.line) + ": YAML syntax error: a quote opened here is never closed");
   if (q.line > 0)
-    throw ScenarioError("line " + std::to_string(q.line) + ": YAML syntax error: a quote opened here closes only on line " +
-                        std::to_string(q.closed_on) + " (a quoted value must end on the line where it starts)");
+    throw ScenarioError("line " + std::to_string(q.line) +
+                        ": YAML syntax error: a quote opened here closes only on line " + std::to_string(q.closed_on) +
+                        " (a quoted value must end on the line where it starts)");
   YAML::Node root;
   try {
     check_constructs(text);
@@ -286,17 +287,13 @@ MapReader::MapReader(const YAML::Node& node, std::string path, ResolvedKeys* res
     throw ScenarioError(path_ + " = " + describe(node_) + ": expected a map of keys");
 }
 
-std::string MapReader::key_path(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
-}
+std::string MapReader::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
 void MapReader::fail(const std::string& key, const std::string& what) const {
   throw ScenarioError(key_path(key) + what);
 }
 
-bool MapReader::has(const std::string& key) const {
-  return node_.IsMap() && node_[key].IsDefined();
-}
+bool MapReader::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
 
 YAML::Node MapReader::scalar(const std::string& key) {
   read_.insert(key);
@@ -359,7 +356,9 @@ void MapReader::integer(const std::string& key, long& out) {
     errno = 0;
     const long v = std::strtol(s.c_str(), &end, 10);
     if (s.empty() || end != s.c_str() + s.size()) fail(key, " = " + describe(n) + ": not an integer");
-    if (errno == ERANGE) fail(key, " = " + describe(n) + ": out of range (" + std::to_string(LONG_MIN) + " to " + std::to_string(LONG_MAX) + ")");
+    if (errno == ERANGE)
+      fail(key, " = " + describe(n) + ": out of range (" + std::to_string(LONG_MIN) + " to " +
+                    std::to_string(LONG_MAX) + ")");
     out = v;
   }
   record(key, std::to_string(out), false);
@@ -375,7 +374,8 @@ void MapReader::unsigned_integer(const std::string& key, std::uint64_t& out) {
     if (s.empty() || s[0] == '-' || end != s.c_str() + s.size())
       fail(key, " = " + describe(n) + ": not a non-negative integer");
     if (errno == ERANGE)
-      fail(key, " = " + describe(n) + ": out of range (0 to " + std::to_string(std::numeric_limits<std::uint64_t>::max()) + ")");
+      fail(key, " = " + describe(n) + ": out of range (0 to " +
+                    std::to_string(std::numeric_limits<std::uint64_t>::max()) + ")");
     out = v;
   }
   record(key, std::to_string(out), false);

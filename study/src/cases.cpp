@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
@@ -82,7 +82,8 @@ std::vector<Variation> grid_point(const Family& f, long point) {
 std::size_t case_count(const Study& s) { return static_cast<std::size_t>(s.total_cases()); }
 
 CaseSpec case_at(const Study& s, std::size_t index) {
-  if (index >= case_count(s)) throw std::out_of_range("case " + std::to_string(index) + " of " + std::to_string(case_count(s)));
+  if (index >= case_count(s))
+    throw std::out_of_range("case " + std::to_string(index) + " of " + std::to_string(case_count(s)));
   long rest = static_cast<long>(index);
   long per_controller = 0;
   for (std::size_t f = 0; f < s.families.size(); ++f) per_controller += s.family_cases(f);
@@ -276,13 +277,18 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
     }
     const auto it = nominal.find(v.key);
     if (it == nominal.end())
-      throw StudyError(origin + ": " + v.key + ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or reference type)");
+      throw StudyError(origin + ": " + v.key +
+                       ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or "
+                       "reference type)");
     if (it->second.is_string || it->second.text == "true" || it->second.text == "false")
-      throw StudyError(origin + ": " + v.key + " = '" + it->second.text + "': cannot scale a value that is not a number");
+      throw StudyError(origin + ": " + v.key + " = '" + it->second.text +
+                       "': cannot scale a value that is not a number");
     const double nominal_value = std::strtod(it->second.text.c_str(), nullptr);
     // Every factor of 0 is 0: the cases would silently all be the nominal one.
     if (nominal_value == 0.0)
-      throw StudyError(origin + ": " + v.key + " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a distribution without scale: true)");
+      throw StudyError(origin + ": " + v.key +
+                       " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a "
+                       "distribution without scale: true)");
     values.emplace_back(v.key, validate::format_number(nominal_value * v.factor));
   }
 

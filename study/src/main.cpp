@@ -6,8 +6,8 @@
 //
 // Exit codes: 0 done (failed cases are reported in results.csv), 2 bad input (study, options,
 // output folder), 1 a failure of the machine.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <optional>
@@ -30,10 +30,8 @@ class Printer final : public feeddrive::study::Reporter {
   void started(const std::string& line) override { spdlog::info("{}", line); }
   void progress_start(std::size_t total) override { progress_.emplace(total, 0, !quiet_); }
   void progress_step(bool reused, bool failed) override {
-    if (reused)
-      progress_->reused();
-    else
-      progress_->step(failed);
+    if (reused) progress_->reused();
+    else progress_->step(failed);
   }
   void progress_end() override {
     if (progress_) progress_->finish();
@@ -56,18 +54,21 @@ int main(int argc, char** argv) {
   } catch (...) {
     return feeddrive::tool::report(std::current_exception());
   }
-  CLI::App app{"feeddrive-study: runs a study of many scenarios (grid, Monte Carlo, controllers) on all cores or MPI ranks"};
+  CLI::App app{
+      "feeddrive-study: runs a study of many scenarios (grid, Monte Carlo, controllers) on all cores or MPI ranks"};
   feeddrive::study::Options o;
   bool no_plots = false;
   app.add_option("study", o.study, "study YAML file (docs/study.md), or with --sweep a scenario file")->required();
   app.add_option("--set", o.sets, "KEY=VALUE: set a scenario key in every case (after the study's own set); repeatable")
       ->type_name("KEY=VALUE");
-  app.add_option("--sweep", o.sweeps,
-                 "KEY=V1,V2,... | KEY=START:STOP:N | KEY=log:START:STOP:N: vary a key of the scenario file given instead "
-                 "of a study (repeat for a grid)")
+  app.add_option(
+         "--sweep", o.sweeps,
+         "KEY=V1,V2,... | KEY=START:STOP:N | KEY=log:START:STOP:N: vary a key of the scenario file given instead "
+         "of a study (repeat for a grid)")
       ->type_name("SWEEP");
   app.add_option("--out,-o", o.out, "output folder; a rerun into it skips the finished cases (not needed with --list)");
-  app.add_option("-j,--jobs", o.jobs, "worker threads (default: every core; per MPI rank: the host's cores / its ranks)")
+  app.add_option("-j,--jobs", o.jobs,
+                 "worker threads (default: every core; per MPI rank: the host's cores / its ranks)")
       ->check(CLI::Range(1, 4096));
   app.add_flag("--no-plots", no_plots, "skip the plots");
   app.add_flag("--retry-failed", o.retry_failed, "run again the cases that failed in an earlier run into DIR");
@@ -81,11 +82,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (!speaks) return e.get_exit_code() == 0 ? 0 : 2;
     if (e.get_exit_code() == 0) return app.exit(e);
-    return feeddrive::tool::report(std::make_exception_ptr(feeddrive::BadInput(std::string(e.what()) + " (see --help)")));
+    return feeddrive::tool::report(
+        std::make_exception_ptr(feeddrive::BadInput(std::string(e.what()) + " (see --help)")));
   }
   if (o.out.empty() && !o.list) {
     if (!speaks) return 2;
-    return feeddrive::tool::report(std::make_exception_ptr(feeddrive::BadInput("--out is required (except with --list)")));
+    return feeddrive::tool::report(
+        std::make_exception_ptr(feeddrive::BadInput("--out is required (except with --list)")));
   }
   o.plots = !no_plots;
   o.command = command;
@@ -107,10 +110,8 @@ int main(int argc, char** argv) {
     const std::string line = r.name + ": " + std::to_string(r.total) + " cases (" + std::to_string(r.ran) + " run, " +
                              std::to_string(r.reused) + " reused), " + std::to_string(r.failed) +
                              " failed (see results.csv) -> " + r.dir + "/results.csv, report.md";
-    if (r.failed > 0)
-      spdlog::warn("{}", line);
-    else
-      spdlog::info("{}", line);
+    if (r.failed > 0) spdlog::warn("{}", line);
+    else spdlog::info("{}", line);
     return 0;
   } catch (...) {
     return feeddrive::tool::report(std::current_exception());

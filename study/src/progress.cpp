@@ -22,8 +22,12 @@ std::string format_duration(double seconds) {
 }
 
 Progress::Progress(std::size_t total, std::size_t already_done, bool enabled)
-    : total_(total), done_(already_done), enabled_(enabled), tty_(::isatty(2) == 1),
-      start_(std::chrono::steady_clock::now()), last_(start_) {
+    : total_(total),
+      done_(already_done),
+      enabled_(enabled),
+      tty_(::isatty(2) == 1),
+      start_(std::chrono::steady_clock::now()),
+      last_(start_) {
   if (enabled_ && tty_) draw(false);
 }
 
@@ -55,8 +59,8 @@ void Progress::draw(bool final_line) {
     const int filled = static_cast<int>(frac * kWidth);
     std::string bar(static_cast<std::size_t>(filled), '#');
     bar += std::string(static_cast<std::size_t>(kWidth - filled), '.');
-    std::snprintf(line, sizeof line, "\r[%s] %zu/%zu %3.0f%%  %zu failed  %s   ", bar.c_str(), done_, total_, 100 * frac,
-                  failed_, eta_text.c_str());
+    std::snprintf(line, sizeof line, "\r[%s] %zu/%zu %3.0f%%  %zu failed  %s   ", bar.c_str(), done_, total_,
+                  100 * frac, failed_, eta_text.c_str());
     std::fputs(line, stderr);
     if (final_line) std::fputc('\n', stderr);
   } else {

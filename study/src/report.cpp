@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -87,7 +87,6 @@ bool parse_number(const std::string& text, double& out) {
   return !text.empty() && end == text.c_str() + text.size() && std::isfinite(out);
 }
 
-
 }  // namespace
 
 // A varied key's values in its engineering unit: the unit its params list gives
@@ -109,7 +108,9 @@ AxisUnit axis_unit(const std::string& key, const std::vector<float>& x, std::siz
   if (unit == "s" && top > 0 && top < 1.0) return {"ms", 1e3};
   return {unit.empty() || unit == "-" ? std::string() : unit, 1.0};
 }
-std::string axis_label(const std::string& key, const AxisUnit& u) { return u.unit.empty() ? key : key + " [" + u.unit + "]"; }
+std::string axis_label(const std::string& key, const AxisUnit& u) {
+  return u.unit.empty() ? key : key + " [" + u.unit + "]";
+}
 
 std::string metric_label(const std::string& metric, const std::string& unit) {
   std::string name = metric;
@@ -142,7 +143,8 @@ std::vector<std::string> warning_lines(const ReportData& d) {
   for (const auto& [w, n] : d.warnings)
     out.push_back(w + " (" + std::to_string(n) + " of " + std::to_string(d.cases) + " cases)");
   if (d.cases_with_other_warnings > 0)
-    out.push_back(std::to_string(d.cases_with_other_warnings) + " cases have further warnings (the warnings column of results.csv)");
+    out.push_back(std::to_string(d.cases_with_other_warnings) +
+                  " cases have further warnings (the warnings column of results.csv)");
   return out;
 }
 
@@ -157,7 +159,10 @@ std::string csv_field(const std::string& value) {
 }
 
 ResultsWriter::ResultsWriter(const Study& s, const fs::path& dir)
-    : s_(s), partial_(dir / "results.csv.partial"), final_(dir / "results.csv"), params_(varied_keys(s)),
+    : s_(s),
+      partial_(dir / "results.csv.partial"),
+      final_(dir / "results.csv"),
+      params_(varied_keys(s)),
       metrics_(sim::summary_metric_names()) {
   for (const std::string& f : sim::summary_flag_names()) metrics_.push_back(f);  // 1 true, 0 false
   out_.open(partial_, std::ios::binary | std::ios::trunc);
@@ -177,9 +182,9 @@ ResultsWriter::~ResultsWriter() {
 }
 
 void ResultsWriter::add(std::size_t index, const CaseRecord& c) {
-  out_ << index << ',' << csv_field(s_.controllers[c.spec.controller].name) << ',' << csv_field(s_.families[c.spec.family].name)
-       << ',' << c.spec.point << ',' << (c.spec.draw >= 0 ? std::to_string(c.spec.draw) : "") << ','
-       << c.resolved.hash.substr(0, 16);
+  out_ << index << ',' << csv_field(s_.controllers[c.spec.controller].name) << ','
+       << csv_field(s_.families[c.spec.family].name) << ',' << c.spec.point << ','
+       << (c.spec.draw >= 0 ? std::to_string(c.spec.draw) : "") << ',' << c.resolved.hash.substr(0, 16);
   for (const std::string& p : params_) {
     const auto it = c.resolved.parameters.find(p);
     out_ << ',' << (it == c.resolved.parameters.end() ? "" : csv_field(it->second));
@@ -201,7 +206,8 @@ void ResultsWriter::add(std::size_t index, const CaseRecord& c) {
 void ResultsWriter::finish() {
   out_.close();
   if (!out_) throw std::runtime_error(partial_.string() + ": write failed");
-  if (::rename(partial_.c_str(), final_.c_str()) != 0) throw std::runtime_error(final_.string() + ": cannot rename into place");
+  if (::rename(partial_.c_str(), final_.c_str()) != 0)
+    throw std::runtime_error(final_.string() + ": cannot rename into place");
   done_ = true;
 }
 
@@ -229,8 +235,11 @@ bool case_passes(const Study& s, const Outcome& o, double shown) {
 }
 
 ReportData::ReportData(const Study& st)
-    : s(st), params(varied_keys(st)), table(st.families.size(), std::vector<Cell>(st.controllers.size())),
-      worst(st.controllers.size()), categories(params.size()) {
+    : s(st),
+      params(varied_keys(st)),
+      table(st.families.size(), std::vector<Cell>(st.controllers.size())),
+      worst(st.controllers.size()),
+      categories(params.size()) {
   const auto n = static_cast<std::size_t>(st.total_cases());  // exact: no doubling of the largest vectors
   controller.reserve(n);
   shown.reserve(n);
@@ -249,7 +258,8 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
   cell_of.verdict_failed += c.outcome.ok && !verdicts_hold(s, c.outcome) ? 1 : 0;
   if (!c.outcome.ok) {
     ++cell_of.failed;
-    if (failures.size() < kListedFailures) failures.push_back({index, c.spec.controller, c.spec.family, c.outcome.error});
+    if (failures.size() < kListedFailures)
+      failures.push_back({index, c.spec.controller, c.spec.family, c.outcome.error});
   } else if (std::isnan(v)) {
     ++cell_of.no_value;
   } else {
@@ -308,11 +318,11 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
   std::ostringstream gp, md;
   gp << "set encoding utf8\nset terminal pngcairo size 1200,650 noenhanced\nset grid ytics\n"
      << "set key outside top center horizontal\nset logscale y\n";
-  const std::string limit_line =
-      std::isnan(s.report.limit)
-          ? std::string()
-          : "set arrow 1 from graph 0, first " + output::number_text(s.report.limit) + " to graph 1, first " +
-                output::number_text(s.report.limit) + " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
+  const std::string limit_line = std::isnan(s.report.limit)
+                                     ? std::string()
+                                     : "set arrow 1 from graph 0, first " + output::number_text(s.report.limit) +
+                                           " to graph 1, first " + output::number_text(s.report.limit) +
+                                           " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
 
   // Box plots: one box per family and controller, grouped by family.
   const auto& t = d.table;
@@ -330,21 +340,25 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
       if (n == 0) continue;
       const std::string file = "box_" + std::to_string(f) + "_" + std::to_string(c) + ".dat";
       output::write_file_atomically(dir / file, data.str());
-      const double x = static_cast<double>(f + 1) + (static_cast<double>(c) - 0.5 * static_cast<double>(nc - 1)) * width;
+      const double x =
+          static_cast<double>(f + 1) + (static_cast<double>(c) - 0.5 * static_cast<double>(nc - 1)) * width;
       items.push_back("'" + file + "' using (" + output::number_text(x) + "):1:(" + output::number_text(0.9 * width) +
                       ") with boxplot linecolor " + std::to_string(c + 1) + " notitle");
     }
   }
   if (!items.empty()) {
-    gp << "set output 'box.png'\nset title " << output::gnuplot_string(s.name + ": " + s.report.metric + " per family and controller")
-       << "\nset ylabel " << ylabel << "\nset style fill solid 0.35 border -1\nset style boxplot outliers pointtype 7\n"
+    gp << "set output 'box.png'\nset title "
+       << output::gnuplot_string(s.name + ": " + s.report.metric + " per family and controller") << "\nset ylabel "
+       << ylabel << "\nset style fill solid 0.35 border -1\nset style boxplot outliers pointtype 7\n"
        << "set xrange [0.4:" << output::number_text(static_cast<double>(nf) + 0.6) << "]\nset xtics (";
-    for (std::size_t f = 0; f < nf; ++f) gp << (f ? ", " : "") << output::gnuplot_string(s.families[f].name, 40) << ' ' << f + 1;
+    for (std::size_t f = 0; f < nf; ++f)
+      gp << (f ? ", " : "") << output::gnuplot_string(s.families[f].name, 40) << ' ' << f + 1;
     gp << ") rotate by -25\n" << limit_line << "plot ";
     for (std::size_t i = 0; i < items.size(); ++i) gp << (i ? ", \\\n  " : "") << items[i];
     // Legend entries: one invisible point per controller.
     for (std::size_t c = 0; c < nc; ++c)
-      gp << ", \\\n  NaN with boxes linecolor " << c + 1 << " title " << output::gnuplot_string(s.controllers[c].name, 60);
+      gp << ", \\\n  NaN with boxes linecolor " << c + 1 << " title "
+         << output::gnuplot_string(s.controllers[c].name, 60);
     gp << "\nunset xtics\nset xtics\nunset xrange\nset autoscale x\n";
     md << "![" << cell(s.report.metric) << " per family and controller](" << prefix << "box.png)\n\n";
   }
@@ -364,7 +378,8 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
       for (std::size_t i = 0; i < d.cases; ++i) {
         if (d.controller[i] != c) continue;
         const std::int16_t k = d.category[i * params.size() + p];
-        const double x = categorical ? (k >= 0 ? k + 1.0 : NAN) : d.x[i * params.size() + p] * ax.factor, y = d.shown[i];
+        const double x = categorical ? (k >= 0 ? k + 1.0 : NAN) : d.x[i * params.size() + p] * ax.factor,
+                     y = d.shown[i];
         if (!std::isfinite(x) || !(y > 0.0)) continue;
         xs.push_back(x);
         data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
@@ -373,19 +388,20 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
       if (n == 0) continue;
       const std::string file = "param_" + std::to_string(p) + "_" + std::to_string(c) + ".dat";
       output::write_file_atomically(dir / file, data.str());
-      series.push_back("'" + file + "' using 1:2 with points pointtype 7 pointsize 0.8 linecolor " + std::to_string(c + 1) +
-                       " title " + output::gnuplot_string(s.controllers[c].name, 60));
+      series.push_back("'" + file + "' using 1:2 with points pointtype 7 pointsize 0.8 linecolor " +
+                       std::to_string(c + 1) + " title " + output::gnuplot_string(s.controllers[c].name, 60));
     }
     if (series.empty()) continue;
     const std::string png = "param_" + std::to_string(p) + ".png";
     gp << "set output '" << png << "'\nset title " << output::gnuplot_string(s.report.metric + " against " + params[p])
-       << "\nset xlabel " << output::gnuplot_string(categorical ? params[p] : axis_label(params[p], ax)) << "\nset ylabel "
-       << ylabel << "\nset xtics rotate by 0\n";
+       << "\nset xlabel " << output::gnuplot_string(categorical ? params[p] : axis_label(params[p], ax))
+       << "\nset ylabel " << ylabel << "\nset xtics rotate by 0\n";
     const bool logx = !categorical && log_axis(s, params[p], xs);
     if (categorical) {
       const auto& values = d.categories[p].values;
       gp << "set xrange [0.5:" << output::number_text(static_cast<double>(values.size()) + 0.5) << "]\nset xtics (";
-      for (std::size_t k = 0; k < values.size(); ++k) gp << (k ? ", " : "") << output::gnuplot_string(values[k], 40) << ' ' << k + 1;
+      for (std::size_t k = 0; k < values.size(); ++k)
+        gp << (k ? ", " : "") << output::gnuplot_string(values[k], 40) << ' ' << k + 1;
       gp << ")\n";
     } else if (logx) {
       gp << "set logscale x\n";
@@ -429,9 +445,10 @@ std::string metric_by_value(const ReportData& d) {
     }
     md << "\n## " << cell(s.report.metric) << " against " << cell(d.params[p]) << "\n\n";
     if (rows.empty() || rows.size() > kMaxRows) {
-      md << (d.categories[p].text && d.categories[p].more ? "More than 50 values that are not all numbers: see results.csv.\n"
-             : rows.empty()                                ? "No value of this key in any case.\n"
-                                                           : "More than 50 values (a distribution): see its plot.\n");
+      md << (d.categories[p].text && d.categories[p].more
+                 ? "More than 50 values that are not all numbers: see results.csv.\n"
+             : rows.empty() ? "No value of this key in any case.\n"
+                            : "More than 50 values (a distribution): see its plot.\n");
       continue;
     }
     md << "| " << cell(categorical ? d.params[p] : axis_label(d.params[p], ax)) << " |";
@@ -441,7 +458,8 @@ std::string metric_by_value(const ReportData& d) {
     md << "\n";
     long fewest = -1, most = 0;
     for (const auto& [x, per] : rows) {
-      md << "| " << (categorical ? cell(d.categories[p].values[static_cast<std::size_t>(x)]) : num(x * ax.factor)) << " |";
+      md << "| " << (categorical ? cell(d.categories[p].values[static_cast<std::size_t>(x)]) : num(x * ax.factor))
+         << " |";
       for (std::size_t c = 0; c < nc; ++c) {
         md << " " << num(per[c].empty() ? NAN : median(per[c])) << " |";
         const long n = counts[x][c];
@@ -468,7 +486,8 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   const std::size_t failed = d.failed, cached = d.cached;
   const std::string unit = s.report.unit;
   md << "# Study: " << cell(s.name) << "\n\n"
-     << "Written by `feeddrive-study`. Command:\n\n```bash\n" << command << "\n```\n\n"
+     << "Written by `feeddrive-study`. Command:\n\n```bash\n"
+     << command << "\n```\n\n"
      << d.cases << " cases (" << s.controllers.size() << " controllers x " << s.families.size() << " families), "
      << failed << " failed, " << cached << " reused from an earlier run into this folder. Every number below is "
      << "`" << s.report.metric << "` in " << unit << " (one row per case in `results.csv`).\n\n";
@@ -491,12 +510,13 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   const auto& t = d.table;
   const std::size_t nc = s.controllers.size();
   // Per controller: worst over everything.
-  md << "## Worst case per controller\n\n| controller | cases | failed | worst [" << unit << "] | family of the worst | median ["
-     << unit << "] |";
+  md << "## Worst case per controller\n\n| controller | cases | failed | worst [" << unit
+     << "] | family of the worst | median [" << unit << "] |";
   if (!std::isnan(s.report.limit)) md << " over " << num(s.report.limit) << " " << unit << " |";
   const bool criterion = s.report.has_criterion();
   if (criterion) md << " pass |";
-  md << "\n|---|---|---|---|---|---|" << (std::isnan(s.report.limit) ? "" : "---|") << (criterion ? "---|" : "") << "\n";
+  md << "\n|---|---|---|---|---|---|" << (std::isnan(s.report.limit) ? "" : "---|") << (criterion ? "---|" : "")
+     << "\n";
   for (std::size_t c = 0; c < nc; ++c) {
     std::vector<double> all;
     long total = 0, fail = 0, over = 0, passed = 0;
@@ -518,8 +538,10 @@ std::string report_md(const ReportData& d, const std::string& command, const std
     }
     md << "| " << cell(s.controllers[c].name) << " | " << total << " | " << fail << " | " << num(worst) << " | "
        << cell(worst_family) << " | " << num(median(all)) << " |";
-    if (!std::isnan(s.report.limit)) md << " " << over + fail << (over + fail == 0 ? " (meets the limit in every case)" : "") << " |";
-    if (criterion) md << " " << (passed == total ? "**" : "") << passed << " of " << total << (passed == total ? "**" : "") << " |";
+    if (!std::isnan(s.report.limit))
+      md << " " << over + fail << (over + fail == 0 ? " (meets the limit in every case)" : "") << " |";
+    if (criterion)
+      md << " " << (passed == total ? "**" : "") << passed << " of " << total << (passed == total ? "**" : "") << " |";
     md << "\n";
   }
   if (!std::isnan(s.report.limit))
@@ -571,7 +593,8 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   grid_table(("Median per family [" + unit + "]").c_str(), false);
 
   // The worst case of each controller, with its parameters.
-  md << "\n## The worst case of each controller\n\n| controller | family | case | " << unit << " | parameters |\n|---|---|---|---|---|\n";
+  md << "\n## The worst case of each controller\n\n| controller | family | case | " << unit
+     << " | parameters |\n|---|---|---|---|---|\n";
   for (std::size_t c = 0; c < nc; ++c) {
     const ReportData::Worst& w = d.worst[c];
     if (!w.any) continue;
@@ -586,13 +609,15 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   if (failed > 0) {
     md << "## Failed cases\n\n| case | controller | family | error |\n|---|---|---|---|\n";
     for (const ReportData::Failure& f : d.failures)
-      md << "| " << f.index << " | " << cell(s.controllers[f.controller].name) << " | " << cell(s.families[f.family].name)
-         << " | " << cell(f.error) << " |\n";
+      md << "| " << f.index << " | " << cell(s.controllers[f.controller].name) << " | "
+         << cell(s.families[f.family].name) << " | " << cell(f.error) << " |\n";
     if (failed > d.failures.size())
-      md << "\nThe first " << d.failures.size() << " of " << failed << " failed cases; `results.csv` lists every one (ok = false).\n";
+      md << "\nThe first " << d.failures.size() << " of " << failed
+         << " failed cases; `results.csv` lists every one (ok = false).\n";
     md << "\n";
   }
-  md << "Each case's complete scenario is `cases/<hash>.yaml` (the hash column of `results.csv` is its first 16 digits); "
+  md << "Each case's complete scenario is `cases/<hash>.yaml` (the hash column of `results.csv` is its first 16 "
+        "digits); "
         "`feeddrive-sim cases/<hash>.yaml --out DIR` reruns it alone.\n";
   return md.str();
 }

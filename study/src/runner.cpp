@@ -20,7 +20,8 @@ Outcome run_case(const std::string& yaml, const interrupt::StopToken& stop) {
     const sim::Scenario s = sim::parse_scenario(yaml, ".", "case");
     // Streamed: the online summary keeps no records (memory independent of the run's length).
     sim::SummaryBuilder builder(s);
-    const sim::RunStats st = sim::run(s, [&builder](const sim::Record& q) { builder.add(q); }, stop);
+    const sim::RunStats st = sim::run(
+        s, [&builder](const sim::Record& q) { builder.add(q); }, stop);
     const sim::Summary sum = builder.summary(st.wall_time_s, st.integrator);
     o.metrics = sim::summary_metrics(sum, s);
     o.warnings = s.warnings;
@@ -68,7 +69,8 @@ std::string outcome_json(const std::string& hash, const Outcome& o) {
 std::optional<Outcome> parse_outcome(const std::string& text, const std::string& hash) {
   try {
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
-    if (!j.is_object() || j.value("format", 0) != kOutcomeFormat || j.value("hash", std::string()) != hash) return std::nullopt;
+    if (!j.is_object() || j.value("format", 0) != kOutcomeFormat || j.value("hash", std::string()) != hash)
+      return std::nullopt;
     Outcome o;
     o.ok = j.at("ok").get<bool>();
     o.error = j.at("error").get<std::string>();

@@ -110,7 +110,7 @@ class CasePool {
   std::mutex mu_;
   std::map<std::size_t, std::string> yaml_;  // handed over, not yet taken by a thread
   const interrupt::StopToken stop_;
-  Pool pool_;                                // last: its threads stop before the map goes
+  Pool pool_;  // last: its threads stop before the map goes
 };
 
 // Cases resolved before any case runs (probe_cases): about 1 ms each, so the check takes about a
@@ -179,8 +179,8 @@ void list_cases(const CheckedStudy& c, const interrupt::StopToken& stop, Reporte
       stop.check();
       const CaseSpec cs = case_at(c.study, i);
       const ResolvedCase r = c.resolver->resolve(cs);
-      std::string line = std::to_string(i) + " " + r.hash.substr(0, 16) + " " + c.study.controllers[cs.controller].name +
-                         " " + c.study.families[cs.family].name;
+      std::string line = std::to_string(i) + " " + r.hash.substr(0, 16) + " " +
+                         c.study.controllers[cs.controller].name + " " + c.study.families[cs.family].name;
       for (const auto& v : cs.variations) line += " " + v.key + "=" + r.parameters.at(v.key);
       reporter.listed(line);
     }
@@ -219,9 +219,15 @@ LockedFolder open_folder(const std::string& out, Transport* t) {
 class CaseStream {
  public:
   CaseStream(const Options& o, Transport* t, const CheckedStudy& c, const fs::path& dir, int jobs, Reporter& reporter)
-      : o_(o), t_(t), c_(c), dir_(dir), jobs_(jobs), reporter_(reporter), report_(c.study),
-        window_(std::max<std::size_t>(256, 16 * static_cast<std::size_t>(jobs) *
-                                               static_cast<std::size_t>(t ? t->size() : 1))) {}
+      : o_(o),
+        t_(t),
+        c_(c),
+        dir_(dir),
+        jobs_(jobs),
+        reporter_(reporter),
+        report_(c.study),
+        window_(std::max<std::size_t>(
+            256, 16 * static_cast<std::size_t>(jobs) * static_cast<std::size_t>(t ? t->size() : 1))) {}
 
   // Runs every case; throws Interrupted with what was kept (the other ranks told), or a failure.
   void run() {
@@ -242,8 +248,9 @@ class CaseStream {
       }
     } catch (const interrupt::Interrupted& e) {
       reporter_.progress_end();
-      throw_interrupted(t_, e.signal(), ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
-                                           " cases finished in order; run the same command to go on");
+      throw_interrupted(t_, e.signal(),
+                        ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
+                            " cases finished in order; run the same command to go on");
     } catch (const std::exception& e) {
       if (t_) t_->abort(1);
       throw std::runtime_error(e.what());
@@ -264,15 +271,17 @@ class CaseStream {
     while (pool.in_flight() > 0)
       if (auto r = pool.pop(std::chrono::milliseconds(100))) record(r->first, std::move(r->second));
     reporter_.progress_end();
-    throw_interrupted(t_, sig, ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
-                                   " cases finished in order (and every case run is kept in " + dir_.string() +
-                                   "/cases); run the same command to go on");
+    throw_interrupted(t_, sig,
+                      ": " + std::to_string(next_row_) + " of " + std::to_string(c_.total) +
+                          " cases finished in order (and every case run is kept in " + dir_.string() +
+                          "/cases); run the same command to go on");
   }
 
   // Hands out cases in order, within the window, as long as a thread or a rank can take one.
   void hand_out(CasePool& pool, int& released) {
     const std::size_t want = static_cast<std::size_t>(jobs_) + waiting_.size() + (t_ ? 1 : 0);
-    while (next_case_ < c_.total && next_case_ - next_row_ < window_ && ready_.size() < want && !o_.stop.stop_requested())
+    while (next_case_ < c_.total && next_case_ - next_row_ < window_ && ready_.size() < want &&
+           !o_.stop.stop_requested())
       prepare_next();
     while (pool.in_flight() < static_cast<std::size_t>(jobs_) && !ready_.empty()) {
       pool.push(ready_.front(), slots_.at(ready_.front()).record.resolved.yaml);
@@ -331,7 +340,8 @@ class CaseStream {
       Outcome out;
       out.error = e.what();
       ++unresolved_;
-      for (const Variation& v : c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
+      for (const Variation& v :
+           c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
         if (!v.scale) c.resolved.parameters[v.key] = v.value;
       for (char& ch : out.error)
         if (ch == '\n' || ch == '\r') ch = ' ';
@@ -430,8 +440,9 @@ void write_report(const Options& o, Transport* t, const fs::path& dir, CaseStrea
     timing["ranks"] = t ? t->size() : 1;
     output::write_file_atomically(dir / "timing.json", timing.dump(2) + "\n");
   } catch (const interrupt::Interrupted& e) {
-    throw_interrupted(t, e.signal(), ": every case finished and is kept in " + dir.string() +
-                                         "/cases; run the same command to write the report");
+    throw_interrupted(
+        t, e.signal(),
+        ": every case finished and is kept in " + dir.string() + "/cases; run the same command to write the report");
   } catch (const std::exception& e) {
     throw std::runtime_error(e.what());
   }

@@ -77,8 +77,10 @@ std::vector<std::string> read_keys(const std::string& where, const YAML::Node& n
     keys.push_back(scalar_text(where + ".key", n["key"]));
   } else {
     const YAML::Node k = n["keys"];
-    if (!k.IsSequence() || k.size() == 0) fail(where + ".keys", " = " + describe(k) + ": expected a non-empty list of keys");
-    for (std::size_t i = 0; i < k.size(); ++i) keys.push_back(scalar_text(where + ".keys[" + std::to_string(i) + "]", k[i]));
+    if (!k.IsSequence() || k.size() == 0)
+      fail(where + ".keys", " = " + describe(k) + ": expected a non-empty list of keys");
+    for (std::size_t i = 0; i < k.size(); ++i)
+      keys.push_back(scalar_text(where + ".keys[" + std::to_string(i) + "]", k[i]));
   }
   std::set<std::string> seen;
   for (const std::string& key : keys) {
@@ -97,7 +99,8 @@ double finite_number(const std::string& where, const std::string& text) {
 }
 
 GridAxis read_axis(const std::string& where, const YAML::Node& n) {
-  if (!n.IsMap()) fail(where, " = " + describe(n) + ": expected a map {key: K, values: [...]} or {keys: [...], scale: [...]}");
+  if (!n.IsMap())
+    fail(where, " = " + describe(n) + ": expected a map {key: K, values: [...]} or {keys: [...], scale: [...]}");
   GridAxis a;
   a.keys = read_keys(where, n);
   const bool has_values = n["values"].IsDefined(), has_scale = n["scale"].IsDefined();
@@ -114,7 +117,8 @@ GridAxis read_axis(const std::string& where, const YAML::Node& n) {
       if (v[i].size() != a.keys.size())
         fail(ik, " = (a list of " + std::to_string(v[i].size()) + "): expected one value per key (" +
                      std::to_string(a.keys.size()) + ")");
-      for (std::size_t k = 0; k < v[i].size(); ++k) point.push_back(scalar_text(ik + "[" + std::to_string(k) + "]", v[i][k]));
+      for (std::size_t k = 0; k < v[i].size(); ++k)
+        point.push_back(scalar_text(ik + "[" + std::to_string(k) + "]", v[i][k]));
     } else {
       point.assign(a.keys.size(), scalar_text(ik, v[i]));  // one value for all keys
     }
@@ -124,7 +128,8 @@ GridAxis read_axis(const std::string& where, const YAML::Node& n) {
   }
   for (const auto& kv : n) {
     const std::string k = kv.first.Scalar();
-    if (k != "key" && k != "keys" && k != "values" && k != "scale") fail(where + "." + k, ": unknown key (expected key, keys, values, scale)");
+    if (k != "key" && k != "keys" && k != "values" && k != "scale")
+      fail(where + "." + k, ": unknown key (expected key, keys, values, scale)");
   }
   return a;
 }
@@ -137,7 +142,8 @@ Distribution distribution_from(const std::string& where, const std::string& s) {
 }
 
 DrawSpec read_draw(const std::string& where, const YAML::Node& n) {
-  if (!n.IsMap()) fail(where, " = " + describe(n) + ": expected a map {key: K, distribution: uniform, low: ..., high: ...}");
+  if (!n.IsMap())
+    fail(where, " = " + describe(n) + ": expected a map {key: K, distribution: uniform, low: ..., high: ...}");
   DrawSpec d;
   d.keys = read_keys(where, n);
   MapReader r(n, where);
@@ -153,7 +159,8 @@ DrawSpec read_draw(const std::string& where, const YAML::Node& n) {
     case Distribution::kUniform:
       need("low", d.a);
       need("high", d.b);
-      if (!(d.a < d.b)) r.fail("high", " = " + validate::format_number(d.b) + ": must be > low (" + validate::format_number(d.a) + ")");
+      if (!(d.a < d.b))
+        r.fail("high", " = " + validate::format_number(d.b) + ": must be > low (" + validate::format_number(d.a) + ")");
       break;
     case Distribution::kNormal:
     case Distribution::kLognormal: {
@@ -163,15 +170,22 @@ DrawSpec read_draw(const std::string& where, const YAML::Node& n) {
       if (!(d.b > 0.0)) r.fail(normal ? "stddev" : "sigma", " = " + validate::format_number(d.b) + ": must be > 0");
       r.number_or_infinite("low", d.low);
       r.number_or_infinite("high", d.high);
-      if (!(d.low < d.high)) r.fail("high", " = " + validate::format_number(d.high) + ": must be > low (" + validate::format_number(d.low) + ")");
-      if (!normal && d.high <= 0.0) r.fail("high", " = " + validate::format_number(d.high) + ": a lognormal draw is > 0, so high must be > 0");
+      if (!(d.low < d.high))
+        r.fail("high",
+               " = " + validate::format_number(d.high) + ": must be > low (" + validate::format_number(d.low) + ")");
+      if (!normal && d.high <= 0.0)
+        r.fail("high", " = " + validate::format_number(d.high) + ": a lognormal draw is > 0, so high must be > 0");
       // Redrawing until inside [low, high] must end: the interval must hold a real share of the
       // distribution (at least ~1e-4: within 3.7 standard deviations of the centre).
       const double centre = d.a, sd = d.b;
       const double lo = normal ? d.low : (d.low > 0.0 ? std::log(d.low) : -std::numeric_limits<double>::infinity());
       const double hi = normal ? d.high : std::log(d.high);
-      const double share = 0.5 * (std::erf((hi - centre) / (sd * std::sqrt(2.0))) - std::erf((lo - centre) / (sd * std::sqrt(2.0))));
-      if (!(share >= 1e-4)) r.fail("low", " = " + validate::format_number(d.low) + ": [low, high] holds almost none of the distribution (share " + validate::format_number(share) + ")");
+      const double share =
+          0.5 * (std::erf((hi - centre) / (sd * std::sqrt(2.0))) - std::erf((lo - centre) / (sd * std::sqrt(2.0))));
+      if (!(share >= 1e-4))
+        r.fail("low", " = " + validate::format_number(d.low) +
+                          ": [low, high] holds almost none of the distribution (share " +
+                          validate::format_number(share) + ")");
       break;
     }
   }
@@ -185,13 +199,16 @@ MonteCarlo read_monte_carlo(const std::string& where, const YAML::Node& n) {
   if (!r.has("draws")) r.fail("draws", ": missing (required)");
   r.integer("draws", mc.draws);
   if (mc.draws < 1) r.fail("draws", " = " + std::to_string(mc.draws) + ": must be >= 1");
-  if (mc.draws > kMaxCases) r.fail("draws", " = " + std::to_string(mc.draws) + ": more than " + std::to_string(kMaxCases) + " cases");
+  if (mc.draws > kMaxCases)
+    r.fail("draws", " = " + std::to_string(mc.draws) + ": more than " + std::to_string(kMaxCases) + " cases");
   if (!r.has("seed")) r.fail("seed", ": missing (required: the same seed gives the same draws)");
   r.unsigned_integer("seed", mc.seed);
   r.known("parameters");
   const YAML::Node p = n["parameters"];
-  if (!p.IsSequence() || p.size() == 0) fail(where + ".parameters", " = " + describe(p) + ": expected a non-empty list of parameters");
-  for (std::size_t i = 0; i < p.size(); ++i) mc.parameters.push_back(read_draw(where + ".parameters[" + std::to_string(i) + "]", p[i]));
+  if (!p.IsSequence() || p.size() == 0)
+    fail(where + ".parameters", " = " + describe(p) + ": expected a non-empty list of parameters");
+  for (std::size_t i = 0; i < p.size(); ++i)
+    mc.parameters.push_back(read_draw(where + ".parameters[" + std::to_string(i) + "]", p[i]));
   r.finish();
   return mc;
 }
@@ -208,7 +225,8 @@ Family read_family(const std::string& where, const YAML::Node& n) {
   if (g.IsDefined() && !g.IsNull()) {
     if (!g.IsSequence()) fail(where + ".grid", " = " + describe(g) + ": expected a list of axes");
     if (g.size() == 0) fail(where + ".grid", ": empty grid (no axes)");
-    for (std::size_t i = 0; i < g.size(); ++i) f.grid.push_back(read_axis(where + ".grid[" + std::to_string(i) + "]", g[i]));
+    for (std::size_t i = 0; i < g.size(); ++i)
+      f.grid.push_back(read_axis(where + ".grid[" + std::to_string(i) + "]", g[i]));
   }
   r.known("monte_carlo");
   if (n["monte_carlo"].IsDefined() && !n["monte_carlo"].IsNull())
@@ -223,7 +241,9 @@ ControllerEntry read_controller(const std::string& where, const YAML::Node& n, c
   MapReader r(n, where);
   c.name = r.required_string("name");
   const bool inline_block = r.has("controller"), from_file = r.has("scenario");
-  if (inline_block == from_file) fail(where, ": give exactly one of controller: (a controller block) or scenario: (a scenario file to take it from)");
+  if (inline_block == from_file)
+    fail(where,
+         ": give exactly one of controller: (a controller block) or scenario: (a scenario file to take it from)");
   r.known("controller");
   if (inline_block) {
     const YAML::Node b = n["controller"];
@@ -246,7 +266,8 @@ ControllerEntry read_controller(const std::string& where, const YAML::Node& n, c
     YAML::Emitter em;
     em << s["controller"];
     c.block = em.c_str();
-    if (s["control_period"].IsDefined()) c.block_set.push_back({"control_period", scalar_text(where + ".scenario control_period", s["control_period"])});
+    if (s["control_period"].IsDefined())
+      c.block_set.push_back({"control_period", scalar_text(where + ".scenario control_period", s["control_period"])});
   }
   r.known("set");
   for (Setting& st : read_settings(where + ".set", n["set"])) c.set.push_back(std::move(st));
@@ -323,7 +344,8 @@ void Study::validate() const {
     const std::string& r = report.require[i];
     const std::string where = "report.require[" + std::to_string(i) + "]";
     if (std::find(flags.begin(), flags.end(), r) != flags.end()) {
-      if (std::find(report.require.begin(), report.require.begin() + static_cast<long>(i), r) != report.require.begin() + static_cast<long>(i))
+      if (std::find(report.require.begin(), report.require.begin() + static_cast<long>(i), r) !=
+          report.require.begin() + static_cast<long>(i))
         fail(where, " = '" + r + "': listed twice");
       continue;
     }
@@ -377,7 +399,8 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
     const YAML::Node cs = root["controllers"];
     if (cs.IsDefined() && !cs.IsNull()) {
       if (!cs.IsSequence() || cs.size() == 0) fail("controllers", " = " + describe(cs) + ": expected a non-empty list");
-      for (std::size_t i = 0; i < cs.size(); ++i) s.controllers.push_back(read_controller("controllers[" + std::to_string(i) + "]", cs[i], base_dir));
+      for (std::size_t i = 0; i < cs.size(); ++i)
+        s.controllers.push_back(read_controller("controllers[" + std::to_string(i) + "]", cs[i], base_dir));
     } else {
       s.controllers.push_back({"base", "", {}, {}});
     }
@@ -385,7 +408,8 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
     const YAML::Node fs_ = root["families"];
     if (fs_.IsDefined() && !fs_.IsNull()) {
       if (!fs_.IsSequence() || fs_.size() == 0) fail("families", " = " + describe(fs_) + ": expected a non-empty list");
-      for (std::size_t i = 0; i < fs_.size(); ++i) s.families.push_back(read_family("families[" + std::to_string(i) + "]", fs_[i]));
+      for (std::size_t i = 0; i < fs_.size(); ++i)
+        s.families.push_back(read_family("families[" + std::to_string(i) + "]", fs_[i]));
     } else {
       s.families.push_back(Family{"nominal", {}, {}, {}});
     }
@@ -451,7 +475,8 @@ GridAxis parse_sweep(const std::string& text) {
     z = std::strtod(parts[1].c_str(), &end);
     if (parts[1].empty() || *end || !std::isfinite(z)) throw bad("STOP = '" + parts[1] + "' is not a finite number");
     const long n = std::strtol(parts[2].c_str(), &end, 10);
-    if (parts[2].empty() || *end || n < 2 || n > 10000) throw bad("N = '" + parts[2] + "' must be an integer in [2, 10000]");
+    if (parts[2].empty() || *end || n < 2 || n > 10000)
+      throw bad("N = '" + parts[2] + "' must be an integer in [2, 10000]");
     if (log && !(a > 0 && z > 0)) throw bad("a logarithmic range needs START and STOP > 0");
     for (long i = 0; i < n; ++i) {
       const double f = static_cast<double>(i) / static_cast<double>(n - 1);
@@ -491,7 +516,8 @@ Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>&
     for (const char* k : {"base", "controllers", "families"})
       if (map[k].IsDefined()) study_keys += (study_keys.empty() ? "" : "/") + std::string(k);
     if (!study_keys.empty())
-      throw StudyError("--sweep takes a scenario file, not a study file (" + scenario_path + " has " + study_keys + ")");
+      throw StudyError("--sweep takes a scenario file, not a study file (" + scenario_path + " has " + study_keys +
+                       ")");
   }
   for (std::size_t i = 0; i < axes.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)

@@ -91,8 +91,9 @@ bool mpi_compiled() { return false; }
 std::unique_ptr<Transport> connect(int&, char**&) {
   const std::string launcher = mpi_launcher();
   if (!launcher.empty())
-    throw StudyError("started by an MPI launcher (" + launcher +
-                     ") but this feeddrive-study was built without MPI (install libopenmpi-dev and rebuild; docs/deployment.md)");
+    throw StudyError(
+        "started by an MPI launcher (" + launcher +
+        ") but this feeddrive-study was built without MPI (install libopenmpi-dev and rebuild; docs/deployment.md)");
   return nullptr;
 }
 

@@ -6,20 +6,20 @@
 //   plant, force F held over [t_k, t_k+1) (zero-order hold), a = c/m, alpha = exp(-a T):
 //     v_{k+1} = alpha v_k + (1 - alpha)/c F_k
 //     x_{k+1} = x_k + (1 - alpha)/a v_k + (T - (1 - alpha)/a)/c F_k
-//   =>  V = Pv F,  Pv = ((1 - alpha)/c)/(z - alpha);   X = Px F,  Px = ((1 - alpha)/a Pv + (T - (1 - alpha)/a)/c)/(z - 1)
-//   cascade (controller/cascade.cpp): e_v = kp (r - x) - v, F = m (kv e_v + ki I), I_{k+1} = I_k + T e_v
+//   =>  V = Pv F,  Pv = ((1 - alpha)/c)/(z - alpha);   X = Px F,  Px = ((1 - alpha)/a Pv + (T - (1 - alpha)/a)/c)/(z -
+//   1) cascade (controller/cascade.cpp): e_v = kp (r - x) - v, F = m (kv e_v + ki I), I_{k+1} = I_k + T e_v
 //   =>  F = m C(z) e_v,  C = kv + ki T/(z - 1)
 //   loop at the force set-point L = m C (kp Px + Pv),  S = 1/(1 + L),
 //   T = m C kp Px/(1 + L),  compliance G_d = X/F_d = Px/(1 + L).
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <cstdio>
-#include <functional>
 #include <unistd.h>
+#include <cmath>
 #include <complex>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "feeddrive/analysis/frequency_response.hpp"
@@ -152,17 +152,18 @@ TEST(FrequencyResponse, FrictionMakesItAmplitudeDependent) {
     o.force_amplitude = force;
     const FrequencyResponse r = measure_frequency_response(s, o);
     k[i++] = r.points[0].stiffness_N_per_um();
-    EXPECT_NE(frequency_response_table(s, r).find("force " + std::to_string(static_cast<int>(force)) + " N"), std::string::npos);
+    EXPECT_NE(frequency_response_table(s, r).find("force " + std::to_string(static_cast<int>(force)) + " N"),
+              std::string::npos);
   }
   // presliding stiffer than sliding by more than 10 %
   EXPECT_GT(k[0], 1.1 * k[1]) << k[0] << " vs " << k[1];
 }
 
-
 // --- the bounds, the summary figures and the texts (issue 23 review F7-F13, F20) ---------------
 
 // A response from given values at given frequencies: compute_figures and the table without a run.
-FrequencyResponse synthetic(const std::vector<double>& fs, const std::function<cd(double)>& t, const std::function<cd(double)>& l) {
+FrequencyResponse synthetic(const std::vector<double>& fs, const std::function<cd(double)>& t,
+                            const std::function<cd(double)>& l) {
   FrequencyResponse r;
   for (double f : fs) {
     FrequencyPoint p;
@@ -199,7 +200,9 @@ TEST(FrequencyResponse, AFrequencyMovedOntoNyquistIsRefused) {
   const sim::Scenario s = linear_drive();
   FrequencyResponseOptions o;
   o.frequencies = {4999.9, 4990.0, 4900.0};
-  EXPECT_EQ(error_of(o, s), "--fr-frequencies 4999.9: is measured as 250 cycles in 500 samples, i.e. at 5000 Hz: must be below Nyquist 5000 Hz");
+  EXPECT_EQ(error_of(o, s),
+            "--fr-frequencies 4999.9: is measured as 250 cycles in 500 samples, i.e. at 5000 Hz: must be below Nyquist "
+            "5000 Hz");
   o.frequencies = {4990.0, 4900.0};  // 250 cycles in 501 samples: 4990.0 Hz
   EXPECT_EQ(error_of(o, s), "");
   o = {};
@@ -211,7 +214,8 @@ TEST(FrequencyResponse, DoubtfulPointsSupplyNoSummaryFigure) {
   // F7: a doubtful point (nonfund > 0.71) with the least stiffness, the largest |T| and the only
   // -3 dB crossing must not supply any of them; the table says they are left out.
   const std::vector<double> fs = {10, 100, 1000, 4000};
-  FrequencyResponse r = synthetic(fs, [](double f) { return cd(f < 2000 ? 1.0 : 0.1); }, [](double f) { return cd(10.0 / f); });
+  FrequencyResponse r = synthetic(
+      fs, [](double f) { return cd(f < 2000 ? 1.0 : 0.1); }, [](double f) { return cd(10.0 / f); });
   r.points[3].closed_loop = cd(30.0);  // +29.5 dB: a bogus peak
   r.points[3].compliance = cd(1.0);    // 1e-6 N/um: a bogus least stiffness
   r.points[3].closed_loop_nonfundamental = r.points[3].disturbance_nonfundamental = 0.99;
@@ -251,8 +255,10 @@ TEST(FrequencyResponse, ARunNotMadeSaysNotMeasured) {
   r.options.reference_amplitude = 0.0;
   compute_figures(r);
   t = frequency_response_table(s, r);
-  EXPECT_NE(t.find("closed-loop bandwidth (-3 dB): not measured (--fr-amplitude 0); peak |T|: not measured (--fr-amplitude 0)"),
-            std::string::npos)
+  EXPECT_NE(
+      t.find(
+          "closed-loop bandwidth (-3 dB): not measured (--fr-amplitude 0); peak |T|: not measured (--fr-amplitude 0)"),
+      std::string::npos)
       << t;
   EXPECT_EQ(t.find("n/a dB"), std::string::npos) << t;
 }
@@ -272,7 +278,8 @@ TEST(FrequencyResponse, ScenarioAndOptionWarningsAreKeptAndWritten) {
   const FrequencyResponse r = measure_frequency_response(s, o);
   ASSERT_EQ(r.warnings, s.warnings);
   EXPECT_NE(r.warnings.front().find("above"), std::string::npos) << r.warnings.front();
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd_fr_warn_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("fd_fr_warn_" + std::to_string(::getpid()));
   write_frequency_response(dir.string(), s, r, false);
   std::ifstream in(dir / "frequency_response.json");
   const auto j = nlohmann::json::parse(in);
@@ -298,7 +305,8 @@ TEST(FrequencyResponse, OpenLoopControllerIsRefused) {
       "controller: {type: open_loop, kind: step, amplitude: 12.0}\nreference: {type: none}\n",
       ".", "ol");
   EXPECT_EQ(error_of(FrequencyResponseOptions{}, s),
-            "controller.type open_loop: no feedback loop to measure (the frequency response needs a closed loop: sliding_mode, "
+            "controller.type open_loop: no feedback loop to measure (the frequency response needs a closed loop: "
+            "sliding_mode, "
             "cascade or plugin)");
 }
 
@@ -311,7 +319,10 @@ TEST(FrequencyResponse, TheWholeMeasurementIsBoundedAsARun) {
   EXPECT_LT(o.total_steps(s), 20 * 2 * 8000.0);  // 3 cycles at 5 Hz = 0.6 s settling, 2 x 0.4 s blocks at most
   o.settle_time = 1e9;
   EXPECT_NEAR(o.total_steps(s), 20 * 2 * 1e13, 20 * 2 * 1e13 * 1e-6);
-  EXPECT_EQ(error_of(o, s).rfind("frequency response: 4e+14 steps (20 frequencies from 5 Hz, --fr-settle 1e+09 s); a run has at most 1e+10 steps", 0), 0u)
+  EXPECT_EQ(error_of(o, s).rfind("frequency response: 4e+14 steps (20 frequencies from 5 Hz, --fr-settle 1e+09 s); a "
+                                 "run has at most 1e+10 steps",
+                                 0),
+            0u)
       << error_of(o, s);
   o = {};
   o.frequencies = {1e-6};
@@ -335,7 +346,9 @@ TEST(FrequencyResponse, PeakOnlyInsideTheRangeAndLowerGainMargin) {
   };
   const double K = 1.0 / std::abs(shape(100.0 / (2.0 * kPi)));
   const auto loop = [&](double f) { return K * shape(f); };
-  const auto phase = [&](double f) { return -270.0 + 2.0 * (std::atan(2 * kPi * f / w1) - std::atan(2 * kPi * f / w2)) * 180.0 / kPi; };
+  const auto phase = [&](double f) {
+    return -270.0 + 2.0 * (std::atan(2 * kPi * f / w1) - std::atan(2 * kPi * f / w2)) * 180.0 / kPi;
+  };
   const auto bisect = [&](double lo, double hi, bool rising) {
     for (int i = 0; i < 100; ++i) {
       const double mid = std::sqrt(lo * hi);
@@ -360,7 +373,8 @@ TEST(FrequencyResponse, PeakOnlyInsideTheRangeAndLowerGainMargin) {
   EXPECT_NEAR(r.gain_margin_db, -20.0 * std::log10(std::abs(loop(f_high))), 0.05);
   EXPECT_NE(t.find("lower gain margin"), std::string::npos) << t;
   // a peak inside the range is one: |T| of a resonance at 100 Hz, zeta 0.2
-  const FrequencyResponse rr = synthetic(log_grid(5, 2000, 1.05), [](double f) { return 1.0 / cd(1.0 - f * f / 1e4, 0.4 * f / 100.0); }, loop);
+  const FrequencyResponse rr = synthetic(
+      log_grid(5, 2000, 1.05), [](double f) { return 1.0 / cd(1.0 - f * f / 1e4, 0.4 * f / 100.0); }, loop);
   EXPECT_TRUE(rr.peak_inside);
   EXPECT_NEAR(rr.peak_hz, 100.0 * std::sqrt(1 - 2 * 0.04), 5.0);
 }
@@ -369,7 +383,10 @@ TEST(FrequencyResponse, BandwidthNamesItsGridAndTheTableUnwrapsThePhase) {
   // F13: the bandwidth says which two measured points it is interpolated between. F20: the table
   // prints the phase unwrapped along f, as the CSV and the plots do: T = 1/(1 + j f/100)^3 goes
   // to -270 deg, which wrapped would read +90.
-  const auto t3 = [](double f) { const cd a(1.0, f / 100.0); return 1.0 / (a * a * a); };
+  const auto t3 = [](double f) {
+    const cd a(1.0, f / 100.0);
+    return 1.0 / (a * a * a);
+  };
   const std::vector<double> fs = {10, 50, 100, 300, 1000};
   const FrequencyResponse r = synthetic(fs, t3, [](double f) { return cd(100.0 / f); });
   ASSERT_FALSE(std::isnan(r.bandwidth_hz));

@@ -48,7 +48,7 @@ TEST(Cascade, LawMatchesTheHandComputation) {
 // and every change of u_unsaturated comes from the integrator): each integrating call changes
 // u_unsaturated by m*ki*e_v*T/(Ka Kf) exactly, a frozen call by 0.
 TEST(Cascade, IntegratorFreezesOnlyWhenSaturatedInTheDirectionOfTheError) {
-  CascadeParams p;  // u in [-10, 10] V
+  CascadeParams p;                                               // u in [-10, 10] V
   const double step = p.mass * p.ki * p.period / p.thrust_gain;  // du per unit e_v per call [V*s/m]
   const plant::Measurement rest{0.0, 0.0, 0.0};
   const auto deltas = [&](const trajectory::Sample& ref, int calls) {
@@ -99,8 +99,8 @@ class NaiveCascade final : public Controller {
   Command update(const trajectory::Sample& ref, const plant::Measurement& m, const Truth*) override {
     const double ev = p_.velocity_feedforward * ref.velocity + p_.kp * (ref.position - m.x) - m.v;
     Command c;
-    c.u_unsaturated = p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ref.acceleration) /
-                      p_.thrust_gain;
+    c.u_unsaturated =
+        p_.mass * (p_.kv * ev + p_.ki * integral_ + p_.acceleration_feedforward * ref.acceleration) / p_.thrust_gain;
     c.u = saturate(c.u_unsaturated, p_.u_min, p_.u_max);
     integral_ += ev * p_.period;
     return c;

@@ -59,8 +59,8 @@ double rk4_reaching_max(double s0, double eta, double k, double lambda) {
 // The same loop in exact discrete time: a pure mass under a zero-order hold is integrated exactly
 // by x+ = x + v T + a T^2/2, v+ = v + a T with a = Ka*Kf*u/m = the law's commanded acceleration
 // (exact model, no forces). Written out here from eq. 19, independently of the controller class.
-double discrete_reaching_max_window(double amplitude, double omega, double eta, double k, double lambda,
-                                    double period, double t0, double t1) {
+double discrete_reaching_max_window(double amplitude, double omega, double eta, double k, double lambda, double period,
+                                    double t0, double t1) {
   double x = 0.0, v = 0.0, e_max = 0.0;
   const long n = std::lround(t1 / period) + 1;
   for (long i = 0; i < n; ++i) {
@@ -77,10 +77,9 @@ double discrete_reaching_max_window(double amplitude, double omega, double eta, 
 }
 
 // max |e| over [0, t_end) of the exact discrete loop.
-double discrete_reaching_max(double amplitude, double omega, double eta, double k, double lambda,
-                             double period, double t_end) {
-  return discrete_reaching_max_window(amplitude, omega, eta, k, lambda, period, 0.0,
-                                      t_end - 0.5 * period);
+double discrete_reaching_max(double amplitude, double omega, double eta, double k, double lambda, double period,
+                             double t_end) {
+  return discrete_reaching_max_window(amplitude, omega, eta, k, lambda, period, 0.0, t_end - 0.5 * period);
 }
 
 // Fig. 18 on an exact pure-mass plant: 100 mm, 1 Hz sinusoid from rest, period 1e-4 s, the paper's

@@ -15,8 +15,8 @@ namespace feeddrive::controller {
 namespace {
 
 // Commands issued at 0, T, 2T with d = 1.5 T act from 1.5T, 2.5T, 3.5T: [2T, 3T] splits at 2.5T
-// into u0 then u1, [3T, 4T] at 3.5T into u1 then u2; before 1.5T nothing acts (0). Exact: the switch times are sums of binary
-// fractions here (T = 0.25).
+// into u0 then u1, [3T, 4T] at 3.5T into u1 then u2; before 1.5T nothing acts (0). Exact: the switch times are sums of
+// binary fractions here (T = 0.25).
 TEST(DelayLine, SplitsAPeriodAtTheSwitchTimes) {
   DelayLine line(0.375, 1e-12);
   line.push(0.0, 1.0);

@@ -176,8 +176,8 @@ TEST(GrindingObserver, ContactAndDisabled) {
   for (int k = 0; k < 10000; ++k) obs.advance(0.02, 1e-5);  // in contact: converged to C v
   const double fg = obs.estimate(0.02);
   EXPECT_NEAR(fg, g.damping() * 1e-5, 1e-12 * fg);
-  EXPECT_EQ(obs.estimate(0.0), 0.0);                        // out of contact: no force
-  for (int k = 0; k < 100; ++k) obs.advance(0.0, 1e-5);     // one tau out of contact
+  EXPECT_EQ(obs.estimate(0.0), 0.0);                     // out of contact: no force
+  for (int k = 0; k < 100; ++k) obs.advance(0.0, 1e-5);  // one tau out of contact
   EXPECT_NEAR(obs.estimate(0.02), fg * std::exp(-1.0), 1e-12 * fg);
 
   g.enabled = false;

@@ -15,10 +15,10 @@
 namespace feeddrive::controller {
 namespace {
 
-constexpr double kPeriod = 1e-4;      // T [s]: 10 kHz for every switching law
-constexpr double kDuration = 1.5;     // [s]: the move (1.10 s) and its settling
+constexpr double kPeriod = 1e-4;           // T [s]: 10 kHz for every switching law
+constexpr double kDuration = 1.5;          // [s]: the move (1.10 s) and its settling
 constexpr double kMaxAcceleration = 1.15;  // [m/s^2] of the move
-constexpr double kMaxVelocity = 0.2;  // [m/s]
+constexpr double kMaxVelocity = 0.2;       // [m/s]
 
 trajectory::SCurveParams jerk_limited_move() {
   trajectory::SCurveParams r;  // 0.1 m, 0.2 m/s, 1.15 m/s^2, 2.4 m/s^3 (Xie & Liang Sec. 5.3)
@@ -63,8 +63,8 @@ std::string mode_name(Mode m) {
 double error_bound(const SlidingModeParams& c, const plant::PlantParams& plant) {
   const double m = plant.mass;
   const double mh = c.model.mass;
-  const double df = plant.friction.static_force + plant.friction.viscous * kMaxVelocity +
-                    std::abs(m - mh) * kMaxAcceleration;
+  const double df =
+      plant.friction.static_force + plant.friction.viscous * kMaxVelocity + std::abs(m - mh) * kMaxAcceleration;
   double s_max = 0.0;
   if (c.switching == Switching::kSign) {
     EXPECT_LT(df, mh * c.eta) << "the reaching condition";
@@ -118,11 +118,11 @@ TEST_P(SlidingModeMismatch, ErrorStaysWithinTheReachingLawBound) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    EveryModeAndSwitchingLaw, SlidingModeMismatch,
-    ::testing::Combine(::testing::Values(Switching::kSign, Switching::kSaturation, Switching::kTanh),
-                       ::testing::Values(Mode::kTrueZ, Mode::kObserver, Mode::kNone)),
-    [](const auto& info) { return test_name(std::get<0>(info.param), std::get<1>(info.param)); });
+INSTANTIATE_TEST_SUITE_P(EveryModeAndSwitchingLaw, SlidingModeMismatch,
+                         ::testing::Combine(::testing::Values(Switching::kSign, Switching::kSaturation,
+                                                              Switching::kTanh),
+                                            ::testing::Values(Mode::kTrueZ, Mode::kObserver, Mode::kNone)),
+                         [](const auto& info) { return test_name(std::get<0>(info.param), std::get<1>(info.param)); });
 
 }  // namespace
 }  // namespace feeddrive::controller

@@ -139,7 +139,8 @@ TEST(OpenLoopTable, BadTablesNameTheRow) {
   EXPECT_EQ(message(table_params({0, 1}, {1}, true)), "controller.file: the table has 2 times and 1 values");
   EXPECT_EQ(message(table_params({0, 0.5, 0.4}, {1, 2, 3}, true)),
             "controller.file[2].t = 0.4: must be greater than the previous t = 0.5");
-  EXPECT_EQ(message(table_params({0, 1}, {1, std::nan("")}, false)), "controller.file[1].u = nan: must be a finite number");
+  EXPECT_EQ(message(table_params({0, 1}, {1, std::nan("")}, false)),
+            "controller.file[1].u = nan: must be a finite number");
 }
 
 TEST(OpenLoop, ValidateAndNames) {

@@ -39,7 +39,8 @@ TEST(SlidingModeParts, SwitchingFunctionIsSignSaturationOrTanh) {
   EXPECT_EQ(switching_function(Switching::kSaturation, phi, 3 * phi), 1.0);
   EXPECT_EQ(switching_function(Switching::kSaturation, phi, -3 * phi), -1.0);
   EXPECT_NEAR(switching_function(Switching::kTanh, phi, 0.5 * phi), std::tanh(0.5), 1e-15);
-  EXPECT_EQ(switching_function(Switching::kTanh, phi, -0.5 * phi), -switching_function(Switching::kTanh, phi, 0.5 * phi));
+  EXPECT_EQ(switching_function(Switching::kTanh, phi, -0.5 * phi),
+            -switching_function(Switching::kTanh, phi, 0.5 * phi));
   EXPECT_NEAR(switching_function(Switching::kTanh, phi, 40 * phi), 1.0, 1e-15);
 }
 

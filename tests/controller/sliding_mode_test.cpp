@@ -105,9 +105,7 @@ TEST(SlidingModeLaw, MatchesEquation19ForEverySwitchingAndCompensation) {
         double expected_sw = 0.0;
         switch (sw.kind) {
           case Switching::kSign: expected_sw = s > 0 ? 1.0 : -1.0; break;
-          case Switching::kSaturation:
-            expected_sw = std::abs(s) < sw.phi ? s / sw.phi : (s > 0 ? 1.0 : -1.0);
-            break;
+          case Switching::kSaturation: expected_sw = std::abs(s) < sw.phi ? s / sw.phi : (s > 0 ? 1.0 : -1.0); break;
           case Switching::kTanh: expected_sw = std::tanh(s / sw.phi); break;
         }
         const double u = hand_u(p, c.ref, c.meas, kTruth, expected_sw);
@@ -139,8 +137,8 @@ TEST(SlidingModeLaw, SaturationIsLinearInsideTheLayerAndUnitOutside) {
     SlidingModeController without_eta(p0);
     const double kakf = p.model.thrust_gain();
     const double r = hand_reluctance(p.model.ripple, 0.0);
-    const double du = with_eta.update(ref, meas, &kTruth).u_unsaturated -
-                      without_eta.update(ref, meas, &kTruth).u_unsaturated;
+    const double du =
+        with_eta.update(ref, meas, &kTruth).u_unsaturated - without_eta.update(ref, meas, &kTruth).u_unsaturated;
     const double sw = du * kakf * (1.0 - r) / (p.model.mass * p.eta);
     const double expected = std::clamp(ratio, -1.0, 1.0);
     EXPECT_NEAR(sw, expected, 1e-12) << ratio;
@@ -283,8 +281,8 @@ TEST(SlidingModeTruth, NeedsTruthOnlyForTrueStatesThatAreUsed) {
     p.grinding_state = c.gs;
     SlidingModeController ctl(p);
     SCOPED_TRACE(plant::to_string(c.friction) + " grinding=" + std::to_string(c.grinding_enabled) +
-                 " comp_f=" + std::to_string(c.comp_f) + " comp_g=" + std::to_string(c.comp_g) + " fs=" +
-                 to_string(c.fs) + " gs=" + to_string(c.gs));
+                 " comp_f=" + std::to_string(c.comp_f) + " comp_g=" + std::to_string(c.comp_g) +
+                 " fs=" + to_string(c.fs) + " gs=" + to_string(c.gs));
     EXPECT_EQ(ctl.needs_truth(), c.expected);
     const trajectory::Sample ref{1e-3, 0.0, 0.0, 0.0};
     const plant::Measurement meas{0.0, 0.0, 0.0};

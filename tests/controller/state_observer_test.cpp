@@ -11,8 +11,8 @@
 namespace feeddrive::controller {
 namespace {
 
-constexpr double kT = 1e-4;    // control period [s]
-constexpr double kW = 300.0;   // observer bandwidth [rad/s] (the SMC default)
+constexpr double kT = 1e-4;   // control period [s]
+constexpr double kW = 300.0;  // observer bandwidth [rad/s] (the SMC default)
 
 // With the exact model acceleration and ideal measurements of a constant-acceleration motion
 // x = x0 + v0 t + a t^2/2, the prediction lands exactly on the next sample, so the innovation is 0
@@ -85,8 +85,7 @@ TEST(StateObserver, ErrorDynamicsHaveAllPolesAtExpMinusWT) {
     const ErrorRun r = error_run(true, 1e-3, n);
     for (const auto* e : {&r.ex, &r.ev, &r.ed}) {
       for (int k = 0; k + 3 < n; ++k) {
-        const double a = (*e)[k + 3], b = 3 * p * (*e)[k + 2], c = 3 * p * p * (*e)[k + 1],
-                     d = p * p * p * (*e)[k];
+        const double a = (*e)[k + 3], b = 3 * p * (*e)[k + 2], c = 3 * p * p * (*e)[k + 1], d = p * p * p * (*e)[k];
         ASSERT_NEAR(a - b + c - d, 0.0, 1e-9 * (std::abs(a) + std::abs(b) + std::abs(c) + std::abs(d))) << k;
       }
     }
@@ -109,8 +108,8 @@ TEST(StateObserver, DecayRatioApproachesThePole) {
     EXPECT_NEAR(r.ev[k], expected, 1e-9 * expected) << k;
   }
   const double ratio = r.ev[n] / r.ev[n - 1];
-  EXPECT_GT(ratio, p);                    // slower than a single pole: the n p^n term is there
-  EXPECT_NEAR(ratio / p, 1.0, 1.0 / n);   // ... but it approaches p (here 1 + 1/(3000 + 33))
+  EXPECT_GT(ratio, p);                   // slower than a single pole: the n p^n term is there
+  EXPECT_NEAR(ratio / p, 1.0, 1.0 / n);  // ... but it approaches p (here 1 + 1/(3000 + 33))
 }
 
 // Sum over j of |h_v(j)|, the l1 norm of the impulse response from a measurement error to the
@@ -143,7 +142,7 @@ double velocity_noise_gain(bool with_d) {
 // up to q/T = 500 um/s. The bound is rigorous, so it is checked as is.
 TEST(StateObserver, QuantizedRampVelocityErrorFarBelowQOverT) {
   const double q = 50e-9;
-  const double v = 1.234e-3;   // m/s: 2.468 counts per period, not commensurate with q
+  const double v = 1.234e-3;  // m/s: 2.468 counts per period, not commensurate with q
   const double x0 = 17e-9;
   const double p = std::exp(-kW * kT);
   {

@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -18,8 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include "feeddrive/sim/scenario.hpp"
 #include "../support/scratch.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -47,8 +47,8 @@ struct ProcResult {
 // Runs `exe args` under timeout (nothing may hang the test), capturing stdout and stderr.
 ProcResult run(const std::string& exe, const std::string& args, int timeout_s = 600) {
   const fs::path out = scratch() / "stdout.txt", err = scratch() / "stderr.txt";
-  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + exe + " " + args + " > " + out.string() +
-                          " 2> " + err.string();
+  const std::string cmd =
+      "timeout " + std::to_string(timeout_s) + " " + exe + " " + args + " > " + out.string() + " 2> " + err.string();
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
@@ -117,13 +117,16 @@ TEST(FitCli, NaNNamesLineAndColumn) {
 TEST(FitCli, RepeatedTime) {
   auto rows = good_rows(100);
   rows[20] = "0.019,0.0,0.1";  // same t as rows[19]: line 22
-  expect_data_error("repeat.csv", csv("t,x,u", rows), {"repeat.csv:22:1:", "column 't'", "0.019 is not greater than the previous t = 0.019 (line 21)"});
+  expect_data_error("repeat.csv", csv("t,x,u", rows),
+                    {"repeat.csv:22:1:", "column 't'", "0.019 is not greater than the previous t = 0.019 (line 21)"});
 }
 
 TEST(FitCli, TimeGoingBackwards) {
   auto rows = good_rows(100);
   rows[30] = "0.025,0.0,0.1";  // before rows[29] (0.029): line 32
-  expect_data_error("backwards.csv", csv("t,x,u", rows), {"backwards.csv:32:1:", "column 't'", "0.025 is not greater than the previous t = 0.029 (line 31)"});
+  expect_data_error(
+      "backwards.csv", csv("t,x,u", rows),
+      {"backwards.csv:32:1:", "column 't'", "0.025 is not greater than the previous t = 0.029 (line 31)"});
 }
 
 TEST(FitCli, TooFewSamples) {
@@ -132,8 +135,9 @@ TEST(FitCli, TooFewSamples) {
 
 TEST(FitCli, UnreadableDataFile) {
   const fs::path out = scratch() / "out_missing";
-  const ProcResult r = run_fit("--scenario " + model_scenario().string() + " --data " +
-                               (scratch() / "does_not_exist.csv").string() + " --out " + out.string() + " -q --no-plots");
+  const ProcResult r =
+      run_fit("--scenario " + model_scenario().string() + " --data " + (scratch() / "does_not_exist.csv").string() +
+              " --out " + out.string() + " -q --no-plots");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("does_not_exist.csv: cannot open"), std::string::npos) << r.err;
@@ -166,7 +170,8 @@ TEST(FitCli, FolderSeparatorAndByteOrderMark) {
 
 TEST(FitCli, ArgumentErrorsAreOneLineAndComeFirst) {
   // A missing or out-of-range option: one line, exit 2.
-  for (const std::string args : {"--scenario x.yaml --data y.csv", "--scenario x.yaml --data y.csv --out z --max-effects 99"}) {
+  for (const std::string args :
+       {"--scenario x.yaml --data y.csv", "--scenario x.yaml --data y.csv --out z --max-effects 99"}) {
     const ProcResult r = run_fit(args);
     EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": [" << r.err << "]";
@@ -207,10 +212,10 @@ TEST(FitCli, WindowsThatHoldTooFewSamplesAreRefused) {
   // slope) then fits away any gap (the issue's "gap 0 -> 0" at --replay-window 1e-9); a filter
   // half-width below 2 periods averages nothing. Both are refused with the record's period.
   const std::string data = csv("t,x,u", good_rows(2000));
-  expect_data_error("short_window.csv", data,
-                    {"short_window.csv", "--replay-window 0.005 s spans fewer than 10 sample periods (0.001 s)",
-                     "at least 0.01 s"},
-                    "--replay-window 0.005");
+  expect_data_error(
+      "short_window.csv", data,
+      {"short_window.csv", "--replay-window 0.005 s spans fewer than 10 sample periods (0.001 s)", "at least 0.01 s"},
+      "--replay-window 0.005");
   expect_data_error("short_filter.csv", data,
                     {"short_filter.csv", "--filter-half-width 0.0015 s is shorter than 2 sample periods (0.001 s)"},
                     "--filter-half-width 0.0015");
@@ -223,8 +228,9 @@ TEST(FitCli, FinitePositionOutliersTooLargeForAFiniteFitAreNamed) {
   for (const std::string big : {"1e308", "1e200"}) {
     auto rows = good_rows(2000);
     rows[700] = "0.7," + big + ",0.05";
-    expect_data_error("outlier_" + big + ".csv", csv("t,x,u", rows),
-                      {"outlier_" + big + ".csv", "at t = 0.7 s", "is the position column in metres and free of outliers?"});
+    expect_data_error(
+        "outlier_" + big + ".csv", csv("t,x,u", rows),
+        {"outlier_" + big + ".csv", "at t = 0.7 s", "is the position column in metres and free of outliers?"});
   }
 }
 
@@ -280,7 +286,8 @@ std::string short_scenario(const std::string& effects) {
 // 4 s of data of the model plus a 15 N constant force (feeddrive-sim, measured position).
 fs::path simulated_data() {
   static const fs::path data = [] {
-    const fs::path truth = write_file("truth4.yaml", short_scenario("  effects:\n    constant_force: {force_N: 15.0}\n"));
+    const fs::path truth =
+        write_file("truth4.yaml", short_scenario("  effects:\n    constant_force: {force_N: 15.0}\n"));
     const fs::path out = scratch() / "sim_truth";
     const ProcResult r = run(kSim, truth.string() + " --out " + out.string() + " --no-plots --quiet");
     if (r.code != 0) throw std::runtime_error("feeddrive-sim failed: " + r.err);
@@ -357,8 +364,8 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   // refused before any work, the file kept; without it, the output is replaced, also as "DIR/".
   EXPECT_TRUE(fs::exists(out / ".feeddrive-output"));
   std::ofstream(out / "notes.txt") << "mine";
-  const std::string again_args = "--scenario " + model.string() + " --data " + data.string() + " --out " + out.string() +
-                                 "/ --position-column x_measured --no-plots -q --max-effects 1";
+  const std::string again_args = "--scenario " + model.string() + " --data " + data.string() + " --out " +
+                                 out.string() + "/ --position-column x_measured --no-plots -q --max-effects 1";
   const ProcResult kept = run_fit(again_args);
   EXPECT_EQ(kept.code, 2) << kept.err;
   EXPECT_EQ(std::count(kept.err.begin(), kept.err.end(), '\n'), 1) << kept.err;
@@ -397,7 +404,8 @@ TEST(FitCli, UnwritableOutRefusedBeforeAnyWork) {
                                  (scratch() / "not_there.csv").string() + " --out " + sh(value) + " -q");
     EXPECT_EQ(r.code, 2) << value << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_EQ(r.err.rfind("error: --out " + (value.empty() ? std::string("\"\"") : value.substr(0, 40)), 0), 0u) << r.err;
+    EXPECT_EQ(r.err.rfind("error: --out " + (value.empty() ? std::string("\"\"") : value.substr(0, 40)), 0), 0u)
+        << r.err;
     EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("not_there.csv"), std::string::npos) << r.err;
   }
@@ -426,7 +434,8 @@ TEST(FitCli, NamesAreNeverRunAsCommands) {
                            " --max-effects 1 -q";
   const ProcResult r = run("sh", "-c " + sh("cd " + sh(base.string()) + " && exec " + kFit + " " + args));
   ASSERT_EQ(r.code, 0) << r.err << r.out;
-  for (const char* f : {"findings.json", "report.md", "replay.png", "gap.png", "plots.gp"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  for (const char* f : {"findings.json", "report.md", "replay.png", "gap.png", "plots.gp"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_FALSE(fs::exists(mark));
   EXPECT_FALSE(fs::exists(out / "MARK"));
   EXPECT_FALSE(fs::exists(fs::path(FEEDDRIVE_BINARY_DIR) / "MARK"));
@@ -531,8 +540,8 @@ TEST(FitVerdict, ExplainedNoDiscrepancyAndTheirExitCodes) {
 // The independent generator (fd-drivegen), as a user would run it: files on disk, the CLI.
 fs::path drivegen(const std::string& name, const std::string& args) {
   const fs::path dir = scratch() / name;
-  const ProcResult g = run(std::string(FEEDDRIVE_BINARY_DIR) + "/bin/fd-drivegen", args.substr(0, args.find(' ')) + " " +
-                                                                                         dir.string() + args.substr(args.find(' ')));
+  const ProcResult g = run(std::string(FEEDDRIVE_BINARY_DIR) + "/bin/fd-drivegen",
+                           args.substr(0, args.find(' ')) + " " + dir.string() + args.substr(args.find(' ')));
   if (g.code != 0) throw std::runtime_error("fd-drivegen failed: " + g.err);
   return dir;
 }
@@ -548,7 +557,8 @@ GeneratedFit generate_and_fit(const std::string& name, const std::string& args) 
   const fs::path dir = drivegen("gen_" + name, args);
   GeneratedFit g{run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
                          " --out " + (scratch() / name).string() + " --no-plots -q"),
-                 {}, scratch() / name};
+                 {},
+                 scratch() / name};
   if (fs::exists(g.out / "findings.json")) g.findings = issue20::findings(g.out);
   return g;
 }
@@ -586,8 +596,9 @@ TEST(FitVerdict, StampErrorRaisesTheFloorAndHidesNoEffect) {
   const fs::path dir = scratch() / "gen_verdict_stamps_plain";
   ASSERT_NE(slurp(dir / "knobs.txt").find("stamp_error_s 5.77350269"), std::string::npos);
   const fs::path out = scratch() / "verdict_stamps";
-  const ProcResult r = run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() +
-                               " --out " + out.string() + " --no-plots -q --time-stamp-error 5.7735e-7");
+  const ProcResult r =
+      run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() + " --out " +
+              out.string() + " --no-plots -q --time-stamp-error 5.7735e-7");
   ASSERT_EQ(r.code, 3) << r.err << r.out;
   ASSERT_EQ(plain.run.code, 3) << plain.run.err;
   const auto j = findings(out);
@@ -625,7 +636,8 @@ TEST(FitVerdict, BorderlinePitchIsTentativeAndASpringWithoutSlopeIsSwapped) {
   ASSERT_TRUE(named.count("constant_force")) << j["conclusion"];
   EXPECT_FALSE(named.count("spring_force")) << j["conclusion"];
   EXPECT_TRUE(named["cogging_ripple"]["tentative"].get<bool>());
-  EXPECT_NE(named["cogging_ripple"]["caveat"].get<std::string>().find("record a travel of at least 3 periods"), std::string::npos);
+  EXPECT_NE(named["cogging_ripple"]["caveat"].get<std::string>().find("record a travel of at least 3 periods"),
+            std::string::npos);
   // the truth (fd-drivegen's truth.txt): pitch 40.19 mm, 10.70 N; 2 % and 20 % as the sweep
   EXPECT_NEAR(named["cogging_ripple"]["parameters"]["pitch_m"].get<double>(), 0.0401917, 0.02 * 0.0401917);
   EXPECT_NEAR(named["constant_force"]["parameters"]["force_N"].get<double>(), 10.6976, 0.2 * 10.6976);
@@ -664,18 +676,22 @@ TEST(FitData, LoggerFilesWithTheirOwnSeparatorDecimalCommaUnitsAndColumns) {
     std::replace(s.begin(), s.end(), '.', ',');
     return s;
   };
-  const fs::path logger = write_file(
-      "logger.csv", derived({"time_ms", "pos_mm", "force_N"}, [&](const auto& c, std::size_t k) {
-        return std::vector<std::string>{comma(g17(num(c.at("t")[k]) * 1e3)), comma(g17(num(c.at("x_measured")[k]) * 1e3)),
-                                        comma(c.at("f_thrust")[k])};
-      }, ";"));
+  const fs::path logger =
+      write_file("logger.csv", derived(
+                                   {"time_ms", "pos_mm", "force_N"},
+                                   [&](const auto& c, std::size_t k) {
+                                     return std::vector<std::string>{comma(g17(num(c.at("t")[k]) * 1e3)),
+                                                                     comma(g17(num(c.at("x_measured")[k]) * 1e3)),
+                                                                     comma(c.at("f_thrust")[k])};
+                                   },
+                                   ";"));
   // without the options: refused, and the line says which option reads it
   expect_data_error("logger_plain.csv", slurp(logger), {"separated by commas", "--separator"});
   const auto fit_ok = [&](const std::string& name, const fs::path& data, const std::string& args) {
     SCOPED_TRACE(name);
     const fs::path out = scratch() / name;
-    const ProcResult r = run_fit("--scenario " + model4().string() + " --data " + data.string() + " --out " + out.string() +
-                                 " --no-plots -q --max-effects 1 " + args);
+    const ProcResult r = run_fit("--scenario " + model4().string() + " --data " + data.string() + " --out " +
+                                 out.string() + " --no-plots -q --max-effects 1 " + args);
     ASSERT_TRUE(r.code == 0 || r.code == 3) << r.err << r.out;
     const auto j = findings(out);
     ASSERT_FALSE(j["effects"].empty()) << j["conclusion"];
@@ -689,13 +705,18 @@ TEST(FitData, LoggerFilesWithTheirOwnSeparatorDecimalCommaUnitsAndColumns) {
   fit_ok("logger_index_out", logger,
          "--separator ';' --decimal-comma --units t=ms,x=mm --time-column 1 --position-column 2 --force-column 3");
   // a 50 nm encoder in counts (the simulated encoder's quantum), time in us, force in kN, tabs
-  const fs::path counts = write_file(
-      "counts.tsv", derived({"t_us", "enc", "F_kN"}, [&](const auto& c, std::size_t k) {
-        return std::vector<std::string>{g17(num(c.at("t")[k]) * 1e6), g17(std::round(num(c.at("x_measured")[k]) / 5e-8)),
-                                        g17(num(c.at("f_thrust")[k]) * 1e-3)};
-      }, "\t"));
+  const fs::path counts =
+      write_file("counts.tsv", derived(
+                                   {"t_us", "enc", "F_kN"},
+                                   [&](const auto& c, std::size_t k) {
+                                     return std::vector<std::string>{g17(num(c.at("t")[k]) * 1e6),
+                                                                     g17(std::round(num(c.at("x_measured")[k]) / 5e-8)),
+                                                                     g17(num(c.at("f_thrust")[k]) * 1e-3)};
+                                   },
+                                   "\t"));
   fit_ok("counts_out", counts,
-         "--separator tab --units t=us,x=counts:5e-8,force=kN --time-column t_us --position-column enc --force-column F_kN");
+         "--separator tab --units t=us,x=counts:5e-8,force=kN --time-column t_us --position-column enc --force-column "
+         "F_kN");
   // a bad unit and a decimal comma with comma separators: one line, exit 2
   expect_data_error("units_bad.csv", slurp(simulated_data()), {"--units 'x=inch'", "unknown unit 'inch' for x"},
                     "--units x=inch --position-column x_measured");
@@ -717,12 +738,15 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
                                       g17(num(c.at("f_thrust")[k]) * f_scale)};
     });
   };
-  expect_data_error("pos_mm.csv", make(1, 1e3, 1, 0, 0), {"column 'x'", "beyond a feed drive", "likely in mm (--units x=mm)"});
-  expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0), {"column 't'", "control period", "likely in ms (--units t=ms)"});
+  expect_data_error("pos_mm.csv", make(1, 1e3, 1, 0, 0),
+                    {"column 'x'", "beyond a feed drive", "likely in mm (--units x=mm)"});
+  expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0),
+                    {"column 't'", "control period", "likely in ms (--units t=ms)"});
   expect_data_error("force_kN.csv", make(1, 1, 1e-3, 0, 0), {"column 'force_N'", "likely in kN (--units force=kN)"});
   expect_data_error("joined.csv", make(1, 1, 1, 1000, 0),
                     {"joined.csv:2002: column 't': the time jumps by 1000 s", "two recordings joined"});
-  expect_data_error("joined_offset.csv", make(1, 1, 1, 1000, 0.05), {"joined_offset.csv:2002:", "the time jumps by 1000 s"});
+  expect_data_error("joined_offset.csv", make(1, 1, 1, 1000, 0.05),
+                    {"joined_offset.csv:2002:", "the time jumps by 1000 s"});
   expect_data_error("pos_jump.csv", make(1, 1, 1, 0, 0.05),
                     {"pos_jump.csv:2002: column 'x': the position jumps by 50 mm in one sample", "split the file"});
 }

@@ -27,7 +27,8 @@ TEST(Emps, NamesThePublishedModelAndNothingForeign) {
   const sim::Scenario model = sim::load_scenario(FEEDDRIVE_SOURCE_DIR "/scenarios/fit/emps.yaml");
   EXPECT_FALSE(model.grinding_process);
   FitOptions opt;
-  const FitResult r = run_fit(prepare(data), model.plant, opt, [](const std::string& s) { std::printf("  %s\n", s.c_str()); });
+  const FitResult r =
+      run_fit(prepare(data), model.plant, opt, [](const std::string& s) { std::printf("  %s\n", s.c_str()); });
   std::map<std::string, std::map<std::string, double>> found;
   for (const auto& e : r.effects) found[e.name] = e.parameters;
   // The tolerance: each within 10 % of the published value. The published values are a
@@ -42,7 +43,8 @@ TEST(Emps, NamesThePublishedModelAndNothingForeign) {
   // The model's constant force opposes the thrust: the published offset on the force side is +F.
   EXPECT_NEAR(found["constant_force"]["force_N"], -3.16, 0.10 * 3.16);
   // Foreign to this drive: it does no grinding, has no spring, and its mass is the published one.
-  for (const char* foreign : {"grinding_force", "spring_force", "mass_error"}) EXPECT_FALSE(found.count(foreign)) << foreign;
+  for (const char* foreign : {"grinding_force", "spring_force", "mass_error"})
+    EXPECT_FALSE(found.count(foreign)) << foreign;
   // Whatever else is named has its evidence: confirmed out of sample and by the replay.
   for (const StepResult& st : r.steps) {
     if (!st.accepted) continue;

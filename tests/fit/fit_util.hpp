@@ -80,9 +80,9 @@ inline std::string write_waypoints(const std::vector<trajectory::Waypoint>& w, c
 /// Runs the recording and returns what the tool sees (t with jitter, measured x, u, xd).
 inline MeasuredData record(const plant::PlantParams& truth, const Recording& r, const std::string& tmp_dir) {
   // one file per process and seed: ctest runs test cases in parallel processes
-  const std::string wp = write_waypoints(rich_waypoints(r.duration, r.seed),
-                                         tmp_dir + "/feeddrive-waypoints-" + std::to_string(::getpid()) + "-" +
-                                             std::to_string(r.seed) + ".csv");
+  const std::string wp = write_waypoints(
+      rich_waypoints(r.duration, r.seed),
+      tmp_dir + "/feeddrive-waypoints-" + std::to_string(::getpid()) + "-" + std::to_string(r.seed) + ".csv");
   sim::RunResult run;
   try {
     run = sim::run(recording_scenario(truth, r, wp));

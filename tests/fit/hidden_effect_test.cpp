@@ -47,7 +47,11 @@ std::vector<Case> cases() {
        {{"bristle_stiffness_N_per_m", 0.2}}},
       {"cogging_ripple",
        {"cogging_ripple",
-        {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7}, {"third_harmonic_N", 1.5}, {"third_phase_rad", -0.4}}},
+        {{"pitch_m", 0.024},
+         {"amplitude_N", 4.0},
+         {"phase_rad", 0.7},
+         {"third_harmonic_N", 1.5},
+         {"third_phase_rad", -0.4}}},
        model,
        {{"pitch_m", 0.02}, {"amplitude_N", 0.2}}},
       {"reluctance_ripple",
@@ -136,10 +140,8 @@ TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
     EXPECT_EQ(r.effects.front().name, e.name);
     if (r.effects.front().name != e.name) continue;
     // pitch within 2 %, delay within 20 % (the tolerances of the 1 kHz tests)
-    if (e.name == "reluctance_ripple")
-      EXPECT_NEAR(r.effects.front().parameters.at("pitch_m"), 0.032, 0.02 * 0.032);
-    else
-      EXPECT_NEAR(r.effects.front().parameters.at("delay_s"), 1.1e-3, 0.2 * 1.1e-3);
+    if (e.name == "reluctance_ripple") EXPECT_NEAR(r.effects.front().parameters.at("pitch_m"), 0.032, 0.02 * 0.032);
+    else EXPECT_NEAR(r.effects.front().parameters.at("delay_s"), 1.1e-3, 0.2 * 1.1e-3);
     EXPECT_LT(r.steps.front().gap_after, r.steps.front().gap_before / 5.0) << e.name;
   }
 }

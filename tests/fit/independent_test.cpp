@@ -70,8 +70,9 @@ TEST(IndependentRecords, Issue20CasesGetNoFalseAllClear) {
   int right = 0;
   for (const auto& c : cases) {
     const sweep::Outcome o = sweep::run_case(c);
-    std::printf("  %s: %s -> %s, %s%s%s\n", o.category.c_str(), sweep::names(o.hidden).c_str(), sweep::names(o.named).c_str(),
-                o.verdict.c_str(), o.tie_partners.empty() ? "" : (", tie " + sweep::names(o.tie_partners)).c_str(),
+    std::printf("  %s: %s -> %s, %s%s%s\n", o.category.c_str(), sweep::names(o.hidden).c_str(),
+                sweep::names(o.named).c_str(), o.verdict.c_str(),
+                o.tie_partners.empty() ? "" : (", tie " + sweep::names(o.tie_partners)).c_str(),
                 o.right ? "" : "  MISS");
     right += o.right;
     EXPECT_FALSE(o.nothing_there) << o.description;
@@ -108,8 +109,8 @@ TEST(NoiseFloor, PerfectModelRecordsSitAtTheFloor) {
     if (!all[i].hidden.empty() || g.knobs.at("base_static_friction") != 0.0) continue;
     const sweep::Outcome o = sweep::run_case(all[i]);
     ++checked;
-    std::printf("  %s: gap %.4g um (floor %.4g), force %.4g N (floor %.4g): %s\n", o.description.c_str(), o.gap_final * 1e6,
-                o.gap_floor * 1e6, o.force_final, o.force_floor, o.verdict.c_str());
+    std::printf("  %s: gap %.4g um (floor %.4g), force %.4g N (floor %.4g): %s\n", o.description.c_str(),
+                o.gap_final * 1e6, o.gap_floor * 1e6, o.force_final, o.force_floor, o.verdict.c_str());
     EXPECT_TRUE(o.named.empty()) << o.description;
     EXPECT_EQ(o.verdict, "no_discrepancy") << o.description;
     EXPECT_GT(o.gap_final, 0.67 * o.gap_floor) << o.description;

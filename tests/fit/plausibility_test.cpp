@@ -32,8 +32,9 @@ TEST(Plausibility, RipplePitchMustBeResolvedByTheData) {
   EXPECT_DOUBLE_EQ(e.min_pitch(), 0.004);
   const plant::PlantParams m;
   const auto cog = [](double p, double a) {
-    return plant::NamedEffect{"cogging_ripple", {{"pitch_m", p}, {"amplitude_N", a}, {"phase_rad", 0.0},
-                                                 {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}};
+    return plant::NamedEffect{
+        "cogging_ripple",
+        {{"pitch_m", p}, {"amplitude_N", a}, {"phase_rad", 0.0}, {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}};
   };
   EXPECT_EQ(implausible(e, m, cog(0.024, 5.0)), "");
   EXPECT_NE(implausible(e, m, cog(2.7, 5.0)).find("fewer than two periods"), std::string::npos);
@@ -85,7 +86,10 @@ TEST(Plausibility, MassWithinAFactorOfTwo) {
 // sin(2 pi x/(p/3) + phi3), is reported at its physical pitch.
 TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
   const Effect raw{"cogging_ripple",
-                   {{"pitch_m", 0.1272}, {"amplitude_N", 0.02}, {"phase_rad", 0.5}, {"third_harmonic_N", 28.3},
+                   {{"pitch_m", 0.1272},
+                    {"amplitude_N", 0.02},
+                    {"phase_rad", 0.5},
+                    {"third_harmonic_N", 28.3},
                     {"third_phase_rad", -0.7}}};
   const Effect c = canonical(raw);
   EXPECT_NEAR(c.parameters.at("pitch_m"), 0.0424, 1e-12);
@@ -94,7 +98,10 @@ TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
   EXPECT_DOUBLE_EQ(c.parameters.at("third_harmonic_N"), 0.0);
   // a real fundamental with a third harmonic is left alone
   const Effect both{"cogging_ripple",
-                    {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7}, {"third_harmonic_N", 1.0},
+                    {{"pitch_m", 0.024},
+                     {"amplitude_N", 4.0},
+                     {"phase_rad", 0.7},
+                     {"third_harmonic_N", 1.0},
                      {"third_phase_rad", -0.4}}};
   EXPECT_EQ(canonical(both).parameters, both.parameters);
 }
@@ -104,7 +111,8 @@ TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
 // at 20.4 N; a spring of 50 N/m resting 0.2 m below the mean position is a constant 10 N; a
 // cogging ripple with a vanishing fundamental is its harmonic; nothing else has a simpler form.
 TEST(SwapMove, ACollapsedEffectBecomesItsSimplerForm) {
-  const auto s = simpler_form({"stribeck_friction", {{"static_N", 20.4}, {"coulomb_N", 20.4}, {"stribeck_velocity_mps", 1e-3}}}, 0.0);
+  const auto s = simpler_form(
+      {"stribeck_friction", {{"static_N", 20.4}, {"coulomb_N", 20.4}, {"stribeck_velocity_mps", 1e-3}}}, 0.0);
   ASSERT_TRUE(s.has_value());
   EXPECT_EQ(s->name, "coulomb_friction");
   EXPECT_DOUBLE_EQ(s->parameters.at("coulomb_N"), 20.4);
@@ -112,12 +120,23 @@ TEST(SwapMove, ACollapsedEffectBecomesItsSimplerForm) {
   ASSERT_TRUE(k.has_value());
   EXPECT_EQ(k->name, "constant_force");
   EXPECT_NEAR(k->parameters.at("force_N"), 10.0, 1e-12);  // 50 N/m * (0.05 - (-0.15)) m
-  const auto c = simpler_form({"cogging_ripple", {{"pitch_m", 0.1272}, {"amplitude_N", 0.02}, {"phase_rad", 0.5},
-                                                  {"third_harmonic_N", 28.3}, {"third_phase_rad", -0.7}}}, 0.0);
+  const auto c = simpler_form({"cogging_ripple",
+                               {{"pitch_m", 0.1272},
+                                {"amplitude_N", 0.02},
+                                {"phase_rad", 0.5},
+                                {"third_harmonic_N", 28.3},
+                                {"third_phase_rad", -0.7}}},
+                              0.0);
   ASSERT_TRUE(c.has_value());
   EXPECT_NEAR(c->parameters.at("pitch_m"), 0.0424, 1e-12);
-  EXPECT_FALSE(simpler_form({"cogging_ripple", {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7},
-                                                {"third_harmonic_N", 1.0}, {"third_phase_rad", -0.4}}}, 0.0).has_value());
+  EXPECT_FALSE(simpler_form({"cogging_ripple",
+                             {{"pitch_m", 0.024},
+                              {"amplitude_N", 4.0},
+                              {"phase_rad", 0.7},
+                              {"third_harmonic_N", 1.0},
+                              {"third_phase_rad", -0.4}}},
+                            0.0)
+                   .has_value());
   EXPECT_FALSE(simpler_form({"viscous_friction", {{"viscous_Ns_per_m", 200.0}}}, 0.0).has_value());
 }
 

@@ -16,8 +16,11 @@ TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   plant::PlantParams truth = model;
   plant::set_effect(truth.effects, {"constant_force", {{"force_N", 15.0}}});
   plant::set_effect(truth.effects, {"cogging_ripple",
-                                    {{"pitch_m", 0.024}, {"amplitude_N", 4.0}, {"phase_rad", 0.7},
-                                     {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}});
+                                    {{"pitch_m", 0.024},
+                                     {"amplitude_N", 4.0},
+                                     {"phase_rad", 0.7},
+                                     {"third_harmonic_N", 0.0},
+                                     {"third_phase_rad", 0.0}}});
   test::Recording ro;
   ro.seed = 5;
   const MeasuredData data = test::record(truth, ro, test::temp_dir());

@@ -44,8 +44,10 @@ void mac(std::mt19937_64& rng, std::int16_t& size, std::vector<std::uint8_t>& m)
 }
 
 // A valid message of each type, its content drawn from rng, within the contract's bounds.
-template <typename Msg> Msg valid(std::mt19937_64& rng);
-template <> control_command_t valid(std::mt19937_64& rng) {
+template <typename Msg>
+Msg valid(std::mt19937_64& rng);
+template <>
+control_command_t valid(std::mt19937_64& rng) {
   control_command_t m{};
   m.run_id = 1;
   m.seq = static_cast<std::int64_t>(rng() % 1000);
@@ -53,7 +55,8 @@ template <> control_command_t valid(std::mt19937_64& rng) {
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> drive_state_t valid(std::mt19937_64& rng) {
+template <>
+drive_state_t valid(std::mt19937_64& rng) {
   drive_state_t m{};
   m.run_id = 1;
   m.seq = static_cast<std::int64_t>(rng() % 1000);
@@ -63,7 +66,8 @@ template <> drive_state_t valid(std::mt19937_64& rng) {
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> process_status_t valid(std::mt19937_64& rng) {
+template <>
+process_status_t valid(std::mt19937_64& rng) {
   process_status_t m{};
   m.run_id = 1;
   m.role = text(rng, wire::Check<process_status_t>::kMax_role);
@@ -72,17 +76,20 @@ template <> process_status_t valid(std::mt19937_64& rng) {
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> reference_block_t valid(std::mt19937_64& rng) {
+template <>
+reference_block_t valid(std::mt19937_64& rng) {
   reference_block_t m{};
   m.run_id = 1;
   m.first_seq = static_cast<std::int64_t>(rng() % 1000);
   m.count = static_cast<std::int32_t>(1 + rng() % 16);
   m.refs.resize(static_cast<std::size_t>(m.count));
-  for (int i = 0; i < m.count; ++i) m.refs[static_cast<std::size_t>(i)].seq = m.first_seq + i, m.refs[static_cast<std::size_t>(i)].position = num(rng);
+  for (int i = 0; i < m.count; ++i)
+    m.refs[static_cast<std::size_t>(i)].seq = m.first_seq + i, m.refs[static_cast<std::size_t>(i)].position = num(rng);
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> resend_request_t valid(std::mt19937_64& rng) {
+template <>
+resend_request_t valid(std::mt19937_64& rng) {
   resend_request_t m{};
   m.run_id = 1;
   m.requester = text(rng, wire::Check<resend_request_t>::kMax_requester);
@@ -90,7 +97,8 @@ template <> resend_request_t valid(std::mt19937_64& rng) {
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> run_info_t valid(std::mt19937_64& rng) {
+template <>
+run_info_t valid(std::mt19937_64& rng) {
   run_info_t m{};
   m.run_id = 1;
   m.scenario = text(rng, 40);
@@ -100,7 +108,8 @@ template <> run_info_t valid(std::mt19937_64& rng) {
   mac(rng, m.mac_size, m.mac);
   return m;
 }
-template <> run_summary_t valid(std::mt19937_64& rng) {
+template <>
+run_summary_t valid(std::mt19937_64& rng) {
   run_summary_t m{};
   m.run_id = 1;
   m.scenario = text(rng, 40);
@@ -123,8 +132,9 @@ void put_be(Bytes& b, std::size_t at, std::int64_t v, std::size_t size) {
 
 // The values a length or count is set to: the edges of its range and the ones that crashed or
 // pinned memory before (issue 19: length 0, count -1, mac_size -1, count 10^7).
-const std::int64_t kHostile[] = {0, -1, 1, 2, 15, 16, 17, 31, 32, 33, 63, 64, 255, 256, 1023, 1024, 1025,
-                                 32767, -32768, 65535, 10000000, 2147483647, -2147483648LL};
+const std::int64_t kHostile[] = {0,    -1,    1,      2,     15,       16,         17,           31,
+                                 32,   33,    63,     64,    255,      256,        1023,         1024,
+                                 1025, 32767, -32768, 65535, 10000000, 2147483647, -2147483648LL};
 
 // Offsets of the 4-byte lengths of the strings in an encoding: the big-endian value len+1 right
 // before those bytes and a NUL after them (found by content: each string is known).
@@ -133,7 +143,8 @@ std::vector<std::size_t> string_length_offsets(const Bytes& b, const std::vector
   for (const std::string& s : strings) {
     const std::size_t len = s.size() + 1;
     for (std::size_t i = 8; i + 4 + len <= b.size(); ++i) {
-      const std::uint32_t v = (std::uint32_t{b[i]} << 24) | (std::uint32_t{b[i + 1]} << 16) | (std::uint32_t{b[i + 2]} << 8) | b[i + 3];
+      const std::uint32_t v =
+          (std::uint32_t{b[i]} << 24) | (std::uint32_t{b[i + 1]} << 16) | (std::uint32_t{b[i + 2]} << 8) | b[i + 3];
       if (v == len && std::memcmp(&b[i + 4], s.data(), s.size()) == 0 && b[i + 4 + s.size()] == 0) {
         at.push_back(i);
         break;
@@ -147,7 +158,10 @@ std::vector<std::string> strings_of(const process_status_t& m) { return {m.role,
 std::vector<std::string> strings_of(const resend_request_t& m) { return {m.requester, m.channel}; }
 std::vector<std::string> strings_of(const run_info_t& m) { return {m.scenario, m.mode, m.friction_model}; }
 std::vector<std::string> strings_of(const run_summary_t& m) { return {m.scenario, m.failure}; }
-template <typename Msg> std::vector<std::string> strings_of(const Msg&) { return {}; }
+template <typename Msg>
+std::vector<std::string> strings_of(const Msg&) {
+  return {};
+}
 
 // Offsets of the fields that size something other than strings: the mac size (its place is
 // known from the end: mac_size is the last field but the mac bytes) and a block's count.
@@ -179,10 +193,13 @@ void fuzz(std::uint64_t seed, int cases, Outcome& out) {
   const std::string ch = std::string("FUZZ_") + Msg::getTypeName();
   std::int64_t delivered = 0;
   bool in_bounds = true;
-  bus.subscribe<Msg>(ch, [&](const Msg& m, std::int64_t) {
-    ++delivered;
-    in_bounds = in_bounds && within_bounds(m);
-  }, Admit::kAnyRun);
+  bus.subscribe<Msg>(
+      ch,
+      [&](const Msg& m, std::int64_t) {
+        ++delivered;
+        in_bounds = in_bounds && within_bounds(m);
+      },
+      Admit::kAnyRun);
   std::mt19937_64 rng(seed);
   for (int k = 0; k < cases; ++k) {
     const Msg m = valid<Msg>(rng);
@@ -224,7 +241,8 @@ void fuzz(std::uint64_t seed, int cases, Outcome& out) {
     ASSERT_NO_THROW({
       bus.publish_raw(ch, b.data(), b.size());
       bus.poll(std::chrono::microseconds(0));
-    }) << Msg::getTypeName() << " case " << k;
+    }) << Msg::getTypeName()
+       << " case " << k;
     const std::int64_t d = delivered - before_d, i = bus.invalid() - before_i;
     // Exactly one outcome per datagram (a mutation can leave a valid message, e.g. a flipped
     // double or a string length set to its own value).
@@ -251,7 +269,7 @@ void fuzz_type(std::uint64_t seed) {
   Outcome o;
   fuzz<Msg>(seed, kCases, o);
   EXPECT_GT(o.invalid, kCases / 2) << Msg::getTypeName();  // most mutations break the encoding
-  EXPECT_GT(o.delivered, 0) << Msg::getTypeName();           // some leave it valid: those still decode
+  EXPECT_GT(o.delivered, 0) << Msg::getTypeName();         // some leave it valid: those still decode
 }
 
 TEST(DecodeFuzz, ControlCommand) { fuzz_type<control_command_t>(101); }
@@ -268,7 +286,8 @@ TEST(DecodeFuzz, TheDatagramsThatKilledARunAreCountedAndDropped) {
   Bus bus("memq://", service::Receive::kEvent);
   bus.set_run_id(1);
   int status = 0, blocks = 0;
-  bus.subscribe<process_status_t>("FD_STATUS", [&](const process_status_t&, std::int64_t) { ++status; }, Admit::kAnyRun);
+  bus.subscribe<process_status_t>(
+      "FD_STATUS", [&](const process_status_t&, std::int64_t) { ++status; }, Admit::kAnyRun);
   bus.subscribe<reference_block_t>("FD_REF", [&](const reference_block_t&, std::int64_t) { ++blocks; });
   auto send = [&](const std::string& ch, const Bytes& b) {
     ASSERT_NO_THROW({

@@ -244,9 +244,9 @@ TEST(BusRunIdentity, ForeignMessagesAreCountedAndIgnored) {
   bus.poll(std::chrono::milliseconds(10));
   EXPECT_EQ(got, std::vector<std::int64_t>{1});
 
-  bus.set_run_id(7);                      // a message of run 7 ...
+  bus.set_run_id(7);  // a message of run 7 ...
   bus.publish("T_CMD", command(2, 0.5));
-  bus.set_run_id(5);                      // ... heard by a process of run 5
+  bus.set_run_id(5);  // ... heard by a process of run 5
   bus.poll(std::chrono::milliseconds(10));
   EXPECT_EQ(got, std::vector<std::int64_t>{1});
   EXPECT_EQ(bus.foreign(), 1);
@@ -254,7 +254,8 @@ TEST(BusRunIdentity, ForeignMessagesAreCountedAndIgnored) {
   Bus attached("memq://");
   attached.join_first_seen();
   std::vector<std::int64_t> seen;
-  attached.subscribe<control_command_t>("T_CMD", [&](const control_command_t& m, std::int64_t) { seen.push_back(m.run_id); });
+  attached.subscribe<control_command_t>("T_CMD",
+                                        [&](const control_command_t& m, std::int64_t) { seen.push_back(m.run_id); });
   attached.publish("T_CMD", command(0, 0.5));  // not joined: stamped with run id 0
   EXPECT_FALSE(attached.run_known());
   attached.poll(std::chrono::milliseconds(10));
@@ -289,7 +290,8 @@ TEST(BusAuthentication, RejectsUnsignedAndForeignKeys) {
 }
 
 TEST(KeyFile, OnlyTheOwnersAndOfAKeysLength) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd-key-test-" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("fd-key-test-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "key").string();
   { std::ofstream(path) << "0123456789abcdef0123456789abcdef"; }
@@ -314,7 +316,8 @@ TEST(KeyFile, OnlyTheOwnersAndOfAKeysLength) {
 // A key behind a symlink (as Kubernetes and Docker mount secrets: key -> ..data/key) is read,
 // and the checks are the target's: a link to a group-readable file is refused, naming the target.
 TEST(KeyFile, ASymlinkIsFollowedAndItsTargetChecked) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd-key-link-" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("fd-key-link-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir / "..data");
   const std::string target = (dir / "..data" / "key").string();
   { std::ofstream(target) << "0123456789abcdef0123456789abcdef"; }
@@ -327,7 +330,8 @@ TEST(KeyFile, ASymlinkIsFollowedAndItsTargetChecked) {
     read_key_file(link);
     FAIL() << "a link to a world-readable key was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("a link to " + std::filesystem::canonical(target).string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a link to " + std::filesystem::canonical(target).string()), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("mode 0644"), std::string::npos) << e.what();
   }
   std::filesystem::remove(target);
@@ -353,8 +357,9 @@ namespace {
 TEST(ScenarioHash, CoversTheTablesItNames) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("fd-hash-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  const std::string yaml = "name: h\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
-                           "reference: {type: waypoints, file: w.csv}\n";
+  const std::string yaml =
+      "name: h\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
+      "reference: {type: waypoints, file: w.csv}\n";
   { std::ofstream(dir / "s.yaml") << yaml; }
   { std::ofstream(dir / "w.csv") << "t,x\n0,0\n0.005,1e-4\n0.01,1e-4\n"; }
   const std::string path = (dir / "s.yaml").string();
@@ -370,8 +375,9 @@ TEST(ScenarioHash, CoversTheTablesItNames) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("a table it names, changed"), std::string::npos) << e.what();
   }
-  const std::string plain = "name: p\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
-                            "reference: {type: step, amplitude: 1.0e-4}\n";
+  const std::string plain =
+      "name: p\nduration: 0.01\ncontrol_period: 1.0e-3\ncontroller: {type: cascade}\n"
+      "reference: {type: step, amplitude: 1.0e-4}\n";
   { std::ofstream(dir / "plain.yaml") << plain; }
   EXPECT_EQ(load_run_scenario((dir / "plain.yaml").string(), NodeOptions{}).sha256, sha256_hex(plain));
   std::filesystem::remove_all(dir);

@@ -3,8 +3,8 @@
 // are: a dropped command, a dropped state, a flipped bit in a channel name or a sequence number,
 // a corrupt event. read_log must use every complete step and name what is missing and where.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <unistd.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -85,7 +85,8 @@ std::vector<Msg> run_messages(long kSteps = kSteps) {
 }
 
 std::string write_log(const std::string& name, const std::vector<Msg>& msgs) {
-  const fs::path p = fs::temp_directory_path() / ("feeddrive_log_gaps_" + std::to_string(::getpid()) + "_" + name + ".lcmlog");
+  const fs::path p =
+      fs::temp_directory_path() / ("feeddrive_log_gaps_" + std::to_string(::getpid()) + "_" + name + ".lcmlog");
   lcm::LogFile log(p.string(), "w");
   EXPECT_TRUE(log.good());
   std::int64_t t = 1700000000000000;
@@ -267,8 +268,8 @@ TEST(LogGaps, LastEventCutShortEndsTheLogAndIsReported) {
   const auto full = fs::file_size(path);
   std::size_t last = 0;  // where the last event begins
   for (std::size_t i = 0; i + 1 < msgs.size(); ++i) last += 28 + msgs[i].channel.size() + msgs[i].data.size();
-  for (const std::uintmax_t keep : {full - 5, static_cast<std::uintmax_t>(last + 30), static_cast<std::uintmax_t>(last + 10),
-                                    static_cast<std::uintmax_t>(last + 2)}) {
+  for (const std::uintmax_t keep : {full - 5, static_cast<std::uintmax_t>(last + 30),
+                                    static_cast<std::uintmax_t>(last + 10), static_cast<std::uintmax_t>(last + 2)}) {
     SCOPED_TRACE(keep);
     fs::resize_file(path, keep);
     const auto [c, rows] = read_all(path);

@@ -17,8 +17,15 @@ using namespace feeddrive::output;
 
 TEST(CsvWriter, EveryDoubleReadsBackExactly) {
   std::mt19937_64 rng(11);
-  std::vector<double> values = {0.0, -0.0, 1.0, 0.1, 1e-300, 5e-324, std::numeric_limits<double>::max(),
-                                -2.2250738585072014e-308, std::numeric_limits<double>::infinity()};
+  std::vector<double> values = {0.0,
+                                -0.0,
+                                1.0,
+                                0.1,
+                                1e-300,
+                                5e-324,
+                                std::numeric_limits<double>::max(),
+                                -2.2250738585072014e-308,
+                                std::numeric_limits<double>::infinity()};
   for (int i = 0; i < 100000; ++i) {
     std::uint64_t bits = rng();
     double v;

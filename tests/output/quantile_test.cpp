@@ -80,8 +80,8 @@ TEST(StreamingQuantile, ZerosNanAndEmpty) {
 }
 
 TEST(StreamingQuantile, KeyOrderIsValueOrder) {
-  const double vals[] = {-std::numeric_limits<double>::infinity(), -1e300, -1.5, -1e-310, -0.0, 0.0, 1e-310,
-                         1.5, 1e300, std::numeric_limits<double>::infinity()};
+  const double vals[] = {-std::numeric_limits<double>::infinity(), -1e300, -1.5, -1e-310, -0.0, 0.0, 1e-310, 1.5, 1e300,
+                         std::numeric_limits<double>::infinity()};
   for (std::size_t i = 0; i + 1 < std::size(vals); ++i) {
     EXPECT_LE(StreamingQuantile::key_of(vals[i]), StreamingQuantile::key_of(vals[i + 1])) << vals[i];
     EXPECT_EQ(StreamingQuantile::value_of(StreamingQuantile::key_of(vals[i])), vals[i]);

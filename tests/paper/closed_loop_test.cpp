@@ -48,13 +48,14 @@ TEST(PaperClosedLoop, SineMaxErrorNearStartThenZero) {
 // paper's 135 mm overshoot comes from how it differentiated the step, see the doc).
 TEST(PaperClosedLoop, StepQualitative) {
   const PaperRun r = simulate("smc_step");
-  const double chatter = r.s.plant.mass * 5.0 / r.s.plant.thrust_gain();  // m*eta/(Ka*Kf) = 1.96 V
-  EXPECT_GT(r.sum.control_max, 5 * chatter);                      // ours 23 V
-  EXPECT_GT(r.sum.velocity_error_max_abs_mps, 0.5);                // ours 0.73 m/s
+  const double chatter = r.s.plant.mass * 5.0 / r.s.plant.thrust_gain();                   // m*eta/(Ka*Kf) = 1.96 V
+  EXPECT_GT(r.sum.control_max, 5 * chatter);                                               // ours 23 V
+  EXPECT_GT(r.sum.velocity_error_max_abs_mps, 0.5);                                        // ours 0.73 m/s
   EXPECT_GT(r.max_of([](const sim::Record& q) { return q.f_friction; }, 1.0, 2.0), 79.0);  // slides: F_f ~ Fc..Fs
-  EXPECT_LT(r.max_of([](const sim::Record& q) { return std::abs(q.f_friction); }, 0.0, 0.99), 10.0);  // presliding before
-  EXPECT_LT(r.sum.max_position_m, 0.1 + 1e-6);                     // no overshoot beyond chatter
-  EXPECT_LT(std::abs(r.r.records.back().x - 0.1), 1e-6);           // converged
+  EXPECT_LT(r.max_of([](const sim::Record& q) { return std::abs(q.f_friction); }, 0.0, 0.99),
+            10.0);                                        // presliding before
+  EXPECT_LT(r.sum.max_position_m, 0.1 + 1e-6);            // no overshoot beyond chatter
+  EXPECT_LT(std::abs(r.r.records.back().x - 0.1), 1e-6);  // converged
 }
 
 // Figs. 21-22, hard sgn at 20 us: max|e| <= 0.8 um, "mostly within +-0.2 um" (we require >= 75 %

@@ -117,8 +117,7 @@ TEST(PaperOpenLoop, SlidingSinesDisplacementFallsWithFrequency) {
 // 73.3 N for 10, 50, 100, 500, 1000 N/s. 1.5 % bands: the crossing time is resolved to one
 // 0.1 ms sample, i.e. 0.1 N at 1000 N/s, and the notes' values carry ~1 % of their own.
 TEST(PaperOpenLoop, BreakawayForceFallsWithForceRate) {
-  const std::vector<std::pair<int, double>> cases = {
-      {10, 120.5}, {50, 119.3}, {100, 117.2}, {500, 98.0}, {1000, 73.3}};
+  const std::vector<std::pair<int, double>> cases = {{10, 120.5}, {50, 119.3}, {100, 117.2}, {500, 98.0}, {1000, 73.3}};
   double previous = 1e9;
   for (const auto& [rate, expected] : cases) {
     const PaperRun r = simulate("open_loop_breakaway_" + std::to_string(rate) + "Nps");
@@ -193,8 +192,11 @@ TEST(PaperOpenLoop, RippleSineDisplacementDrifts) {
 // 10 % on x (x integrates the creep velocity).
 TEST(PaperOpenLoop, AllForces180NGrindingDominates) {
   const PaperRun r = simulate("open_loop_all_forces_180N");
-  struct Row { double t, fg, ff, x; };
-  for (const Row& row : {Row{0.1, 165, 15, 10.3e-6}, Row{1, 140, 40, 26e-6}, Row{2, 122, 58, 42e-6}, Row{5, 92, 88, 81e-6}}) {
+  struct Row {
+    double t, fg, ff, x;
+  };
+  for (const Row& row :
+       {Row{0.1, 165, 15, 10.3e-6}, Row{1, 140, 40, 26e-6}, Row{2, 122, 58, 42e-6}, Row{5, 92, 88, 81e-6}}) {
     const auto& q = r.at(row.t);
     EXPECT_NEAR(q.f_grinding, row.fg, 3.0) << row.t;
     EXPECT_NEAR(q.f_friction, row.ff, 3.0) << row.t;

@@ -448,8 +448,7 @@ TEST(EffectsParams, ValidateNamesKeyAndValue) {
   EXPECT_EQ(error_of(p), "plant.effects.constant_force.force_N = nan: must be a finite number");
   p = PlantParams{};
   p.effects.reluctance_ripple = {true, 0.03, 1.5, 0.0};
-  EXPECT_EQ(error_of(p),
-            "plant.effects.reluctance_ripple.relative_amplitude = 1.5: |relative_amplitude| must be < 1");
+  EXPECT_EQ(error_of(p), "plant.effects.reluctance_ripple.relative_amplitude = 1.5: |relative_amplitude| must be < 1");
 
   // The sections the effects use are checked even where they are off themselves.
   p = PlantParams{};

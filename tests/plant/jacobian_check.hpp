@@ -23,8 +23,8 @@ inline void expect_jacobian_matches_differences(
     const PlantParams& p, std::uint64_t seed, double v_max,
     const std::function<void(const State&, double, const Jacobian&)>& each = {}) {
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> ux(-0.05, 0.05), uv(-v_max, v_max), uz(-5e-5, 5e-5), ufg(-50, 50),
-      ui(-5, 5), uu(-3, 3);
+  std::uniform_real_distribution<double> ux(-0.05, 0.05), uv(-v_max, v_max), uz(-5e-5, 5e-5), ufg(-50, 50), ui(-5, 5),
+      uu(-3, 3);
   const StateVector scale{1e-2, 1e-1, 1e-5, 10.0, 1.0};
   for (int trial = 0; trial < 200; ++trial) {
     const State s{ux(rng), uv(rng), uz(rng), ufg(rng), ui(rng)};
@@ -40,8 +40,7 @@ inline void expect_jacobian_matches_differences(
       const StateVector fm = derivative(p, State::from_vector(ym), u);
       for (int r = 0; r < kStateSize; ++r) {
         const double fd = (fp[r] - fm[r]) / (2 * h);
-        const double tol =
-            1e-5 * std::abs(J[r][c]) + 1e-14 * std::max(std::abs(fp[r]), std::abs(fm[r])) / h + 1e-12;
+        const double tol = 1e-5 * std::abs(J[r][c]) + 1e-14 * std::max(std::abs(fp[r]), std::abs(fm[r])) / h + 1e-12;
         EXPECT_NEAR(J[r][c], fd, tol) << "trial " << trial << " row " << r << " col " << c;
       }
     }

@@ -47,12 +47,18 @@ void expect_one_line(const std::string& e, const std::string& library, const std
 
 TEST(PluginHost, ErrorsAreOneLineNamingLibraryAndCause) {
   expect_one_line(error_of(params_of("no_such_plugin")), module("no_such_plugin"), "no such file");
-  expect_one_line(error_of(params_of("fd_fault_version")), module("fd_fault_version"), "ABI version 999, this feeddrive hosts ABI version 1");
-  expect_one_line(error_of(params_of("fd_fault_no_reset")), module("fd_fault_no_reset"), "missing symbol feeddrive_controller_reset");
-  expect_one_line(error_of(params_of("fd_fault_refuse")), module("fd_fault_refuse"), "create refused: gain is required");
-  expect_one_line(error_of(params_of("fd_fault_nan")), module("fd_fault_nan"), "update at t = 0.002 s returned u = nan");
-  expect_one_line(error_of(params_of("fd_fault_throw")), module("fd_fault_throw"), "update at t = 0.001 s: an exception left the plugin");
-  expect_one_line(error_of(params_of("fd_fault_fail")), module("fd_fault_fail"), "update at t = 0.001 s failed: position sensor lost");
+  expect_one_line(error_of(params_of("fd_fault_version")), module("fd_fault_version"),
+                  "ABI version 999, this feeddrive hosts ABI version 1");
+  expect_one_line(error_of(params_of("fd_fault_no_reset")), module("fd_fault_no_reset"),
+                  "missing symbol feeddrive_controller_reset");
+  expect_one_line(error_of(params_of("fd_fault_refuse")), module("fd_fault_refuse"),
+                  "create refused: gain is required");
+  expect_one_line(error_of(params_of("fd_fault_nan")), module("fd_fault_nan"),
+                  "update at t = 0.002 s returned u = nan");
+  expect_one_line(error_of(params_of("fd_fault_throw")), module("fd_fault_throw"),
+                  "update at t = 0.001 s: an exception left the plugin");
+  expect_one_line(error_of(params_of("fd_fault_fail")), module("fd_fault_fail"),
+                  "update at t = 0.001 s failed: position sensor lost");
   auto p = params_of("fd_fault_none");
   p.parameters = {{"gian", "2"}};
   expect_one_line(error_of(p), module("fd_fault_none"), "create refused: unknown parameter 'gian'");
@@ -71,8 +77,8 @@ TEST(PluginHost, PassesParametersAndResetRestoresTheInitialState) {
   m.x = 0.2;
   controller::Command cmd;
   for (int k = 0; k < 3; ++k) cmd = c.update(r, m, nullptr);
-  EXPECT_EQ(cmd.u, 2.5 * (1.0 - 0.2));  // the same expression, so exactly equal
-  EXPECT_EQ(cmd.sliding, 3.0);          // three updates
+  EXPECT_EQ(cmd.u, 2.5 * (1.0 - 0.2));      // the same expression, so exactly equal
+  EXPECT_EQ(cmd.sliding, 3.0);              // three updates
   EXPECT_TRUE(std::isnan(cmd.z_estimate));  // a diagnostic the plugin did not set stays NaN
   c.reset();
   EXPECT_EQ(c.update(r, m, nullptr).sliding, 1.0);
@@ -92,7 +98,8 @@ TEST(PluginHost, ManyInstancesOfOneLibraryAreIndependent) {
 // order). The ramp with friction, ripple and grinding exercises every force term it compensates.
 TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
   for (const char* name : {"smc_bl_jerk_limited", "smc_bl_ramp_all_forces"}) {
-    sim::Scenario builtin = sim::load_scenario(std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml");
+    sim::Scenario builtin =
+        sim::load_scenario(std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml");
     builtin.duration = 0.4;  // the move's start, its constant velocity and (ramp) the contact: 4,000 periods
     ASSERT_EQ(builtin.controller.type, sim::ControllerType::kSlidingMode);
     const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
@@ -109,7 +116,8 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
     ASSERT_EQ(a.records.size(), b.records.size());
     for (std::size_t k = 0; k < a.records.size(); ++k) {
       const auto va = sim::record_values(a.records[k]), vb = sim::record_values(b.records[k]);
-      ASSERT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)), 0) << name << ": record " << k << " differs";
+      ASSERT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)), 0)
+          << name << ": record " << k << " differs";
     }
   }
 }
@@ -120,8 +128,8 @@ namespace {
 
 std::string plugin_scenario(const std::string& controller_extra) {
   return "duration: 0.01\ncontrol_period: 1e-4\nplant: {friction: {model: lugre}}\n"
-         "controller:\n  type: plugin\n  library: " + module("fd_example_smc_bl") + "\n" + controller_extra +
-         "reference: {type: step, amplitude: 1.0e-6}\n";
+         "controller:\n  type: plugin\n  library: " +
+         module("fd_example_smc_bl") + "\n" + controller_extra + "reference: {type: step, amplitude: 1.0e-6}\n";
 }
 
 std::string load_error(const std::string& yaml) {
@@ -136,9 +144,9 @@ std::string load_error(const std::string& yaml) {
 // The scenario keys: parameters as text (numbers in their shortest exact text), limits, the
 // nominal model defaulting to the plant; bad keys refused with one line naming them.
 TEST(PluginScenario, KeysAreReadAndBadOnesRefused) {
-  const sim::Scenario s = sim::parse_scenario(plugin_scenario(
-      "  parameters: {eta: 5.0, lambda: 5.0e+1, boundary_layer: 0.0005, switching: sat}\n  u_max: 8\n"
-      "  model: {mass: 90}\n"));
+  const sim::Scenario s = sim::parse_scenario(
+      plugin_scenario("  parameters: {eta: 5.0, lambda: 5.0e+1, boundary_layer: 0.0005, switching: sat}\n  u_max: 8\n"
+                      "  model: {mass: 90}\n"));
   ASSERT_EQ(s.controller.type, sim::ControllerType::kPlugin);
   const std::vector<std::pair<std::string, std::string>> want = {
       {"eta", "5"}, {"lambda", "50"}, {"boundary_layer", "5e-04"}, {"switching", "sat"}};  // std::to_chars shortest
@@ -151,15 +159,18 @@ TEST(PluginScenario, KeysAreReadAndBadOnesRefused) {
 
   EXPECT_NE(load_error(plugin_scenario("  parameters: {bad-name: 1}\n")).find("controller.parameters.bad-name"),
             std::string::npos);
-  EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: .nan}\n")).find("controller.parameters.eta"), std::string::npos);
+  EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: .nan}\n")).find("controller.parameters.eta"),
+            std::string::npos);
   EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: [1, 2]}\n")).find("controller.parameters.eta"),
             std::string::npos);
   EXPECT_NE(load_error(plugin_scenario("  libary: x.so\n")).find("libary"), std::string::npos);
-  EXPECT_NE(load_error(plugin_scenario("  model: {effects: {constant_force: {force_N: 1}}}\n")).find("controller.model.effects"),
+  EXPECT_NE(load_error(plugin_scenario("  model: {effects: {constant_force: {force_N: 1}}}\n"))
+                .find("controller.model.effects"),
             std::string::npos);
   const std::string missing = load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin}\n");
   EXPECT_NE(missing.find("controller.library"), std::string::npos) << missing;
-  const std::string absent = load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin, library: nowhere.so}\n");
+  const std::string absent =
+      load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin, library: nowhere.so}\n");
   EXPECT_NE(absent.find("nowhere.so: no such file"), std::string::npos) << absent;
   EXPECT_EQ(absent.find('\n'), std::string::npos);
 }

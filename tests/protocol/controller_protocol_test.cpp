@@ -40,7 +40,8 @@ struct Trajectory {
   std::unique_ptr<service::Bus> bus;
   std::vector<reference_t> refs;
   std::vector<resend_request_t> requests;
-  Trajectory(const Memq& m, const sim::Scenario& s, std::set<std::int64_t> withheld = {}) : bus(peer(m)), refs(references(s)) {
+  Trajectory(const Memq& m, const sim::Scenario& s, std::set<std::int64_t> withheld = {})
+      : bus(peer(m)), refs(references(s)) {
     bus->subscribe<resend_request_t>(kCh.resend, [this, withheld](const resend_request_t& r, std::int64_t) {
       if (r.channel != kCh.reference) return;
       requests.push_back(r);
@@ -74,10 +75,14 @@ struct Plant {
   std::map<std::int64_t, controller::Command> expected;
   std::vector<control_command_t> commands;  ///< every command received, copies too
   std::function<bool(Plant&, std::int64_t)> next_step;
-  Plant(const Memq& m, const sim::Scenario& sc, int copies_ = 1,
-        std::function<bool(Plant&, std::int64_t)> hook = {})
-      : bus(peer(m)), s(sc), drive(sc.drive(), sc.control_period), twin(sim::make_controller(sc)), refs(references(sc)),
-        copies(copies_), next_step(std::move(hook)) {
+  Plant(const Memq& m, const sim::Scenario& sc, int copies_ = 1, std::function<bool(Plant&, std::int64_t)> hook = {})
+      : bus(peer(m)),
+        s(sc),
+        drive(sc.drive(), sc.control_period),
+        twin(sim::make_controller(sc)),
+        refs(references(sc)),
+        copies(copies_),
+        next_step(std::move(hook)) {
     bus->subscribe<control_command_t>(kCh.command, [this](const control_command_t& c, std::int64_t) {
       commands.push_back(c);
       if (sent.count(c.seq + 1) || c.seq >= s.steps()) return;  // answered already
@@ -103,7 +108,8 @@ struct Plant {
     sent[m.seq] = m;
     if (!m.end_of_run) {
       const controller::Truth truth = service::to_truth(m.truth);
-      expected[m.seq] = twin->update(service::to_sample(refs[static_cast<std::size_t>(m.seq)]), service::to_measurement(m), &truth);
+      expected[m.seq] =
+          twin->update(service::to_sample(refs[static_cast<std::size_t>(m.seq)]), service::to_measurement(m), &truth);
     }
     for (int i = 0; i < copies; ++i) bus->publish(kCh.state, m);
   }
@@ -238,7 +244,8 @@ TEST_F(ControllerProtocol, ASkippedStepIsThePlantsProtocolError) {
     return true;
   });
   const std::string what = run_to_failure(plant);
-  EXPECT_EQ(what.rfind("protocol error of the plant: it published state 4 while step 3 has no command yet", 0), 0u) << what;
+  EXPECT_EQ(what.rfind("protocol error of the plant: it published state 4 while step 3 has no command yet", 0), 0u)
+      << what;
 }
 
 // A controller that subscribes late (CI, stop 28: the launcher's controller was slower to start
@@ -261,8 +268,8 @@ TEST_F(ControllerProtocol, ALateJoinerAnswersTheFirstStateItHearsAndDoesNotBlame
   });
   plant.start();
   ASSERT_TRUE(poll_until(*forger, [&] { return plant.sent.count(5) == 1; })) << "the forger drove states 0..4";
-  make_node();                 // subscribes now: states 0..5 and commands 0..4 went by
-  Trajectory traj(memq, s);    // after the node, which would miss references sent before it
+  make_node();                                      // subscribes now: states 0..5 and commands 0..4 went by
+  Trajectory traj(memq, s);                         // after the node, which would miss references sent before it
   plant.bus->publish(kCh.state, plant.sent.at(5));  // the plant's re-publication of the unanswered state
   const std::string what = failure_of([&] { node_->run(); });
   EXPECT_EQ(what, "") << "a late join taken for the plant's error";
@@ -309,7 +316,8 @@ TEST_F(ControllerProtocol, NoTrajectoryFailsAfterTheStartTimeout) {
   ControllerNode& node = make_node(opt);
   std::vector<resend_request_t> asked;
   auto listener = peer(memq);
-  listener->subscribe<resend_request_t>(kCh.resend, [&](const resend_request_t& r, std::int64_t) { asked.push_back(r); });
+  listener->subscribe<resend_request_t>(kCh.resend,
+                                        [&](const resend_request_t& r, std::int64_t) { asked.push_back(r); });
   Plant plant(memq, s);
   plant.start();
   expect_failure_after(0.3, "no reference from the trajectory for step 0 within 0.3 s",

@@ -97,14 +97,17 @@ struct Listener {
       if (s.role == "monitor") statuses.push_back(s);
     });
     bus->subscribe<run_info_t>(kCh.info, [this](const run_info_t& i, std::int64_t) { infos.push_back(i); });
-    bus->subscribe<run_summary_t>(kCh.summary, [this](const run_summary_t& s, std::int64_t) { summaries.push_back(s); });
-    bus->subscribe<resend_request_t>(kCh.resend, [this](const resend_request_t& r, std::int64_t) { requests.push_back(r); });
+    bus->subscribe<run_summary_t>(kCh.summary,
+                                  [this](const run_summary_t& s, std::int64_t) { summaries.push_back(s); });
+    bus->subscribe<resend_request_t>(kCh.resend,
+                                     [this](const resend_request_t& r, std::int64_t) { requests.push_back(r); });
   }
   /// Waits (at most 5 s) for the monitor's closing messages, published as run() returned: its
   /// summary and its last status.
   void wait_for_the_end() {
     EXPECT_TRUE(poll_until(*bus, [this] {
-      return !summaries.empty() && !statuses.empty() && (statuses.back().state == "done" || statuses.back().state == "failed");
+      return !summaries.empty() && !statuses.empty() &&
+             (statuses.back().state == "done" || statuses.back().state == "failed");
     })) << "no run_summary_t and closing status from the monitor within 5 s";
   }
 };
@@ -257,7 +260,8 @@ TEST_F(MonitorProtocol, ACommandConflictNamesTheCommandThePlantApplied) {
   const std::string failure = node.summary().failure;
   EXPECT_EQ(failure.rfind("conflict on FD_CMD step 5", 0), 0u) << failure;
   EXPECT_NE(failure.find("the plant applied u = 0.55 V from an unknown sender at step 5 (the other command, u = -1 V"),
-            std::string::npos) << failure;
+            std::string::npos)
+      << failure;
 }
 
 // Messages of another run (a second run on the group): counted as foreign, never recorded, the

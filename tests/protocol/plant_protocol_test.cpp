@@ -44,11 +44,14 @@ struct Controller {
   Controller(const Memq& m, std::function<std::vector<control_command_t>(std::int64_t, int)> answer,
              std::int64_t run_id = kRunId)
       : bus(peer(m, run_id)) {
-    bus->subscribe<drive_state_t>(kCh.state, [this, answer](const drive_state_t& s, std::int64_t) {
-      states.push_back(s);
-      if (s.end_of_run) return;
-      for (const control_command_t& c : answer(s.seq, ++copies[s.seq])) bus->publish(kCh.command, c);
-    }, service::Admit::kAnyRun);
+    bus->subscribe<drive_state_t>(
+        kCh.state,
+        [this, answer](const drive_state_t& s, std::int64_t) {
+          states.push_back(s);
+          if (s.end_of_run) return;
+          for (const control_command_t& c : answer(s.seq, ++copies[s.seq])) bus->publish(kCh.command, c);
+        },
+        service::Admit::kAnyRun);
   }
   /// After the plant's run(): takes what it published last (the end-of-run marker: the plant,
   /// with no monitor to linger for, does not poll again), waiting at most 5 s for it.
@@ -200,9 +203,12 @@ TEST_F(PlantProtocol, KeepFirstAppliesTheFirstOfTwoCommands) {
 // foreign and never applied; this run's controller drives the plant.
 TEST_F(PlantProtocol, CommandsOfAnotherRunAreCountedAndIgnored) {
   PlantNode& plant = make_plant();
-  Controller other(memq, [](std::int64_t k, int copy) {
-    return copy == 1 ? std::vector<control_command_t>{command(k, -2.0)} : std::vector<control_command_t>{};
-  }, 99);
+  Controller other(
+      memq,
+      [](std::int64_t k, int copy) {
+        return copy == 1 ? std::vector<control_command_t>{command(k, -2.0)} : std::vector<control_command_t>{};
+      },
+      99);
   Controller ctl(memq, answer_first_copy);
   run_to_end(ctl);
   EXPECT_EQ(plant.bus().foreign(), kSteps) << "one foreign command per step";
@@ -213,7 +219,8 @@ TEST_F(PlantProtocol, CommandsOfAnotherRunAreCountedAndIgnored) {
 TEST_F(PlantProtocol, ACommandAheadOfTheStepFailsTheRun) {
   PlantNode& plant = make_plant();
   Controller ctl(memq, [](std::int64_t k, int copy) {
-    return copy == 1 ? std::vector<control_command_t>{command(k == 3 ? 5 : k, u_of(k))} : std::vector<control_command_t>{};
+    return copy == 1 ? std::vector<control_command_t>{command(k == 3 ? 5 : k, u_of(k))}
+                     : std::vector<control_command_t>{};
   });
   const std::string what = failure_of([&] { plant.run(); });
   EXPECT_EQ(what, "the controller answered step 5 while the plant is at step 3");
@@ -280,7 +287,8 @@ TEST_F(PlantProtocol, NoMonitorFailsAfterTheStartTimeout) {
   opt.start_timeout_s = 0.3;
   PlantNode& plant = make_plant(opt);
   Controller ctl(memq, [](std::int64_t k, int) { return std::vector<control_command_t>{command(k, u_of(k))}; });
-  expect_failure_after(0.3, "no acknowledgement from the monitor for step 0 within 0.3 s (is feeddrive-monitor running?)",
+  expect_failure_after(0.3,
+                       "no acknowledgement from the monitor for step 0 within 0.3 s (is feeddrive-monitor running?)",
                        [&] { return failure_of([&] { plant.run(); }); });
   EXPECT_TRUE(ctl.states.empty()) << "no state before the monitor is up";
 }

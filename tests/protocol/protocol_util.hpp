@@ -102,8 +102,8 @@ std::string failure_of(F&& f) {
 
 /// Checks that `failure` names a conflict on `channel` at `step` between two `type` messages
 /// whose `fields` differ, as Node::admit says it.
-inline void expect_conflict(const std::string& failure, const std::string& channel, std::int64_t step, const std::string& type,
-                            const std::string& fields) {
+inline void expect_conflict(const std::string& failure, const std::string& channel, std::int64_t step,
+                            const std::string& type, const std::string& fields) {
   const std::string line = "conflict on " + channel + " step " + std::to_string(step) + ": two different " + type +
                            " for one step (" + fields + " differ)";
   EXPECT_NE(failure.find(line), std::string::npos) << failure;

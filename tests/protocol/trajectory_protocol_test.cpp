@@ -21,7 +21,6 @@ namespace {
 
 using service::TrajectoryNode;
 
-
 drive_state_t state(std::int64_t k, long steps) {
   drive_state_t m{};
   m.seq = k;
@@ -38,7 +37,8 @@ struct Blocks {
   std::unique_ptr<service::Bus> bus;
   std::vector<reference_block_t> got;
   explicit Blocks(const Memq& m) : bus(peer(m)) {
-    bus->subscribe<reference_block_t>(kCh.reference, [this](const reference_block_t& b, std::int64_t) { got.push_back(b); });
+    bus->subscribe<reference_block_t>(kCh.reference,
+                                      [this](const reference_block_t& b, std::int64_t) { got.push_back(b); });
   }
   std::map<std::int64_t, int> copies() const {
     std::map<std::int64_t, int> c;
@@ -88,7 +88,7 @@ TEST(TrajectoryProtocol, LockstepKeepsTheReferencesALeadAhead) {
   TrajectoryNode node(s, node_options(), memq.lcm);
   Blocks blocks(memq);
   auto plant = peer(memq);
-  std::int64_t seen = -1;  // the newest state dispatched
+  std::int64_t seen = -1;        // the newest state dispatched
   std::int64_t sent_up_to = -1;  // the last step of the blocks received
   plant->subscribe<drive_state_t>(kCh.state, [&](const drive_state_t& m, std::int64_t) {
     if (m.end_of_run) return;
@@ -212,9 +212,11 @@ TEST(TrajectoryProtocol, NoPlantHeartbeatToJoinFailsAfterTheStartTimeout) {
   opt.run_id = 0;
   opt.start_timeout_s = 0.3;
   TrajectoryNode node(scenario(20), opt, memq.lcm);
-  expect_failure_after(0.3, "no heartbeat from the plant within 0.3 s to join its run (start the plant, or give every process "
-                  "the same --run-id)",
-                       [&] { return failure_of([&] { node.run(); }); });
+  expect_failure_after(
+      0.3,
+      "no heartbeat from the plant within 0.3 s to join its run (start the plant, or give every process "
+      "the same --run-id)",
+      [&] { return failure_of([&] { node.run(); }); });
 }
 
 // States 0..3, then nothing (and no heartbeat): --step-timeout at step 4.

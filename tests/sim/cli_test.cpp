@@ -1,9 +1,9 @@
 // feeddrive-sim end to end: outputs, exit codes, no half-written output folder, --out checked
 // before the run and never replacing a folder feeddrive did not write, names never run as code.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/statvfs.h>
 #include <sys/wait.h>
-#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -75,13 +75,15 @@ TEST(Cli, WritesTimeseriesSummaryAndPlots) {
   fs::remove_all(out);
   const ProcResult r = run_sim(scen.string() + " --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* f : {"timeseries.csv", "summary.json", "position.png", "velocity_error.png", "control.png", "forces.png"})
+  for (const char* f :
+       {"timeseries.csv", "summary.json", "position.png", "velocity_error.png", "control.png", "forces.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
 
   std::ifstream csv(out / "timeseries.csv");
   std::string header;
   std::getline(csv, header);
-  for (const char* col : {"t", "xd", "vd", "ad", "x", "x_measured", "v", "z", "u", "f_friction", "f_ripple", "f_grinding"})
+  for (const char* col :
+       {"t", "xd", "vd", "ad", "x", "x_measured", "v", "z", "u", "f_friction", "f_ripple", "f_grinding"})
     EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << col;
   int rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;
@@ -91,8 +93,9 @@ TEST(Cli, WritesTimeseriesSummaryAndPlots) {
   const auto j = nlohmann::json::parse(js);
   EXPECT_EQ(j["steps"].get<long>(), 500);
   EXPECT_NEAR(j["sim_time_s"].get<double>(), 0.05, 1e-12);
-  for (const char* key : {"wall_time_s", "position_error_max_abs_m", "position_error_rms_m", "velocity_error_max_abs_mps",
-                          "control_min", "control_max", "control_total_variation", "position_error_max_abs_settled_m"})
+  for (const char* key :
+       {"wall_time_s", "position_error_max_abs_m", "position_error_rms_m", "velocity_error_max_abs_mps", "control_min",
+        "control_max", "control_total_variation", "position_error_max_abs_settled_m"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_LE(j["control_min"].get<double>(), j["control_max"].get<double>());
 }
@@ -113,7 +116,8 @@ void expect_bad_input(const std::string& scenario_text, const std::string& expec
 TEST(Cli, BadInputExitsTwoWithOneLine) {
   std::string s = kGood;
   expect_bad_input(std::string(kGood) + "plnt: {}\n", "plnt: unknown key (did you mean 'plant'?)");
-  expect_bad_input(std::string(kGood).replace(s.find("plant: {"), 8, "plant: {mass: -1, "), "plant.mass = -1: must be > 0");
+  expect_bad_input(std::string(kGood).replace(s.find("plant: {"), 8, "plant: {mass: -1, "),
+                   "plant.mass = -1: must be > 0");
   expect_bad_input(std::string(kGood).replace(s.find("control_period: 1e-4"), 20, "control_period: 0"),
                    "control_period = 0: must be > 0");
   expect_bad_input(std::string(kGood).replace(s.find("plant: {"), 8, "plant: {mass: .nan, "), "plant.mass = '.nan'");
@@ -130,7 +134,8 @@ TEST(Cli, SetIsCheckedLikeTheFile) {
            {"plant.mass=-1", "with --set: plant.mass = -1: must be > 0"},
            {"controller.switching=sign", "controller.switching = 'sign': expected one of sgn, sat, tanh"},
            {"plant.mass", "--set plant.mass: expected key=value"},
-           {"plant.friction.model.x=1", "plant.friction.model.x: plant.friction.model is a single value in the scenario"}}) {
+           {"plant.friction.model.x=1",
+            "plant.friction.model.x: plant.friction.model is a single value in the scenario"}}) {
     const ProcResult r = run_sim(scen.string() + " --set " + set + " --out " + out.string());
     EXPECT_EQ(r.code, 2) << set << ": " << r.err;
     EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
@@ -139,15 +144,17 @@ TEST(Cli, SetIsCheckedLikeTheFile) {
   }
   // A value that loads but is implausible for a linear drive: a warning naming the likely unit,
   // and summary.json lists it; a move cut off by `duration` too (issue 23, unit sanity).
-  const ProcResult r = run_sim(scen.string() + " --set reference.max_velocity=500 --set reference.distance=200 --out " +
-                               out.string());
+  const ProcResult r =
+      run_sim(scen.string() + " --set reference.max_velocity=500 --set reference.distance=200 --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("reference.max_velocity: 500 m/s is above any linear drive (10 m/s); mm/s?"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("reference.max_velocity: 500 m/s is above any linear drive (10 m/s); mm/s?"), std::string::npos)
+      << r.err;
   std::ifstream js(out / "summary.json");
   const auto j = nlohmann::json::parse(js);
   EXPECT_FALSE(j["move_finished"].get<bool>());
   const std::string warnings = j["warnings"].dump();
-  EXPECT_NE(warnings.find("reference.distance: 200 m is above the travel of any linear feed drive (5 m); mm?"), std::string::npos)
+  EXPECT_NE(warnings.find("reference.distance: 200 m is above the travel of any linear feed drive (5 m); mm?"),
+            std::string::npos)
       << warnings;
   EXPECT_NE(warnings.find("the run cuts it off"), std::string::npos) << warnings;
 }
@@ -333,8 +340,9 @@ TEST(Cli, OutputEveryAndColumnsKeepTheSummaryOfEveryStep) {
   fs::remove_all(all_out);
   fs::remove_all(some_out);
   ASSERT_EQ(run_sim(write_file("all.yaml", kGood).string() + " --out " + all_out.string() + " --no-plots").code, 0);
-  const ProcResult r = run_sim(write_file("some.yaml", std::string(kGood) + "output: {every: 7, columns: [t, x, u]}\n").string() +
-                               " --out " + some_out.string() + " --no-plots");
+  const ProcResult r =
+      run_sim(write_file("some.yaml", std::string(kGood) + "output: {every: 7, columns: [t, x, u]}\n").string() +
+              " --out " + some_out.string() + " --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto all = csv_lines(all_out / "timeseries.csv"), some = csv_lines(some_out / "timeseries.csv");
   ASSERT_EQ(some.front(), "t,x,u");
@@ -379,7 +387,8 @@ TEST(Cli, TimeseriesThatCannotFitTheDiskIsRefusedBeforeAnyWork) {
   const ProcResult r = run_sim(write_file("huge.yaml", text).string() + " --out " + out.string());
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("duration, control_period, output.every, output.columns: timeseries.csv needs at least 400 GB"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(out));
 }
@@ -409,16 +418,17 @@ TEST(Cli, ACsvThatCannotFitIsRefusedOnItsFirstRowsWithExitTwo) {
   const ProcResult r = run_sim(write_file("projected.yaml", text).string() + " --out " + out.string() + " --no-plots");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("duration, control_period, output.every, output.columns: timeseries.csv would take about"),
-            std::string::npos) << r.err;
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("measured on the first 1000"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(has_staging("cli_projected"));
 }
 
-
 TEST(Cli, InterruptLeavesNoOutputAndNoStagingFolder) {
   std::string s = kGood;
-  const fs::path scen = write_file("long.yaml", std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1000"));
+  const fs::path scen =
+      write_file("long.yaml", std::string(kGood).replace(s.find("duration: 0.05"), 14, "duration: 1000"));
   for (int sig : {SIGINT, SIGTERM}) {
     const fs::path out = scratch() / "cli_interrupted";
     fs::remove_all(out);
@@ -472,9 +482,11 @@ TEST(Cli, FrequencyResponseWritesTableDataAndBodePlots) {
                                   "name: fr\nduration: 1.0\ncontrol_period: 1.0e-4\nplant: {friction: {model: none}}\n"
                                   "controller: {type: cascade, tuning: rule}\n");
   const fs::path out = scratch() / "fr_out";
-  const ProcResult ok = run_sim(scn.string() + " --out " + out.string() + " --frequency-response --fr-frequencies 50,500 --fr-force 20");
+  const ProcResult ok =
+      run_sim(scn.string() + " --out " + out.string() + " --frequency-response --fr-frequencies 50,500 --fr-force 20");
   ASSERT_EQ(ok.code, 0) << ok.err;
-  for (const char* f : {"frequency_response.csv", "frequency_response.json", "bode_reference.png", "bode_compliance.png", "bode_loop.png"})
+  for (const char* f : {"frequency_response.csv", "frequency_response.json", "bode_reference.png",
+                        "bode_compliance.png", "bode_loop.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const auto j = nlohmann::json::parse(slurp(out / "frequency_response.json"));
   EXPECT_EQ(j["excitation"]["force_amplitude_N"], 20.0);
@@ -487,9 +499,10 @@ TEST(Cli, FrequencyResponseWritesTableDataAndBodePlots) {
   EXPECT_EQ(e.err, "error: --fr-frequencies 7000: must be > 0 and below Nyquist 5000 Hz\n");
   EXPECT_FALSE(fs::exists(bad));
   // review F10: an open-loop controller has no loop to measure: one line, exit 2
-  const fs::path ol = write_file("fr_ol.yaml",
-                                 "name: fr_ol\nduration: 1.0\ncontrol_period: 1.0e-4\nplant: {friction: {model: none}}\n"
-                                 "controller: {type: open_loop, kind: step, amplitude: 12.0}\nreference: {type: none}\n");
+  const fs::path ol =
+      write_file("fr_ol.yaml",
+                 "name: fr_ol\nduration: 1.0\ncontrol_period: 1.0e-4\nplant: {friction: {model: none}}\n"
+                 "controller: {type: open_loop, kind: step, amplitude: 12.0}\nreference: {type: none}\n");
   const ProcResult eo = run_sim(ol.string() + " --out " + bad.string() + " --frequency-response --fr-frequencies 50");
   EXPECT_EQ(eo.code, 2);
   EXPECT_EQ(eo.err.rfind("error: controller.type open_loop: no feedback loop to measure", 0), 0u) << eo.err;
@@ -506,7 +519,8 @@ TEST(Cli, FrequencyResponseWritesTableDataAndBodePlots) {
   EXPECT_NE(slurp(h_out).find("not measured (--fr-force 0)"), std::string::npos) << slurp(h_out);
   const auto jh = nlohmann::json::parse(slurp(heavy / "frequency_response.json"));
   ASSERT_TRUE(jh["warnings"].is_array());
-  EXPECT_NE(jh["warnings"][0].get<std::string>().find("plant.mass: 50000 kg is above"), std::string::npos) << jh["warnings"];
+  EXPECT_NE(jh["warnings"][0].get<std::string>().find("plant.mass: 50000 kg is above"), std::string::npos)
+      << jh["warnings"];
 }
 
 }  // namespace

@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "feeddrive/sim/scenario.hpp"
-#include "scenario_error.hpp"
 #include "feeddrive/sim/simulation.hpp"
+#include "scenario_error.hpp"
 
 namespace feeddrive::sim {
 namespace {
@@ -17,7 +17,8 @@ duration: 0.01
 control_period: 1e-4
 plant:
   effects:
-)" + effects + R"(
+)" + effects +
+         R"(
 controller: {type: sliding_mode}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
 )";

@@ -16,8 +16,8 @@ namespace {
 using test::error_of;
 
 std::string scenario(const std::string& controller, const std::string& reference, const std::string& plant = "{}") {
-  return "duration: 0.01\ncontrol_period: 1e-4\nplant: " + plant + "\ncontroller: " + controller + "\nreference: " + reference +
-         "\n";
+  return "duration: 0.01\ncontrol_period: 1e-4\nplant: " + plant + "\ncontroller: " + controller +
+         "\nreference: " + reference + "\n";
 }
 
 // Every key a list declares is read by the loader (it appears among the resolved keys of a
@@ -33,8 +33,10 @@ TEST(Fields, EveryListedKeyIsReadAndEveryReadKeyIsListed) {
       {"{type: sliding_mode}", "{type: ramp}"},
   };
   const std::string effects =
-      "{effects: {constant_force: {}, coulomb_friction: {}, viscous_friction: {}, stribeck_friction: {}, presliding: {},"
-      " cogging_ripple: {}, reluctance_ripple: {}, grinding_force: {}, spring_force: {}, mass_error: {}, input_delay: {}}}";
+      "{effects: {constant_force: {}, coulomb_friction: {}, viscous_friction: {}, stribeck_friction: {}, presliding: "
+      "{},"
+      " cogging_ripple: {}, reluctance_ripple: {}, grinding_force: {}, spring_force: {}, mass_error: {}, input_delay: "
+      "{}}}";
   for (const auto& [c, r] : runs) {
     ResolvedKeys keys;
     parse_scenario(scenario(c, r, effects), ".", "s.yaml", &keys);
@@ -55,7 +57,8 @@ TEST(Fields, EveryListedKeyIsReadAndEveryReadKeyIsListed) {
 }
 
 TEST(Fields, ValidateRangesComeFromTheList) {
-  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{mass: -1}")), "s.yaml: plant.mass = -1: must be > 0");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{mass: -1}")),
+            "s.yaml: plant.mass = -1: must be > 0");
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {quantization: 50}}")),
             "s.yaml: plant.sensor.quantization = 50: must be <= 1 m (um?)");
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: scurve, max_velocity: 1500}")),
@@ -66,7 +69,8 @@ TEST(Fields, ValidateRangesComeFromTheList) {
 }
 
 TEST(Fields, EnumsAreReadByTheirNames) {
-  const Scenario s = parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {velocity: difference}}"));
+  const Scenario s =
+      parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {velocity: difference}}"));
   EXPECT_EQ(s.plant.sensor.velocity, plant::VelocityMeasurement::kDifference);
   EXPECT_TRUE(s.plant.sensor.differenced_velocity());
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{sensor: {velocity: tacho}}")),
@@ -90,7 +94,8 @@ TEST(Fields, CascadeTuningRuleIsAppliedAfterReading) {
 
 // Issue 23: the ripple's parts are 0 unless the paper's ripple is named.
 TEST(Fields, RippleIsZeroUnlessThePaperIsNamed) {
-  const Scenario own = parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {enabled: true, cogging_amplitude: 6}}"));
+  const Scenario own = parse_scenario(
+      scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {enabled: true, cogging_amplitude: 6}}"));
   EXPECT_DOUBLE_EQ(own.plant.ripple.cogging_amplitude, 6.0);
   EXPECT_DOUBLE_EQ(own.plant.ripple.cogging_third, 0.0);
   EXPECT_DOUBLE_EQ(own.plant.ripple.reluctance_amplitude, 0.0);
@@ -100,8 +105,8 @@ TEST(Fields, RippleIsZeroUnlessThePaperIsNamed) {
   EXPECT_DOUBLE_EQ(paper.plant.ripple.cogging_third, 1.0);
   EXPECT_DOUBLE_EQ(paper.plant.ripple.reluctance_amplitude, 0.03);
   EXPECT_DOUBLE_EQ(paper.plant.ripple.reluctance_third, 0.01);
-  const Scenario paper6 =
-      parse_scenario(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {preset: paper, cogging_amplitude: 6}}"));
+  const Scenario paper6 = parse_scenario(
+      scenario("{type: sliding_mode}", "{type: sine}", "{ripple: {preset: paper, cogging_amplitude: 6}}"));
   EXPECT_DOUBLE_EQ(paper6.plant.ripple.cogging_amplitude, 6.0);
   EXPECT_DOUBLE_EQ(paper6.plant.ripple.cogging_third, 1.0);
   // The resolved keys read back to the same ripple (feeddrive-study's cases).

@@ -14,20 +14,20 @@
 #include <string>
 #include <vector>
 
+#include "../support/scratch.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
-#include "../support/scratch.hpp"
 
 namespace {
 namespace fs = std::filesystem;
-using feeddrive::test_support::names;
-using feeddrive::test_support::slurp;
 using feeddrive::output::check_output_dir;
 using feeddrive::output::gnuplot_string;
 using feeddrive::output::is_feeddrive_output;
 using feeddrive::output::kMarkerFile;
 using feeddrive::output::normalise;
 using feeddrive::output::StagedFolder;
+using feeddrive::test_support::names;
+using feeddrive::test_support::slurp;
 
 fs::path scratch() {
   static const fs::path dir = feeddrive::test_support::make_scratch("output");
@@ -68,7 +68,8 @@ std::string inner(const std::string& quoted) {
 // Nothing gnuplot interprets inside a double-quoted string, and nothing that ends it.
 void expect_inert(const std::string& quoted) {
   const std::string in = inner(quoted);
-  for (char c : std::string("\"'\\`@$\n\r\t{}\0", 13)) EXPECT_EQ(in.find(c), std::string::npos) << "char " << int(c) << " in " << quoted;
+  for (char c : std::string("\"'\\`@$\n\r\t{}\0", 13))
+    EXPECT_EQ(in.find(c), std::string::npos) << "char " << int(c) << " in " << quoted;
   for (unsigned char c : in) EXPECT_TRUE(c >= 0x20 && c != 0x7f) << quoted;
 }
 
@@ -92,14 +93,15 @@ TEST(GnuplotString, ReplacesEveryCharacterGnuplotInterprets) {
 }
 
 TEST(GnuplotString, Utf8KeptMalformedBytesReplaced) {
-  EXPECT_EQ(gnuplot_string("\xC2\xB5m \xC3\xBC \xE2\x82\xAC \xF0\x9F\x98\x80"), "\"\xC2\xB5m \xC3\xBC \xE2\x82\xAC \xF0\x9F\x98\x80\"");
-  EXPECT_EQ(gnuplot_string("\xFF\xFE"), "\"??\"");                 // not UTF-8
-  EXPECT_EQ(gnuplot_string("\xC0\xA7"), "\"??\"");                 // overlong '
-  EXPECT_EQ(gnuplot_string("\xE0\x80\xA2"), "\"???\"");             // overlong "
-  EXPECT_EQ(gnuplot_string("\xC2\x85"), "\"??\"");                 // C1 control (NEL)
-  EXPECT_EQ(gnuplot_string("\xED\xA0\x80"), "\"???\"");             // surrogate
-  EXPECT_EQ(gnuplot_string("\xF4\x90\x80\x80"), "\"????\"");        // above U+10FFFF
-  EXPECT_EQ(gnuplot_string("\xE2\x82"), "\"??\"");                 // cut short
+  EXPECT_EQ(gnuplot_string("\xC2\xB5m \xC3\xBC \xE2\x82\xAC \xF0\x9F\x98\x80"),
+            "\"\xC2\xB5m \xC3\xBC \xE2\x82\xAC \xF0\x9F\x98\x80\"");
+  EXPECT_EQ(gnuplot_string("\xFF\xFE"), "\"??\"");            // not UTF-8
+  EXPECT_EQ(gnuplot_string("\xC0\xA7"), "\"??\"");            // overlong '
+  EXPECT_EQ(gnuplot_string("\xE0\x80\xA2"), "\"???\"");       // overlong "
+  EXPECT_EQ(gnuplot_string("\xC2\x85"), "\"??\"");            // C1 control (NEL)
+  EXPECT_EQ(gnuplot_string("\xED\xA0\x80"), "\"???\"");       // surrogate
+  EXPECT_EQ(gnuplot_string("\xF4\x90\x80\x80"), "\"????\"");  // above U+10FFFF
+  EXPECT_EQ(gnuplot_string("\xE2\x82"), "\"??\"");            // cut short
   EXPECT_EQ(gnuplot_string("\xC3"), "\"?\"");
 }
 
@@ -400,8 +402,9 @@ TEST(OutputFolder, AnotherOutputOfTheRunMustLieOutsideTheFolder) {
     const std::string w = refusal([&] { check_outside((base / f).string(), "--lcm-log", (base / "run/").string()); });
     EXPECT_EQ(w.rfind("--lcm-log " + (base / f).string() + ": lies inside --out", 0), 0u) << w;
   }
-  EXPECT_NE(refusal([&] { check_outside((base / "run").string(), "--lcm-log", (base / "run").string()); }).find("itself"),
-            std::string::npos);
+  EXPECT_NE(
+      refusal([&] { check_outside((base / "run").string(), "--lcm-log", (base / "run").string()); }).find("itself"),
+      std::string::npos);
 }
 
 TEST(OutputFolder, FailureBeforeCommitKeepsThePreviousOutput) {
@@ -415,8 +418,7 @@ TEST(OutputFolder, FailureBeforeCommitKeepsThePreviousOutput) {
     StagedFolder second((base / "prev/").string(), "t");
     put(second.dir() / "half.txt", "half");
     throw std::runtime_error("the run failed");
-  } catch (const std::runtime_error&) {
-  }
+  } catch (const std::runtime_error&) {}
   EXPECT_EQ(slurp(base / "prev" / "old.txt"), "old");
   EXPECT_EQ(names(base), std::vector<std::string>{"prev"}) << "the temporary folder is removed";
 }

@@ -25,7 +25,8 @@ control_period: 1e-4
 controller: {type: sliding_mode, switching: sat}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
 plant: {effects: {input_delay: {delay_s: 2.0e-4}}}
-)", ".", "s.yaml", &keys);
+)",
+                 ".", "s.yaml", &keys);
   // Given values, in shortest round-trip form.
   EXPECT_EQ(keys.at("control_period").text, "1e-04");
   EXPECT_EQ(keys.at("controller.switching").text, "sat");
@@ -68,7 +69,8 @@ TEST(ResolvedKeys, EveryRepositoryScenarioRoundTrips) {
     EXPECT_EQ(a.plant.mass, b.plant.mass);
     EXPECT_EQ(a.plant.friction.static_force, b.plant.friction.static_force);
     EXPECT_EQ(a.controller.type, b.controller.type);
-    EXPECT_EQ(a.controller.sliding_mode.model.friction.coulomb_force, b.controller.sliding_mode.model.friction.coulomb_force);
+    EXPECT_EQ(a.controller.sliding_mode.model.friction.coulomb_force,
+              b.controller.sliding_mode.model.friction.coulomb_force);
     EXPECT_EQ(a.controller.cascade.kv, b.controller.cascade.kv);
     EXPECT_EQ(a.reference.type, b.reference.type);
     ++n;
@@ -84,7 +86,8 @@ duration: 0.01
 control_period: 1e-4
 controller: {type: sliding_mode}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
-)", ".", "s.yaml", &keys);
+)",
+                 ".", "s.yaml", &keys);
   ResolvedKeys back;
   parse_scenario(resolved_yaml(keys), ".", "r.yaml", &back);
   EXPECT_EQ(back.at("name").text, "a: b, #c 'd'");

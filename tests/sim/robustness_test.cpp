@@ -31,7 +31,8 @@ controller: {type: cascade, computation_delay: 1.5e-4}
   EXPECT_DOUBLE_EQ(d.effects.input_delay.delay_s, 3.5e-4);
   EXPECT_EQ(s.plant.effects.input_delay.delay_s, 2.0e-4) << "the plant as given is unchanged";
   // Without a plant delay the drive gets the computation delay alone; without either, none.
-  const Scenario t = parse_scenario("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: 1e-3}\n");
+  const Scenario t =
+      parse_scenario("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: 1e-3}\n");
   EXPECT_TRUE(t.drive().effects.input_delay.enabled);
   EXPECT_EQ(t.drive().effects.input_delay.delay_s, 1e-3);
   EXPECT_FALSE(parse_scenario("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade}\n")
@@ -40,19 +41,23 @@ controller: {type: cascade, computation_delay: 1.5e-4}
 }
 
 TEST(ComputationDelay, BadValuesAreOneLineErrors) {
-  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: -1e-4}\n"),
-            "s.yaml: controller.computation_delay = -1e-4: must be >= 0");
-  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: sliding_mode, compensate_delay: true}\n"),
+  EXPECT_EQ(
+      test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: -1e-4}\n"),
+      "s.yaml: controller.computation_delay = -1e-4: must be >= 0");
+  EXPECT_EQ(test::error_of(
+                "duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: sliding_mode, compensate_delay: true}\n"),
             "s.yaml: controller.compensate_delay = true: needs motion_state: observer (the model predictor)");
 }
 
 // An encoder measures position only: the true velocity is refused with quantization or noise.
 TEST(SensorHonesty, AnEncoderHasNoTrueVelocity) {
-  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {quantization: 5e-8, velocity: 'true'}}\n"
-                           "controller: {type: cascade}\n"),
-            "s.yaml: plant.sensor.velocity = 'true': an encoder with quantization or noise measures position only; "
-            "use difference (or auto)");
-  EXPECT_NO_THROW(parse_scenario("duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {velocity: 'true'}}\ncontroller: {type: cascade}\n"));
+  EXPECT_EQ(
+      test::error_of("duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {quantization: 5e-8, velocity: 'true'}}\n"
+                     "controller: {type: cascade}\n"),
+      "s.yaml: plant.sensor.velocity = 'true': an encoder with quantization or noise measures position only; "
+      "use difference (or auto)");
+  EXPECT_NO_THROW(parse_scenario(
+      "duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {velocity: 'true'}}\ncontroller: {type: cascade}\n"));
 }
 
 // tuning: rule sets kp, kv, ki from the period, the delay and the sensor (cascade_tuning());
@@ -68,8 +73,9 @@ controller: {type: cascade, tuning: rule, bandwidth_scale: 0.5, computation_dela
   EXPECT_EQ(s.controller.cascade.kv, g.kv);
   EXPECT_EQ(s.controller.cascade.kp, g.kp);
   EXPECT_EQ(s.controller.cascade.ki, g.ki);
-  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, tuning: rule, kv: 3000}\n"),
-            "s.yaml: controller.kv: set by tuning: rule (remove it, or use tuning: manual)");
+  EXPECT_EQ(
+      test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, tuning: rule, kv: 3000}\n"),
+      "s.yaml: controller.kv: set by tuning: rule (remove it, or use tuning: manual)");
   // The observer's v^ is no difference (no T/2), the Smith predictor takes the delay out of the
   // loop (observer with compensate_delay), a velocity filter adds its time constant 1/(2 pi f_v).
   const Scenario o = parse_scenario(R"(
@@ -85,11 +91,13 @@ controller: {type: cascade, tuning: rule, computation_delay: 1e-3, motion_state:
   EXPECT_EQ(o.controller.cascade.motion_state, controller::MotionSource::kObserver);
   EXPECT_EQ(o.controller.cascade.velocity_filter_cutoff, 2000.0);
   // Without the observer the delay stays in tau; the filter's lag is added.
-  const Scenario f = parse_scenario("duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {quantization: 5e-8}}\n"
-                                    "controller: {type: cascade, tuning: rule, computation_delay: 1e-3, velocity_filter_cutoff: 1000}\n");
+  const Scenario f = parse_scenario(
+      "duration: 0.01\ncontrol_period: 1e-4\nplant: {sensor: {quantization: 5e-8}}\n"
+      "controller: {type: cascade, tuning: rule, computation_delay: 1e-3, velocity_filter_cutoff: 1000}\n");
   EXPECT_EQ(f.controller.cascade.kv, controller::cascade_tuning(1e-4, 1e-3, true, 1.0, 1.0 / (2.0 * M_PI * 1000.0)).kv);
-  EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, motion_state: observer}\n"),
-            "s.yaml: controller.motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
+  EXPECT_EQ(
+      test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, motion_state: observer}\n"),
+      "s.yaml: controller.motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
   EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, motion_state: guess}\n"),
             "s.yaml: controller.motion_state = 'guess': expected one of measured, observer");
   EXPECT_EQ(test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, tuning: fast}\n"),

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "../support/scratch.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/summary.hpp"
-#include "../support/scratch.hpp"
 
 namespace feeddrive::sim {
 namespace {

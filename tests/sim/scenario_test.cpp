@@ -33,13 +33,15 @@ std::string with(const std::string& from, const std::string& to) {
 // Issue 23, review: a section that is off still has its written keys checked (exit 2), and the
 // loader warns that they do not act (a forgotten `enabled: true`).
 TEST(Scenario, ASectionThatIsOffIsCheckedAndWarnedAbout) {
-  EXPECT_EQ(error_of(with("plant: {}", "plant: {ripple: {pitch: -1}}")), "s.yaml: plant.ripple.pitch = -1: must be > 0");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {ripple: {pitch: -1}}")),
+            "s.yaml: plant.ripple.pitch = -1: must be > 0");
   EXPECT_EQ(error_of(with("plant: {}", "plant: {grinding: {workpiece_diameter: -1}}")),
             "s.yaml: plant.grinding.workpiece_diameter = -1: must be > 0");
   const Scenario s = parse_scenario(with("plant: {}", "plant: {ripple: {cogging_amplitude: 6, pitch: 0.03}}"));
   EXPECT_FALSE(s.plant.ripple.enabled);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_EQ(s.warnings[0], "plant.ripple: keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
+  EXPECT_EQ(s.warnings[0],
+            "plant.ripple: keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
   // `enabled: false` written is off on purpose (the paper's scenarios keep their values so): no warning.
   EXPECT_TRUE(parse_scenario(with("plant: {}", "plant: {ripple: {enabled: false, pitch: 0.03}}")).warnings.empty());
 }
@@ -51,7 +53,8 @@ TEST(Scenario, AStepAfterTheRunIsAMoveCutOff) {
                                          "reference: {type: step, amplitude: 1e-5, step_time: 500}"));
   EXPECT_EQ(s.move_end_s, 500.0);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("the run cuts it off (summary.json move_finished: false); a step_time in ms?"), std::string::npos)
+  EXPECT_NE(s.warnings[0].find("the run cuts it off (summary.json move_finished: false); a step_time in ms?"),
+            std::string::npos)
       << s.warnings[0];
   const Scenario in_time = parse_scenario(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
                                                "reference: {type: step, amplitude: 1e-5, step_time: 0.005}"));
@@ -90,7 +93,8 @@ TEST(Scenario, MinimalUsesDefaultsAndModelEqualsPlant) {
 }
 
 TEST(Scenario, ControllerModelOverridesOnlyGivenKeys) {
-  const Scenario s = parse_scenario(with("{type: sliding_mode}", "{type: sliding_mode, model: {mass: 110, friction: {coulomb_force: 70}}}"));
+  const Scenario s = parse_scenario(
+      with("{type: sliding_mode}", "{type: sliding_mode, model: {mass: 110, friction: {coulomb_force: 70}}}"));
   EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.mass, 110.0);
   EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.friction.coulomb_force, 70.0);
   EXPECT_DOUBLE_EQ(s.controller.sliding_mode.model.friction.static_force, 120.0);
@@ -116,20 +120,16 @@ TEST(Scenario, MissingValuesAndSections) {
 TEST(Scenario, NonPositiveMassAndPeriod) {
   EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: 0}")), "s.yaml: plant.mass = 0: must be > 0");
   EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: -3.5}")), "s.yaml: plant.mass = -3.5: must be > 0");
-  EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: 0")),
-            "s.yaml: control_period = 0: must be > 0");
+  EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: 0")), "s.yaml: control_period = 0: must be > 0");
   EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: -1e-4")),
             "s.yaml: control_period = -1e-4: must be > 0");
 }
 
 TEST(Scenario, NanInfAndGarbage) {
-  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: .nan}")),
-            "s.yaml: plant.mass = '.nan': NaN is not allowed");
-  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: nan}")),
-            "s.yaml: plant.mass = 'nan': NaN is not allowed");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: .nan}")), "s.yaml: plant.mass = '.nan': NaN is not allowed");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: nan}")), "s.yaml: plant.mass = 'nan': NaN is not allowed");
   EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: .inf}")), "s.yaml: plant.mass = .inf: must be finite");
-  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: heavy}")),
-            "s.yaml: plant.mass = 'heavy': not a number");
+  EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: heavy}")), "s.yaml: plant.mass = 'heavy': not a number");
   EXPECT_EQ(error_of(with("plant: {}", "plant: {ripple: {enabled: maybe}}")),
             "s.yaml: plant.ripple.enabled = 'maybe': expected true or false");
   EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: [1, 2]}")),
@@ -196,8 +196,8 @@ std::string temp_csv(const std::string& name, const std::string& text) {
 
 TEST(Scenario, TablesAreReadWhenTheScenarioIsLoaded) {
   const std::string force = temp_csv("force.csv", "\xEF\xBB\xBF# force\nt,note,force_N\r\n0.1,a,10\n0.2,b,-4.5\n");
-  const Scenario ol = parse_scenario(with("controller: {type: sliding_mode}",
-                                          "controller: {type: open_loop, kind: csv, file: '" + force + "'}"));
+  const Scenario ol = parse_scenario(
+      with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv, file: '" + force + "'}"));
   EXPECT_EQ(ol.controller.open_loop.table_t, (std::vector<double>{0.1, 0.2}));
   EXPECT_EQ(ol.controller.open_loop.table_value, (std::vector<double>{10.0, -4.5}));
   EXPECT_TRUE(ol.controller.open_loop.table_is_force);
@@ -212,11 +212,13 @@ TEST(Scenario, TablesAreReadWhenTheScenarioIsLoaded) {
 
 TEST(Scenario, BadTablesAreOneLineScenarioErrors) {
   const std::string bad = temp_csv("bad.csv", "t,u\n0,1\n0.5,2x\n");
-  EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv, file: '" + bad + "'}")),
+  EXPECT_EQ(error_of(with("controller: {type: sliding_mode}",
+                          "controller: {type: open_loop, kind: csv, file: '" + bad + "'}")),
             "s.yaml: " + bad + ":3:5: column 'u': not a number: '2x'");
   EXPECT_EQ(error_of(with("controller: {type: sliding_mode}", "controller: {type: open_loop, kind: csv}")),
             "s.yaml: controller.file = '': kind = csv needs a file");
-  EXPECT_EQ(error_of(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}", "reference: {type: waypoints, file: /dev/zero}")),
+  EXPECT_EQ(error_of(with("reference: {type: sine, amplitude: 0.1, frequency: 1.0}",
+                          "reference: {type: waypoints, file: /dev/zero}")),
             "s.yaml: /dev/zero: is a device, not a regular file");  // refused before it is opened for reading
 }
 
@@ -224,7 +226,8 @@ TEST(Scenario, OutputOptions) {
   const Scenario s = parse_scenario(std::string(kMinimal) + "output: {every: 10, columns: [t, x, u]}\n");
   EXPECT_EQ(s.output.every, 10);
   EXPECT_EQ(s.output.columns, (std::vector<std::string>{"t", "x", "u"}));
-  EXPECT_EQ(error_of(std::string(kMinimal) + "output: {columns: [t, t]}\n"), "s.yaml: output.columns: column 't' listed twice");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "output: {columns: [t, t]}\n"),
+            "s.yaml: output.columns: column 't' listed twice");
   EXPECT_EQ(error_of(std::string(kMinimal) + "output: {columns: []}\n"),
             "s.yaml: output.columns: empty list (leave the key out to record every column)");
   EXPECT_EQ(error_of(std::string(kMinimal) + "output: {every: 1.5}\n"), "s.yaml: output.every = '1.5': not an integer");

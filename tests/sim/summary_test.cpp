@@ -70,7 +70,8 @@ namespace {
 
 TEST(Summary, ACascadeReportsTheGainsItRunsWith) {
   // tuning: rule chooses kp, kv, ki (docs/controllers.md): summary.json says which.
-  const Scenario c = parse_scenario("name: c\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: cascade, tuning: rule}\n", ".", "c");
+  const Scenario c = parse_scenario(
+      "name: c\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: cascade, tuning: rule}\n", ".", "c");
   Summary m;
   m.steps = 1;
   const auto j = nlohmann::json::parse(summary_json(m, c));
@@ -81,7 +82,8 @@ TEST(Summary, ACascadeReportsTheGainsItRunsWith) {
   // Ideal sensor, T = 100 us: tau = T/2, crossover ~10,800 rad/s, kv ~10,490 1/s (docs/controllers.md,
   // "Cascade tuning rule"); 1 % covers the rounding of the documented figure.
   EXPECT_NEAR(c.controller.cascade.kv, 10490.0, 105.0);
-  const Scenario smc = parse_scenario("name: s\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: sliding_mode}\n", ".", "s");
+  const Scenario smc =
+      parse_scenario("name: s\nduration: 0.1\ncontrol_period: 1.0e-4\ncontroller: {type: sliding_mode}\n", ".", "s");
   EXPECT_FALSE(nlohmann::json::parse(summary_json(m, smc)).contains("cascade_gains"));
 }
 
@@ -107,10 +109,10 @@ TEST(Summary, ARecordWithoutTrueStateHasNoErrorMetricsNotZero) {
     b.add(r);
   }
   const auto j = nlohmann::json::parse(summary_json(b.summary(0.0, {}), s));
-  for (const char* key : {"position_error_max_abs_m", "position_error_rms_m", "position_error_p95_abs_m",
-                          "velocity_error_max_abs_mps", "velocity_error_max_abs_after_first_mps", "velocity_error_rms_mps",
-                          "position_error_max_abs_settled_m", "position_error_rms_settled_m",
-                          "velocity_error_max_abs_settled_mps"})
+  for (const char* key :
+       {"position_error_max_abs_m", "position_error_rms_m", "position_error_p95_abs_m", "velocity_error_max_abs_mps",
+        "velocity_error_max_abs_after_first_mps", "velocity_error_rms_mps", "position_error_max_abs_settled_m",
+        "position_error_rms_settled_m", "velocity_error_max_abs_settled_mps"})
     EXPECT_TRUE(j[key].is_null()) << key << " = " << j[key];
   EXPECT_EQ(j["steps"], 10);
   // Truth on some steps only: the metrics are over those (here e = 1e-3 - 0 on two steps).
@@ -181,7 +183,9 @@ TEST(Summary, StepMetricsOfASecondOrderResponse) {
   s.reference.step = {1e-3, 0.1, 0.0};
   const double D = 1e-3, t0 = 0.1, zeta = 0.3, wn = 60.0, wd = wn * std::sqrt(1 - zeta * zeta), T = 1e-4;
   const auto y = [&](double tp) {
-    return tp < 0 ? 0.0 : D * (1 - std::exp(-zeta * wn * tp) * (std::cos(wd * tp) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * tp)));
+    return tp < 0 ? 0.0
+                  : D * (1 - std::exp(-zeta * wn * tp) *
+                                 (std::cos(wd * tp) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * tp)));
   };
   SummaryBuilder b(s);
   for (long k = 0; k < 10000; ++k) {
@@ -208,7 +212,7 @@ TEST(Summary, StepMetricsOfASecondOrderResponse) {
   for (double tp = 0.0; tp < 0.9; tp += 1e-6)
     if (std::abs(y(tp) - D) > 0.02 * D) last_out = tp;
   EXPECT_NEAR(m.settling_time_s, last_out, T);
-  EXPECT_NEAR(m.settle_after_move_s, m.settling_time_s, 1e-12);  // a step ends where it starts
+  EXPECT_NEAR(m.settle_after_move_s, m.settling_time_s, 1e-12);   // a step ends where it starts
   EXPECT_NEAR(m.position_error_max_abs_during_move_m, D, 1e-15);  // the jump itself
   // after the move: the largest |D - y| after t0, the first undershoot below D: at t' = 0+ ~ D
   EXPECT_LE(m.position_error_max_abs_after_move_m, D);
@@ -220,7 +224,8 @@ TEST(Summary, StepMetricsOfASecondOrderResponse) {
   EXPECT_EQ(j["controller_model"], "plant");  // no controller.model: the plant's own parameters
   // The plant ran elsewhere (a monitor's record): its integrator counts are unknown, null.
   const auto jm = nlohmann::json::parse(summary_json(b.summary(1.0, {}), s));
-  for (const char* key : {"integrator_steps", "integrator_rhs_evals", "integrator_jac_evals", "integrator_error_test_fails"})
+  for (const char* key :
+       {"integrator_steps", "integrator_rhs_evals", "integrator_jac_evals", "integrator_error_test_fails"})
     EXPECT_TRUE(jm[key].is_null()) << key;
 }
 
@@ -239,8 +244,9 @@ TEST(Summary, MoveMetricsApplyOnlyToMoves) {
     b.add(r);
   }
   const auto j = nlohmann::json::parse(summary_json(b.summary(0.1, {}), s));
-  for (const char* key : {"move_start_s", "move_end_s", "rise_time_s", "overshoot_m", "settling_time_s",
-                          "settling_band_m", "position_error_max_abs_during_move_m", "position_error_max_abs_after_move_m"})
+  for (const char* key :
+       {"move_start_s", "move_end_s", "rise_time_s", "overshoot_m", "settling_time_s", "settling_band_m",
+        "position_error_max_abs_during_move_m", "position_error_max_abs_after_move_m"})
     EXPECT_TRUE(j[key].is_null()) << key;
   EXPECT_EQ(j["control_reversals_per_s"], 0.0);
   EXPECT_EQ(j["control_chattering"], false);
@@ -263,14 +269,16 @@ TEST(Summary, AMoveCutOffHasNoOvershoot) {
   }
   const auto j = nlohmann::json::parse(summary_json(b.summary(0.1, {}), s));
   EXPECT_TRUE(j["move_start_s"].is_number());
-  for (const char* key : {"overshoot_m", "overshoot_percent", "rise_time_s", "settling_time_s"}) EXPECT_TRUE(j[key].is_null()) << key;
+  for (const char* key : {"overshoot_m", "overshoot_percent", "rise_time_s", "settling_time_s"})
+    EXPECT_TRUE(j[key].is_null()) << key;
 }
 
 // Control-signal quality (summary.hpp, docs/scenario.md "Control-signal quality") on commands
 // whose figures are known in closed form. Scenario{}: T = 1e-4 s, u in [-10, 10] V (delta = 0.2 V,
 // h = 0.02 V), Ka*Kf = 260 N/V.
-Summary signal_summary(double period, long n, const std::function<double(long)>& u,
-                       const std::function<bool(long)>& saturated = [](long) { return false; }) {
+Summary signal_summary(
+    double period, long n, const std::function<double(long)>& u,
+    const std::function<bool(long)>& saturated = [](long) { return false; }) {
   Scenario s;
   s.control_period = period;
   SummaryBuilder b(s);
@@ -288,10 +296,10 @@ TEST(Summary, SignalQualityOfASquareWave) {
   // +-1 V, toggling every 50 steps (a 100 Hz square wave) for 10,000 steps (1 s): 199 edges of
   // 2 V each among 9,999 differences; every edge after the first reverses the direction (198);
   // the first 250 steps marked saturated: 2.5 %.
-  const Summary m = signal_summary(1e-4, 10000, [](long k) { return (k / 50) % 2 == 0 ? 1.0 : -1.0; },
-                                   [](long k) { return k < 250; });
+  const Summary m = signal_summary(
+      1e-4, 10000, [](long k) { return (k / 50) % 2 == 0 ? 1.0 : -1.0; }, [](long k) { return k < 250; });
   EXPECT_NEAR(m.control_step_rms_V, std::sqrt(199.0 * 4.0 / 9999.0), 1e-12);  // rounding only
-  EXPECT_NEAR(m.control_direction_changes_per_s, 198.0, 1e-9);               // sim_time = 1 s
+  EXPECT_NEAR(m.control_direction_changes_per_s, 198.0, 1e-9);                // sim_time = 1 s
   EXPECT_NEAR(m.control_saturated_fraction, 0.025, 1e-15);
   EXPECT_DOUBLE_EQ(m.control_direction_band_V, 0.02);
   EXPECT_DOUBLE_EQ(m.force_hf_limit_N, 260.0 * 0.2);
@@ -322,10 +330,12 @@ TEST(Summary, SignalQualityOfSines) {
   }
   // 2 kHz at 1 V: 0.98 of 184 N RMS above 1 kHz, 4,000 changes/s: out of limits. 100 Hz at
   // 0.1 V: 0.0044 V step RMS, 200 changes/s, 0.17 N above 1 kHz: within.
-  EXPECT_FALSE(signal_summary(T, 10000, [&](long k) { return std::cos(2.0 * M_PI * 2000.0 * k * T); })
-                   .control_signal_within_limits);
-  EXPECT_TRUE(signal_summary(T, 10000, [&](long k) { return 0.1 * std::cos(2.0 * M_PI * 100.0 * k * T); })
-                  .control_signal_within_limits);
+  EXPECT_FALSE(signal_summary(T, 10000, [&](long k) {
+                 return std::cos(2.0 * M_PI * 2000.0 * k * T);
+               }).control_signal_within_limits);
+  EXPECT_TRUE(signal_summary(T, 10000, [&](long k) {
+                return 0.1 * std::cos(2.0 * M_PI * 100.0 * k * T);
+              }).control_signal_within_limits);
 }
 
 TEST(Summary, SignalQualityOfAConstantAndOfASlowRate) {
@@ -337,7 +347,8 @@ TEST(Summary, SignalQualityOfAConstantAndOfASlowRate) {
   EXPECT_EQ(c.force_hf_rms_N, 0.0);
   EXPECT_TRUE(c.control_signal_within_limits);
   // Noise smaller than the band h = 0.02 V (+-0.009 V every step) is no change of direction.
-  EXPECT_EQ(signal_summary(1e-4, 1000, [](long k) { return k % 2 ? 0.009 : -0.009; }).control_direction_changes_per_s, 0.0);
+  EXPECT_EQ(signal_summary(1e-4, 1000, [](long k) { return k % 2 ? 0.009 : -0.009; }).control_direction_changes_per_s,
+            0.0);
   // At T = 1 ms nothing above 1 kHz is representable (Nyquist 500 Hz): null, never 0.
   Scenario s;
   s.control_period = 1e-3;

@@ -73,9 +73,10 @@ TEST_P(YamlConstructs, EveryToolExitsTwoWithOneLineNamingIt) {
   }
   // The study: the scenario as its base file, as an inline base map, and as a controller's file.
   feeddrive::test_support::write_text(scratch() / "file.yaml", "name: t\nbase: s.yaml\n");
-  feeddrive::test_support::write_text(scratch() / "ctrl.yaml",
-                                      "name: t\nbase: " + std::string(FEEDDRIVE_SOURCE_DIR) +
-                                          "/scenarios/paper/smc_bl_jerk_limited.yaml\ncontrollers: [{name: c, scenario: s.yaml}]\n");
+  feeddrive::test_support::write_text(
+      scratch() / "ctrl.yaml",
+      "name: t\nbase: " + std::string(FEEDDRIVE_SOURCE_DIR) +
+          "/scenarios/paper/smc_bl_jerk_limited.yaml\ncontrollers: [{name: c, scenario: s.yaml}]\n");
   std::string indented = "name: t\nbase:\n";
   std::istringstream lines(scenario_with(text));
   for (std::string l; std::getline(lines, l);) indented += "  " + l + "\n";
@@ -89,7 +90,8 @@ TEST_P(YamlConstructs, EveryToolExitsTwoWithOneLineNamingIt) {
 
 INSTANTIATE_TEST_SUITE_P(
     Issue19, YamlConstructs,
-    ::testing::Values(std::make_pair(kRecursive, "line 22, column 33: extra.inner: recursive YAML alias *f inside its own anchor &f"),
-                      std::make_pair(kMerge, "line 24, column 3: extra.<<: YAML merge key (<<) not supported")));
+    ::testing::Values(
+        std::make_pair(kRecursive, "line 22, column 33: extra.inner: recursive YAML alias *f inside its own anchor &f"),
+        std::make_pair(kMerge, "line 24, column 3: extra.<<: YAML merge key (<<) not supported")));
 
 }  // namespace

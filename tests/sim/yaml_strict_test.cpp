@@ -16,7 +16,8 @@ const std::string kTail = "duration: 0.01\ncontrol_period: 1e-4\ncontroller: {ty
 
 TEST(YamlStrict, UnclosedQuoteIsASyntaxErrorOnItsLine) {
   // yaml-cpp reads the rest of the file into the name and the error was "duration: missing".
-  EXPECT_EQ(error_of("name: \"abc\n" + kTail), "s.yaml: line 1: YAML syntax error: a quote opened here is never closed");
+  EXPECT_EQ(error_of("name: \"abc\n" + kTail),
+            "s.yaml: line 1: YAML syntax error: a quote opened here is never closed");
   EXPECT_EQ(error_of(kTail + "name: 'abc\n"), "s.yaml: line 4: YAML syntax error: a quote opened here is never closed");
   // Closed on a later line: legal YAML, but it swallows the keys in between.
   EXPECT_EQ(error_of("name: \"abc\n" + kTail + "reference: {type: \"none\"}\n"),
@@ -36,7 +37,8 @@ TEST(YamlStrict, DuplicateKeysNameTheKeyAndBothLines) {
   EXPECT_EQ(error_of("duration: 0.01\n" + kTail), "s.yaml: line 2: duration: duplicate key on lines 1 and 2");
   EXPECT_EQ(error_of(kTail + "plant:\n  mass: 1\n  friction: {model: none, model: lugre}\n"),
             "s.yaml: line 6: plant.friction.model: duplicate key on lines 6 and 6");
-  EXPECT_EQ(error_of(kTail + "plant:\n  mass: 1\n  mass: 2\n"), "s.yaml: line 6: plant.mass: duplicate key on lines 5 and 6");
+  EXPECT_EQ(error_of(kTail + "plant:\n  mass: 1\n  mass: 2\n"),
+            "s.yaml: line 6: plant.mass: duplicate key on lines 5 and 6");
 }
 
 TEST(YamlStrict, ExplodingAliasesAreRefused) {
@@ -54,7 +56,8 @@ TEST(YamlStrict, NameIsBoundedPrintableUtf8) {
             "s.yaml: name: byte 2 (0x09) is not printable UTF-8 (control character or malformed sequence)");
   EXPECT_EQ(error_of("name: " + std::string(kMaxNameBytes + 1, 'x') + "\n" + kTail),
             "s.yaml: name: 257 bytes: too long (at most 256)");
-  EXPECT_EQ(parse_scenario("name: Schleifen \xc3\xa4 \xe2\x80\x94 ok\n" + kTail).name, "Schleifen \xc3\xa4 \xe2\x80\x94 ok");
+  EXPECT_EQ(parse_scenario("name: Schleifen \xc3\xa4 \xe2\x80\x94 ok\n" + kTail).name,
+            "Schleifen \xc3\xa4 \xe2\x80\x94 ok");
   EXPECT_EQ(parse_scenario("name: " + std::string(kMaxNameBytes, 'x') + "\n" + kTail).name.size(), kMaxNameBytes);
 }
 
@@ -81,14 +84,16 @@ TEST(YamlStrict, MergeKeyIsRefusedAtTheKey) {
             "s.yaml: line 6, column 3: b.<<: YAML merge key (<<) not supported: write the keys out");
   EXPECT_EQ(error_of("<<: {duration: 1}\n" + kTail),
             "s.yaml: line 1, column 1: <<: YAML merge key (<<) not supported: write the keys out");
-  EXPECT_NE(error_of(kTail + "plant: {<<: [{mass: 1}, {mass: 2}]}\n").find("plant.<<: YAML merge key"), std::string::npos);
+  EXPECT_NE(error_of(kTail + "plant: {<<: [{mass: 1}, {mass: 2}]}\n").find("plant.<<: YAML merge key"),
+            std::string::npos);
   // A quoted '<<' is an ordinary key (YAML 1.1): the loader's unknown-key rule names it.
   EXPECT_EQ(error_of(kTail + "'<<': 1\n"), "s.yaml: <<: unknown key");
 }
 
 TEST(YamlStrict, AliasesOfFinishedNodesStillWork) {
   // An alias that repeats a finished node is no cycle: it loads like the written-out copy.
-  const Scenario a = parse_scenario(kTail + "plant: {friction: {model: lugre, static_force: &v 150, coulomb_force: *v}}\n");
+  const Scenario a =
+      parse_scenario(kTail + "plant: {friction: {model: lugre, static_force: &v 150, coulomb_force: *v}}\n");
   EXPECT_EQ(a.plant.friction.static_force, 150.0);
   EXPECT_EQ(a.plant.friction.coulomb_force, 150.0);
 }

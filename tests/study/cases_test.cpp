@@ -83,7 +83,8 @@ TEST(StudyCases, CaseAtIndexIsTheDocumentedOrder) {
   // The variations too: case_at(113) is the last draw of the cascade's Monte Carlo family.
   const CaseSpec last = case_at(s, 113);
   ASSERT_EQ(last.variations.size(), 4u);
-  EXPECT_EQ(last.variations[0].value, validate::format_number(draw_value(s.families[2].monte_carlo.parameters[0], 11, 49, 0)));
+  EXPECT_EQ(last.variations[0].value,
+            validate::format_number(draw_value(s.families[2].monte_carlo.parameters[0], 11, 49, 0)));
 }
 
 TEST(StudyCases, ProbesCoverEveryAxisValueOnceWithinTheBudget) {
@@ -233,7 +234,8 @@ TEST(StudyCases, WrongKeysAndValuesAreTheLoadersOneLineErrors) {
   EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: plant.frction.static_force, values: [1]}]}\n")
                 .find("family 'f', point 0: plant.frction: unknown key (did you mean 'friction'?)"),
             std::string::npos);
-  EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: plant.mass, values: [-3]}]}\n").find("plant.mass = -3: must be > 0"),
+  EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: plant.mass, values: [-3]}]}\n")
+                .find("plant.mass = -3: must be > 0"),
             std::string::npos);
   EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: plant.friction.model.x, values: [1]}]}\n")
                 .find("plant.friction.model is a single value in the scenario, not a map of keys"),
@@ -245,10 +247,12 @@ TEST(StudyCases, WrongKeysAndValuesAreTheLoadersOneLineErrors) {
                 .find("reference.frequency: cannot scale a key the scenario does not have"),
             std::string::npos);
   // A factor on a zero (the default computation delay) would make every case the nominal one.
-  EXPECT_NE(error_of("families:\n  - {name: f, grid: [{key: controller.computation_delay, scale: [2, 3]}]}\n")
-                .find("family 'f', point 0: controller.computation_delay = 0: scaling a zero value gives 0 for every factor"),
-            std::string::npos);
-  EXPECT_NE(error_of("families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, parameters: [{key: controller.computation_delay,"
+  EXPECT_NE(
+      error_of("families:\n  - {name: f, grid: [{key: controller.computation_delay, scale: [2, 3]}]}\n")
+          .find("family 'f', point 0: controller.computation_delay = 0: scaling a zero value gives 0 for every factor"),
+      std::string::npos);
+  EXPECT_NE(error_of("families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, parameters: [{key: "
+                     "controller.computation_delay,"
                      " distribution: uniform, low: 0.5, high: 2, scale: true}]}\n")
                 .find("controller.computation_delay = 0: scaling a zero value"),
             std::string::npos);
@@ -257,11 +261,14 @@ TEST(StudyCases, WrongKeysAndValuesAreTheLoadersOneLineErrors) {
 TEST(StudyCases, TheStudysSetHoldsForEveryControllerAndAControllersOwnSetIsMoreSpecific) {
   // Before: the controller block and its scenario's control_period replaced what the study's set
   // said, silently (a 1 ms delay in set: ran with none).
-  const std::string t = "set: {duration: 0.02, control_period: 2.0e-4, controller.computation_delay: 1.0e-3, controller.lambda: 77}\n"
-                        "controllers:\n"
-                        "  - {name: sgn, scenario: " + test::scenarios() + "/smc_jerk_limited.yaml}\n"
-                        "  - {name: bl, controller: {type: sliding_mode, switching: sat, lambda: 1000},"
-                        " set: {controller.lambda: 500}}\n";
+  const std::string t =
+      "set: {duration: 0.02, control_period: 2.0e-4, controller.computation_delay: 1.0e-3, controller.lambda: 77}\n"
+      "controllers:\n"
+      "  - {name: sgn, scenario: " +
+      test::scenarios() +
+      "/smc_jerk_limited.yaml}\n"
+      "  - {name: bl, controller: {type: sliding_mode, switching: sat, lambda: 1000},"
+      " set: {controller.lambda: 500}}\n";
   const Study s = parse_study("name: t\nbase: " + test::scenarios() + "/smc_bl_jerk_limited.yaml\n" + t, ".", "s.yaml");
   Resolver r(s);
   const auto cases = expand(s);
@@ -276,9 +283,11 @@ TEST(StudyCases, TheStudysSetHoldsForEveryControllerAndAControllersOwnSetIsMoreS
   EXPECT_DOUBLE_EQ(b.controller.sliding_mode.lambda, 500);  // the controller's own set wins
   // A study-level set naming a key another controller type does not have is the loader's
   // one-line error, not dropped.
-  const Study c = parse_study("name: t\nbase: " + test::scenarios() + "/smc_bl_jerk_limited.yaml\n"
-                              "set: {controller.lambda: 77}\ncontrollers:\n  - {name: c, controller: {type: cascade}}\n",
-                              ".", "s.yaml");
+  const Study c =
+      parse_study("name: t\nbase: " + test::scenarios() +
+                      "/smc_bl_jerk_limited.yaml\n"
+                      "set: {controller.lambda: 77}\ncontrollers:\n  - {name: c, controller: {type: cascade}}\n",
+                  ".", "s.yaml");
   Resolver rc(c);
   try {
     rc.resolve(expand(c)[0]);

@@ -11,8 +11,8 @@
 #include <sstream>
 #include <string>
 
-#include "study_util.hpp"
 #include "../support/scratch.hpp"
+#include "study_util.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -45,18 +45,23 @@ ProcResult study(const std::string& args) {
 std::string small_study(const std::string& extra_value = "0.8") {
   return feeddrive::study::test::study_text(
       "controllers:\n"
-      "  - {name: smc, scenario: " + feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml}\n"
+      "  - {name: smc, scenario: " +
+      feeddrive::study::test::scenarios() +
+      "/smc_bl_jerk_limited.yaml}\n"
       "  - {name: cascade, controller: {type: cascade, kv: 3000}}\n"
       "families:\n"
       "  - name: nominal\n"
       "  - name: mass\n"
-      "    grid: [{key: plant.mass, scale: [" + extra_value + ", 1.2]}]\n"
+      "    grid: [{key: plant.mass, scale: [" +
+      extra_value +
+      ", 1.2]}]\n"
       "  - name: mc\n"
       "    monte_carlo:\n"
       "      draws: 3\n"
       "      seed: 5\n"
       "      parameters:\n"
-      "        - {keys: [plant.friction.static_force, plant.friction.coulomb_force], distribution: uniform, low: 0.7, high: 1.3, scale: true}\n"
+      "        - {keys: [plant.friction.static_force, plant.friction.coulomb_force], distribution: uniform, low: 0.7, "
+      "high: 1.3, scale: true}\n"
       "  - name: broken\n"
       "    set: {plant.integrator.max_steps: 1}\n"
       "report: {limit: 0.8}\n");
@@ -138,21 +143,27 @@ TEST(StudyCli, BadStudiesAndFoldersExit2WithOneLine) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     return r.err;
   };
-  const fs::path bad = write_file("bad.yaml", feeddrive::study::test::study_text(
-                                                   "families:\n  - {name: f, grid: [{key: plant.frction.static_force, values: [1]}]}\n"));
-  EXPECT_NE(one_line(study(bad.string() + " --out " + (scratch() / "x").string())).find("plant.frction: unknown key"), std::string::npos);
+  const fs::path bad =
+      write_file("bad.yaml", feeddrive::study::test::study_text(
+                                 "families:\n  - {name: f, grid: [{key: plant.frction.static_force, values: [1]}]}\n"));
+  EXPECT_NE(one_line(study(bad.string() + " --out " + (scratch() / "x").string())).find("plant.frction: unknown key"),
+            std::string::npos);
   EXPECT_FALSE(fs::exists(scratch() / "x"));  // nothing written for a bad study
-  const fs::path mc = write_file("mc.yaml", feeddrive::study::test::study_text(
-                                                "families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, parameters: [{key: plant.mass, distribution: weibull}]}\n"));
-  EXPECT_NE(one_line(study(mc.string() + " --out " + (scratch() / "x").string())).find("distribution = 'weibull'"), std::string::npos);
-  EXPECT_NE(one_line(study((scratch() / "missing.yaml").string() + " --out " + (scratch() / "x").string())).find("cannot read the study file"),
+  const fs::path mc = write_file(
+      "mc.yaml", feeddrive::study::test::study_text("families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, "
+                                                    "parameters: [{key: plant.mass, distribution: weibull}]}\n"));
+  EXPECT_NE(one_line(study(mc.string() + " --out " + (scratch() / "x").string())).find("distribution = 'weibull'"),
+            std::string::npos);
+  EXPECT_NE(one_line(study((scratch() / "missing.yaml").string() + " --out " + (scratch() / "x").string()))
+                .find("cannot read the study file"),
             std::string::npos);
   // A folder feeddrive did not write is never touched.
   const fs::path mine = scratch() / "mine";
   fs::create_directories(mine);
   std::ofstream(mine / "notes.txt") << "keep";
   const fs::path ok = write_file("ok.yaml", feeddrive::study::test::study_text(""));
-  EXPECT_NE(one_line(study(ok.string() + " --out " + mine.string())).find("is not a feeddrive output"), std::string::npos);
+  EXPECT_NE(one_line(study(ok.string() + " --out " + mine.string())).find("is not a feeddrive output"),
+            std::string::npos);
   EXPECT_EQ(slurp(mine / "notes.txt"), "keep");
   // -j must be a count.
   EXPECT_EQ(study(ok.string() + " --out " + (scratch() / "y").string() + " -j 0").code, 2);
@@ -161,8 +172,9 @@ TEST(StudyCli, BadStudiesAndFoldersExit2WithOneLine) {
 TEST(StudyCli, ReplacesTheOutputOfAnotherFeeddriveTool) {
   const fs::path dir = scratch() / "was_sim";
   const std::string sim = std::string(FEEDDRIVE_BINARY_DIR) + "/bin/feeddrive-sim";
-  ASSERT_EQ(std::system((sim + " " + feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml --out " + dir.string() +
-                         " --no-plots --quiet").c_str()),
+  ASSERT_EQ(std::system((sim + " " + feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml --out " +
+                         dir.string() + " --no-plots --quiet")
+                            .c_str()),
             0);
   ASSERT_TRUE(fs::exists(dir / "timeseries.csv"));
   const fs::path ok = write_file("ok2.yaml", feeddrive::study::test::study_text(""));
@@ -178,10 +190,12 @@ TEST(StudyCli, WithoutGnuplotTheResultsAndReportAreStillWritten) {
   const fs::path dir = scratch() / "no_gnuplot";
   const fs::path f = write_file("nogp.yaml", feeddrive::study::test::study_text(""));
   const int status = std::system(("PATH=/nonexistent " + kStudy + " -q " + f.string() + " --out " + dir.string() +
-                                  " -j 1 2> " + (scratch() / "nogp.err").string() + " > /dev/null").c_str());
+                                  " -j 1 2> " + (scratch() / "nogp.err").string() + " > /dev/null")
+                                     .c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << slurp(scratch() / "nogp.err");
-  EXPECT_NE(slurp(scratch() / "nogp.err").find("plots not drawn ("), std::string::npos) << slurp(scratch() / "nogp.err");
+  EXPECT_NE(slurp(scratch() / "nogp.err").find("plots not drawn ("), std::string::npos)
+      << slurp(scratch() / "nogp.err");
   EXPECT_TRUE(fs::exists(dir / "results.csv"));
   EXPECT_NE(slurp(dir / "report.md").find("Plots not drawn"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / ".plots.partial"));
@@ -191,8 +205,8 @@ TEST(StudyCli, ACaseWithoutAValueOfTheMetricIsNotCountedAsFailed) {
   // A settled metric of a run shorter than settled_after (0.02 s < 0.25 s) has no value: the
   // report once counted such cases as failed while results.csv said ok.
   const fs::path dir = scratch() / "no_value";
-  const fs::path f = write_file("novalue.yaml", feeddrive::study::test::study_text(
-                                                    "report: {metric: position_error_max_abs_settled_m}\n"));
+  const fs::path f = write_file(
+      "novalue.yaml", feeddrive::study::test::study_text("report: {metric: position_error_max_abs_settled_m}\n"));
   const ProcResult r = study("-q --no-plots " + f.string() + " --out " + dir.string() + " -j 1");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = slurp(dir / "report.md");
@@ -208,7 +222,8 @@ namespace {
 TEST(StudyCli, SweepWithoutAStudyFileReportsTheMetricAgainstEachValue) {
   const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
   const fs::path out = scratch() / "sweep";
-  const ProcResult r = study(scen + " --sweep plant.mass=80:120:3 --set duration=0.02 --out " + out.string() + " -j 2 --no-plots");
+  const ProcResult r =
+      study(scen + " --sweep plant.mass=80:120:3 --set duration=0.02 --out " + out.string() + " -j 2 --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = slurp(out / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 cases
@@ -245,8 +260,8 @@ TEST(StudyCli, ASweepShowsItsCasesWarningsAndTheMovesThatDidNotFinish) {
   const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
   const fs::path out = scratch() / "warn";
   // 10 ms: both moves (about a second) are cut off; 500 m/s is mm/s meant.
-  const ProcResult r = study(scen + " --sweep reference.max_velocity=0.2,500 --set duration=0.01 --out " + out.string() +
-                             " -j 2 --no-plots");
+  const ProcResult r = study(scen + " --sweep reference.max_velocity=0.2,500 --set duration=0.01 --out " +
+                             out.string() + " -j 2 --no-plots");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("[warning] reference.max_velocity: 500 m/s"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("mm/s? (1 of 2 cases)"), std::string::npos) << r.err;

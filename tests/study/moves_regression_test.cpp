@@ -9,10 +9,9 @@
 // measured by the study plus 10 %: room for another compiler or libm moving CVODE's adaptive
 // steps (the error is a maximum over noise-driven samples, so it moves by a fraction of itself,
 // not by rounding), small enough that a real regression of the size the docs would have to
-// report (a tenth of the worst case) fails; and at least half of it (check()). The signal limits are checked as the verdict
-// itself (control_signal_within_limits) and, where the controller is known to miss one, as a
-// bound on its measured figure with the same 10 %: it must not get worse while the docs say
-// how far over the limit it is.
+// report (a tenth of the worst case) fails; and at least half of it (check()). The signal limits are checked as the
+// verdict itself (control_signal_within_limits) and, where the controller is known to miss one, as a bound on its
+// measured figure with the same 10 %: it must not get worse while the docs say how far over the limit it is.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -46,7 +45,8 @@ Outcome run(const Study& s, const std::string& controller, const std::string& fa
             long draw = -1) {
   Resolver resolver(s);
   for (const CaseSpec& c : expand(s)) {
-    if (s.controllers[c.controller].name != controller || s.families[c.family].name != family || c.draw != draw) continue;
+    if (s.controllers[c.controller].name != controller || s.families[c.family].name != family || c.draw != draw)
+      continue;
     bool match = true;
     for (const Want& w : want) {
       bool found = false;

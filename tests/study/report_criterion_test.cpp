@@ -24,15 +24,17 @@ Outcome outcome(double max_abs_m, double within_limits) {
 }
 
 TEST(StudyReportCriterion, RequireNamesVerdictsStrictly) {
-  const Study s = parse_study(study_text("report: {limit: 0.8, require: [control_signal_within_limits]}\n"), ".", "s.yaml");
+  const Study s =
+      parse_study(study_text("report: {limit: 0.8, require: [control_signal_within_limits]}\n"), ".", "s.yaml");
   ASSERT_EQ(s.report.require.size(), 1u);
   EXPECT_EQ(s.report.require[0], "control_signal_within_limits");
   EXPECT_TRUE(s.report.has_criterion());
   // A misspelt verdict: the nearest name.
-  EXPECT_NE(study_error(study_text("report: {require: [control_signal_within_limit]}\n"))
-                .find("report.require[0] = 'control_signal_within_limit': not a true/false verdict of summary.json (did you "
-                      "mean 'control_signal_within_limits'?)"),
-            std::string::npos);
+  EXPECT_NE(
+      study_error(study_text("report: {require: [control_signal_within_limit]}\n"))
+          .find("report.require[0] = 'control_signal_within_limit': not a true/false verdict of summary.json (did you "
+                "mean 'control_signal_within_limits'?)"),
+      std::string::npos);
   // A number is a metric, not a verdict: nothing close, so the list of verdicts.
   const std::string e = study_error(study_text("report: {require: [position_error_max_abs_m]}\n"));
   EXPECT_NE(e.find("report.require[0] = 'position_error_max_abs_m': not a true/false verdict"), std::string::npos) << e;
@@ -40,29 +42,32 @@ TEST(StudyReportCriterion, RequireNamesVerdictsStrictly) {
   EXPECT_NE(study_error(study_text("report: {require: [control_chattering, control_chattering]}\n"))
                 .find("report.require[1] = 'control_chattering': listed twice"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text("report: {require: {a: 1}}\n")).find("report.require = (a map): expected a list of names"),
-            std::string::npos);
+  EXPECT_NE(
+      study_error(study_text("report: {require: {a: 1}}\n")).find("report.require = (a map): expected a list of names"),
+      std::string::npos);
   EXPECT_FALSE(parse_study(study_text(""), ".", "s.yaml").report.has_criterion());
 }
 
 // Each way to fail, one at a time: over the limit, a verdict false, a verdict missing (an
 // outcome of an older version), a failed case, no value; and the case that passes.
 TEST(StudyReportCriterion, ACasePassesOnlyWithinTheLimitAndWithEveryVerdictTrue) {
-  const Study s = parse_study(study_text("report: {limit: 0.8, require: [control_signal_within_limits]}\n"), ".", "s.yaml");
+  const Study s =
+      parse_study(study_text("report: {limit: 0.8, require: [control_signal_within_limits]}\n"), ".", "s.yaml");
   EXPECT_TRUE(case_passes(s, outcome(0.5e-6, 1.0), 0.5));
-  EXPECT_TRUE(case_passes(s, outcome(0.8e-6, 1.0), 0.8));    // at the limit: passes (<=)
-  EXPECT_FALSE(case_passes(s, outcome(0.9e-6, 1.0), 0.9));   // over the limit
-  EXPECT_FALSE(case_passes(s, outcome(0.5e-6, 0.0), 0.5));   // the signal outside its limits
+  EXPECT_TRUE(case_passes(s, outcome(0.8e-6, 1.0), 0.8));   // at the limit: passes (<=)
+  EXPECT_FALSE(case_passes(s, outcome(0.9e-6, 1.0), 0.9));  // over the limit
+  EXPECT_FALSE(case_passes(s, outcome(0.5e-6, 0.0), 0.5));  // the signal outside its limits
   Outcome old = outcome(0.5e-6, 1.0);
   old.metrics.pop_back();
-  EXPECT_FALSE(case_passes(s, old, 0.5));                     // no verdict recorded: not a pass
+  EXPECT_FALSE(case_passes(s, old, 0.5));  // no verdict recorded: not a pass
   Outcome failed;
   EXPECT_FALSE(case_passes(s, failed, NAN));
-  EXPECT_FALSE(case_passes(s, outcome(0.5e-6, 1.0), NAN));    // no value of the metric
+  EXPECT_FALSE(case_passes(s, outcome(0.5e-6, 1.0), NAN));  // no value of the metric
   // Only a limit: the verdict does not count; only a verdict: the metric does not.
   const Study limit_only = parse_study(study_text("report: {limit: 0.8}\n"), ".", "s.yaml");
   EXPECT_TRUE(case_passes(limit_only, outcome(0.5e-6, 0.0), 0.5));
-  const Study verdict_only = parse_study(study_text("report: {require: [control_signal_within_limits]}\n"), ".", "s.yaml");
+  const Study verdict_only =
+      parse_study(study_text("report: {require: [control_signal_within_limits]}\n"), ".", "s.yaml");
   EXPECT_TRUE(case_passes(verdict_only, outcome(5e-6, 1.0), 5.0));
   EXPECT_FALSE(case_passes(verdict_only, outcome(0.1e-6, 0.0), 0.1));
 }

@@ -58,8 +58,7 @@ Outcome ok_with(double error_m) {
 std::string plot_script(const fs::path& dir, const ReportData& d) {
   try {
     write_plots(dir, "plots/", d);
-  } catch (const std::runtime_error&) {
-  }
+  } catch (const std::runtime_error&) {}
   return test_support::slurp(dir / "plots.gp");
 }
 
@@ -158,9 +157,9 @@ TEST(StudyReport, ALogSweepIsPlottedOnALogAxis) {
   const Study s = sweep({"plant.sensor.quantization=log:1e-9:1e-6:3"});
   EXPECT_TRUE(log_axis(s, "plant.sensor.quantization", {0.001, 0.0316, 1}));
   const Study lin = sweep({"plant.mass=1:1000:3"});
-  EXPECT_TRUE(log_axis(lin, "plant.mass", {1, 500.5, 1000}));    // three decades
-  EXPECT_FALSE(log_axis(lin, "plant.mass", {80, 100, 120}));     // a fraction of one
-  EXPECT_FALSE(log_axis(lin, "plant.mass", {0, 100, 1000}));     // 0 has no logarithm
+  EXPECT_TRUE(log_axis(lin, "plant.mass", {1, 500.5, 1000}));  // three decades
+  EXPECT_FALSE(log_axis(lin, "plant.mass", {80, 100, 120}));   // a fraction of one
+  EXPECT_FALSE(log_axis(lin, "plant.mass", {0, 100, 1000}));   // 0 has no logarithm
   ReportData d(s);
   report_of(s, d, [](std::size_t) { return ok_with(1e-6); });
   const std::string gp = plot_script(test_support::make_scratch("study-report-log"), d);

@@ -40,16 +40,19 @@ TEST(StudySpec, AMisspeltReportMetricIsRefusedWithTheNearestName) {
                    "'position_error_max_abs_m'?)"),
             std::string::npos)
       << e;
-  EXPECT_NE(study_error(study_text("report: {metric: wall_time_s}\n")).find("report.metric = 'wall_time_s': not a metric"),
-            std::string::npos);  // a wall-clock metric is not in results.csv
-  EXPECT_NE(study_error(study_text("report: {metric: wobble}\n")).find("; one of control_period_s, steps, sim_time_s, position_error_max_abs_m, "),
+  EXPECT_NE(
+      study_error(study_text("report: {metric: wall_time_s}\n")).find("report.metric = 'wall_time_s': not a metric"),
+      std::string::npos);  // a wall-clock metric is not in results.csv
+  EXPECT_NE(study_error(study_text("report: {metric: wobble}\n"))
+                .find("; one of control_period_s, steps, sim_time_s, position_error_max_abs_m, "),
             std::string::npos);  // nothing close: the list
   EXPECT_NO_THROW(parse_study(study_text("report: {metric: control_total_variation}\n"), ".", "s.yaml"));
 }
 
 TEST(StudySpec, ASeedBeyondSixtyFourBitsIsRefusedNotClamped) {
-  const std::string mc = "families:\n  - name: f\n    monte_carlo:\n      draws: 2\n      parameters:\n"
-                         "        - {key: plant.mass, distribution: uniform, low: 90, high: 110}\n      seed: ";
+  const std::string mc =
+      "families:\n  - name: f\n    monte_carlo:\n      draws: 2\n      parameters:\n"
+      "        - {key: plant.mass, distribution: uniform, low: 90, high: 110}\n      seed: ";
   EXPECT_NO_THROW(parse_study(study_text(mc + "18446744073709551615\n"), ".", "s.yaml"));
   const std::string e = study_error(study_text(mc + "18446744073709551616\n"));
   EXPECT_NE(e.find("seed = '18446744073709551616': out of range (0 to 18446744073709551615)"), std::string::npos) << e;
@@ -72,7 +75,8 @@ families:
       seed: 3
       parameters:
         - {key: plant.friction.viscous, distribution: lognormal, mu: 0, sigma: 0.2, scale: true}
-)"), ".", "s.yaml");
+)"),
+                              ".", "s.yaml");
   EXPECT_EQ(s.family_cases(0), 1);
   EXPECT_EQ(s.family_cases(1), 3 * 2 * 4);
   EXPECT_EQ(s.total_cases(), 3 * (1 + 24));
@@ -80,7 +84,8 @@ families:
 
 TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
   const std::string fam = "families:\n  - name: f\n";
-  EXPECT_NE(study_error(study_text("familes: []\n")).find("familes: unknown key (did you mean 'families'?)"), std::string::npos);
+  EXPECT_NE(study_error(study_text("familes: []\n")).find("familes: unknown key (did you mean 'families'?)"),
+            std::string::npos);
   EXPECT_NE(study_error(study_text(fam + "    grid: []\n")).find("families[0].grid: empty grid"), std::string::npos);
   EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: plant.mass, values: []}\n")).find("empty grid axis"),
             std::string::npos);
@@ -90,28 +95,38 @@ TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
   EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: plant.mass, scale: [x]}\n"))
                 .find("families[0].grid[0].scale[0] = 'x': not a number"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: 'plant..mass', values: [1]}\n")).find("not a dotted scenario key"),
+  EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {key: 'plant..mass', values: [1]}\n"))
+                .find("not a dotted scenario key"),
             std::string::npos);
   EXPECT_NE(study_error(study_text(fam + "    grid:\n      - {keys: [a, b], values: [[1, 2, 3]]}\n"))
                 .find("expected one value per key (2)"),
             std::string::npos);
   const std::string mc = fam + "    monte_carlo:\n";
-  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: cauchy}\n"))
-                .find("distribution = 'cauchy': expected one of uniform, normal, lognormal"),
-            std::string::npos);
-  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: uniform, low: 2, high: 1}\n"))
+  EXPECT_NE(
+      study_error(
+          study_text(
+              mc +
+              "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: cauchy}\n"))
+          .find("distribution = 'cauchy': expected one of uniform, normal, lognormal"),
+      std::string::npos);
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, "
+                                        "distribution: uniform, low: 2, high: 1}\n"))
                 .find("parameters[0].high = 1: must be > low (2)"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: normal, mean: 1}\n"))
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, "
+                                        "distribution: normal, mean: 1}\n"))
                 .find("stddev: missing (required by distribution normal)"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, distribution: normal, mean: 0, stddev: 1, low: 50, high: 60}\n"))
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      seed: 1\n      parameters:\n        - {key: plant.mass, "
+                                        "distribution: normal, mean: 0, stddev: 1, low: 50, high: 60}\n"))
                 .find("holds almost none of the distribution"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      parameters:\n        - {key: plant.mass, distribution: uniform, low: 1, high: 2}\n"))
+  EXPECT_NE(study_error(study_text(mc + "      draws: 2\n      parameters:\n        - {key: plant.mass, distribution: "
+                                        "uniform, low: 1, high: 2}\n"))
                 .find("seed: missing"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text(mc + "      draws: 0\n      seed: 1\n      parameters: []\n")).find("draws = 0: must be >= 1"),
+  EXPECT_NE(study_error(study_text(mc + "      draws: 0\n      seed: 1\n      parameters: []\n"))
+                .find("draws = 0: must be >= 1"),
             std::string::npos);
   // Impossible case counts: each axis is fine, the product is not.
   std::string axis = "[";
@@ -120,14 +135,20 @@ TEST(StudySpec, BadFilesGetOneLineErrorsNamingKeyAndValue) {
   std::string huge = fam + "    grid:\n";
   for (int i = 0; i < 4; ++i) huge += "      - {key: plant.k" + std::to_string(i) + ", values: " + axis + "}\n";
   EXPECT_NE(study_error(study_text(huge)).find("more than 1000000 cases"), std::string::npos);
-  EXPECT_NE(study_error(study_text("controllers:\n  - {name: a, controller: {type: cascade}}\n  - {name: a, controller: {type: cascade}}\n"))
-                .find("controllers[1].name = 'a': used twice"),
+  EXPECT_NE(
+      study_error(
+          study_text(
+              "controllers:\n  - {name: a, controller: {type: cascade}}\n  - {name: a, controller: {type: cascade}}\n"))
+          .find("controllers[1].name = 'a': used twice"),
+      std::string::npos);
+  EXPECT_NE(study_error(study_text("controllers:\n  - {name: a}\n")).find("give exactly one of controller:"),
             std::string::npos);
-  EXPECT_NE(study_error(study_text("controllers:\n  - {name: a}\n")).find("give exactly one of controller:"), std::string::npos);
   EXPECT_NE(study_error("name: t\n").find("base: missing"), std::string::npos);
-  EXPECT_NE(study_error("name: t\nbase: /nonexistent.yaml\n").find("/nonexistent.yaml: cannot read the base file"), std::string::npos);
+  EXPECT_NE(study_error("name: t\nbase: /nonexistent.yaml\n").find("/nonexistent.yaml: cannot read the base file"),
+            std::string::npos);
   EXPECT_NE(study_error("name: [t\n").find("YAML syntax error"), std::string::npos);
-  EXPECT_NE(study_error(study_text("report: {scale: .nan}\n")).find("report.scale = '.nan': NaN is not allowed"), std::string::npos);
+  EXPECT_NE(study_error(study_text("report: {scale: .nan}\n")).find("report.scale = '.nan': NaN is not allowed"),
+            std::string::npos);
 }
 
 }  // namespace
@@ -155,7 +176,8 @@ TEST(StudySpec, SweepRefusesAStudyFileAndAKeySweptTwice) {
     EXPECT_EQ(std::string(e.what()), "--sweep plant.mass: the key is swept twice (give all its values in one --sweep)");
   }
   // Different keys make a grid; a log sweep is marked for the report's log axis.
-  const Study s = sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.sensor.quantization=log:1e-9:1e-6:3")});
+  const Study s =
+      sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.sensor.quantization=log:1e-9:1e-6:3")});
   EXPECT_EQ(s.total_cases(), 6);
   EXPECT_FALSE(s.families[0].grid[0].log);
   EXPECT_TRUE(s.families[0].grid[1].log);

@@ -18,8 +18,7 @@ using testing::check_profile;
 using testing::Limits;
 using testing::Move;
 
-AccelLimitedParams make_params(double d, double vmax, double amax, double t0 = 0.0,
-                               double initial = 0.0) {
+AccelLimitedParams make_params(double d, double vmax, double amax, double t0 = 0.0, double initial = 0.0) {
   AccelLimitedParams p;
   p.distance = d;
   p.max_velocity = vmax;
@@ -64,10 +63,9 @@ TEST(AccelLimited, TrapezoidWhenVmaxIsReached) {
   struct Point {
     double t, x, v, a;
   };
-  for (const Point& q :
-       {Point{1.0, 3.0, 0.0, 1.0}, Point{2.0, 3.5, 1.0, 1.0}, Point{3.0, 5.0, 2.0, 0.0},
-        Point{4.5, 8.0, 2.0, 0.0}, Point{6.0, 11.0, 2.0, -1.0}, Point{7.0, 12.5, 1.0, -1.0},
-        Point{8.0, 13.0, 0.0, 0.0}, Point{9.0, 13.0, 0.0, 0.0}}) {
+  for (const Point& q : {Point{1.0, 3.0, 0.0, 1.0}, Point{2.0, 3.5, 1.0, 1.0}, Point{3.0, 5.0, 2.0, 0.0},
+                         Point{4.5, 8.0, 2.0, 0.0}, Point{6.0, 11.0, 2.0, -1.0}, Point{7.0, 12.5, 1.0, -1.0},
+                         Point{8.0, 13.0, 0.0, 0.0}, Point{9.0, 13.0, 0.0, 0.0}}) {
     const Sample s = tr->sample(q.t);
     // Values of order 1-10 from 2-3 operations: 1e-14 is ~50 ulps; errors would be O(1).
     EXPECT_NEAR(s.position, q.x, 1e-14) << q.t;
@@ -135,8 +133,8 @@ TEST(AccelLimited, RandomSweepProperties) {
     if (unit(rng) < 0.5) p.distance = -p.distance;
     std::ostringstream label;
     label.precision(17);
-    label << "set " << n << ": D=" << p.distance << " vmax=" << p.max_velocity
-          << " amax=" << p.max_acceleration << " t0=" << p.start_time << " x0=" << p.initial;
+    label << "set " << n << ": D=" << p.distance << " vmax=" << p.max_velocity << " amax=" << p.max_acceleration
+          << " t0=" << p.start_time << " x0=" << p.initial;
     SCOPED_TRACE(label.str());
 
     const auto tr = make_accel_limited(p);
@@ -150,8 +148,7 @@ TEST(AccelLimited, RandomSweepProperties) {
     // Acceleration is bang-coast-bang: exactly +-amax or 0; jerk is 0.
     for (double f : {0.1, 0.4, 0.6, 0.9}) {
       const Sample s = tr->sample(p.start_time + f * t);
-      EXPECT_TRUE(s.acceleration == 0.0 || std::abs(s.acceleration) == p.max_acceleration)
-          << s.acceleration;
+      EXPECT_TRUE(s.acceleration == 0.0 || std::abs(s.acceleration) == p.max_acceleration) << s.acceleration;
       EXPECT_EQ(s.jerk, 0.0);
     }
     // Peak: vmax for a trapezoid, sqrt(D amax) for a triangle. The grid (4000 points over

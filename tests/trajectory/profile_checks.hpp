@@ -31,7 +31,7 @@ constexpr double kRoundRel = 64.0 * kEps;
 // relative). The brief asks for ~1e-9 relative to |D|, which is what we assert.
 constexpr double kSimpsonRelTol = 1e-9;
 constexpr int kSimpsonPanelsPerSegment = 16;  // even; exactness does not depend on it
-constexpr double kTinySegment = 64.0;  // segments below 64 "time roundings" are not integrated
+constexpr double kTinySegment = 64.0;         // segments below 64 "time roundings" are not integrated
 
 struct Limits {
   double vmax;
@@ -68,9 +68,8 @@ struct Peaks {
   double v{0.0};
   double a{0.0};
 };
-inline Peaks check_profile(const Trajectory& tr, const Move& m, const Limits& lim,
-                           bool accel_continuous, const std::string& label,
-                           int grid_points = 2000) {
+inline Peaks check_profile(const Trajectory& tr, const Move& m, const Limits& lim, bool accel_continuous,
+                           const std::string& label, int grid_points = 2000) {
   SCOPED_TRACE(label);
   Peaks peaks;
   const double dir = m.distance < 0.0 ? -1.0 : 1.0;
@@ -108,26 +107,23 @@ inline Peaks check_profile(const Trajectory& tr, const Move& m, const Limits& li
   for (int k = 1; k <= grid_points && failures < 5; ++k) {
     const double t = lo + k * dt;
     const Sample s = tr.sample(t);
-    const bool finite = std::isfinite(s.position) && std::isfinite(s.velocity) &&
-                        std::isfinite(s.acceleration) && std::isfinite(s.jerk);
+    const bool finite = std::isfinite(s.position) && std::isfinite(s.velocity) && std::isfinite(s.acceleration) &&
+                        std::isfinite(s.jerk);
     const bool within = std::abs(s.velocity) <= lim.vmax * (1.0 + kLimitRelTol) &&
                         std::abs(s.acceleration) <= lim.amax * (1.0 + kLimitRelTol) &&
                         std::abs(s.jerk) <= lim.jmax * (1.0 + kLimitRelTol);
     const double h = dt + dt_round;
     const bool lipschitz =
-        std::abs(s.position - prev.position) <=
-            lim.vmax * h * (1.0 + kLimitRelTol) + kRoundRel * x_scale &&
-        std::abs(s.velocity - prev.velocity) <=
-            lim.amax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.vmax &&
-        (!accel_continuous || std::abs(s.acceleration - prev.acceleration) <=
-                                  lim.jmax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.amax);
-    const bool monotone =
-        dir * (s.position - prev.position) >= -kRoundRel * x_scale && dir * s.velocity >= 0.0;
+        std::abs(s.position - prev.position) <= lim.vmax * h * (1.0 + kLimitRelTol) + kRoundRel * x_scale &&
+        std::abs(s.velocity - prev.velocity) <= lim.amax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.vmax &&
+        (!accel_continuous ||
+         std::abs(s.acceleration - prev.acceleration) <= lim.jmax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.amax);
+    const bool monotone = dir * (s.position - prev.position) >= -kRoundRel * x_scale && dir * s.velocity >= 0.0;
     if (!(finite && within && lipschitz && monotone)) {
       ++failures;
-      ADD_FAILURE() << "t=" << t << " finite=" << finite << " within=" << within
-                    << " lipschitz=" << lipschitz << " monotone=" << monotone << " x=" << s.position
-                    << " v=" << s.velocity << " a=" << s.acceleration << " j=" << s.jerk;
+      ADD_FAILURE() << "t=" << t << " finite=" << finite << " within=" << within << " lipschitz=" << lipschitz
+                    << " monotone=" << monotone << " x=" << s.position << " v=" << s.velocity << " a=" << s.acceleration
+                    << " j=" << s.jerk;
     }
     peaks.v = std::max(peaks.v, std::abs(s.velocity));
     peaks.a = std::max(peaks.a, std::abs(s.acceleration));
@@ -147,15 +143,12 @@ inline Peaks check_profile(const Trajectory& tr, const Move& m, const Limits& li
     const Sample l = tr.sample(t - delta);
     const Sample r = tr.sample(t + delta);
     const double h = 2.0 * delta + dt_round;
-    EXPECT_LE(std::abs(r.position - l.position),
-              lim.vmax * h * (1.0 + kLimitRelTol) + kRoundRel * x_scale)
+    EXPECT_LE(std::abs(r.position - l.position), lim.vmax * h * (1.0 + kLimitRelTol) + kRoundRel * x_scale)
         << "x jumps at t0+" << b;
-    EXPECT_LE(std::abs(r.velocity - l.velocity),
-              lim.amax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.vmax)
+    EXPECT_LE(std::abs(r.velocity - l.velocity), lim.amax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.vmax)
         << "v jumps at t0+" << b;
     if (accel_continuous) {
-      EXPECT_LE(std::abs(r.acceleration - l.acceleration),
-                lim.jmax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.amax)
+      EXPECT_LE(std::abs(r.acceleration - l.acceleration), lim.jmax * h * (1.0 + kLimitRelTol) + kRoundRel * lim.amax)
           << "a jumps at t0+" << b;
     }
   }
@@ -179,12 +172,10 @@ inline Peaks check_profile(const Trajectory& tr, const Move& m, const Limits& li
     if (b - a <= kTinySegment * dt_round) continue;
     const double e = std::max(1e-6 * (b - a), 4.0 * dt_round);
     const double scale = (b - a) / (b - a - 2.0 * e);
-    x_integral +=
-        simpson([&](double t) { return tr.sample(t).velocity; }, a, b, kSimpsonPanelsPerSegment);
-    v_integral += scale * simpson([&](double t) { return tr.sample(t).acceleration; }, a + e, b - e,
-                                  kSimpsonPanelsPerSegment);
-    a_integral += scale * simpson([&](double t) { return tr.sample(t).jerk; }, a + e, b - e,
-                                  kSimpsonPanelsPerSegment);
+    x_integral += simpson([&](double t) { return tr.sample(t).velocity; }, a, b, kSimpsonPanelsPerSegment);
+    v_integral +=
+        scale * simpson([&](double t) { return tr.sample(t).acceleration; }, a + e, b - e, kSimpsonPanelsPerSegment);
+    a_integral += scale * simpson([&](double t) { return tr.sample(t).jerk; }, a + e, b - e, kSimpsonPanelsPerSegment);
     const Sample at_b = tr.sample(b);
     // Besides kSimpsonRelTol: in absolute time a segment's length is only known to a few
     // ulp(|t|) (dt_round); that shifts each integral by up to (derivative bound) * dt_round.

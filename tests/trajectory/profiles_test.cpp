@@ -35,10 +35,8 @@ TEST(Sine, AnalyticDerivativesMatchFiniteDifferences) {
     const Sample lo = tr->sample(t - kH);
     const Sample hi = tr->sample(t + kH);
     EXPECT_NEAR(s.velocity, (hi.position - lo.position) / (2 * kH), kRelTol * p.amplitude * w);
-    EXPECT_NEAR(s.acceleration, (hi.velocity - lo.velocity) / (2 * kH),
-                kRelTol * p.amplitude * w * w);
-    EXPECT_NEAR(s.jerk, (hi.acceleration - lo.acceleration) / (2 * kH),
-                kRelTol * p.amplitude * w * w * w);
+    EXPECT_NEAR(s.acceleration, (hi.velocity - lo.velocity) / (2 * kH), kRelTol * p.amplitude * w * w);
+    EXPECT_NEAR(s.jerk, (hi.acceleration - lo.acceleration) / (2 * kH), kRelTol * p.amplitude * w * w * w);
     // And the closed form itself (same expression; 1e-16 ~ 1 ulp of 0.1).
     const double theta = w * (t - p.start_time) + p.phase;
     EXPECT_NEAR(s.position, p.offset + p.amplitude * std::sin(theta), 1e-16);
@@ -55,7 +53,7 @@ TEST(Sine, HoldsTheStartValueBeforeStartTime) {
   EXPECT_EQ(before.velocity, 0.0);
   EXPECT_EQ(before.acceleration, 0.0);
   EXPECT_EQ(before.jerk, 0.0);
-  EXPECT_EQ(tr->sample(2.0).position, before.position);  // x is continuous at t0
+  EXPECT_EQ(tr->sample(2.0).position, before.position);                            // x is continuous at t0
   EXPECT_NEAR(tr->sample(2.0).velocity, 0.1 * 2.0 * M_PI * std::cos(0.5), 1e-15);  // ~2 ulps
   EXPECT_EQ(tr->end_time(), kInf);
 }
@@ -163,27 +161,23 @@ TEST(Validate, MessagesNameKeyAndValue) {
   EXPECT_EQ(message_of([&] { s.validate(); }), "reference.max_velocity = 0: must be > 0");
   s = SCurveParams{};
   s.max_acceleration = kNaN;
-  EXPECT_EQ(message_of([&] { s.validate(); }),
-            "reference.max_acceleration = nan: must be a finite number");
+  EXPECT_EQ(message_of([&] { s.validate(); }), "reference.max_acceleration = nan: must be a finite number");
   s = SCurveParams{};
   s.distance = kInf;
   EXPECT_EQ(message_of([&] { s.validate(); }), "reference.distance = inf: must be a finite number");
   s = SCurveParams{};
   s.start_time = -kInf;
-  EXPECT_EQ(message_of([&] { s.validate(); }),
-            "reference.start_time = -inf: must be a finite number");
+  EXPECT_EQ(message_of([&] { s.validate(); }), "reference.start_time = -inf: must be a finite number");
   s = SCurveParams{};
   s.initial = kNaN;
   EXPECT_EQ(message_of([&] { s.validate(); }), "reference.initial = nan: must be a finite number");
 
   AccelLimitedParams a;
   a.max_acceleration = -0.4;
-  EXPECT_EQ(message_of([&] { make_accel_limited(a); }),
-            "reference.max_acceleration = -0.4: must be > 0");
+  EXPECT_EQ(message_of([&] { make_accel_limited(a); }), "reference.max_acceleration = -0.4: must be > 0");
   a = AccelLimitedParams{};
   a.max_velocity = kInf;
-  EXPECT_EQ(message_of([&] { a.validate(); }),
-            "reference.max_velocity = inf: must be a finite number");
+  EXPECT_EQ(message_of([&] { a.validate(); }), "reference.max_velocity = inf: must be a finite number");
   a = AccelLimitedParams{};
   a.distance = kNaN;
   EXPECT_EQ(message_of([&] { a.validate(); }), "reference.distance = nan: must be a finite number");
@@ -193,8 +187,7 @@ TEST(Validate, MessagesNameKeyAndValue) {
   EXPECT_EQ(message_of([&] { make_sine(sn); }), "reference.frequency = -1: must be >= 0");
   sn = SineParams{};
   sn.amplitude = kNaN;
-  EXPECT_EQ(message_of([&] { sn.validate(); }),
-            "reference.amplitude = nan: must be a finite number");
+  EXPECT_EQ(message_of([&] { sn.validate(); }), "reference.amplitude = nan: must be a finite number");
   sn = SineParams{};
   sn.phase = kInf;
   EXPECT_EQ(message_of([&] { sn.validate(); }), "reference.phase = inf: must be a finite number");
@@ -203,29 +196,24 @@ TEST(Validate, MessagesNameKeyAndValue) {
   EXPECT_EQ(message_of([&] { sn.validate(); }), "reference.offset = nan: must be a finite number");
   sn = SineParams{};
   sn.start_time = kNaN;
-  EXPECT_EQ(message_of([&] { sn.validate(); }),
-            "reference.start_time = nan: must be a finite number");
+  EXPECT_EQ(message_of([&] { sn.validate(); }), "reference.start_time = nan: must be a finite number");
 
   StepParams st;
   st.step_time = kInf;
-  EXPECT_EQ(message_of([&] { make_step(st); }),
-            "reference.step_time = inf: must be a finite number");
+  EXPECT_EQ(message_of([&] { make_step(st); }), "reference.step_time = inf: must be a finite number");
   st = StepParams{};
   st.amplitude = kNaN;
-  EXPECT_EQ(message_of([&] { st.validate(); }),
-            "reference.amplitude = nan: must be a finite number");
+  EXPECT_EQ(message_of([&] { st.validate(); }), "reference.amplitude = nan: must be a finite number");
   st = StepParams{};
   st.initial = -kInf;
-  EXPECT_EQ(message_of([&] { st.validate(); }),
-            "reference.initial = -inf: must be a finite number");
+  EXPECT_EQ(message_of([&] { st.validate(); }), "reference.initial = -inf: must be a finite number");
 
   RampParams r;
   r.velocity = kNaN;
   EXPECT_EQ(message_of([&] { make_ramp(r); }), "reference.velocity = nan: must be a finite number");
   r = RampParams{};
   r.start_time = kInf;
-  EXPECT_EQ(message_of([&] { r.validate(); }),
-            "reference.start_time = inf: must be a finite number");
+  EXPECT_EQ(message_of([&] { r.validate(); }), "reference.start_time = inf: must be a finite number");
 }
 
 TEST(Validate, ValuesPrintInShortestRoundTripForm) {
@@ -247,15 +235,12 @@ TEST(Validate, OverflowingMovesAreRejected) {
   AccelLimitedParams a;
   a.distance = -1e300;
   a.max_velocity = 1e-300;
-  EXPECT_EQ(message_of([&] {
-              a.validate();
-            }).rfind("reference.distance = -1e+300: the move's duration overflows", 0),
+  EXPECT_EQ(message_of([&] { a.validate(); }).rfind("reference.distance = -1e+300: the move's duration overflows", 0),
             0u);
   a = AccelLimitedParams{};
   a.initial = 1.7e308;
   a.distance = 1e308;
-  EXPECT_EQ(message_of([&] { a.validate(); }),
-            "reference.distance = 1e+308: initial + distance overflows");
+  EXPECT_EQ(message_of([&] { a.validate(); }), "reference.distance = 1e+308: initial + distance overflows");
 }
 
 TEST(Validate, EveryMessageIsOneLine) {

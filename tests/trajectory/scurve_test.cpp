@@ -26,8 +26,7 @@ constexpr double kPlanTol = 1e-14;
 // absolute is ~50 ulps, while any formula error would be O(1).
 constexpr double kHandTol = 1e-14;
 
-SCurveParams make_params(double d, double vmax, double amax, double jmax, double t0 = 0.0,
-                         double initial = 0.0) {
+SCurveParams make_params(double d, double vmax, double amax, double jmax, double t0 = 0.0, double initial = 0.0) {
   SCurveParams p;
   p.distance = d;
   p.max_velocity = vmax;
@@ -38,8 +37,7 @@ SCurveParams make_params(double d, double vmax, double amax, double jmax, double
   return p;
 }
 
-void expect_plan(const SCurvePlan& got, double tj, double ta, double tv, double v_peak,
-                 double a_peak) {
+void expect_plan(const SCurvePlan& got, double tj, double ta, double tv, double v_peak, double a_peak) {
   const auto near = [](double a, double b) { return std::abs(a - b) <= kPlanTol * std::abs(b); };
   EXPECT_PRED2(near, got.t_jerk_accel, tj);
   EXPECT_PRED2(near, got.t_accel, ta);
@@ -128,12 +126,11 @@ TEST(SCurve, Case1VelocityAndAccelerationReached) {
     double t, x, v, a, j;
   };
   for (const Point& q :
-       {Point{0.0, 0.0, 0.0, 0.0, 1.0}, Point{0.5, 0.125 / 6.0, 0.125, 0.5, 1.0},
-        Point{1.0, 1.0 / 6.0, 0.5, 1.0, 0.0}, Point{1.5, 3.25 / 6.0, 1.0, 1.0, 0.0},
-        Point{2.0, 7.0 / 6.0, 1.5, 1.0, -1.0}, Point{3.0, 3.0, 2.0, 0.0, 0.0},
-        Point{4.0, 5.0, 2.0, 0.0, 0.0}, Point{5.0, 7.0, 2.0, 0.0, -1.0},
-        Point{6.0, 10.0 - 7.0 / 6.0, 1.5, -1.0, 0.0}, Point{7.0, 10.0 - 1.0 / 6.0, 0.5, -1.0, 1.0},
-        Point{7.5, 10.0 - 0.125 / 6.0, 0.125, -0.5, 1.0}, Point{8.0, 10.0, 0.0, 0.0, 0.0}}) {
+       {Point{0.0, 0.0, 0.0, 0.0, 1.0}, Point{0.5, 0.125 / 6.0, 0.125, 0.5, 1.0}, Point{1.0, 1.0 / 6.0, 0.5, 1.0, 0.0},
+        Point{1.5, 3.25 / 6.0, 1.0, 1.0, 0.0}, Point{2.0, 7.0 / 6.0, 1.5, 1.0, -1.0}, Point{3.0, 3.0, 2.0, 0.0, 0.0},
+        Point{4.0, 5.0, 2.0, 0.0, 0.0}, Point{5.0, 7.0, 2.0, 0.0, -1.0}, Point{6.0, 10.0 - 7.0 / 6.0, 1.5, -1.0, 0.0},
+        Point{7.0, 10.0 - 1.0 / 6.0, 0.5, -1.0, 1.0}, Point{7.5, 10.0 - 0.125 / 6.0, 0.125, -0.5, 1.0},
+        Point{8.0, 10.0, 0.0, 0.0, 0.0}}) {
     const Sample s = tr->sample(q.t);
     EXPECT_NEAR(s.position, q.x, kHandTol) << "t=" << q.t;
     EXPECT_NEAR(s.velocity, q.v, kHandTol) << "t=" << q.t;
@@ -186,8 +183,7 @@ TEST(SCurve, CaseBoundariesAreContinuous) {
   // vmax=2, amax=jmax=1: Ta = 3, D = vmax*Ta = 6 -> Tv = 0, identical to case 3's plan
   // (D=6 with vmax = 2 exactly reached).
   expect_plan(plan_scurve(make_params(6.0, 2.0, 1.0, 1.0)), 1.0, 3.0, 0.0, 2.0, 1.0);
-  expect_plan(plan_scurve(make_params(6.0, 2.0 * (1.0 + 1e-15), 1.0, 1.0)), 1.0, 3.0, 0.0, 2.0,
-              1.0);
+  expect_plan(plan_scurve(make_params(6.0, 2.0 * (1.0 + 1e-15), 1.0, 1.0)), 1.0, 3.0, 0.0, 2.0, 1.0);
 }
 
 TEST(SCurve, NegativeDistanceMirrors) {
@@ -266,8 +262,7 @@ TEST(SCurve, RandomSweepProperties) {
       p = make_params(0.1 * log_uniform(-1, 1), 0.2 * log_uniform(-1, 1), 1.15 * log_uniform(-1, 1),
                       2.4 * log_uniform(-1, 1));
     } else {
-      p = make_params(log_uniform(-6, 1), log_uniform(-3, 1), log_uniform(-3, 2),
-                      log_uniform(-2, 4));
+      p = make_params(log_uniform(-6, 1), log_uniform(-3, 1), log_uniform(-3, 2), log_uniform(-2, 4));
     }
     if (unit(rng) < 0.5) p.distance = -p.distance;
     p.start_time = -5.0 + 10.0 * unit(rng);
@@ -277,9 +272,8 @@ TEST(SCurve, RandomSweepProperties) {
     const auto tr = make_scurve(p);
     std::ostringstream label;
     label.precision(17);
-    label << "set " << n << ": D=" << p.distance << " vmax=" << p.max_velocity
-          << " amax=" << p.max_acceleration << " jmax=" << p.max_jerk << " t0=" << p.start_time
-          << " x0=" << p.initial;
+    label << "set " << n << ": D=" << p.distance << " vmax=" << p.max_velocity << " amax=" << p.max_acceleration
+          << " jmax=" << p.max_jerk << " t0=" << p.start_time << " x0=" << p.initial;
     SCOPED_TRACE(label.str());
     const Move move{p.start_time, p.initial, p.distance, plan.duration(), breakpoints(plan)};
     const Limits lim{p.max_velocity, p.max_acceleration, p.max_jerk};
@@ -296,8 +290,7 @@ TEST(SCurve, RandomSweepProperties) {
     // Segment durations are consistent: Ta >= 2 Tj (exact, or 1 ulp in case 1/3 rounding),
     // D = v_peak (Ta + Tv) (Tv = D/vmax - Ta loses a few ulps of Ta: 1e-13 of D is ample).
     EXPECT_GE(plan.t_accel, 2.0 * plan.t_jerk_accel * (1.0 - 1e-15));
-    EXPECT_NEAR(plan.peak_velocity * (plan.t_accel + plan.t_const), std::abs(p.distance),
-                1e-13 * std::abs(p.distance));
+    EXPECT_NEAR(plan.peak_velocity * (plan.t_accel + plan.t_const), std::abs(p.distance), 1e-13 * std::abs(p.distance));
 
     // Time-optimality sanity. Lower bounds: the accel-limited trapezoid (it ignores jerk), and
     // a pure jerk-limited move ignoring vmax and amax (4 (D/(2 jmax))^(1/3)). Upper bound: the
@@ -308,10 +301,8 @@ TEST(SCurve, RandomSweepProperties) {
     // T_trap + amax/jmax does NOT hold for triangles: D=1.395e-6, vmax=0.136, amax=4.26e-3,
     // jmax=0.767 gives T = 0.04216 s > 0.03618 + 0.00556.) Tolerance: a few ulps.
     const double t_trap = trapezoid_duration(p.distance, p.max_velocity, p.max_acceleration);
-    const double trap_cruise =
-        t_trap - 2.0 * std::min(p.max_velocity / p.max_acceleration, 0.5 * t_trap);
-    const double w = (trap_cruise >= p.max_acceleration / p.max_jerk ? 1.0 : 2.0) *
-                     p.max_acceleration / p.max_jerk;
+    const double trap_cruise = t_trap - 2.0 * std::min(p.max_velocity / p.max_acceleration, 0.5 * t_trap);
+    const double w = (trap_cruise >= p.max_acceleration / p.max_jerk ? 1.0 : 2.0) * p.max_acceleration / p.max_jerk;
     const double t_pure_s = 4.0 * std::cbrt(std::abs(p.distance) / (2.0 * p.max_jerk));
     const double t = plan.duration();
     EXPECT_GE(t, t_trap * (1.0 - 1e-14));

@@ -100,8 +100,7 @@ TEST(Waypoints, RandomSplinesInterpolateAreC2AndNatural) {
       // with h >= 1e-2, products of up to 4 terms; 1e-9 relative to the largest term is a
       // loose bound that a mismatch in x, v or a at the knot (O(1) relative) would blow.
       const double v_scale = std::abs(r.velocity) + a_scale * d + j_scale * d * d;
-      EXPECT_NEAR(l.position,
-                  r.position - r.velocity * d + r.acceleration * d * d / 2 - j * d * d * d / 6,
+      EXPECT_NEAR(l.position, r.position - r.velocity * d + r.acceleration * d * d / 2 - j * d * d * d / 6,
                   1e-9 * (x_scale + v_scale * d));
       EXPECT_NEAR(l.velocity, r.velocity - r.acceleration * d + j * d * d / 2, 1e-9 * v_scale);
       EXPECT_NEAR(l.acceleration, r.acceleration - j * d, 1e-9 * (a_scale + j_scale * d));
@@ -130,10 +129,8 @@ TEST(Waypoints, InvalidPointsAreRejected) {
   EXPECT_EQ(message({}), "waypoints: need at least 2 points, got 0");
   EXPECT_EQ(message({{0.0, 0.0}, {0.3, 1.0}, {0.2, 1.0}}),
             "waypoints[2].t = 0.2: must be greater than the previous t = 0.3");
-  EXPECT_EQ(message({{0.0, 0.0}, {0.0, 1.0}}),
-            "waypoints[1].t = 0: must be greater than the previous t = 0");
-  EXPECT_EQ(message({{0.0, 0.0}, {1.0, std::nan("")}}),
-            "waypoints[1].x = nan: must be a finite number");
+  EXPECT_EQ(message({{0.0, 0.0}, {0.0, 1.0}}), "waypoints[1].t = 0: must be greater than the previous t = 0");
+  EXPECT_EQ(message({{0.0, 0.0}, {1.0, std::nan("")}}), "waypoints[1].x = nan: must be a finite number");
   EXPECT_EQ(message({{-std::numeric_limits<double>::infinity(), 0.0}, {1.0, 1.0}}),
             "waypoints[0].t = -inf: must be a finite number");
 }

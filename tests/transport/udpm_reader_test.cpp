@@ -41,7 +41,8 @@ void put16(std::vector<std::uint8_t>& b, std::uint16_t v) {
   b.push_back(static_cast<std::uint8_t>(v));
 }
 
-std::vector<std::uint8_t> short_datagram(std::uint32_t seq, const std::string& channel, const std::vector<std::uint8_t>& payload) {
+std::vector<std::uint8_t> short_datagram(std::uint32_t seq, const std::string& channel,
+                                         const std::vector<std::uint8_t>& payload) {
   std::vector<std::uint8_t> b;
   put32(b, 0x4c433032);
   put32(b, seq);
@@ -83,7 +84,8 @@ std::vector<std::uint8_t> random_bytes(std::size_t n, unsigned seed) {
 }
 
 std::int64_t now_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
@@ -257,7 +259,8 @@ TEST(UdpmReader, BatchedBusDecodesAndCountsWrongTypes) {
   }
   control_command_t wrong{};
   event.publish("T_STATE", wrong);
-  for (int i = 0; i < 200 && (seqs.size() < 50 || batched.invalid() < 1); ++i) batched.poll(std::chrono::milliseconds(5));
+  for (int i = 0; i < 200 && (seqs.size() < 50 || batched.invalid() < 1); ++i)
+    batched.poll(std::chrono::milliseconds(5));
   ASSERT_EQ(seqs.size(), 50u);
   for (std::int64_t k = 0; k < 50; ++k) EXPECT_EQ(seqs[static_cast<std::size_t>(k)], k);
   EXPECT_EQ(batched.invalid(), 1);

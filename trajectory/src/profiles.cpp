@@ -41,9 +41,7 @@ class Sine final : public Trajectory {
   }
 
   // Periodic, hence never constant -- unless it is degenerate (f = 0 or A = 0).
-  double end_time() const override {
-    return (p_.frequency == 0.0 || p_.amplitude == 0.0) ? p_.start_time : kInfinity;
-  }
+  double end_time() const override { return (p_.frequency == 0.0 || p_.amplitude == 0.0) ? p_.start_time : kInfinity; }
 
  private:
   SineParams p_;
@@ -166,12 +164,10 @@ class AccelLimited final : public Trajectory {
 };
 
 // A planned move must end at a finite time (huge distance over tiny limits can overflow).
-void require_finite_end(const std::string& prefix, double distance, double start_time,
-                        double duration) {
+void require_finite_end(const std::string& prefix, double distance, double start_time, double duration) {
   if (!std::isfinite(duration) || !std::isfinite(start_time + duration))
     detail::fail(prefix + ".distance", distance,
-                 "the move's duration overflows for these limits (" +
-                     detail::format_number(duration) + " s)");
+                 "the move's duration overflows for these limits (" + detail::format_number(duration) + " s)");
 }
 
 }  // namespace
@@ -179,31 +175,23 @@ void require_finite_end(const std::string& prefix, double distance, double start
 // ------------------------------------------------------------------------------------------
 // validate(): every number must be finite; limits must be > 0; a frequency must be >= 0.
 
-void SineParams::validate(const std::string& prefix) const {
-  fields::check_fields(*this, prefix);
-}
+void SineParams::validate(const std::string& prefix) const { fields::check_fields(*this, prefix); }
 
-void StepParams::validate(const std::string& prefix) const {
-  fields::check_fields(*this, prefix);
-}
+void StepParams::validate(const std::string& prefix) const { fields::check_fields(*this, prefix); }
 
 void AccelLimitedParams::validate(const std::string& prefix) const {
   fields::check_fields(*this, prefix);
-  if (!std::isfinite(initial + distance))
-    detail::fail(prefix + ".distance", distance, "initial + distance overflows");
+  if (!std::isfinite(initial + distance)) detail::fail(prefix + ".distance", distance, "initial + distance overflows");
   require_finite_end(prefix, distance, start_time, plan_accel_limited(*this).duration());
 }
 
 void SCurveParams::validate(const std::string& prefix) const {
   fields::check_fields(*this, prefix);
-  if (!std::isfinite(initial + distance))
-    detail::fail(prefix + ".distance", distance, "initial + distance overflows");
+  if (!std::isfinite(initial + distance)) detail::fail(prefix + ".distance", distance, "initial + distance overflows");
   require_finite_end(prefix, distance, start_time, plan_scurve(*this).duration());
 }
 
-void RampParams::validate(const std::string& prefix) const {
-  fields::check_fields(*this, prefix);
-}
+void RampParams::validate(const std::string& prefix) const { fields::check_fields(*this, prefix); }
 
 // ------------------------------------------------------------------------------------------
 

@@ -51,19 +51,15 @@ Sample accel_phase(const SCurvePlan& plan, double jerk, double sigma, bool right
   const double ta = plan.t_accel;
   const double a_lim = plan.peak_acceleration;
   const double v_lim = plan.peak_velocity;
-  const auto before = [right_closed](double s, double edge) {
-    return right_closed ? s <= edge : s < edge;
-  };
+  const auto before = [right_closed](double s, double edge) { return right_closed ? s <= edge : s < edge; };
   if (before(sigma, tj)) {
     return {jerk * sigma * sigma * sigma / 6.0, 0.5 * jerk * sigma * sigma, jerk * sigma, jerk};
   }
   if (before(sigma, ta - tj)) {
-    return {a_lim * (3.0 * sigma * (sigma - tj) + tj * tj) / 6.0, a_lim * (sigma - 0.5 * tj), a_lim,
-            0.0};
+    return {a_lim * (3.0 * sigma * (sigma - tj) + tj * tj) / 6.0, a_lim * (sigma - 0.5 * tj), a_lim, 0.0};
   }
   const double r = std::fmax(ta - sigma, 0.0);
-  return {v_lim * (0.5 * ta - r) + jerk * r * r * r / 6.0, v_lim - 0.5 * jerk * r * r, jerk * r,
-          -jerk};
+  return {v_lim * (0.5 * ta - r) + jerk * r * r * r / 6.0, v_lim - 0.5 * jerk * r * r, jerk * r, -jerk};
 }
 
 class SCurve final : public Trajectory {
@@ -92,8 +88,7 @@ class SCurve final : public Trajectory {
       const Sample r = accel_phase(plan_, p_.max_jerk, s, true);
       m = {abs_distance_ - r.position, r.velocity, -r.acceleration, r.jerk};
     }
-    return {p_.initial + sign_ * m.position, sign_ * m.velocity, sign_ * m.acceleration,
-            sign_ * m.jerk};
+    return {p_.initial + sign_ * m.position, sign_ * m.velocity, sign_ * m.acceleration, sign_ * m.jerk};
   }
   double end_time() const override { return end_; }
 

@@ -28,7 +28,7 @@
 namespace feeddrive::trajectory {
 namespace {
 
-constexpr std::size_t kMinPoints = 2;             // a spline needs at least one interval
+constexpr std::size_t kMinPoints = 2;  // a spline needs at least one interval
 
 class Waypoints final : public Trajectory {
  public:
@@ -67,13 +67,13 @@ class Waypoints final : public Trajectory {
     if (t < p_.front().t) return {p_.front().x, 0.0, 0.0, 0.0};
     if (t >= p_.back().t) return {p_.back().x, 0.0, 0.0, 0.0};
     // Interval i with t_i <= t < t_{i+1}.
-    const auto it = std::upper_bound(p_.begin(), p_.end(), t,
-                                     [](double value, const Waypoint& w) { return value < w.t; });
+    const auto it =
+        std::upper_bound(p_.begin(), p_.end(), t, [](double value, const Waypoint& w) { return value < w.t; });
     const std::size_t i = static_cast<std::size_t>(std::distance(p_.begin(), it)) - 1;
     const double u = t - p_[i].t;
     const double c = 0.5 * m_[i];
-    return {p_[i].x + u * (b_[i] + u * (c + u * d_[i])), b_[i] + u * (m_[i] + 3.0 * d_[i] * u),
-            m_[i] + 6.0 * d_[i] * u, 6.0 * d_[i]};
+    return {p_[i].x + u * (b_[i] + u * (c + u * d_[i])), b_[i] + u * (m_[i] + 3.0 * d_[i] * u), m_[i] + 6.0 * d_[i] * u,
+            6.0 * d_[i]};
   }
   double end_time() const override { return p_.back().t; }
 
@@ -88,16 +88,14 @@ class Waypoints final : public Trajectory {
 
 std::unique_ptr<Trajectory> make_waypoints(const std::vector<Waypoint>& points) {
   if (points.size() < kMinPoints)
-    throw std::invalid_argument("waypoints: need at least 2 points, got " +
-                                std::to_string(points.size()));
+    throw std::invalid_argument("waypoints: need at least 2 points, got " + std::to_string(points.size()));
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string key = "waypoints[" + std::to_string(i) + "]";
     detail::require_finite(key + ".t", points[i].t);
     detail::require_finite(key + ".x", points[i].x);
     if (i > 0 && !(points[i].t > points[i - 1].t))
-      detail::fail(
-          key + ".t", points[i].t,
-          "must be greater than the previous t = " + detail::format_number(points[i - 1].t));
+      detail::fail(key + ".t", points[i].t,
+                   "must be greater than the previous t = " + detail::format_number(points[i - 1].t));
   }
   return std::make_unique<Waypoints>(points);
 }

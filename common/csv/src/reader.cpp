@@ -1,5 +1,5 @@
-#include "feeddrive/common/text_file.hpp"
 #include "feeddrive/csv/reader.hpp"
+#include "feeddrive/common/text_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -34,7 +34,8 @@ void split(std::string_view line, char sep, std::vector<Field>& out) {
   std::size_t start = 0;
   for (;;) {
     const auto comma = line.find(sep, start);
-    const std::string_view raw = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    const std::string_view raw =
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     const auto lead = raw.find_first_not_of(" \t");
     out.push_back({trim(raw), start + 1 + (lead == std::string_view::npos ? 0 : lead)});
     if (comma == std::string_view::npos) break;
@@ -70,7 +71,8 @@ class Parser {
     for (std::size_t i = 0; i < l.size(); ++i) {
       const unsigned char c = static_cast<unsigned char>(l[i]);
       if ((c < 0x20 && c != '\t') || c == 0x7f)
-        fail_line(i + 1 + bom_, "not a text file: byte " + hex(c) + " in \"" + shown(l.substr(i >= 8 ? i - 8 : 0), 24) + "\"");
+        fail_line(i + 1 + bom_,
+                  "not a text file: byte " + hex(c) + " in \"" + shown(l.substr(i >= 8 ? i - 8 : 0), 24) + "\"");
     }
     const std::string_view t = trim(l);
     if (t.empty() || t.front() == '#') return;
@@ -90,8 +92,9 @@ class Parser {
       throw CsvError(origin_ + ": no header line (expected the columns " + want + ")");
     }
     if (table_.rows() < opt_.limits.min_rows)
-      throw CsvError(origin_ + ":" + std::to_string(line_no_) + ": need at least " + std::to_string(opt_.limits.min_rows) +
-                     " data rows, found " + std::to_string(table_.rows()) + " (end of file)");
+      throw CsvError(origin_ + ":" + std::to_string(line_no_) + ": need at least " +
+                     std::to_string(opt_.limits.min_rows) + " data rows, found " + std::to_string(table_.rows()) +
+                     " (end of file)");
     return std::move(table_);
   }
 
@@ -112,17 +115,22 @@ class Parser {
     std::map<std::string, std::size_t> seen;
     for (std::size_t i = 0; i < fields_.size(); ++i) {
       const std::string name = unquote(fields_[i].text);
-      if (name.empty()) fail_line(fields_[i].column + bom_, "empty column name (column " + std::to_string(i + 1) + " of the header)");
-      if (!seen.emplace(name, i).second) fail_line(fields_[i].column + bom_, "duplicate column '" + shown(name) + "' in the header");
+      if (name.empty())
+        fail_line(fields_[i].column + bom_, "empty column name (column " + std::to_string(i + 1) + " of the header)");
+      if (!seen.emplace(name, i).second)
+        fail_line(fields_[i].column + bom_, "duplicate column '" + shown(name) + "' in the header");
       header_.push_back(name);
     }
     bool one = false;
     for (const char other : {',', ';', '\t'})
       one = one || (other != opt_.separator && fields_.size() == 1 && l.find(other) != std::string_view::npos);
-    const std::string sep_name = opt_.separator == ',' ? "commas" : opt_.separator == '\t' ? "tabs" : "'" + std::string(1, opt_.separator) + "'";
-    const std::string hint = one ? "; columns must be separated by " + sep_name +
-                                       (opt_.separator_option.empty() ? "" : " (or give the separator with " + opt_.separator_option + ")")
-                                 : "";
+    const std::string sep_name = opt_.separator == ','    ? "commas"
+                                 : opt_.separator == '\t' ? "tabs"
+                                                          : "'" + std::string(1, opt_.separator) + "'";
+    const std::string hint =
+        one ? "; columns must be separated by " + sep_name +
+                  (opt_.separator_option.empty() ? "" : " (or give the separator with " + opt_.separator_option + ")")
+            : "";
     for (std::size_t c = 0; c < opt_.columns.size(); ++c) {
       for (std::size_t a = 0; a < opt_.columns[c].names.size(); ++a) {
         const std::string& n = opt_.columns[c].names[a];
@@ -166,8 +174,9 @@ class Parser {
       const double v = number(f, table_.used[c]);
       auto& col = table_.values[c];
       if (static_cast<int>(c) == opt_.increasing && !col.empty() && !(v > col.back()))
-        fail_line(f.column + bom_, "column '" + table_.used[c] + "': " + shown(f.text) + " is not greater than the previous " +
-                                       table_.used[c] + " = " + previous_text_ + " (line " + std::to_string(table_.lines.back()) + ")");
+        fail_line(f.column + bom_, "column '" + table_.used[c] + "': " + shown(f.text) +
+                                       " is not greater than the previous " + table_.used[c] + " = " + previous_text_ +
+                                       " (line " + std::to_string(table_.lines.back()) + ")");
       if (static_cast<int>(c) == opt_.increasing) previous_text_ = shown(f.text);
       col.push_back(v);
     }
@@ -194,7 +203,8 @@ class Parser {
     const auto res = std::from_chars(first, last, v);
     if (first == last || res.ptr != last || (res.ec != std::errc() && res.ec != std::errc::result_out_of_range))
       fail_line(col, where + "not a number: '" + shown(f.text) + "'");
-    if (res.ec == std::errc::result_out_of_range) fail_line(col, where + "out of the range of a double: '" + shown(f.text) + "'");
+    if (res.ec == std::errc::result_out_of_range)
+      fail_line(col, where + "out of the range of a double: '" + shown(f.text) + "'");
     if (!std::isfinite(v)) fail_line(col, where + "not a finite number: '" + shown(f.text) + "'");
     return v;
   }
@@ -265,7 +275,8 @@ Table read_file(const std::string& path, const Options& opt) {
   struct stat st {};
   if (::fstat(fd, &st) == 0) {
     if (S_ISDIR(st.st_mode)) throw CsvError(who + ": is a folder, not a data file");
-    if (!S_ISREG(st.st_mode)) throw CsvError(who + ": is " + text::non_regular_kind(st.st_mode) + ", not a regular file");
+    if (!S_ISREG(st.st_mode))
+      throw CsvError(who + ": is " + text::non_regular_kind(st.st_mode) + ", not a regular file");
     ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
     if (S_ISREG(st.st_mode) && static_cast<std::uint64_t>(st.st_size) > opt.limits.max_file_bytes)
       throw CsvError(who + ": " + std::to_string(st.st_size) + " bytes, larger than the reader's limit of " +
@@ -284,7 +295,8 @@ Table read_file(const std::string& path, const Options& opt) {
     if (n == 0) break;
     total += static_cast<std::uint64_t>(n);
     if (total > opt.limits.max_file_bytes)
-      throw CsvError(who + ": larger than the reader's limit of " + std::to_string(opt.limits.max_file_bytes) + " bytes");
+      throw CsvError(who + ": larger than the reader's limit of " + std::to_string(opt.limits.max_file_bytes) +
+                     " bytes");
     std::string_view chunk(buf.data(), static_cast<std::size_t>(n));
     while (!chunk.empty()) {
       const auto nl = chunk.find('\n');

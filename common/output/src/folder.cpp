@@ -3,9 +3,9 @@
 #include <signal.h>
 
 #include <fcntl.h>
-#include <sys/statfs.h>
 #include <stdio.h>  // renameat2, RENAME_EXCHANGE (_GNU_SOURCE)
 #include <sys/stat.h>
+#include <sys/statfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -42,7 +42,7 @@ std::string error_text(int err) { return std::strerror(err); }
 fs::path unused_sibling(const fs::path& target, const std::string& kind) {
   for (int n = 0;; ++n) {
     const fs::path p = target.parent_path() / ("." + target.filename().string() + "." + kind + "-" +
-                                                std::to_string(::getpid()) + "-" + std::to_string(n));
+                                               std::to_string(::getpid()) + "-" + std::to_string(n));
     std::error_code ec;
     if (!fs::exists(fs::symlink_status(p, ec))) return p;
   }
@@ -85,7 +85,8 @@ void sync_folder(const fs::path& dir, const std::string& what) {
       throw std::runtime_error(what + "cannot flush " + it->path().string() + " to disk: " + error_text(e));
   }
   if (ec) throw std::runtime_error(what + "cannot list " + dir.string() + ": " + ec.message());
-  if (const int e = sync_path(dir, true)) throw std::runtime_error(what + "cannot flush " + dir.string() + " to disk: " + error_text(e));
+  if (const int e = sync_path(dir, true))
+    throw std::runtime_error(what + "cannot flush " + dir.string() + " to disk: " + error_text(e));
 }
 
 // After a rename: the parent's entry is durable too. Best effort (the results are in place).
@@ -186,7 +187,9 @@ fs::path normalise(const std::string& out, const std::string& option) {
   fs::path p = fs::path(out).lexically_normal();
   while (!p.empty() && !p.has_filename() && p.has_relative_path()) p = p.parent_path();  // "prev/" -> "prev"
   if (p.empty() || !p.has_filename() || p.filename() == "." || p.filename() == "..")
-    refuse(option, out, "names no folder of its own (the current folder, a parent or the root); name the output folder, e.g. out/run");
+    refuse(
+        option, out,
+        "names no folder of its own (the current folder, a parent or the root); name the output folder, e.g. out/run");
   return p;
 }
 
@@ -194,12 +197,16 @@ fs::path check_output_dir(const std::string& out, const std::string& option) {
   const fs::path p = normalise(out, option);
   const std::size_t name = p.filename().string().size();
   if (name > kMaxName)
-    refuse(option, out, "the folder name is too long (" + std::to_string(name) + " bytes; at most " + std::to_string(kMaxName) + ")");
+    refuse(
+        option, out,
+        "the folder name is too long (" + std::to_string(name) + " bytes; at most " + std::to_string(kMaxName) + ")");
   std::error_code ec;
   const fs::path abs = fs::absolute(p, ec);
   if (ec) refuse(option, out, "cannot resolve the path: " + ec.message());
   if (abs.string().size() > kMaxPath)
-    refuse(option, out, "the path is too long (" + std::to_string(abs.string().size()) + " bytes; at most " + std::to_string(kMaxPath) + ")");
+    refuse(option, out,
+           "the path is too long (" + std::to_string(abs.string().size()) + " bytes; at most " +
+               std::to_string(kMaxPath) + ")");
 
   const auto st = fs::symlink_status(abs, ec);
   if (!ec && fs::exists(st)) {
@@ -209,11 +216,13 @@ fs::path check_output_dir(const std::string& out, const std::string& option) {
     const bool empty = fs::is_empty(abs, ec2);
     if (ec2) refuse(option, out, "cannot read the folder: " + ec2.message());
     if (!empty && !is_feeddrive_output(abs))
-      refuse(option, out, std::string("folder exists, is not empty and is not a feeddrive output (no ") + kMarkerFile +
-                              " marker); refusing to replace it");
+      refuse(option, out,
+             std::string("folder exists, is not empty and is not a feeddrive output (no ") + kMarkerFile +
+                 " marker); refusing to replace it");
     if (const std::string f = foreign_entry(abs); !f.empty())
-      refuse(option, out, "holds '" + shown(f) + "', which feeddrive did not write (its " + kMarkerFile +
-                              " lists what it wrote); move it out or choose another folder");
+      refuse(option, out,
+             "holds '" + shown(f) + "', which feeddrive did not write (its " + kMarkerFile +
+                 " lists what it wrote); move it out or choose another folder");
   } else if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
     refuse(option, out, "cannot be checked: " + ec.message());
   }
@@ -232,7 +241,8 @@ fs::path check_output_dir(const std::string& out, const std::string& option) {
     if (!up.has_relative_path()) refuse(option, out, "no existing folder above it");
     up = up.parent_path();
   }
-  if (const int err = writable(up); err != 0) refuse(option, out, "cannot write in " + up.string() + ": " + error_text(err));
+  if (const int err = writable(up); err != 0)
+    refuse(option, out, "cannot write in " + up.string() + ": " + error_text(err));
   return p;
 }
 
@@ -247,9 +257,11 @@ void check_outside(const std::string& file, const std::string& file_option, cons
   auto fi = f.begin();
   for (auto di = d.begin(); di != d.end(); ++di, ++fi)
     if (fi == f.end() || *fi != *di) return;
-  if (fi == f.end()) refuse(file_option, file, "is the output folder " + option + " " + shown(out) + " itself; name a file next to it");
-  refuse(file_option, file, "lies inside " + option + " " + shown(out) +
-                                ", which is replaced when the run ends (the file would be lost); put it next to the folder");
+  if (fi == f.end())
+    refuse(file_option, file, "is the output folder " + option + " " + shown(out) + " itself; name a file next to it");
+  refuse(file_option, file,
+         "lies inside " + option + " " + shown(out) +
+             ", which is replaced when the run ends (the file would be lost); put it next to the folder");
 }
 
 void check_output_file(const std::string& file, const std::string& option, const std::string& magic) {
@@ -259,12 +271,14 @@ void check_output_file(const std::string& file, const std::string& option, const
     if (S_ISDIR(st.st_mode)) refuse(option, file, "is a folder; name a file");
     if (S_ISFIFO(st.st_mode)) refuse(option, file, "is a FIFO (a writer would block on it); name a regular file");
     if (!S_ISREG(st.st_mode)) refuse(option, file, "is a device or socket, not a regular file");
-    if (::access(file.c_str(), W_OK) != 0) refuse(option, file, "exists and is not writable (" + error_text(errno) + ")");
+    if (::access(file.c_str(), W_OK) != 0)
+      refuse(option, file, "exists and is not writable (" + error_text(errno) + ")");
     // Opened for writing, without truncating it: what root's access() does not see (a read-only
     // mount, a pseudo file system) shows here.
     // /proc and /sys files pass every check above for root and take no log.
     struct statfs fs {};
-    if (::statfs(file.c_str(), &fs) == 0 && (fs.f_type == 0x9fa0 /* PROC_SUPER_MAGIC */ || fs.f_type == 0x62656572 /* SYSFS_MAGIC */))
+    if (::statfs(file.c_str(), &fs) == 0 &&
+        (fs.f_type == 0x9fa0 /* PROC_SUPER_MAGIC */ || fs.f_type == 0x62656572 /* SYSFS_MAGIC */))
       refuse(option, file, "is a kernel pseudo file (/proc, /sys), not a file to write a log to");
     const int fd = ::open(file.c_str(), O_RDWR | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) refuse(option, file, "cannot be opened for writing (" + error_text(errno) + ")");
@@ -272,8 +286,9 @@ void check_output_file(const std::string& file, const std::string& option, const
     const ssize_t got = magic.empty() || st.st_size == 0 ? 0 : ::read(fd, head.data(), head.size());
     ::close(fd);
     if (!magic.empty() && st.st_size > 0 && (got != static_cast<ssize_t>(magic.size()) || head != magic))
-      refuse(option, file, "exists and is not a file this option writes (" + std::to_string(st.st_size) +
-                               " bytes); it is not replaced: name a new file, or remove it first");
+      refuse(option, file,
+             "exists and is not a file this option writes (" + std::to_string(st.st_size) +
+                 " bytes); it is not replaced: name a new file, or remove it first");
     return;
   }
   if (errno != ENOENT) refuse(option, file, "cannot be examined (" + error_text(errno) + ")");
@@ -295,7 +310,8 @@ void replace_folder(const fs::path& fresh, const fs::path& target) {
   std::error_code ec;
   if (!fs::exists(fs::symlink_status(target, ec))) {
     if (::rename(fresh.c_str(), target.c_str()) != 0)
-      throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() + " into place: " + error_text(errno));
+      throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() +
+                               " into place: " + error_text(errno));
   } else {
     int err = 0;
     if (exchange(fresh, target, err)) {
@@ -303,7 +319,8 @@ void replace_folder(const fs::path& fresh, const fs::path& target) {
     } else if (err == EINVAL || err == ENOSYS || err == EOPNOTSUPP) {
       fs::remove_all(target, ec);
       if (::rename(fresh.c_str(), target.c_str()) != 0)
-        throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() + " into place: " + error_text(errno));
+        throw std::runtime_error(target.string() + ": cannot rename " + fresh.string() +
+                                 " into place: " + error_text(errno));
     } else {
       throw std::runtime_error(target.string() + ": cannot swap " + fresh.string() + " into place: " + error_text(err));
     }
@@ -324,7 +341,8 @@ bool remove_output(const fs::path& dir) noexcept {
 }
 
 // Moves folder `from` to the first free TARGET.KIND-N beside `target` and returns it.
-static fs::path move_beside(const fs::path& from, const fs::path& target, const std::string& kind, const std::string& what) {
+static fs::path move_beside(const fs::path& from, const fs::path& target, const std::string& kind,
+                            const std::string& what) {
   std::error_code ec;
   for (int n = 1;; ++n) {
     const fs::path p = target.parent_path() / (target.filename().string() + "." + kind + "-" + std::to_string(n));
@@ -379,8 +397,7 @@ int remove_stale_staging(const fs::path& target) noexcept {
       if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // running (or not ours to ask): keep
       if (remove_output(it->path())) ++removed;
     }
-  } catch (...) {
-  }
+  } catch (...) {}
   return removed;
 }
 
@@ -390,8 +407,8 @@ StagedFolder::StagedFolder(const std::string& out, const std::string& tool, cons
   std::error_code ec;
   fs::create_directories(target_.parent_path(), ec);
   if (ec)
-    throw std::runtime_error(option_ + " " + shown(value_) + ": cannot create " + target_.parent_path().string() + ": " +
-                             ec.message());
+    throw std::runtime_error(option_ + " " + shown(value_) + ": cannot create " + target_.parent_path().string() +
+                             ": " + ec.message());
   remove_stale_staging(target_);
   for (;;) {
     staging_ = unused_sibling(target_, "partial");
@@ -480,10 +497,14 @@ void StagedFolder::commit(bool list_files) {
     sync_parent(target_);
     return;
   }
-  const auto ours = [](const fs::path& d) { return (is_feeddrive_output(d) && foreign_entry(d).empty()) || empty_folder(d); };
+  const auto ours = [](const fs::path& d) {
+    return (is_feeddrive_output(d) && foreign_entry(d).empty()) || empty_folder(d);
+  };
   if (!fs::is_directory(st) || !ours(target_))
-    throw std::runtime_error(what + "changed during the run: no longer a feeddrive output, or it holds files feeddrive did "
-                             "not write; not replaced" + kept);
+    throw std::runtime_error(what +
+                             "changed during the run: no longer a feeddrive output, or it holds files feeddrive did "
+                             "not write; not replaced" +
+                             kept);
 
   int err = 0;
   if (exchange(staging_, target_, err)) {
@@ -492,10 +513,12 @@ void StagedFolder::commit(bool list_files) {
     if (!ours(staging_)) {
       int err2 = 0;
       if (exchange(staging_, target_, err2))
-        throw std::runtime_error(what + "changed during the run: no longer a feeddrive output, or it holds files feeddrive "
-                                 "did not write; not replaced" + kept);
-      throw std::runtime_error(what + "changed during the run; the folder found there was moved to " + staging_.string() +
-                               " and could not be moved back (" + error_text(err2) + ")");
+        throw std::runtime_error(what +
+                                 "changed during the run: no longer a feeddrive output, or it holds files feeddrive "
+                                 "did not write; not replaced" +
+                                 kept);
+      throw std::runtime_error(what + "changed during the run; the folder found there was moved to " +
+                               staging_.string() + " and could not be moved back (" + error_text(err2) + ")");
     }
     if (!remove_output(staging_))
       std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),

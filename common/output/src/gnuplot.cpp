@@ -102,8 +102,7 @@ void run_gnuplot(const fs::path& dir, const std::string& script, const interrupt
     if (errno != EINTR) throw std::runtime_error(std::string("gnuplot: waitpid failed: ") + std::strerror(errno));
     if (stop.stop_requested()) {  // Ctrl-C or SIGTERM: stop gnuplot at once, then unwind
       ::kill(pid, SIGKILL);
-      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-      }
+      while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
       stop.check();
     }
   }

@@ -47,7 +47,6 @@ int report_interrupt(const interrupt::Interrupted& e, const std::string& detail)
   return e.exit_code();
 }
 
-
 namespace {
 
 // A refusal's one line: to the launcher's pipe when started by feeddrive-launch (it prints each

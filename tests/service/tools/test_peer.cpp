@@ -31,9 +31,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <vector>
 #include <random>
 #include <thread>
+#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -56,8 +56,7 @@ int main(int argc, char** argv) {
   app.add_option("mode", mode)
       ->required()
       ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
-                             "forge-reference", "malformed", "fake-monitor", "fake-heartbeats",
-                             "replay-status"}));
+                             "forge-reference", "malformed", "fake-monitor", "fake-heartbeats", "replay-status"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -84,7 +83,8 @@ int main(int argc, char** argv) {
         const std::int64_t now = mono_us();
         if (first_us < 0) first_us = now;
         if (now - first_us < 300000 && kept.size() < 200)
-          kept.emplace_back(static_cast<const std::uint8_t*>(rb->data), static_cast<const std::uint8_t*>(rb->data) + rb->data_size);
+          kept.emplace_back(static_cast<const std::uint8_t*>(rb->data),
+                            static_cast<const std::uint8_t*>(rb->data) + rb->data_size);
       }
     } cap;
     raw.subscribe(ch.status, &Capture::on, &cap);
@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
     const std::int64_t run = bus.run_id();
     // be(b, at, v, n): v big-endian into n bytes at `at` (LCM's byte order).
     const auto be = [](std::vector<std::uint8_t>& b, std::size_t at, std::int64_t v, std::size_t n) {
-      for (std::size_t i = 0; i < n; ++i) b[at + i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(v) >> (8 * (n - 1 - i)));
+      for (std::size_t i = 0; i < n; ++i)
+        b[at + i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(v) >> (8 * (n - 1 - i)));
     };
     const auto bytes = [](const auto& m) {
       std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));

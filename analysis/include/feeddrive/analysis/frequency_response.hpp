@@ -59,10 +59,10 @@ struct FrequencyResponseOptions {
   double f_min{5.0};                ///< [Hz]
   double f_max{0.0};                ///< [Hz]; 0: 0.4/T (4 kHz at T = 0.1 ms), below Nyquist 0.5/T
   int points{20};
-  double reference_amplitude{1e-5};   ///< A [m]; 0: no reference run
-  double acceleration_limit{0.0};     ///< a_lim [m/s^2]; 0: a quarter of the controller's force range / mass
-  double force_amplitude{100.0};      ///< F [N]; 0: no disturbance run
-  double feed_velocity{0.0};          ///< v_feed [m/s]: the excitation rides on this constant motion
+  double reference_amplitude{1e-5};  ///< A [m]; 0: no reference run
+  double acceleration_limit{0.0};    ///< a_lim [m/s^2]; 0: a quarter of the controller's force range / mass
+  double force_amplitude{100.0};     ///< F [N]; 0: no disturbance run
+  double feed_velocity{0.0};         ///< v_feed [m/s]: the excitation rides on this constant motion
   double settle_cycles{3.0};
   double settle_time{0.1};    ///< [s]
   int block_cycles{2};        ///< at least this many cycles per block
@@ -85,8 +85,8 @@ inline constexpr double kDoubtfulNonfundamental = 0.70710678118654752;  // 1/sqr
 inline constexpr double kDoubtfulDrift = 0.1;
 
 struct FrequencyPoint {
-  double frequency_hz{0.0};          ///< as measured (moved to whole cycles in a block)
-  double reference_amplitude_m{0.0}; ///< A(f)
+  double frequency_hz{0.0};           ///< as measured (moved to whole cycles in a block)
+  double reference_amplitude_m{0.0};  ///< A(f)
   std::complex<double> closed_loop{}, compliance{}, sensitivity{}, loop{};  ///< T, G_d [m/N], S_i, L
   double closed_loop_drift{0.0}, closed_loop_nonfundamental{0.0};
   double disturbance_drift{0.0}, disturbance_nonfundamental{0.0};
@@ -94,19 +94,21 @@ struct FrequencyPoint {
   bool has_reference{false}, has_disturbance{false};
   double stiffness_N_per_um() const { return 1e-6 / std::abs(compliance); }
   bool reference_doubtful() const {
-    return has_reference && (closed_loop_nonfundamental > kDoubtfulNonfundamental || closed_loop_drift > kDoubtfulDrift);
+    return has_reference &&
+           (closed_loop_nonfundamental > kDoubtfulNonfundamental || closed_loop_drift > kDoubtfulDrift);
   }
   bool disturbance_doubtful() const {
-    return has_disturbance && (disturbance_nonfundamental > kDoubtfulNonfundamental || disturbance_drift > kDoubtfulDrift);
+    return has_disturbance &&
+           (disturbance_nonfundamental > kDoubtfulNonfundamental || disturbance_drift > kDoubtfulDrift);
   }
   bool doubtful() const { return reference_doubtful() || disturbance_doubtful(); }
 };
 
 struct FrequencyResponse {
   FrequencyResponseOptions options;
-  double acceleration_limit{0.0};  ///< a_lim used [m/s^2]
+  double acceleration_limit{0.0};      ///< a_lim used [m/s^2]
   std::vector<FrequencyPoint> points;  ///< in frequency order
-  std::vector<std::string> warnings;  ///< the scenario's plausibility warnings and the options'
+  std::vector<std::string> warnings;   ///< the scenario's plausibility warnings and the options'
   double bandwidth_hz{kNaN};
   double bandwidth_between_hz[2]{kNaN, kNaN};  ///< the measured points the bandwidth is interpolated between
   /// Where no -3 dB crossing was found: -1 |T| below -3 dB at the lowest (non-doubtful) point, +1 above throughout.
@@ -114,7 +116,7 @@ struct FrequencyResponse {
   double peak_db{kNaN}, peak_hz{kNaN};  ///< the largest |T| measured, and where
   bool peak_inside{false};              ///< not at the lowest or highest frequency: a resonance peak
   double lower_gain_margin_db{kNaN}, lower_phase_crossover_hz{kNaN};  ///< -180 deg below the crossover
-  double sensitivity_peak{kNaN}, sensitivity_peak_hz{kNaN};  ///< Ms (linear), at
+  double sensitivity_peak{kNaN}, sensitivity_peak_hz{kNaN};           ///< Ms (linear), at
   double phase_margin_deg{kNaN}, crossover_hz{kNaN};
   double gain_margin_db{kNaN}, phase_crossover_hz{kNaN};
   double min_stiffness_N_per_um{kNaN}, min_stiffness_hz{kNaN};

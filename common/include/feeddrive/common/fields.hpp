@@ -65,14 +65,30 @@ template <typename T>
 struct Field {
   Meta meta;
   T* value;
-  Field unit(const char* u) const { return with([&](Meta& m) { m.unit = u; }); }
-  Field doc(const char* d) const { return with([&](Meta& m) { m.doc = d; }); }
-  Field positive() const { return with([](Meta& m) { m.check = Check::kPositive; }); }
-  Field non_negative() const { return with([](Meta& m) { m.check = Check::kNonNegative; }); }
-  Field minus_inf_allowed() const { return with([](Meta& m) { m.check = Check::kNotPlusInf; }); }
-  Field unchecked() const { return with([](Meta& m) { m.check = Check::kNone; }); }
-  Field at_most(double hi) const { return with([&](Meta& m) { m.max = hi; }); }
-  Field at_least(double lo) const { return with([&](Meta& m) { m.min = lo; }); }
+  Field unit(const char* u) const {
+    return with([&](Meta& m) { m.unit = u; });
+  }
+  Field doc(const char* d) const {
+    return with([&](Meta& m) { m.doc = d; });
+  }
+  Field positive() const {
+    return with([](Meta& m) { m.check = Check::kPositive; });
+  }
+  Field non_negative() const {
+    return with([](Meta& m) { m.check = Check::kNonNegative; });
+  }
+  Field minus_inf_allowed() const {
+    return with([](Meta& m) { m.check = Check::kNotPlusInf; });
+  }
+  Field unchecked() const {
+    return with([](Meta& m) { m.check = Check::kNone; });
+  }
+  Field at_most(double hi) const {
+    return with([&](Meta& m) { m.max = hi; });
+  }
+  Field at_least(double lo) const {
+    return with([&](Meta& m) { m.min = lo; });
+  }
   /// Plausible for a linear feed drive in [lo, hi]; outside, a warning naming `hint_high`
   /// (above hi) or `hint_low` (below lo) as the unit the value was probably written in.
   Field plausible(double lo, double hi, const char* hint_high = "", const char* hint_low = "",
@@ -155,7 +171,8 @@ struct is_serializable<T, std::void_t<decltype(std::declval<T&>().Serialize(stat
 /// bristle keys).
 class CheckArchive {
  public:
-  CheckArchive(std::string prefix, std::vector<std::string> skip) : prefix_(std::move(prefix)), skip_(std::move(skip)) {}
+  CheckArchive(std::string prefix, std::vector<std::string> skip)
+      : prefix_(std::move(prefix)), skip_(std::move(skip)) {}
   template <typename T>
   void Visit(const Field<T>& f) {
     if constexpr (std::is_same_v<T, double>) {
@@ -181,9 +198,13 @@ class CheckArchive {
     // Beyond the hard bounds a value cannot be meant; the likely unit is named as in the warnings.
     const std::string unit = std::string(m.unit) == "-" ? "" : std::string(" ") + m.unit;
     if (v < m.min)
-      validate::fail(key, v, "must be >= " + validate::format_number(m.min) + unit + (*m.hint_low ? std::string(" (") + m.hint_low + "?)" : ""));
+      validate::fail(key, v,
+                     "must be >= " + validate::format_number(m.min) + unit +
+                         (*m.hint_low ? std::string(" (") + m.hint_low + "?)" : ""));
     if (v > m.max)
-      validate::fail(key, v, "must be <= " + validate::format_number(m.max) + unit + (*m.hint_high ? std::string(" (") + m.hint_high + "?)" : ""));
+      validate::fail(key, v,
+                     "must be <= " + validate::format_number(m.max) + unit +
+                         (*m.hint_high ? std::string(" (") + m.hint_high + "?)" : ""));
   }
 
  private:
@@ -203,7 +224,8 @@ void check_fields(const S& obj, const std::string& prefix, std::vector<std::stri
 ///   "reference.max_velocity: 500 m/s is above any linear feed drive (10 m/s); mm/s?"
 class PlausibilityArchive {
  public:
-  explicit PlausibilityArchive(std::string prefix, std::vector<std::string>* out) : prefix_(std::move(prefix)), out_(out) {}
+  explicit PlausibilityArchive(std::string prefix, std::vector<std::string>* out)
+      : prefix_(std::move(prefix)), out_(out) {}
   template <typename T>
   void Visit(const Field<T>& f) {
     const std::string key = prefix_.empty() ? f.meta.name : prefix_ + "." + f.meta.name;

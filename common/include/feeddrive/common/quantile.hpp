@@ -34,8 +34,8 @@ namespace feeddrive::stats {
 class StreamingQuantile {
  public:
   static constexpr int kMantissaBits = 10;
-  static constexpr int kBlockBits = kMantissaBits;       // buckets per block: 2^10
-  static constexpr int kBlocks = 1 << 12;                // sign + 11 exponent bits
+  static constexpr int kBlockBits = kMantissaBits;        // buckets per block: 2^10
+  static constexpr int kBlocks = 1 << 12;                 // sign + 11 exponent bits
   static constexpr int kShift = 64 - 12 - kMantissaBits;  // key bits dropped inside a bucket
 
   StreamingQuantile() = default;
@@ -75,12 +75,13 @@ class StreamingQuantile {
       for (std::size_t i = 0; i < b.size(); ++i) {
         seen += b[i];
         if (seen > k) {
-          const std::uint64_t lo_key = (static_cast<std::uint64_t>(blk) << 52) | (static_cast<std::uint64_t>(i) << kShift);
+          const std::uint64_t lo_key =
+              (static_cast<std::uint64_t>(blk) << 52) | (static_cast<std::uint64_t>(i) << kShift);
           const std::uint64_t hi_key = lo_key | ((std::uint64_t{1} << kShift) - 1);
           const double a = value_of(lo_key), c = value_of(hi_key);
           double mid = a + (c - a) / 2;
           if (!std::isfinite(mid)) mid = std::isnan(a) ? c : a;  // the buckets of +-inf
-          if (a == 0.0 || c == 0.0) mid = a == 0.0 ? a : c;  // the bucket holding zero is exact
+          if (a == 0.0 || c == 0.0) mid = a == 0.0 ? a : c;      // the bucket holding zero is exact
           return std::clamp(mid, min_, max_);
         }
       }

@@ -1,6 +1,6 @@
 #pragma once
-// The one reader of small text files (scenario and study YAML): bounded in size, so a wrong path (/dev/zero, a log, a disk image) is refused in one line instead
-// of filling the memory. Header-only.
+// The one reader of small text files (scenario and study YAML): bounded in size, so a wrong path (/dev/zero, a log, a
+// disk image) is refused in one line instead of filling the memory. Header-only.
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,7 +11,6 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
-
 
 namespace feeddrive::text {
 
@@ -46,12 +45,13 @@ int open_regular_file(const std::string& path, const std::string& what) {
 }
 
 /// The bytes of the file `path`, read in 64 kB chunks (a regular file of at most max_bytes, 1 MB by
-/// default: read in milliseconds, so Ctrl-C is seen by the caller's next poll). Throws Error("PATH: cannot read the WHAT"), Error("PATH: the WHAT is
-/// a FIFO, not a regular file") or Error("PATH: the WHAT is larger than ... bytes ..."), one
-/// line; Error is the caller's exception type (ScenarioError, StudyError), constructible from a
-/// std::string. Never blocks in open().
+/// default: read in milliseconds, so Ctrl-C is seen by the caller's next poll). Throws Error("PATH: cannot read the
+/// WHAT"), Error("PATH: the WHAT is a FIFO, not a regular file") or Error("PATH: the WHAT is larger than ... bytes
+/// ..."), one line; Error is the caller's exception type (ScenarioError, StudyError), constructible from a std::string.
+/// Never blocks in open().
 template <typename Error>
-std::string read_text_file(const std::string& path, const std::string& what, std::size_t max_bytes = kMaxTextFileBytes) {
+std::string read_text_file(const std::string& path, const std::string& what,
+                           std::size_t max_bytes = kMaxTextFileBytes) {
   const int fd = open_regular_file<Error>(path, what);
   std::string text;
   static constexpr std::size_t kChunk = 1 << 16;

@@ -49,52 +49,73 @@ namespace feeddrive::controller {
 /// controller.tuning: kp, kv, ki as given, or from cascade_tuning() (the rule).
 enum class CascadeTuning { kManual, kRule };
 inline const std::vector<std::pair<CascadeTuning, const char*>>& enum_names(CascadeTuning) {
-  static const std::vector<std::pair<CascadeTuning, const char*>> n = {{CascadeTuning::kManual, "manual"}, {CascadeTuning::kRule, "rule"}};
+  static const std::vector<std::pair<CascadeTuning, const char*>> n = {{CascadeTuning::kManual, "manual"},
+                                                                       {CascadeTuning::kRule, "rule"}};
   return n;
 }
 
 struct CascadeParams {
   CascadeTuning tuning{CascadeTuning::kManual};
-  double bandwidth_scale{1.0};  ///< with the rule: multiplies its bandwidth
-  double kp{100.0};            ///< position gain [1/s]
-  double kv{600.0};            ///< velocity gain [1/s]
-  double ki{40000.0};          ///< velocity integral gain [1/s^2]
-  double velocity_feedforward{1.0};      ///< kff_v [-]
-  double acceleration_feedforward{1.0};  ///< kff_a [-]
-  bool friction_feedforward{false};      ///< add the model friction along the reference
+  double bandwidth_scale{1.0};                 ///< with the rule: multiplies its bandwidth
+  double kp{100.0};                            ///< position gain [1/s]
+  double kv{600.0};                            ///< velocity gain [1/s]
+  double ki{40000.0};                          ///< velocity integral gain [1/s^2]
+  double velocity_feedforward{1.0};            ///< kff_v [-]
+  double acceleration_feedforward{1.0};        ///< kff_a [-]
+  bool friction_feedforward{false};            ///< add the model friction along the reference
   double disturbance_observer_bandwidth{0.0};  ///< w_d [rad/s]; 0 = no disturbance observer
-  double quantization{0.0};    ///< encoder count q [m] for the observer's dead zone
-  double computation_delay{0.0};  ///< d [s]: the command acts d after its sample
-  bool compensate_delay{false};   ///< preview the reference by d; observer predicts with the acting command
+  double quantization{0.0};                    ///< encoder count q [m] for the observer's dead zone
+  double computation_delay{0.0};               ///< d [s]: the command acts d after its sample
+  bool compensate_delay{false};  ///< preview the reference by d; observer predicts with the acting command
   /// Feed back the observer's x^, v^ (observer; needs disturbance_observer_bandwidth > 0) or the
   /// measurement (measured, the default); with compensate_delay: predicted to t_k + d.
   MotionSource motion_state{MotionSource::kMeasured};
   double velocity_filter_cutoff{0.0};  ///< f_v [Hz] of the velocity low-pass; 0 = none
-  double mass{102.04};         ///< m^ [kg]
-  double thrust_gain{260.0};   ///< (Ka*Kf)^ [N/V]
-  plant::FrictionParams friction;  ///< the model's friction (friction feedforward)
-  double u_min{-10.0};         ///< [V]
-  double u_max{10.0};          ///< [V]
-  double period{1e-4};         ///< T [s]
+  double mass{102.04};                 ///< m^ [kg]
+  double thrust_gain{260.0};           ///< (Ka*Kf)^ [N/V]
+  plant::FrictionParams friction;      ///< the model's friction (friction feedforward)
+  double u_min{-10.0};                 ///< [V]
+  double u_max{10.0};                  ///< [V]
+  double period{1e-4};                 ///< T [s]
 
   /// The scenario keys (controller.*); quantization, computation_delay, mass, thrust_gain,
   /// friction and period come from the scenario (controller.model, control_period, ...).
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(tuning).doc("manual: kp, kv, ki as given; rule: from the control period, computation_delay and the sensor (kp, kv, ki then not given)"));
-    a->Visit(FD_FIELD(bandwidth_scale).unit("-").positive().plausible(0.01, 10).doc("with tuning rule: multiplies the rule's bandwidth"));
+    a->Visit(
+        FD_FIELD(tuning).doc("manual: kp, kv, ki as given; rule: from the control period, computation_delay and the "
+                             "sensor (kp, kv, ki then not given)"));
+    a->Visit(FD_FIELD(bandwidth_scale)
+                 .unit("-")
+                 .positive()
+                 .plausible(0.01, 10)
+                 .doc("with tuning rule: multiplies the rule's bandwidth"));
     a->Visit(FD_FIELD(kp).unit("1/s").non_negative().plausible(0, 1e4).doc("position gain"));
     a->Visit(FD_FIELD(kv).unit("1/s").non_negative().plausible(0, 1e5).doc("velocity gain"));
     a->Visit(FD_FIELD(ki).unit("1/s^2").non_negative().plausible(0, 1e9).doc("velocity integral gain"));
     a->Visit(FD_FIELD(velocity_feedforward).unit("-").plausible(0, 2).doc("kff_v"));
     a->Visit(FD_FIELD(acceleration_feedforward).unit("-").plausible(0, 2).doc("kff_a"));
     a->Visit(FD_FIELD(friction_feedforward).doc("add the model's LuGre friction along the reference"));
-    a->Visit(FD_FIELD(disturbance_observer_bandwidth).unit("rad/s").non_negative().plausible(0, 1e5).doc("x,v,d observer fed by the encoder; 0: off"));
-    a->Visit(FD_FIELD(compensate_delay).doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command (with motion_state observer: the feedback state too)"));
-    a->Visit(FD_FIELD(motion_state).doc("the x, v fed back: measured (the encoder, velocity as the sensor gives it) or observer (x^, v^; needs disturbance_observer_bandwidth > 0)"));
-    a->Visit(FD_FIELD(velocity_filter_cutoff).unit("Hz").non_negative().plausible(0, 1e5).doc("first-order low-pass on the velocity fed back; 0: none"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
+    a->Visit(FD_FIELD(disturbance_observer_bandwidth)
+                 .unit("rad/s")
+                 .non_negative()
+                 .plausible(0, 1e5)
+                 .doc("x,v,d observer fed by the encoder; 0: off"));
+    a->Visit(FD_FIELD(compensate_delay)
+                 .doc("feedforward forces at t_k + computation_delay; the observer predicts with the acting command "
+                      "(with motion_state observer: the feedback state too)"));
+    a->Visit(FD_FIELD(motion_state)
+                 .doc("the x, v fed back: measured (the encoder, velocity as the sensor gives it) or observer (x^, v^; "
+                      "needs disturbance_observer_bandwidth > 0)"));
+    a->Visit(FD_FIELD(velocity_filter_cutoff)
+                 .unit("Hz")
+                 .non_negative()
+                 .plausible(0, 1e5)
+                 .doc("first-order low-pass on the velocity fed back; 0: none"));
+    a->Visit(
+        FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(
+        FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
   }
   void validate(const std::string& prefix = "controller") const;
 };
@@ -118,14 +139,13 @@ void apply_tuning(CascadeParams& p, bool differenced_velocity);
 struct CascadeGains {
   double kp, kv, ki;
 };
-CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity,
-                            double scale = 1.0, double extra_lag = 0.0);
+CascadeGains cascade_tuning(double period, double computation_delay, bool differenced_velocity, double scale = 1.0,
+                            double extra_lag = 0.0);
 
 class CascadeController final : public Controller {
  public:
   explicit CascadeController(const CascadeParams& p);
-  Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
-                 const Truth* truth) override;
+  Command update(const trajectory::Sample& ref, const plant::Measurement& meas, const Truth* truth) override;
   std::string name() const override { return "cascade"; }
 
  private:

@@ -32,8 +32,7 @@ class Controller {
   /// Computes the command for sample instant ref/meas (both at the same t). Called once per
   /// control period, in time order. `truth` may be nullptr (hardware); a controller that
   /// needs it (needs_truth()) throws std::logic_error then.
-  virtual Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
-                         const Truth* truth) = 0;
+  virtual Command update(const trajectory::Sample& ref, const plant::Measurement& meas, const Truth* truth) = 0;
   virtual bool needs_truth() const { return false; }
   virtual std::string name() const = 0;
 };

@@ -18,7 +18,10 @@ namespace feeddrive::controller {
 
 enum class OpenLoopKind { kStep, kSine, kRamp, kCsv };
 inline const std::vector<std::pair<OpenLoopKind, const char*>>& enum_names(OpenLoopKind) {
-  static const std::vector<std::pair<OpenLoopKind, const char*>> n = {{OpenLoopKind::kStep, "step"}, {OpenLoopKind::kSine, "sine"}, {OpenLoopKind::kRamp, "ramp"}, {OpenLoopKind::kCsv, "csv"}};
+  static const std::vector<std::pair<OpenLoopKind, const char*>> n = {{OpenLoopKind::kStep, "step"},
+                                                                      {OpenLoopKind::kSine, "sine"},
+                                                                      {OpenLoopKind::kRamp, "ramp"},
+                                                                      {OpenLoopKind::kCsv, "csv"}};
   return n;
 }
 std::string to_string(OpenLoopKind k);
@@ -26,25 +29,26 @@ OpenLoopKind open_loop_kind_from_string(const std::string& s);  ///< "step"|"sin
 
 struct OpenLoopParams {
   OpenLoopKind kind{OpenLoopKind::kStep};
-  double amplitude{12.0};   ///< [N] (step height, sine amplitude, ramp cap; 0 = no cap)
-  double frequency{1.0};    ///< [Hz] (sine)
-  double phase{0.0};        ///< [rad] (sine)
-  double offset{0.0};       ///< [N]
-  double rate{100.0};       ///< [N/s] (ramp)
-  double start_time{0.0};   ///< [s]
+  double amplitude{12.0};           ///< [N] (step height, sine amplitude, ramp cap; 0 = no cap)
+  double frequency{1.0};            ///< [Hz] (sine)
+  double phase{0.0};                ///< [rad] (sine)
+  double offset{0.0};               ///< [N]
+  double rate{100.0};               ///< [N/s] (ramp)
+  double start_time{0.0};           ///< [s]
   std::vector<double> table_t;      ///< csv: row times [s], strictly increasing
   std::vector<double> table_value;  ///< csv: force [N] (table_is_force) or u [V] of each row
   bool table_is_force{true};
   double thrust_gain{260.0};  ///< Ka*Kf [N/V] used to turn force into u
-  double u_min{-1e9};       ///< [V]
-  double u_max{1e9};        ///< [V]
+  double u_min{-1e9};         ///< [V]
+  double u_max{1e9};          ///< [V]
 
   /// The scenario keys (controller.*); the table and thrust_gain come from the scenario
   /// (controller.file, the plant's Ka*Kf).
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(kind).doc("step, sine, ramp or csv"));
-    a->Visit(FD_FIELD(amplitude).unit("N").plausible(-1e5, 1e5).doc("step height, sine amplitude, ramp cap (0 = none)"));
+    a->Visit(
+        FD_FIELD(amplitude).unit("N").plausible(-1e5, 1e5).doc("step height, sine amplitude, ramp cap (0 = none)"));
     a->Visit(FD_FIELD(frequency).unit("Hz").non_negative().plausible(0, 1e4).doc("sine"));
     a->Visit(FD_FIELD(phase).unit("rad").plausible(-7, 7, "deg").doc("sine"));
     a->Visit(FD_FIELD(offset).unit("N").plausible(-1e5, 1e5).doc("added to every kind"));
@@ -59,8 +63,7 @@ struct OpenLoopParams {
 class OpenLoopSource final : public Controller {
  public:
   explicit OpenLoopSource(const OpenLoopParams& p);
-  Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
-                 const Truth* truth) override;
+  Command update(const trajectory::Sample& ref, const plant::Measurement& meas, const Truth* truth) override;
   std::string name() const override { return "open_loop"; }
   /// The force F(t) [N] of the source.
   double force(double t) const;

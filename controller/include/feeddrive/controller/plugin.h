@@ -42,24 +42,28 @@ extern "C" {
 #define FEEDDRIVE_CONTROLLER_ABI_VERSION 1u
 
 /* The friction law of the nominal model (plant/params.hpp FrictionModel). */
-enum feeddrive_friction_model { FEEDDRIVE_FRICTION_LUGRE = 0, FEEDDRIVE_FRICTION_STATIC = 1, FEEDDRIVE_FRICTION_NONE = 2 };
+enum feeddrive_friction_model {
+  FEEDDRIVE_FRICTION_LUGRE = 0,
+  FEEDDRIVE_FRICTION_STATIC = 1,
+  FEEDDRIVE_FRICTION_NONE = 2
+};
 
 /* The controller's nominal model of the drive (the scenario's controller.model, which defaults
  * to the plant without its effects): the fields of plant/params.hpp, same names and units. */
 typedef struct feeddrive_model {
-  double mass;            /* m [kg] */
-  double thrust_gain;     /* Ka*Kf [N/V] (amplifier_gain * force_constant) */
-  double amplifier_gain;  /* Ka */
-  double force_constant;  /* Kf [N/A] */
+  double mass;           /* m [kg] */
+  double thrust_gain;    /* Ka*Kf [N/V] (amplifier_gain * force_constant) */
+  double amplifier_gain; /* Ka */
+  double force_constant; /* Kf [N/A] */
   /* friction: F = sigma0*z + sigma1(v)*z' + sigma2*v (LuGre) or g(v)*tanh(v/eps) + sigma2*v (static) */
-  int32_t friction_model; /* enum feeddrive_friction_model */
-  double static_force;    /* Fs [N] */
-  double coulomb_force;   /* Fc [N] */
-  double stribeck_velocity;   /* vs [m/s] */
-  double stribeck_exponent;   /* delta */
-  double bristle_stiffness;   /* sigma0 [N/m] */
-  double bristle_damping;     /* sigma1 [N s/m] */
-  double viscous;             /* sigma2 [N s/m] */
+  int32_t friction_model;           /* enum feeddrive_friction_model */
+  double static_force;              /* Fs [N] */
+  double coulomb_force;             /* Fc [N] */
+  double stribeck_velocity;         /* vs [m/s] */
+  double stribeck_exponent;         /* delta */
+  double bristle_stiffness;         /* sigma0 [N/m] */
+  double bristle_damping;           /* sigma1 [N s/m] */
+  double viscous;                   /* sigma2 [N s/m] */
   double damping_decay_velocity;    /* vd [m/s], 0 = constant sigma1 */
   double static_smoothing_velocity; /* eps [m/s] */
   /* ripple (Xie & Liang eqs. 14-15) */
@@ -68,22 +72,22 @@ typedef struct feeddrive_model {
   double reluctance_amplitude, reluctance_phase, reluctance_third, reluctance_third_phase;
   /* grinding (Hahn-Lindsay, eq. 13): force s(x)*Fg, s(x) = clamp((x - contact_position)/contact_width, 0, 1) */
   int32_t grinding_enabled;
-  double grinding_stiffness;  /* ke [N/m] */
-  double grinding_damping;    /* C = c*pi*dw*bs [N s/m] */
-  double contact_position;    /* [m], -inf = always in contact */
-  double contact_width;       /* [m] */
+  double grinding_stiffness; /* ke [N/m] */
+  double grinding_damping;   /* C = c*pi*dw*bs [N s/m] */
+  double contact_position;   /* [m], -inf = always in contact */
+  double contact_width;      /* [m] */
   /* encoder */
   double sensor_quantization; /* q [m], 0 = ideal */
 } feeddrive_model;
 
 /* What a run tells the plugin when it creates it. */
 typedef struct feeddrive_run_info {
-  uint32_t abi_version;        /* the host's FEEDDRIVE_CONTROLLER_ABI_VERSION */
-  uint32_t size;               /* sizeof(feeddrive_run_info) as the host was compiled */
-  double period;               /* control period T [s] */
-  double u_min, u_max;         /* command limits [V] (scenario controller.u_min, u_max) */
-  double computation_delay;    /* [s]: the command computed at t_k acts from t_k + delay */
-  feeddrive_model model;       /* the nominal model */
+  uint32_t abi_version;     /* the host's FEEDDRIVE_CONTROLLER_ABI_VERSION */
+  uint32_t size;            /* sizeof(feeddrive_run_info) as the host was compiled */
+  double period;            /* control period T [s] */
+  double u_min, u_max;      /* command limits [V] (scenario controller.u_min, u_max) */
+  double computation_delay; /* [s]: the command computed at t_k acts from t_k + delay */
+  feeddrive_model model;    /* the nominal model */
 } feeddrive_run_info;
 
 /* One user parameter: the scenario's controller.parameters entry as text ("5e-4", "sat"). */
@@ -94,21 +98,21 @@ typedef struct feeddrive_parameter {
 
 /* The input of one control period (sample instant t). */
 typedef struct feeddrive_input {
-  uint32_t size;               /* sizeof(feeddrive_input) */
-  double t;                    /* [s] */
-  double xd, vd, ad, jd;       /* reference: position, velocity, acceleration, jerk */
-  double x, v;                 /* measured position and velocity */
-  int32_t has_truth;           /* 1 in simulation: z and fg are the plant's true states */
-  double z;                    /* LuGre bristle deflection [m] (NaN without truth) */
-  double fg;                   /* grinding force state [N] (NaN without truth) */
+  uint32_t size;         /* sizeof(feeddrive_input) */
+  double t;              /* [s] */
+  double xd, vd, ad, jd; /* reference: position, velocity, acceleration, jerk */
+  double x, v;           /* measured position and velocity */
+  int32_t has_truth;     /* 1 in simulation: z and fg are the plant's true states */
+  double z;              /* LuGre bristle deflection [m] (NaN without truth) */
+  double fg;             /* grinding force state [N] (NaN without truth) */
 } feeddrive_input;
 
 /* The output. The host fills the diagnostics with NaN before each call. */
 typedef struct feeddrive_output {
-  double u;                    /* command [V], applied as given (saturate it yourself) */
-  double u_unsaturated;        /* diagnostic: before saturation [V] */
-  double sliding;              /* diagnostic: sliding variable S [m/s] */
-  double z_estimate;           /* diagnostic: bristle state used by the law [m] */
+  double u;             /* command [V], applied as given (saturate it yourself) */
+  double u_unsaturated; /* diagnostic: before saturation [V] */
+  double sliding;       /* diagnostic: sliding variable S [m/s] */
+  double z_estimate;    /* diagnostic: bristle state used by the law [m] */
 } feeddrive_output;
 
 /* The five exported functions (their names are the ABI; the typedefs are for hosts). */

@@ -31,10 +31,10 @@ struct PluginParams {
   std::string library;  ///< path of the shared library
   /// controller.parameters, as text, in the scenario's order.
   std::vector<std::pair<std::string, std::string>> parameters;
-  plant::PlantParams model;  ///< the nominal model (controller.model; defaults to the plant)
-  double period{1e-4};       ///< T [s]
-  double u_min{-10.0};       ///< [V]
-  double u_max{10.0};        ///< [V]
+  plant::PlantParams model;       ///< the nominal model (controller.model; defaults to the plant)
+  double period{1e-4};            ///< T [s]
+  double u_min{-10.0};            ///< [V]
+  double u_max{10.0};             ///< [V]
   double computation_delay{0.0};  ///< [s]
   void validate(const std::string& prefix = "controller") const;
 };

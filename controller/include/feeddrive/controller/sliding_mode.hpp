@@ -62,7 +62,8 @@ struct ModelForces;  // sliding_mode_law.hpp
 
 enum class Switching { kSign, kSaturation, kTanh };
 inline const std::vector<std::pair<Switching, const char*>>& enum_names(Switching) {
-  static const std::vector<std::pair<Switching, const char*>> n = {{Switching::kSign, "sgn"}, {Switching::kSaturation, "sat"}, {Switching::kTanh, "tanh"}};
+  static const std::vector<std::pair<Switching, const char*>> n = {
+      {Switching::kSign, "sgn"}, {Switching::kSaturation, "sat"}, {Switching::kTanh, "tanh"}};
   return n;
 }
 std::string to_string(Switching s);
@@ -74,7 +75,8 @@ enum class StateSource {
   kObserver,  ///< from an observer driven by the measured velocity
 };
 inline const std::vector<std::pair<StateSource, const char*>>& enum_names(StateSource) {
-  static const std::vector<std::pair<StateSource, const char*>> n = {{StateSource::kTrue, "true"}, {StateSource::kObserver, "observer"}};
+  static const std::vector<std::pair<StateSource, const char*>> n = {{StateSource::kTrue, "true"},
+                                                                     {StateSource::kObserver, "observer"}};
   return n;
 }
 std::string to_string(StateSource s);
@@ -105,10 +107,10 @@ struct SlidingModeParams {
   /// the command that actually acts (DelayLine), and the law acts on the state predicted to
   /// t_k + d through the commands already issued, with the reference previewed to t_k + d.
   bool compensate_delay{false};
-  double u_min{-10.0};        ///< [V]
-  double u_max{10.0};         ///< [V]
-  plant::PlantParams model;   ///< the controller's model of the drive
-  double period{1e-4};        ///< control period T [s] (for the observers)
+  double u_min{-10.0};       ///< [V]
+  double u_max{10.0};        ///< [V]
+  plant::PlantParams model;  ///< the controller's model of the drive
+  double period{1e-4};       ///< control period T [s] (for the observers)
 
   /// The scenario keys (controller.*); model, period and computation_delay come from the
   /// scenario (controller.model, control_period, controller.computation_delay).
@@ -118,20 +120,39 @@ struct SlidingModeParams {
     a->Visit(FD_FIELD(k).unit("1/s").non_negative().plausible(0, 1e4).doc("proportional reaching rate"));
     a->Visit(FD_FIELD(lambda).unit("1/s").positive().plausible(0.1, 1e5).doc("sliding-surface slope"));
     a->Visit(FD_FIELD(switching).doc("sgn, sat (sat(S/phi)) or tanh (tanh(S/phi))"));
-    a->Visit(FD_FIELD(boundary_layer).unit("m/s").unchecked().plausible(1e-9, 1.0, "mm/s").doc("phi, for sat and tanh (> 0 there)"));
+    a->Visit(FD_FIELD(boundary_layer)
+                 .unit("m/s")
+                 .unchecked()
+                 .plausible(1e-9, 1.0, "mm/s")
+                 .doc("phi, for sat and tanh (> 0 there)"));
     a->Visit(FD_FIELD(compensate_friction).doc("the model friction term of eq. 19"));
     a->Visit(FD_FIELD(compensate_ripple).doc("the model ripple term of eq. 19"));
     a->Visit(FD_FIELD(compensate_grinding).doc("the model grinding term of eq. 19"));
     a->Visit(FD_FIELD(feedforward_acceleration).doc("the m*xd'' term"));
-    a->Visit(FD_FIELD(friction_state).doc("true: the friction estimate from the plant's true z (the paper); observer: from the bristle observer"));
+    a->Visit(FD_FIELD(friction_state)
+                 .doc("true: the friction estimate from the plant's true z (the paper); observer: from the bristle "
+                      "observer"));
     a->Visit(FD_FIELD(grinding_state).doc("the same choice for the grinding force"));
-    a->Visit(FD_FIELD(observer_gain).unit("1/s").non_negative().plausible(0, 1e5).doc("correction gain of the bristle observer"));
-    a->Visit(FD_FIELD(motion_state).doc("measured: e and de/dt from the measured x and v (the paper); observer: from the x,v observer"));
-    a->Visit(FD_FIELD(motion_observer_bandwidth).unit("rad/s").positive().plausible(1, 1e5).doc("pole of the x,v observer, p = exp(-w*T)"));
-    a->Visit(FD_FIELD(motion_observer_disturbance).doc("with motion_state observer: estimate a disturbance acceleration and add m*d^"));
-    a->Visit(FD_FIELD(compensate_delay).doc("predict the state to t_k + computation_delay (needs motion_state observer)"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
+    a->Visit(FD_FIELD(observer_gain)
+                 .unit("1/s")
+                 .non_negative()
+                 .plausible(0, 1e5)
+                 .doc("correction gain of the bristle observer"));
+    a->Visit(FD_FIELD(motion_state)
+                 .doc("measured: e and de/dt from the measured x and v (the paper); observer: from the x,v observer"));
+    a->Visit(FD_FIELD(motion_observer_bandwidth)
+                 .unit("rad/s")
+                 .positive()
+                 .plausible(1, 1e5)
+                 .doc("pole of the x,v observer, p = exp(-w*T)"));
+    a->Visit(FD_FIELD(motion_observer_disturbance)
+                 .doc("with motion_state observer: estimate a disturbance acceleration and add m*d^"));
+    a->Visit(
+        FD_FIELD(compensate_delay).doc("predict the state to t_k + computation_delay (needs motion_state observer)"));
+    a->Visit(
+        FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
+    a->Visit(
+        FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
   }
   void validate(const std::string& prefix = "controller") const;
 };
@@ -139,8 +160,7 @@ struct SlidingModeParams {
 class SlidingModeController final : public Controller {
  public:
   explicit SlidingModeController(const SlidingModeParams& p);
-  Command update(const trajectory::Sample& ref, const plant::Measurement& meas,
-                 const Truth* truth) override;
+  Command update(const trajectory::Sample& ref, const plant::Measurement& meas, const Truth* truth) override;
   bool needs_truth() const override;
   std::string name() const override { return "sliding_mode"; }
 

@@ -22,12 +22,12 @@ namespace feeddrive::controller::smc {
 /// The model's forces at the estimate (each opposing the thrust, eq. 19) and its additive effects,
 /// affine in the thrust F: F_extra = e0 + e1*F (e1: the reluctance_ripple effect, docs/fit.md).
 struct ModelForces {
-  double friction{0.0};    ///< F^f [N]
-  double grinding{0.0};    ///< F^g [N]
-  double cogging{0.0};     ///< Fcog(x) [N]
-  double reluctance{0.0};  ///< r(x) [-], the thrust-proportional ripple
-  double e0{0.0};          ///< [N]
-  double e1{0.0};          ///< [-]
+  double friction{0.0};     ///< F^f [N]
+  double grinding{0.0};     ///< F^g [N]
+  double cogging{0.0};      ///< Fcog(x) [N]
+  double reluctance{0.0};   ///< r(x) [-], the thrust-proportional ripple
+  double e0{0.0};           ///< [N]
+  double e1{0.0};           ///< [-]
   std::optional<double> z;  ///< the bristle state used for F^f (none without friction)
 };
 

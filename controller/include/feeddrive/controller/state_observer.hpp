@@ -47,8 +47,7 @@ class StateObserver {
  public:
   /// bandwidth: w_o [rad/s]; period: T [s]; with_disturbance: estimate d; quantization: the
   /// encoder's resolution q [m] (0: an ideal sensor).
-  StateObserver(double bandwidth, double period, bool with_disturbance = true,
-                double quantization = 0.0);
+  StateObserver(double bandwidth, double period, bool with_disturbance = true, double quantization = 0.0);
 
   /// Corrects the prediction with a new measurement; the first call initialises x^ = x_meas,
   /// v^ = v0, d^ = 0.

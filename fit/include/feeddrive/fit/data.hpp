@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::fit {
 
@@ -29,15 +29,15 @@ enum class InputKind {
 };
 
 struct MeasuredData {
-  std::string source;               ///< file name, for messages
-  std::vector<double> t;            ///< sample times [s], strictly increasing
-  std::vector<double> x;            ///< measured position [m]
-  std::vector<double> input;        ///< u [V] or thrust [N], held from t[k] to t[k+1]
+  std::string source;         ///< file name, for messages
+  std::vector<double> t;      ///< sample times [s], strictly increasing
+  std::vector<double> x;      ///< measured position [m]
+  std::vector<double> input;  ///< u [V] or thrust [N], held from t[k] to t[k+1]
   InputKind input_kind{InputKind::kCommand};
-  std::vector<double> xd;           ///< reference [m], empty if absent
-  std::vector<double> v;            ///< measured velocity [m/s], empty if absent
-  double time_offset{0.0};          ///< subtracted from the file's time stamps (t[0] is 0) [s]
-  std::vector<std::string> notes;   ///< what the loader did to the record (report.md, findings.json)
+  std::vector<double> xd;          ///< reference [m], empty if absent
+  std::vector<double> v;           ///< measured velocity [m/s], empty if absent
+  double time_offset{0.0};         ///< subtracted from the file's time stamps (t[0] is 0) [s]
+  std::vector<std::string> notes;  ///< what the loader did to the record (report.md, findings.json)
   /// The file line of each sample (CSV; empty for an LCM log), for messages naming a row.
   std::vector<long> lines;
   /// The file's names of the time, position and input columns (for messages).
@@ -68,14 +68,14 @@ Units parse_units(const std::string& spec);
 /// The CSV columns of each role (a drive's own export names them as it likes). A column is named
 /// by its header name or, if the header has no such name, by its 1-based index ("2").
 struct CsvOptions {
-  char separator{','};                   ///< column separator (',', ';', '\t')
-  bool decimal_comma{false};             ///< "0,25" means 0.25
-  Units units;                           ///< unit of each role (SI by default)
-  std::string time_column{"t"};          ///< time [s]
-  std::string position_column{"x"};      ///< the measured position [m]
-  std::string command_column{"u"};       ///< the command in the model's unit (thrust = Ka*Kf*u)
-  std::string force_column{"force_N"};   ///< or the thrust [N] (used when the command column is absent)
-  std::string reference_column{"xd"};    ///< optional position reference [m]
+  char separator{','};                  ///< column separator (',', ';', '\t')
+  bool decimal_comma{false};            ///< "0,25" means 0.25
+  Units units;                          ///< unit of each role (SI by default)
+  std::string time_column{"t"};         ///< time [s]
+  std::string position_column{"x"};     ///< the measured position [m]
+  std::string command_column{"u"};      ///< the command in the model's unit (thrust = Ka*Kf*u)
+  std::string force_column{"force_N"};  ///< or the thrust [N] (used when the command column is absent)
+  std::string reference_column{"xd"};   ///< optional position reference [m]
 };
 
 /// Reads a CSV file (see above). Throws DataError.

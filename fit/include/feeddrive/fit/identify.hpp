@@ -29,15 +29,15 @@ using Effect = plant::NamedEffect;
 enum class Reason { kNone, kPrerequisite, kImplausible, kBelowThreshold, kNotConfirmed, kNoGapReduction, kInvalid };
 
 struct CandidateFit {
-  Effect effect;            ///< as fitted jointly with the effects already added
-  int parameters{0};        ///< k of the candidate in the BIC
-  double rss{0.0};          ///< sum of squared filtered residuals of the joint fit [N^2]
+  Effect effect;      ///< as fitted jointly with the effects already added
+  int parameters{0};  ///< k of the candidate in the BIC
+  double rss{0.0};    ///< sum of squared filtered residuals of the joint fit [N^2]
   double bic{0.0};
-  double score{0.0};        ///< BIC(model) - BIC(model + candidate, joint fit); > 0 favours the effect
+  double score{0.0};  ///< BIC(model) - BIC(model + candidate, joint fit); > 0 favours the effect
   bool converged{false};
-  std::string passed_over;  ///< empty if eligible; else why not (prerequisite, implausible values, ...)
-  plant::PlantParams joint; ///< the model plus the candidate, every free parameter jointly refitted
-  double seconds{0.0};      ///< wall time of its fits
+  std::string passed_over;       ///< empty if eligible; else why not (prerequisite, implausible values, ...)
+  plant::PlantParams joint;      ///< the model plus the candidate, every free parameter jointly refitted
+  double seconds{0.0};           ///< wall time of its fits
   Reason reason{Reason::kNone};  ///< why it was passed over (kNone: eligible)
   /// Named although it fails a plausibility limit, because the limit lies within the 95 %
   /// confidence interval of the fitted value (docs/fit.md, "Tentative"): the caveat says which.
@@ -55,7 +55,8 @@ struct CandidateFit {
 /// central-difference Jacobian of the filtered residual in the vocabulary's own parameters
 /// (pseudo-inverse: a phase of a vanishing amplitude is undetermined and gets NaN).
 /// Returns {effect: {parameter: 1.96 sigma}}.
-std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec, const plant::PlantParams& fitted,
+std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec,
+                                                                          const plant::PlantParams& fitted,
                                                                           const std::vector<std::string>& effects);
 
 /// BIC of a residual vector with k parameters over n_active points (0: all of r).

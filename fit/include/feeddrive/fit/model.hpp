@@ -30,8 +30,8 @@ struct Record {
   const MeasuredData* data{nullptr};
   Motion motion;
   FilterBank bank;
-  Eigen::VectorXd input;        ///< input per interval (u or force), size n-1
-  double period{0.0};           ///< median sample period [s]
+  Eigen::VectorXd input;  ///< input per interval (u or force), size n-1
+  double period{0.0};     ///< median sample period [s]
   double x_min{0.0}, x_max{0.0};
   double v_max_abs{0.0}, a_max_abs{0.0};
   /// Filter points left out of the residual (set to 0): those whose window holds a stick phase

@@ -19,9 +19,9 @@
 namespace feeddrive::fit {
 
 struct Replay {
-  double gap{0.0};                 ///< RMS position error [m]
-  std::vector<double> x_sim;       ///< replayed position at every sample [m]
-  std::vector<double> error;       ///< x_sim - x at every sample [m] (0 at window starts)
+  double gap{0.0};            ///< RMS position error [m]
+  std::vector<double> x_sim;  ///< replayed position at every sample [m]
+  std::vector<double> error;  ///< x_sim - x at every sample [m] (0 at window starts)
 };
 
 /// window: W [s]; 0 picks 0.1 s (at least 20 samples).
@@ -35,14 +35,14 @@ double rms(const Eigen::VectorXd& r, long n_active = 0);
 struct Bin {
   std::string label;
   long points{0};
-  double force_rms{0.0};           ///< RMS filtered force residual in the bin [N]
-  double share{0.0};               ///< fraction of the total squared residual
-  double concentration{0.0};       ///< share / fraction of the points (1 = uniform)
-  double gap{0.0};                 ///< RMS replay position error of the samples in the bin [m]
+  double force_rms{0.0};      ///< RMS filtered force residual in the bin [N]
+  double share{0.0};          ///< fraction of the total squared residual
+  double concentration{0.0};  ///< share / fraction of the points (1 = uniform)
+  double gap{0.0};            ///< RMS replay position error of the samples in the bin [m]
 };
 struct Localisation {
   std::vector<Bin> time, velocity, acceleration, position;
-  std::string summary;             ///< one sentence: where the gap concentrates
+  std::string summary;  ///< one sentence: where the gap concentrates
 };
 
 Localisation localise(const Record& rec, const Eigen::VectorXd& residual, const Replay& rp);

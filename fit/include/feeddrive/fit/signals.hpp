@@ -28,10 +28,10 @@ double kernel_cdf(double s, double L);
 
 /// x^, v^, a^ at every sample and at the midpoint of every interval (size n-1).
 struct Motion {
-  std::vector<double> x, v, a;            ///< at the samples [m, m/s, m/s^2]
-  std::vector<double> x_mid, v_mid;       ///< at the interval midpoints (t_j + t_j+1)/2
-  std::vector<double> t_mid;              ///< interval midpoints [s]
-  std::vector<double> dt;                 ///< interval lengths t_j+1 - t_j [s]
+  std::vector<double> x, v, a;       ///< at the samples [m, m/s, m/s^2]
+  std::vector<double> x_mid, v_mid;  ///< at the interval midpoints (t_j + t_j+1)/2
+  std::vector<double> t_mid;         ///< interval midpoints [s]
+  std::vector<double> dt;            ///< interval lengths t_j+1 - t_j [s]
 };
 /// half_window: M, the samples on each side of the local cubic (>= 2).
 Motion estimate_motion(const std::vector<double>& t, const std::vector<double>& x, int half_window);
@@ -39,11 +39,11 @@ Motion estimate_motion(const std::vector<double>& t, const std::vector<double>& 
 /// The filter evaluated at points tau_i = t_0 + L + i*2L (non-overlapping supports, so the
 /// filtered noise of different points is independent).
 struct FilterBank {
-  double half_width{0.0};                 ///< L [s]
-  std::vector<double> tau;                ///< evaluation times [s]
-  std::vector<long> nearest;              ///< sample index nearest to each tau
+  double half_width{0.0};                          ///< L [s]
+  std::vector<double> tau;                         ///< evaluation times [s]
+  std::vector<long> nearest;                       ///< sample index nearest to each tau
   Eigen::SparseMatrix<double, Eigen::RowMajor> w;  ///< w(i, j) = weight of interval j at tau_i
-  std::vector<double> accel;              ///< Int h''(tau_i - t) x(t) dt = filtered x'' [m/s^2]
+  std::vector<double> accel;                       ///< Int h''(tau_i - t) x(t) dt = filtered x'' [m/s^2]
 };
 /// Builds the bank for samples t, x; throws std::invalid_argument if the record holds fewer
 /// than 4 filter windows.

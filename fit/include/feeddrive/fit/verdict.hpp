@@ -48,16 +48,16 @@
 namespace feeddrive::fit {
 
 struct NoiseFloor {
-  double quantization{0.0};  ///< q [m]
-  double noise{0.0};         ///< sigma_n [m]
-  double position{0.0};      ///< sigma_x [m]
-  double gap{0.0};           ///< [m]
-  double force{0.0};         ///< [N]: sqrt(force_noise^2 + force_discretisation^2)
-  double stamp_error{0.0};   ///< sigma_t of the time stamps [s] (FloorOptions)
-  double force_noise{0.0};   ///< of the sensor's noise (and stamp errors) through the filter [N]
+  double quantization{0.0};          ///< q [m]
+  double noise{0.0};                 ///< sigma_n [m]
+  double position{0.0};              ///< sigma_x [m]
+  double gap{0.0};                   ///< [m]
+  double force{0.0};                 ///< [N]: sqrt(force_noise^2 + force_discretisation^2)
+  double stamp_error{0.0};           ///< sigma_t of the time stamps [s] (FloorOptions)
+  double force_noise{0.0};           ///< of the sensor's noise (and stamp errors) through the filter [N]
   double force_discretisation{0.0};  ///< of the filter's discretisation on this record [N]
-  bool from_scenario{true};  ///< false: q estimated from the record
-  std::string source;        ///< one line: where q and sigma_n come from
+  bool from_scenario{true};          ///< false: q estimated from the record
+  std::string source;                ///< one line: where q and sigma_n come from
 };
 
 /// "Within the floor": at most this many times the floor.

@@ -29,30 +29,30 @@ namespace feeddrive::fit {
 
 struct FitOptions {
   int max_effects{4};
-  int cv_folds{5};                  ///< blocks of time of the cross-validation
-  bool fit_form{true};              ///< refit the Coulomb transition velocity (model form)
+  int cv_folds{5};      ///< blocks of time of the cross-validation
+  bool fit_form{true};  ///< refit the Coulomb transition velocity (model form)
   PlausibilityOptions plausibility;
-  double score_threshold{10.0};     ///< least BIC score of a significant effect
-  double min_gap_reduction{0.05};   ///< the replay gap must shrink by at least this fraction
-  double replay_window{0.0};        ///< W [s] of the replay (0: default)
-  double stamp_error{0.0};          ///< sigma_t [s] of the record's time stamps, for the noise floor (verdict.hpp)
-  interrupt::StopToken stop;        ///< polled by the replays and solves (Ctrl-C in the tool; the default never stops)
+  double score_threshold{10.0};    ///< least BIC score of a significant effect
+  double min_gap_reduction{0.05};  ///< the replay gap must shrink by at least this fraction
+  double replay_window{0.0};       ///< W [s] of the replay (0: default)
+  double stamp_error{0.0};         ///< sigma_t [s] of the record's time stamps, for the noise floor (verdict.hpp)
+  interrupt::StopToken stop;       ///< polled by the replays and solves (Ctrl-C in the tool; the default never stops)
   RecordOptions record;
 };
 
 struct StepResult {
-  std::vector<CandidateFit> ranking;   ///< best first
-  Localisation localisation;           ///< of the model before the step
+  std::vector<CandidateFit> ranking;  ///< best first
+  Localisation localisation;          ///< of the model before the step
   bool accepted{false};
-  std::string verdict;                 ///< one line: what was decided and why
-  Effect effect;                       ///< the winner as fitted jointly when it was added
+  std::string verdict;  ///< one line: what was decided and why
+  Effect effect;        ///< the winner as fitted jointly when it was added
   double score{0.0};
   /// Out-of-sample evidence of the winner: per block of time, the squared residual [N^2] of the
   /// model without and with it, each refitted on the other blocks.
   std::vector<double> cv_without, cv_with;
-  std::vector<std::string> removed;    ///< effects removed by the backward step after the addition
-  std::string swap;                    ///< a swap move of this step, e.g. "stribeck_friction -> coulomb_friction"
-  std::string caveat;                  ///< the winner was named as tentative: why (else empty)
+  std::vector<std::string> removed;  ///< effects removed by the backward step after the addition
+  std::string swap;                  ///< a swap move of this step, e.g. "stribeck_friction -> coulomb_friction"
+  std::string caveat;                ///< the winner was named as tentative: why (else empty)
   /// Candidates the record cannot tell from the winner (docs/fit.md, "Ties"), with their evidence.
   std::vector<std::string> ties, tie_notes;
   double gap_before{0.0}, gap_after{0.0};              ///< replay gap [m]
@@ -64,10 +64,10 @@ struct FitResult {
   plant::PlantParams initial, fitted;
   Replay replay_initial, replay_final;
   double force_rms_initial{0.0}, force_rms_final{0.0};
-  std::vector<StepResult> steps;       ///< every step, the last one may be rejected
-  std::vector<Effect> effects;         ///< the added effects with their final (jointly refitted) parameters
+  std::vector<StepResult> steps;  ///< every step, the last one may be rejected
+  std::vector<Effect> effects;    ///< the added effects with their final (jointly refitted) parameters
   Localisation final_localisation;
-  Envelope envelope;                   ///< what the record spans (plausibility rules)
+  Envelope envelope;                                    ///< what the record spans (plausibility rules)
   double smoothing_initial{0.0}, smoothing_final{0.0};  ///< eps of sgn_eps [m/s], before and after
   double shape_initial{0.0}, shape_final{0.0};          ///< b of sgn_eps [-] (0 tanh, 1 algebraic), before and after
   bool smoothing_fitted{false};                         ///< eps or b was refitted
@@ -75,7 +75,7 @@ struct FitResult {
   /// friction level), carried by constant_force in `fitted` but not named as an effect [N].
   double asymmetry_offset{0.0};
   std::string conclusion;
-  NoiseFloor floor;                    ///< the sensor's noise floor (verdict.hpp)
+  NoiseFloor floor;  ///< the sensor's noise floor (verdict.hpp)
   Verdict verdict{Verdict::kUnexplained};
   /// For an unexplained verdict: where the discrepancy is, what it resembles, why each resembling
   /// candidate was not named and what record would settle it (one sentence each).

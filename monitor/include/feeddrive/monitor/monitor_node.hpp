@@ -14,18 +14,18 @@
 // comes for --step-timeout (the run or the played-back log is over) it records what it can and
 // ends.
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
-#include <map>
 #include <vector>
 
-#include "feeddrive/record/lcm_log.hpp"
-#include "feeddrive/output/folder.hpp"
-#include "feeddrive/monitor/histogram.hpp"
-#include "feeddrive/record/recorder.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
+#include "feeddrive/monitor/histogram.hpp"
+#include "feeddrive/output/folder.hpp"
+#include "feeddrive/record/lcm_log.hpp"
+#include "feeddrive/record/recorder.hpp"
 #include "feeddrive/run_info_t.hpp"
 #include "feeddrive/run_summary_t.hpp"
 #include "feeddrive/service/loggers.hpp"
@@ -112,7 +112,7 @@ class MonitorNode : public service::Node {
   std::int64_t asking_seq_{-1}, asking_since_us_{0}, asking_requests_{0};
   std::int64_t last_state_us_{0};  ///< attach mode: when the last state arrived (mono_us)
   run_summary_t summary_{};
-  service::StepLedger<drive_state_t> state_ledger_;          ///< for conflicts (service::Node::admit)
+  service::StepLedger<drive_state_t> state_ledger_;  ///< for conflicts (service::Node::admit)
   service::StepLedger<reference_t> reference_ledger_;
   service::StepLedger<control_command_t> command_ledger_;
   /// The first command of each recent step and who sent it ("IP:PORT"), to name the two sides of
@@ -144,13 +144,13 @@ class MonitorNode : public service::Node {
   std::string log_error_;  ///< the first write error of the LCM log (ends the run)
   std::int64_t heartbeats_{0};
   Histogram hist_sc_, hist_cs_, hist_late_;
-  std::string failure_;  ///< set by the bus events: the run cannot go on (run() throws it)
+  std::string failure_;                        ///< set by the bus events: the run cannot go on (run() throws it)
   std::map<std::string, std::int64_t> named_;  ///< what was named already (one line per sender and kind) -> count
-  std::int64_t plant_seq_seen_{-1};  ///< the highest step of the plant's heartbeats
-  std::map<std::string, std::string> source_process_;  ///< command source "IP:PORT" -> local process
+  std::int64_t plant_seq_seen_{-1};            ///< the highest step of the plant's heartbeats
+  std::map<std::string, std::string> source_process_;             ///< command source "IP:PORT" -> local process
   std::map<std::string, std::int64_t> first_unauthenticated_us_;  ///< per channel and role (mono_us)
-  std::int64_t last_file_flush_us_{0};  ///< when the record last went to its file (mono_us)
-  std::vector<service::StockLogger> loggers_;  ///< stock loggers seen on the bus during the run
+  std::int64_t last_file_flush_us_{0};                            ///< when the record last went to its file (mono_us)
+  std::vector<service::StockLogger> loggers_;                     ///< stock loggers seen on the bus during the run
   std::int64_t rate_since_us_{-1}, rate_since_step_{0};
   double peak_rate_{0.0};  ///< the most steps per second recorded in one window of >= 1 s
   std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight

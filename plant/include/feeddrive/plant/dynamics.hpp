@@ -46,7 +46,7 @@ struct Forces {
   double friction{0.0};  ///< F_friction [N]
   double ripple{0.0};    ///< F_ripple [N]
   double grinding{0.0};  ///< F_grinding [N] (0 out of contact)
-  double extra{0.0};  ///< F_extra [N] (effects.hpp)
+  double extra{0.0};     ///< F_extra [N] (effects.hpp)
 };
 
 /// The params the equations run on: effective_params(p) (effects.hpp), computed once, and whether

@@ -20,8 +20,8 @@
 //                            + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
 //       reluctance_ripple  F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)
 //       spring_force       F = stiffness_N_per_m*(x - rest_position_m)
-//     with sgn_eps(v) the smoothed sign of forces.hpp (tanh(v/eps) by default), eps = friction.static_smoothing_velocity, and
-//     delta = friction.stribeck_exponent.
+//     with sgn_eps(v) the smoothed sign of forces.hpp (tanh(v/eps) by default), eps =
+//     friction.static_smoothing_velocity, and delta = friction.stribeck_exponent.
 
 #include <map>
 #include <string>

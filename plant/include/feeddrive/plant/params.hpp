@@ -40,13 +40,13 @@ FrictionModel friction_model_from_string(const std::string& s);
 /// LuGre / static friction parameters. Defaults: Xie & Liang Table 1, delta = 2.
 struct FrictionParams {
   FrictionModel model{FrictionModel::kLuGre};
-  double static_force{120.0};       ///< Fs [N], stiction level of g(v).
-  double coulomb_force{80.0};       ///< Fc [N], Coulomb level of g(v).
-  double stribeck_velocity{0.1};    ///< vs [m/s].
-  double stribeck_exponent{2.0};    ///< delta [-], shape of exp(-|v/vs|^delta).
-  double bristle_stiffness{2e6};    ///< sigma0 [N/m].
-  double bristle_damping{2e4};      ///< sigma1 [N*s/m].
-  double viscous{0.4};              ///< sigma2 [N*s/m].
+  double static_force{120.0};     ///< Fs [N], stiction level of g(v).
+  double coulomb_force{80.0};     ///< Fc [N], Coulomb level of g(v).
+  double stribeck_velocity{0.1};  ///< vs [m/s].
+  double stribeck_exponent{2.0};  ///< delta [-], shape of exp(-|v/vs|^delta).
+  double bristle_stiffness{2e6};  ///< sigma0 [N/m].
+  double bristle_damping{2e4};    ///< sigma1 [N*s/m].
+  double viscous{0.4};            ///< sigma2 [N*s/m].
   /// vd [m/s]: if > 0, sigma1(v) = sigma1*exp(-(v/vd)^2) (passivity remedy, Olsson et al. 1998).
   /// 0 (default) keeps the paper's constant sigma1.
   double damping_decay_velocity{0.0};
@@ -60,16 +60,38 @@ struct FrictionParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(model).doc("friction law: lugre, static (Coulomb + Stribeck + viscous map) or none"));
-    a->Visit(FD_FIELD(static_force).unit("N").positive().plausible(0.1, 2e4, "", "", "a linear guide").doc("Fs, stiction level of g(v)"));
-    a->Visit(FD_FIELD(coulomb_force).unit("N").positive().plausible(0.1, 2e4, "", "", "a linear guide").doc("Fc, Coulomb level of g(v); <= static_force"));
-    a->Visit(FD_FIELD(stribeck_velocity).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s").doc("vs, Stribeck velocity"));
-    a->Visit(FD_FIELD(stribeck_exponent).unit("-").positive().plausible(0.3, 5.0).doc("delta, shape of exp(-|v/vs|^delta)"));
+    a->Visit(FD_FIELD(static_force)
+                 .unit("N")
+                 .positive()
+                 .plausible(0.1, 2e4, "", "", "a linear guide")
+                 .doc("Fs, stiction level of g(v)"));
+    a->Visit(FD_FIELD(coulomb_force)
+                 .unit("N")
+                 .positive()
+                 .plausible(0.1, 2e4, "", "", "a linear guide")
+                 .doc("Fc, Coulomb level of g(v); <= static_force"));
+    a->Visit(
+        FD_FIELD(stribeck_velocity).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s").doc("vs, Stribeck velocity"));
+    a->Visit(
+        FD_FIELD(stribeck_exponent).unit("-").positive().plausible(0.3, 5.0).doc("delta, shape of exp(-|v/vs|^delta)"));
     a->Visit(FD_FIELD(bristle_stiffness).unit("N/m").positive().plausible(1e3, 1e10, "", "N/um").doc("sigma0 (lugre)"));
     a->Visit(FD_FIELD(bristle_damping).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1 (lugre)"));
     a->Visit(FD_FIELD(viscous).unit("N*s/m").non_negative().plausible(0, 1e5).doc("sigma2, viscous coefficient"));
-    a->Visit(FD_FIELD(damping_decay_velocity).unit("m/s").non_negative().plausible(0, 1.0, "mm/s").doc("vd: > 0 gives sigma1(v) = sigma1*exp(-(v/vd)^2); 0 keeps sigma1 constant"));
-    a->Visit(FD_FIELD(static_smoothing_velocity).unit("m/s").positive().plausible(1e-9, 1e-2, "mm/s").doc("eps of the static model's smoothed sign sgn_eps(v) (static only)"));
-    a->Visit(FD_FIELD(static_smoothing_shape).unit("-").non_negative().at_most(1).doc("b: sgn_eps(v) = (1-b)*tanh(v/eps) + b*v/sqrt(v^2+eps^2); 0 tanh, 1 algebraic (static only)"));
+    a->Visit(FD_FIELD(damping_decay_velocity)
+                 .unit("m/s")
+                 .non_negative()
+                 .plausible(0, 1.0, "mm/s")
+                 .doc("vd: > 0 gives sigma1(v) = sigma1*exp(-(v/vd)^2); 0 keeps sigma1 constant"));
+    a->Visit(FD_FIELD(static_smoothing_velocity)
+                 .unit("m/s")
+                 .positive()
+                 .plausible(1e-9, 1e-2, "mm/s")
+                 .doc("eps of the static model's smoothed sign sgn_eps(v) (static only)"));
+    a->Visit(FD_FIELD(static_smoothing_shape)
+                 .unit("-")
+                 .non_negative()
+                 .at_most(1)
+                 .doc("b: sgn_eps(v) = (1-b)*tanh(v/eps) + b*v/sqrt(v^2+eps^2); 0 tanh, 1 algebraic (static only)"));
   }
   void validate(const std::string& prefix = "friction") const;
 };
@@ -91,11 +113,11 @@ inline const std::vector<std::pair<RipplePreset, const char*>>& enum_names(Rippl
 struct RippleParams {
   RipplePreset preset{RipplePreset::kNone};
   bool enabled{false};
-  double pitch{0.03};             ///< p [m], magnet pitch.
-  double cogging_amplitude{0.0};  ///< ac [N].
-  double cogging_phase{0.0};      ///< phi_c1 [rad].
-  double cogging_third{0.0};      ///< bc [N], third harmonic (6*pi*x/p).
-  double cogging_third_phase{0.0};///< phi_c3 [rad].
+  double pitch{0.03};                  ///< p [m], magnet pitch.
+  double cogging_amplitude{0.0};       ///< ac [N].
+  double cogging_phase{0.0};           ///< phi_c1 [rad].
+  double cogging_third{0.0};           ///< bc [N], third harmonic (6*pi*x/p).
+  double cogging_third_phase{0.0};     ///< phi_c3 [rad].
   double reluctance_amplitude{0.0};    ///< af [-], fraction of the desired force.
   double reluctance_phase{0.0};        ///< phi_11 [rad].
   double reluctance_third{0.0};        ///< bf [-].
@@ -119,14 +141,19 @@ struct RippleParams {
 
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(preset).doc("paper: start from the paper's values (ac 3 N, bc 1 N, af 0.03, bf 0.01, on); `ripple: paper` alone says the same; none: every part 0"));
+    a->Visit(
+        FD_FIELD(preset).doc("paper: start from the paper's values (ac 3 N, bc 1 N, af 0.03, bf 0.01, on); `ripple: "
+                             "paper` alone says the same; none: every part 0"));
     a->Visit(FD_FIELD(enabled).doc("the ripple force of eqs. 14-15 acts"));
     a->Visit(FD_FIELD(pitch).unit("m").positive().at_most(10).plausible(1e-3, 0.2, "mm").doc("p, magnet pitch"));
     a->Visit(FD_FIELD(cogging_amplitude).unit("N").plausible(-2000, 2000).doc("ac, cogging amplitude"));
     a->Visit(FD_FIELD(cogging_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c1"));
     a->Visit(FD_FIELD(cogging_third).unit("N").plausible(-2000, 2000).doc("bc, cogging third harmonic (6*pi*x/p)"));
     a->Visit(FD_FIELD(cogging_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c3"));
-    a->Visit(FD_FIELD(reluctance_amplitude).unit("-").plausible(-0.5, 0.5, "%").doc("af, fraction of the desired force; |af| + |bf| < 1"));
+    a->Visit(FD_FIELD(reluctance_amplitude)
+                 .unit("-")
+                 .plausible(-0.5, 0.5, "%")
+                 .doc("af, fraction of the desired force; |af| + |bf| < 1"));
     a->Visit(FD_FIELD(reluctance_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_11"));
     a->Visit(FD_FIELD(reluctance_third).unit("-").plausible(-0.5, 0.5, "%").doc("bf, third harmonic fraction"));
     a->Visit(FD_FIELD(reluctance_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_12"));
@@ -137,10 +164,10 @@ struct RippleParams {
 /// Hahn-Lindsay plunge-grinding normal force (Xie & Liang eq. 13).
 struct GrindingParams {
   bool enabled{false};
-  double stiffness{2e7};              ///< ke [N/m], effective wheel-work-machine stiffness.
-  double dullness{2.5e9};             ///< c [N*s/m^3], force per material removal rate.
-  double workpiece_diameter{0.05};    ///< dw [m].
-  double wheel_width{0.02};           ///< bs [m].
+  double stiffness{2e7};            ///< ke [N/m], effective wheel-work-machine stiffness.
+  double dullness{2.5e9};           ///< c [N*s/m^3], force per material removal rate.
+  double workpiece_diameter{0.05};  ///< dw [m].
+  double wheel_width{0.02};         ///< bs [m].
   /// Contact begins when x > contact_position [m]. -inf (default): always in contact.
   double contact_position{-std::numeric_limits<double>::infinity()};
   /// w [m]: the wheel engages over x in (contact_position, contact_position + w) (surface
@@ -151,12 +178,25 @@ struct GrindingParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(enabled).doc("the Hahn-Lindsay grinding force of eq. 13 acts"));
-    a->Visit(FD_FIELD(stiffness).unit("N/m").positive().plausible(1e5, 1e10, "", "N/um").doc("ke, wheel-work-machine stiffness"));
-    a->Visit(FD_FIELD(dullness).unit("N*s/m^3").positive().plausible(1e6, 1e13).doc("c, force per material removal rate"));
+    a->Visit(FD_FIELD(stiffness)
+                 .unit("N/m")
+                 .positive()
+                 .plausible(1e5, 1e10, "", "N/um")
+                 .doc("ke, wheel-work-machine stiffness"));
+    a->Visit(
+        FD_FIELD(dullness).unit("N*s/m^3").positive().plausible(1e6, 1e13).doc("c, force per material removal rate"));
     a->Visit(FD_FIELD(workpiece_diameter).unit("m").positive().plausible(1e-3, 2.0, "mm").doc("dw"));
     a->Visit(FD_FIELD(wheel_width).unit("m").positive().plausible(1e-3, 0.5, "mm").doc("bs"));
-    a->Visit(FD_FIELD(contact_position).unit("m").minus_inf_allowed().plausible(-5, 5, "mm").doc("contact for x > contact_position; -.inf: always in contact"));
-    a->Visit(FD_FIELD(contact_width).unit("m").non_negative().plausible(0, 1e-2, "um").doc("w: the force rises linearly over (contact_position, contact_position + w); 0: a step"));
+    a->Visit(FD_FIELD(contact_position)
+                 .unit("m")
+                 .minus_inf_allowed()
+                 .plausible(-5, 5, "mm")
+                 .doc("contact for x > contact_position; -.inf: always in contact"));
+    a->Visit(FD_FIELD(contact_width)
+                 .unit("m")
+                 .non_negative()
+                 .plausible(0, 1e-2, "um")
+                 .doc("w: the force rises linearly over (contact_position, contact_position + w); 0: a step"));
   }
   /// C = c*pi*dw*bs [N*s/m]: the steady-state force per infeed velocity.
   double damping() const;
@@ -169,9 +209,9 @@ struct GrindingParams {
 /// Off by default, as in the paper (Section 2.1 neglects the electrical dynamics).
 struct ElectricalParams {
   bool enabled{false};
-  double resistance{1.0};     ///< R [ohm].
-  double inductance{2e-3};    ///< L [H].
-  double back_emf{100.0};     ///< Ke [V*s/m].
+  double resistance{1.0};   ///< R [ohm].
+  double inductance{2e-3};  ///< L [H].
+  double back_emf{100.0};   ///< Ke [V*s/m].
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -197,7 +237,8 @@ struct ConstantForceEffect {  ///< F = force_N (gravity on an incline, cable wei
     a->Visit(FD_FIELD(force_N).unit("N").plausible(-1e4, 1e4).doc("the constant force"));
   }
 };
-struct CoulombFrictionEffect {  ///< F = coulomb_N*sgn(v), sgn smoothed as tanh(v/eps) (eps: friction.static_smoothing_velocity)
+struct CoulombFrictionEffect {  ///< F = coulomb_N*sgn(v), sgn smoothed as tanh(v/eps) (eps:
+                                ///< friction.static_smoothing_velocity)
   bool enabled{false};
   double coulomb_N{0.0};
   template <class Archive>
@@ -240,7 +281,11 @@ struct PreslidingEffect {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(bristle_stiffness_N_per_m).unit("N/m").positive().plausible(1e3, 1e10, "", "N/um").doc("sigma0 of the LuGre friction it makes"));
+    a->Visit(FD_FIELD(bristle_stiffness_N_per_m)
+                 .unit("N/m")
+                 .positive()
+                 .plausible(1e3, 1e10, "", "N/um")
+                 .doc("sigma0 of the LuGre friction it makes"));
     a->Visit(FD_FIELD(bristle_damping_Ns_per_m).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1"));
   }
 };
@@ -342,11 +387,19 @@ struct EffectsParams {
     a->Visit(FD_FIELD(constant_force).doc("F = force_N (gravity on an incline, cable weight, an offset)"));
     a->Visit(FD_FIELD(coulomb_friction).doc("F = coulomb_N*sgn_eps(v)"));
     a->Visit(FD_FIELD(viscous_friction).doc("F = viscous_Ns_per_m*v"));
-    a->Visit(FD_FIELD(stribeck_friction).doc("F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))"));
-    a->Visit(FD_FIELD(presliding).doc("the friction becomes LuGre with sigma0, sigma1 below, keeping Fs, Fc, vs, delta, sigma2 of friction"));
-    a->Visit(FD_FIELD(cogging_ripple).doc("F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)"));
+    a->Visit(FD_FIELD(stribeck_friction)
+                 .doc("F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))"));
+    a->Visit(
+        FD_FIELD(presliding)
+            .doc(
+                "the friction becomes LuGre with sigma0, sigma1 below, keeping Fs, Fc, vs, delta, sigma2 of friction"));
+    a->Visit(FD_FIELD(cogging_ripple)
+                 .doc("F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + "
+                      "third_phase_rad)"));
     a->Visit(FD_FIELD(reluctance_ripple).doc("F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)"));
-    a->Visit(FD_FIELD(grinding_force).doc("the grinding section's force on, with C = gain_Ns_per_m, ke = stiffness_N_per_m, contact past contact_position_m"));
+    a->Visit(FD_FIELD(grinding_force)
+                 .doc("the grinding section's force on, with C = gain_Ns_per_m, ke = stiffness_N_per_m, contact past "
+                      "contact_position_m"));
     a->Visit(FD_FIELD(spring_force).doc("F = stiffness_N_per_m*(x - rest_position_m) (a cable carrier)"));
     a->Visit(FD_FIELD(mass_error).doc("the true moving mass mass_kg replaces plant.mass"));
     a->Visit(FD_FIELD(input_delay).doc("F_thrust(t) = Ka*Kf*u(t - delay_s)"));
@@ -363,15 +416,17 @@ enum class VelocityMeasurement {
 };
 inline const std::vector<std::pair<VelocityMeasurement, const char*>>& enum_names(VelocityMeasurement) {
   static const std::vector<std::pair<VelocityMeasurement, const char*>> n = {
-      {VelocityMeasurement::kAuto, "auto"}, {VelocityMeasurement::kTrue, "true"}, {VelocityMeasurement::kDifference, "difference"}};
+      {VelocityMeasurement::kAuto, "auto"},
+      {VelocityMeasurement::kTrue, "true"},
+      {VelocityMeasurement::kDifference, "difference"}};
   return n;
 }
 
 /// Position sensor (encoder) model. Both effects off by default.
 struct SensorParams {
-  double quantization{0.0};    ///< q [m]; 0 = ideal. x_meas = q*round((x + n)/q).
-  double noise_stddev{0.0};    ///< standard deviation of Gaussian position noise n [m].
-  std::uint64_t seed{1};       ///< seed of the noise generator (std::mt19937_64).
+  double quantization{0.0};  ///< q [m]; 0 = ideal. x_meas = q*round((x + n)/q).
+  double noise_stddev{0.0};  ///< standard deviation of Gaussian position noise n [m].
+  std::uint64_t seed{1};     ///< seed of the noise generator (std::mt19937_64).
   /// How the measured velocity is formed; kTrue only with an ideal sensor: validate() refuses
   /// it with quantization or noise, which measure position only.
   VelocityMeasurement velocity{VelocityMeasurement::kAuto};
@@ -385,10 +440,22 @@ struct SensorParams {
   template <class Archive>
   void Serialize(Archive* a) {
     // 0 or in [1e-12, 1] m: beyond, the measurement overflows or rounds to nothing (validate()).
-    a->Visit(FD_FIELD(quantization).unit("m").non_negative().at_most(1.0).plausible(1e-10, 1e-4, "um").doc("encoder count q; 0 = ideal; else in [1e-12, 1]"));
-    a->Visit(FD_FIELD(noise_stddev).unit("m").non_negative().at_most(1.0).plausible(0, 1e-4, "um").doc("standard deviation of Gaussian position noise; at most 1"));
+    a->Visit(FD_FIELD(quantization)
+                 .unit("m")
+                 .non_negative()
+                 .at_most(1.0)
+                 .plausible(1e-10, 1e-4, "um")
+                 .doc("encoder count q; 0 = ideal; else in [1e-12, 1]"));
+    a->Visit(FD_FIELD(noise_stddev)
+                 .unit("m")
+                 .non_negative()
+                 .at_most(1.0)
+                 .plausible(0, 1e-4, "um")
+                 .doc("standard deviation of Gaussian position noise; at most 1"));
     a->Visit(FD_FIELD(seed).doc("seed of the noise generator"));
-    a->Visit(FD_FIELD(velocity).doc("auto: true for an ideal sensor, else difference; true (a tachometer) only with an ideal sensor; difference: (x_k - x_k-1)/T"));
+    a->Visit(
+        FD_FIELD(velocity).doc("auto: true for an ideal sensor, else difference; true (a tachometer) only with an "
+                               "ideal sensor; difference: (x_k - x_k-1)/T"));
   }
   void validate(const std::string& prefix = "sensor") const;
 };
@@ -397,12 +464,12 @@ struct SensorParams {
 /// Defaults are tight enough that halving them moves every paper figure by < 1% (tested).
 struct IntegratorParams {
   double rtol{1e-8};
-  double atol_position{1e-12};   ///< [m]
-  double atol_velocity{1e-12};   ///< [m/s]
-  double atol_bristle{1e-13};    ///< [m]
-  double atol_grinding{1e-9};    ///< [N]
-  double atol_current{1e-9};     ///< [A]
-  long max_steps{100000};        ///< per control period.
+  double atol_position{1e-12};  ///< [m]
+  double atol_velocity{1e-12};  ///< [m/s]
+  double atol_bristle{1e-13};   ///< [m]
+  double atol_grinding{1e-9};   ///< [N]
+  double atol_current{1e-9};    ///< [A]
+  long max_steps{100000};       ///< per control period.
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -439,8 +506,8 @@ struct InitialState {
 struct PlantParams {
   /// m [kg]: from the paper's zeta = 0.7, m = ((sigma1+sigma2)/1.4)^2/sigma0 = 102.04 kg.
   double mass{102.04};
-  double amplifier_gain{2.6};   ///< Ka [A/V] (or V/V with the electrical option); Ka*Kf = 260 N/V.
-  double force_constant{100.0}; ///< Kf [N/A]. Thrust = Ka*Kf*u without electrical dynamics.
+  double amplifier_gain{2.6};    ///< Ka [A/V] (or V/V with the electrical option); Ka*Kf = 260 N/V.
+  double force_constant{100.0};  ///< Kf [N/A]. Thrust = Ka*Kf*u without electrical dynamics.
   /// Amplifier input range [V]: |u| above it is clipped, a non-finite u is rejected
   /// (command.hpp). 100 V: far above every controller's own limit, so it only guards.
   double input_limit{100.0};
@@ -456,9 +523,17 @@ struct PlantParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(mass).unit("kg").positive().plausible(0.5, 5000, "g").doc("m, moving mass"));
-    a->Visit(FD_FIELD(amplifier_gain).unit("A/V").positive().plausible(0.01, 100).doc("Ka (V/V with the electrical option); Ka*Kf = thrust per volt"));
+    a->Visit(FD_FIELD(amplifier_gain)
+                 .unit("A/V")
+                 .positive()
+                 .plausible(0.01, 100)
+                 .doc("Ka (V/V with the electrical option); Ka*Kf = thrust per volt"));
     a->Visit(FD_FIELD(force_constant).unit("N/A").positive().plausible(1, 2000).doc("Kf"));
-    a->Visit(FD_FIELD(input_limit).unit("V").positive().plausible(1, 1000).doc("the amplifier's input range: a larger |u| is clipped, a NaN/inf u is rejected and 0 V applied"));
+    a->Visit(FD_FIELD(input_limit)
+                 .unit("V")
+                 .positive()
+                 .plausible(1, 1000)
+                 .doc("the amplifier's input range: a larger |u| is clipped, a NaN/inf u is rejected and 0 V applied"));
     a->Visit(FD_FIELD(friction));
     a->Visit(FD_FIELD(ripple));
     a->Visit(FD_FIELD(grinding));

@@ -62,9 +62,9 @@ class Plant {
   EffectiveParams effective_;
   CvodeIntegrator integrator_;
   Sensor sensor_;
-  bool delayed_;      ///< input_delay enabled
-  double delay_;      ///< d [s]
-  double snap_;       ///< switch times within snap_ of an interval end are taken as that end [s]
+  bool delayed_;  ///< input_delay enabled
+  double delay_;  ///< d [s]
+  double snap_;   ///< switch times within snap_ of an interval end are taken as that end [s]
   std::deque<HeldCommand> history_;
 };
 

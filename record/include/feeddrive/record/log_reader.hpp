@@ -10,7 +10,7 @@
 namespace feeddrive::record {
 
 struct LogConversion {
-  Recorder recorder{true, true};        ///< rows found (attach mode: from the first state logged)
+  Recorder recorder{true, true};  ///< rows found (attach mode: from the first state logged)
   long events{0};                 ///< events read
   long foreign_events{0};         ///< events on channels of other prefixes
   long undecodable{0};            ///< events on our channels that are not our type

@@ -79,8 +79,8 @@ class Recorder {
   /// Sum of gaps()' steps.
   std::int64_t missing_steps() const;
 
-  std::int64_t next() const { return next_; }             ///< first step not recorded
-  std::int64_t steps() const { return steps_; }           ///< steps of the run (-1 until known)
+  std::int64_t next() const { return next_; }    ///< first step not recorded
+  std::int64_t steps() const { return steps_; }  ///< steps of the run (-1 until known)
   std::int64_t highest_state() const { return highest_state_; }
   bool end_seen() const { return end_seen_; }
   bool complete() const { return end_seen_ && next_ >= steps_; }

@@ -12,12 +12,12 @@
 //
 // Nothing here knows about drives: the nodes (plant_node.hpp, ...) hold the protocol logic.
 
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <exception>
 #include <functional>
@@ -162,8 +162,7 @@ class Bus {
     std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f;
     void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { f(rbuf, channel); }
   };
-  void subscribe_raw(const std::string& channel,
-                     std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f);
+  void subscribe_raw(const std::string& channel, std::function<void(const lcm::ReceiveBuffer*, const std::string&)> f);
   bool poll_event(std::chrono::microseconds timeout);
   bool poll_batched(std::chrono::microseconds timeout);
   bool poll_direct(std::chrono::microseconds timeout);

@@ -62,7 +62,7 @@ int run_scenario_node(CLI::App& app, int argc, char** argv) {
   add_node_options(app, opt);
   return run_process(app, argc, argv, opt, [&] {
     const RunScenario rs = load_run_scenario(scenario_path, opt);  // the launcher's scenario, or exit 2
-    opt.scenario_hash = rs.sha256;  // checked against the monitor's run_info_t
+    opt.scenario_hash = rs.sha256;                                 // checked against the monitor's run_info_t
     NodeType node(rs.scenario, opt);
     return run_node(node);
   });

@@ -33,9 +33,9 @@ class ControllerNode : public Node {
   std::int64_t pending_since_us_{0};
   std::int64_t last_ref_request_us_{0};
   std::map<std::int64_t, reference_t> refs_;
-  StepLedger<drive_state_t> state_ledger_;      ///< every state received, for conflicts
-  StepLedger<reference_t> reference_ledger_;    ///< every reference received, for conflicts
-  std::int64_t next_seq_{0};       ///< first step not answered yet
+  StepLedger<drive_state_t> state_ledger_;    ///< every state received, for conflicts
+  StepLedger<reference_t> reference_ledger_;  ///< every reference received, for conflicts
+  std::int64_t next_seq_{0};                  ///< first step not answered yet
   /// Steps >= next_seq_ for which a command of another publisher was seen on the command channel
   /// (a forged or stray answer: the plant may then move on without this controller's command).
   std::set<std::int64_t> answered_by_others_;

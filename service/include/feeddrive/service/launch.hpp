@@ -55,7 +55,7 @@ struct LaunchOptions {
 std::vector<int> parse_cpu_list(const std::string& text, const std::string& option = "--cpus");
 
 struct LaunchResult {
-  int exit_code{0};             ///< 0 if every started process exited 0
+  int exit_code{0};                 ///< 0 if every started process exited 0
   std::vector<std::string> failed;  ///< "role (exit n)" of each process that did not exit 0
   /// The monitor was killed (no unwinding, e.g. SIGKILL): where its record so far was moved
   /// (DIR.incomplete-N, output::rescue_staging); "" otherwise.

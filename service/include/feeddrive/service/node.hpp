@@ -28,17 +28,17 @@ namespace feeddrive::service {
 struct NodeOptions {
   std::string lcm_url{default_lcm_url()};
   std::string prefix{"FD"};
-  double start_timeout_s{30.0};      ///< how long to wait for the other roles to show up (step 0)
-  double step_timeout_s{5.0};        ///< no progress for this long: fail, naming the missing role
-  double resend_interval_s{0.002};   ///< re-publish a pending message after this long
-  long monitor_window{4096};         ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
-  double linger_s{10.0};             ///< after the end: keep answering resend requests until the monitor is done
-  bool realtime{false};              ///< plant: paced by the wall clock, applies the latest command
+  double start_timeout_s{30.0};     ///< how long to wait for the other roles to show up (step 0)
+  double step_timeout_s{5.0};       ///< no progress for this long: fail, naming the missing role
+  double resend_interval_s{0.002};  ///< re-publish a pending message after this long
+  long monitor_window{4096};        ///< plant: max steps ahead of the monitor's ack; 0: ignore the monitor
+  double linger_s{10.0};            ///< after the end: keep answering resend requests until the monitor is done
+  bool realtime{false};             ///< plant: paced by the wall clock, applies the latest command
   /// Lockstep: the plant publishes at most this many steps per second (each state at least
   /// 1/max_rate after the previous one, never catching up); 0: as fast as the chain answers. The
   /// pace at which the stock lcm-logger records without loss is loggers.hpp's kStockLoggerSteps.
   double max_rate{0.0};
-  int max_bad_commands{10};          ///< real time: consecutive missed/invalid commands before the safe state
+  int max_bad_commands{10};  ///< real time: consecutive missed/invalid commands before the safe state
   /// Real time: busy-wait this long before a period start (after clock_nanosleep). 30 us: a timer
   /// wakes 20-40 us late on the development VM (measured: bench/realtime_bench.sh with 10 us
   /// gave a median 767 plant overruns and 75 misses of 15,000, with 30 us 156 and 56).
@@ -53,7 +53,7 @@ struct NodeOptions {
   /// Hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash); "":
   /// the monitor hashes the file it read.
   std::string scenario_hash;
-  std::string key_file;              ///< --key: authenticate every message with this key; "": off
+  std::string key_file;  ///< --key: authenticate every message with this key; "": off
   /// --set key=value: scenario settings applied before the scenario is read (sim::load_scenario),
   /// the same in every process (the scenario hash covers them).
   std::vector<std::string> sets;
@@ -96,7 +96,10 @@ class Node {
   void heartbeat(bool force = false);
   /// Publishes state "failed" with the message (several times: it must not get lost).
   void announce_failure(const std::string& message);
-  void set_state(const std::string& state) { state_ = state; heartbeat(true); }
+  void set_state(const std::string& state) {
+    state_ = state;
+    heartbeat(true);
+  }
   void set_seq(std::int64_t seq) { seq_ = seq; }
 
   void request_resend(const std::string& channel, std::int64_t seq);
@@ -163,9 +166,9 @@ class Node {
   std::int64_t seq_{-1};
   std::int64_t last_heartbeat_us_{-1};
   std::int64_t last_conflict_log_us_{-1};
-  std::string scenario_mismatch_;  ///< set when run_info_t names another scenario hash than ours
-  std::int64_t attached_acked_{-2};        ///< the attached monitor's last acknowledgement
-  std::int64_t attached_progress_us_{-1};  ///< when it last moved (mono_us)
+  std::string scenario_mismatch_;                ///< set when run_info_t names another scenario hash than ours
+  std::int64_t attached_acked_{-2};              ///< the attached monitor's last acknowledgement
+  std::int64_t attached_progress_us_{-1};        ///< when it last moved (mono_us)
   static constexpr double kAttachedHoldS = 2.0;  ///< longest an attached monitor holds the linger
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;

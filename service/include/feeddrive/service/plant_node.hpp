@@ -67,12 +67,12 @@ class PlantNode : public Node {
   std::int64_t steps_;
   plant::Plant drive_;
   Outbox<drive_state_t> states_;
-  std::optional<control_command_t> command_;  ///< the newest command received, any seq
-  StepLedger<control_command_t> command_ledger_;  ///< every command received, for conflicts
+  std::optional<control_command_t> command_;                         ///< the newest command received, any seq
+  StepLedger<control_command_t> command_ledger_;                     ///< every command received, for conflicts
   std::vector<std::pair<control_command_t, std::int64_t>> arrived_;  ///< real time: (command, recv_us) not yet taken
-  std::int64_t newest_seq_{-1};  ///< real time: the newest command seq taken
-  std::int64_t t0_us_{0};        ///< real time: the wall (monotonic) time of t = 0 [us]
-  double u_now_{0.0};            ///< real time: the input the drive holds now [V]
+  std::int64_t newest_seq_{-1};                                      ///< real time: the newest command seq taken
+  std::int64_t t0_us_{0};  ///< real time: the wall (monotonic) time of t = 0 [us]
+  double u_now_{0.0};      ///< real time: the input the drive holds now [V]
   applied_t previous_;
   std::int64_t rejected_{0};
   std::int64_t missed_{0};

@@ -38,7 +38,7 @@ class TrajectoryNode : public Node {
   Outbox<reference_block_t> blocks_;
   std::int64_t highest_state_{-1};
   StepLedger<drive_state_t> state_ledger_;  ///< every state received, for conflicts
-  std::int64_t next_block_{0};  ///< the first block not yet published
+  std::int64_t next_block_{0};              ///< the first block not yet published
   std::int64_t last_progress_us_{0};
   bool end_{false};
 };

@@ -46,8 +46,8 @@ std::optional<UdpmAddress> parse_udpm_url(const std::string& url);
 
 /// One complete LCM message: its channel and payload, and the wall-clock time [us since the
 /// epoch] at which the kernel queued its (last) datagram.
-using MessageSink = std::function<void(std::string_view channel, const std::uint8_t* data, std::size_t size,
-                                       std::int64_t recv_utime)>;
+using MessageSink =
+    std::function<void(std::string_view channel, const std::uint8_t* data, std::size_t size, std::int64_t recv_utime)>;
 
 /// Turns datagrams into LCM messages: small messages pass through, fragments are reassembled
 /// per (sender, sequence number). Pure: no sockets. Malformed datagrams (bad magic, truncated
@@ -55,7 +55,8 @@ using MessageSink = std::function<void(std::string_view channel, const std::uint
 class Reassembler {
  public:
   /// Returns true if the datagram completed a message (passed to `sink`).
-  bool feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime, const MessageSink& sink);
+  bool feed(const std::uint8_t* d, std::size_t n, std::uint64_t sender, std::int64_t recv_utime,
+            const MessageSink& sink);
   std::int64_t malformed() const { return malformed_; }
   std::size_t pending() const { return partial_.size(); }
 

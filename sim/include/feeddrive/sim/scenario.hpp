@@ -46,8 +46,9 @@ inline const std::vector<std::pair<ControllerType, const char*>>& enum_names(Con
 enum class ReferenceType { kNone, kSine, kStep, kAccelLimited, kSCurve, kRamp, kWaypoints };
 inline const std::vector<std::pair<ReferenceType, const char*>>& enum_names(ReferenceType) {
   static const std::vector<std::pair<ReferenceType, const char*>> n = {
-      {ReferenceType::kNone, "none"},   {ReferenceType::kSine, "sine"},          {ReferenceType::kStep, "step"},
-      {ReferenceType::kAccelLimited, "accel_limited"}, {ReferenceType::kSCurve, "scurve"}, {ReferenceType::kRamp, "ramp"},
+      {ReferenceType::kNone, "none"},          {ReferenceType::kSine, "sine"},
+      {ReferenceType::kStep, "step"},          {ReferenceType::kAccelLimited, "accel_limited"},
+      {ReferenceType::kSCurve, "scurve"},      {ReferenceType::kRamp, "ramp"},
       {ReferenceType::kWaypoints, "waypoints"}};
   return n;
 }
@@ -59,7 +60,7 @@ struct ReferenceConfig {
   trajectory::AccelLimitedParams accel_limited;
   trajectory::SCurveParams scurve;
   trajectory::RampParams ramp;
-  std::string waypoints_file;  ///< resolved against the scenario file's folder
+  std::string waypoints_file;                   ///< resolved against the scenario file's folder
   std::vector<trajectory::Waypoint> waypoints;  ///< read from waypoints_file when loaded
 };
 
@@ -102,10 +103,10 @@ inline constexpr double kMaxSteps = 1e10;
 inline constexpr std::size_t kMaxNameBytes = 256;
 
 struct Scenario {
-  std::string name;  ///< printable UTF-8, at most kMaxNameBytes
-  std::string path;  ///< file it was loaded from ("" if parsed from a string)
-  double duration{1.0};        ///< [s]
-  double control_period{1e-4}; ///< [s]
+  std::string name;             ///< printable UTF-8, at most kMaxNameBytes
+  std::string path;             ///< file it was loaded from ("" if parsed from a string)
+  double duration{1.0};         ///< [s]
+  double control_period{1e-4};  ///< [s]
   plant::PlantParams plant;
   ControllerConfig controller;
   ReferenceConfig reference;

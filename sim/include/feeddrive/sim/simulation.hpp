@@ -20,8 +20,8 @@
 #include "feeddrive/plant/cvode_integrator.hpp"
 #include "feeddrive/plant/dynamics.hpp"
 #include "feeddrive/plant/sensor.hpp"
-#include "feeddrive/trajectory/trajectory.hpp"
 #include "feeddrive/sim/scenario.hpp"
+#include "feeddrive/trajectory/trajectory.hpp"
 
 namespace feeddrive::sim {
 
@@ -29,12 +29,12 @@ namespace feeddrive::sim {
 /// visit_record_columns).
 struct Record {
   double t{0.0};
-  double xd{0.0}, vd{0.0}, ad{0.0}, jd{0.0};  ///< reference [m, m/s, m/s^2, m/s^3]
-  double x{0.0}, v{0.0}, z{0.0}, fg{0.0}, i{0.0};  ///< true state
-  double x_measured{0.0}, v_measured{0.0};   ///< sensor output
-  double u{0.0}, u_unsaturated{0.0};         ///< command [V]
+  double xd{0.0}, vd{0.0}, ad{0.0}, jd{0.0};                              ///< reference [m, m/s, m/s^2, m/s^3]
+  double x{0.0}, v{0.0}, z{0.0}, fg{0.0}, i{0.0};                         ///< true state
+  double x_measured{0.0}, v_measured{0.0};                                ///< sensor output
+  double u{0.0}, u_unsaturated{0.0};                                      ///< command [V]
   double f_thrust{0.0}, f_friction{0.0}, f_ripple{0.0}, f_grinding{0.0};  ///< [N]
-  double sliding{0.0}, z_estimate{0.0};      ///< controller diagnostics (NaN if none)
+  double sliding{0.0}, z_estimate{0.0};                                   ///< controller diagnostics (NaN if none)
 };
 
 /// The one list of the record's columns, in timeseries.csv's order: f(name, unit, meaning,

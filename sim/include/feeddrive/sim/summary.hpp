@@ -125,11 +125,11 @@ struct Summary {
 /// loop bandwidth of servo amplifiers, thermal limit of a linear motor). In units of delta (the
 /// chatter threshold, 1 % of the output range) where they scale with the command range.
 struct SignalLimits {
-  double step_rms_deltas{1.0};            ///< control_step_rms_V <= 1 delta
+  double step_rms_deltas{1.0};             ///< control_step_rms_V <= 1 delta
   double direction_changes_per_s{2000.0};  ///< 2 per period of a 1 kHz current loop
-  double saturated_fraction{0.01};        ///< 1 % of the run at the amplifier's peak
-  double force_hf_rms_deltas{1.0};        ///< force_hf_rms_N <= Ka*Kf*delta
-  double hf_corner_hz{1000.0};            ///< f_c of force_hf_rms_N
+  double saturated_fraction{0.01};         ///< 1 % of the run at the amplifier's peak
+  double force_hf_rms_deltas{1.0};         ///< force_hf_rms_N <= Ka*Kf*delta
+  double hf_corner_hz{1000.0};             ///< f_c of force_hf_rms_N
 };
 inline constexpr SignalLimits kSignalLimits{};
 

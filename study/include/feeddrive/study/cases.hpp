@@ -83,8 +83,8 @@ std::vector<std::string> varied_keys(const Study& s);
 void set_key(YAML::Node& root, const std::string& key, const std::string& value);
 
 struct ResolvedCase {
-  std::string yaml;    ///< the complete scenario (loads in feeddrive-sim)
-  std::string hash;    ///< SHA-256 (hex) of the format tag and yaml
+  std::string yaml;  ///< the complete scenario (loads in feeddrive-sim)
+  std::string hash;  ///< SHA-256 (hex) of the format tag and yaml
   /// Effective value of every key of varied_keys() that this case's scenario has, by key.
   std::map<std::string, std::string> parameters;
 };

@@ -69,7 +69,8 @@ struct ReportData {
   struct Cell {
     std::vector<double> values;
     long failed{0};    ///< cases that failed (ok = false)
-    long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than settled_after)
+    long no_value{0};  ///< cases that ran but have no value of the metric (e.g. a settled metric of a run shorter than
+                       ///< settled_after)
     long total{0};
     long passed{0};          ///< cases that pass (case_passes)
     long verdict_failed{0};  ///< cases that ran with a required verdict false or missing
@@ -89,13 +90,13 @@ struct ReportData {
   void add(std::size_t index, const CaseRecord& c);
 
   const Study& s;
-  std::vector<std::string> params;              ///< varied_keys(s)
-  std::vector<std::vector<Cell>> table;         ///< [family][controller]
-  std::vector<std::uint32_t> controller;        ///< per case
-  std::vector<double> shown;                    ///< per case: the report metric x scale, NaN without one
-  std::vector<float> x;                         ///< per case, params.size() each: the varied keys' values (NaN if not a number)
-  std::vector<Worst> worst;                     ///< per controller
-  std::vector<Failure> failures;                ///< the first kListedFailures
+  std::vector<std::string> params;        ///< varied_keys(s)
+  std::vector<std::vector<Cell>> table;   ///< [family][controller]
+  std::vector<std::uint32_t> controller;  ///< per case
+  std::vector<double> shown;              ///< per case: the report metric x scale, NaN without one
+  std::vector<float> x;           ///< per case, params.size() each: the varied keys' values (NaN if not a number)
+  std::vector<Worst> worst;       ///< per controller
+  std::vector<Failure> failures;  ///< the first kListedFailures
   std::size_t cases{0}, failed{0}, cached{0};
   /// Per varied key: its values in order of first appearance (at most kMaxCategories; `more`
   /// set when there were more), and whether any of them is not a number.
@@ -103,12 +104,13 @@ struct ReportData {
     std::vector<std::string> values;
     bool more{false}, text{false};
   };
-  std::vector<Categories> categories;           ///< per varied key
-  std::vector<std::int16_t> category;           ///< per case, params.size() each: index in categories[p].values, -1 beyond
-  std::map<std::string, std::size_t> warnings;  ///< distinct loader warning -> cases with it (the first kListedWarnings)
-  std::size_t cases_with_other_warnings{0};     ///< cases with a warning beyond those kept
-  std::size_t moves{0};                         ///< cases that ran a move (move_finished true or false)
-  std::size_t moves_unfinished{0};              ///< of those, cases whose move `duration` cut off
+  std::vector<Categories> categories;  ///< per varied key
+  std::vector<std::int16_t> category;  ///< per case, params.size() each: index in categories[p].values, -1 beyond
+  std::map<std::string, std::size_t>
+      warnings;                              ///< distinct loader warning -> cases with it (the first kListedWarnings)
+  std::size_t cases_with_other_warnings{0};  ///< cases with a warning beyond those kept
+  std::size_t moves{0};                      ///< cases that ran a move (move_finished true or false)
+  std::size_t moves_unfinished{0};           ///< of those, cases whose move `duration` cut off
 };
 
 /// The report metric's name as a label: without its SI suffix (_m, _s, _mps, _N, _V, _Hz ...),

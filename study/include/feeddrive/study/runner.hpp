@@ -31,7 +31,7 @@ struct Outcome {
   std::vector<std::string> warnings;
   /// summary.json's move_finished: nullopt if the reference is not a move (or the case failed).
   std::optional<bool> move_finished;
-  double wall_s{0.0};  ///< time of this case (not a result: kept out of results.csv)
+  double wall_s{0.0};       ///< time of this case (not a result: kept out of results.csv)
   bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
 };
 

@@ -18,17 +18,17 @@
 namespace feeddrive::study {
 
 struct Options {
-  std::string study;  ///< the study file, or with `sweeps` the scenario file
+  std::string study;                ///< the study file, or with `sweeps` the scenario file
   std::vector<std::string> sets;    ///< --set KEY=VALUE: every case, after the study's own set
   std::vector<std::string> sweeps;  ///< --sweep: the grid of a study without a study file (spec.hpp parse_sweep)
   std::string out;
   int jobs{0};  ///< worker threads of this process; 0: every core it may use (per MPI rank: shared)
   bool quiet{false};
   bool plots{true};
-  bool retry_failed{false};  ///< run again the cases that failed in an earlier run
-  bool list{false};          ///< only resolve and print the cases
-  std::string command;       ///< the command line, for report.md
-  interrupt::StopToken stop; ///< polled by the study and its cases (Ctrl-C in the tool; the default never stops)
+  bool retry_failed{false};   ///< run again the cases that failed in an earlier run
+  bool list{false};           ///< only resolve and print the cases
+  std::string command;        ///< the command line, for report.md
+  interrupt::StopToken stop;  ///< polled by the study and its cases (Ctrl-C in the tool; the default never stops)
 };
 
 /// The cores this process may run on (sched_getaffinity), at least 1.

@@ -51,9 +51,9 @@ std::unique_ptr<Trajectory> make_sine(const SineParams& p);
 /// x = initial for t < t_step, initial + amplitude after; all derivatives 0 (the jump has no
 /// derivative; Xie & Liang Fig. 19 is reproduced qualitatively only).
 struct StepParams {
-  double amplitude{0.1};   ///< [m]
-  double step_time{1.0};   ///< [s]
-  double initial{0.0};     ///< [m]
+  double amplitude{0.1};  ///< [m]
+  double step_time{1.0};  ///< [s]
+  double initial{0.0};    ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(amplitude).unit("m").plausible(-5, 5, "mm"));
@@ -77,8 +77,13 @@ struct AccelLimitedParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(
+        FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration)
+                 .unit("m/s^2")
+                 .positive()
+                 .at_most(1e5)
+                 .plausible(0, 500, "mm/s^2", "", "any linear drive"));
     a->Visit(FD_FIELD(start_time).unit("s"));
     a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
   }
@@ -100,9 +105,15 @@ struct SCurveParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration).unit("m/s^2").positive().at_most(1e5).plausible(0, 500, "mm/s^2", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_jerk).unit("m/s^3").positive().at_most(1e8).plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
+    a->Visit(
+        FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+    a->Visit(FD_FIELD(max_acceleration)
+                 .unit("m/s^2")
+                 .positive()
+                 .at_most(1e5)
+                 .plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    a->Visit(
+        FD_FIELD(max_jerk).unit("m/s^3").positive().at_most(1e8).plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
     a->Visit(FD_FIELD(start_time).unit("s"));
     a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
   }
@@ -110,12 +121,12 @@ struct SCurveParams {
 };
 /// The segment durations of a planned S-curve.
 struct SCurvePlan {
-  double t_jerk_accel{0.0};   ///< Tj1: duration of each jerk phase while accelerating [s]
-  double t_accel{0.0};        ///< Ta: whole acceleration phase [s]
-  double t_const{0.0};        ///< Tv: constant-velocity phase [s]
-  double t_jerk_decel{0.0};   ///< Tj2 [s] (= Tj1 for rest-to-rest)
-  double t_decel{0.0};        ///< Td [s] (= Ta for rest-to-rest)
-  double peak_velocity{0.0};  ///< [m/s], magnitude
+  double t_jerk_accel{0.0};       ///< Tj1: duration of each jerk phase while accelerating [s]
+  double t_accel{0.0};            ///< Ta: whole acceleration phase [s]
+  double t_const{0.0};            ///< Tv: constant-velocity phase [s]
+  double t_jerk_decel{0.0};       ///< Tj2 [s] (= Tj1 for rest-to-rest)
+  double t_decel{0.0};            ///< Td [s] (= Ta for rest-to-rest)
+  double peak_velocity{0.0};      ///< [m/s], magnitude
   double peak_acceleration{0.0};  ///< [m/s^2], magnitude
   double duration() const { return t_accel + t_const + t_decel; }
 };

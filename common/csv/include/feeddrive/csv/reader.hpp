@@ -5,10 +5,10 @@
 //
 // Format: UTF-8 text (a byte-order mark is skipped), lines ending in LF or CRLF. Blank lines and
 // lines whose first non-blank character is '#' are skipped. The first other line is the header:
-// column names separated by Options::separator (a comma by default) (spaces around them and double quotes are dropped; no name may
-// be empty or appear twice). Every data row has exactly as many fields as the header. The
-// columns asked for are read as numbers by std::from_chars (locale-independent; a leading '+'
-// is accepted) and must be finite; other columns are ignored.
+// column names separated by Options::separator (a comma by default) (spaces around them and double quotes are dropped;
+// no name may be empty or appear twice). Every data row has exactly as many fields as the header. The columns asked for
+// are read as numbers by std::from_chars (locale-independent; a leading '+' is accepted) and must be finite; other
+// columns are ignored.
 //
 // Every error is a CsvError (std::invalid_argument), one line:
 //   FILE: ...                    (the file as a whole: cannot open, too large, no header)
@@ -36,10 +36,10 @@ class CsvError : public std::invalid_argument {
 };
 
 struct Limits {
-  std::size_t max_line_bytes{1 << 20};               ///< 1 MiB
+  std::size_t max_line_bytes{1 << 20};                   ///< 1 MiB
   std::uint64_t max_file_bytes{std::uint64_t{4} << 30};  ///< 4 GiB
-  std::size_t max_rows{50'000'000};                  ///< e.g. 1.4 hours at 10 kHz
-  std::size_t min_rows{1};                           ///< fewer data rows is an error
+  std::size_t max_rows{50'000'000};                      ///< e.g. 1.4 hours at 10 kHz
+  std::size_t min_rows{1};                               ///< fewer data rows is an error
 };
 
 /// A column asked for: the first of `names` that the header has is used.

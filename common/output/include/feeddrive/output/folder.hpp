@@ -131,7 +131,7 @@ class StagedFolder {
  private:
   // Writes the marker's file list (when asked) and flushes every file and the folder to disk.
   void finish_marker(bool list_files);
-  std::string value_;   // as the user gave it, for messages
+  std::string value_;  // as the user gave it, for messages
   std::string option_;
   std::string tool_;
   std::filesystem::path target_;
