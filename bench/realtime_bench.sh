@@ -21,6 +21,9 @@
 # a CPU stay), and puts them back at the end: what an isolated core gives the same chain
 # (docs/lcm-contract.md, "An isolated core"). OFF_PATH_CPUS=LIST passes --off-path-cpus LIST: the
 # monitor and the trajectory there, the plant and controller on CPUS.
+# The plant and the controller hold the CPU wake-up latency at 0 (/dev/cpu_dma_latency, as
+# cyclictest does). LATENCY_HOLD=alternate runs the odd rounds with it and the even ones without
+# (FEEDDRIVE_CPU_LATENCY_HOLD=0) and prints the medians of each: what the hold changes, same run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -75,10 +78,13 @@ print(','.join(map(str, rest)))" "$ALL" "$CPUS")
   echo $$ > "$CPUSET/tasks"  # this bench (and what it starts) stays where it can reach CPUS
   echo "ISOLATE: $moved tasks moved to CPUs $REST for the bench; CPUs $CPUS keep the run, cyclictest and per-CPU kernel threads"
 fi
-misses=(); overruns=(); lates=(); ratios=()
+misses=(); overruns=(); lates=(); ratios=(); held_misses=(); held_ratios=(); free_misses=(); free_ratios=()
 for r in $(seq "$ROUNDS"); do
   late=$(machine_late)
   lates+=("$late")
+  hold=held
+  if [ "${LATENCY_HOLD:-}" = alternate ] && [ $((r % 2)) = 0 ]; then hold="not held"; export FEEDDRIVE_CPU_LATENCY_HOLD=0
+  else unset FEEDDRIVE_CPU_LATENCY_HOLD; fi
   ext=()
   if [ -n "$ADAPTER" ]; then
     taskset -c "$CPUS" chrt -f 80 "$ADAPTER" --url "$URL" --prefix "RT$r" 2> "$TMP/adapter$r.err" &
@@ -96,8 +102,13 @@ for r in $(seq "$ROUNDS"); do
   misses+=("$(jq -r .lockstep.deadline_misses "$j")")
   overruns+=("$(jq -r .lockstep.plant_overruns "$j")")
   ratios+=("$(awk -v m="${misses[-1]}" -v l="$late" 'BEGIN { printf "%.2f", m / (l > 0 ? l : 1) }')")
-  echo "round $r: machine (cyclictest, CPUs $CPUS): $late of 15000 wake-ups later than 50 us; feeddrive misses / machine = ${ratios[-1]}"
+  if [ "$hold" = held ]; then held_misses+=("${misses[-1]}"); held_ratios+=("${ratios[-1]}")
+  else free_misses+=("${misses[-1]}"); free_ratios+=("${ratios[-1]}"); fi
+  echo "round $r (CPU wake-up latency $hold): machine (cyclictest, CPUs $CPUS): $late of 15000 wake-ups later than 50 us; feeddrive misses / machine = ${ratios[-1]}"
   echo "round $r: $(jq -r "$hist_p99"' .lockstep as $l | "\($l.deadline_misses) of \($l.steps_expected) deadlines missed, \($l.plant_overruns) plant overruns; state->command p50 \($l.latency_us.state_to_command.p50) us, p99 \($l.latency_us.state_to_command.p99) us; period-start lateness p99 <= \(p99($l.latency_histogram_us.period_start_lateness; $l.latency_histogram_us.bin_us)) us"' "$j"); max |e| $(jq -r "(.position_error_max_abs_m // .measured_position_error_max_abs_m)" "$j") m (measured where no true state); $sched"
 done
 echo "median deadline misses: $(median "${misses[@]}") of 15000 (target < 15, 0.1 %); median plant overruns (periods the plant itself started more than its guard late): $(median "${overruns[@]}")"
 echo "machine (cyclictest on CPUs $CPUS): median $(median "${lates[@]}") of 15000 wake-ups later than 50 us; RATIO feeddrive misses / machine's late wake-ups: median $(median "${ratios[@]}") (per round: ${ratios[*]}; goal <= 2)"
+if [ "${#free_misses[@]}" -gt 0 ] && [ "${#held_misses[@]}" -gt 0 ]; then
+  echo "CPU wake-up latency held at 0: median misses $(median "${held_misses[@]}") (${held_misses[*]}), ratio $(median "${held_ratios[@]}"); not held: median misses $(median "${free_misses[@]}") (${free_misses[*]}), ratio $(median "${free_ratios[@]}")"
+fi

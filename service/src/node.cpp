@@ -6,6 +6,9 @@
 #include <sys/mman.h>
 #include <sys/prctl.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -24,11 +27,33 @@ std::string enter_realtime(int priority) {
   const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
   const std::string lock =
       locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
+  const std::string idle = hold_cpu_latency_zero();
   sched_param sp{};
   sp.sched_priority = priority;
-  if (::sched_setscheduler(0, SCHED_FIFO, &sp) == 0) return "SCHED_FIFO " + std::to_string(priority) + ", " + lock;
+  if (::sched_setscheduler(0, SCHED_FIFO, &sp) == 0)
+    return "SCHED_FIFO " + std::to_string(priority) + ", " + lock + ", " + idle;
   return std::string("normal scheduling (SCHED_FIFO not permitted: ") + std::strerror(errno) +
-         "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock;
+         "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock + ", " + idle;
+}
+
+std::string hold_cpu_latency_zero() {
+  // One request per process, held to its exit (the kernel drops it when the descriptor closes).
+  static int fd = -1;
+  if (fd >= 0) return "CPU wake-up latency held at 0 us";
+  if (const char* e = std::getenv("FEEDDRIVE_CPU_LATENCY_HOLD"); e != nullptr && std::string(e) == "0")
+    return "CPU wake-up latency not held (FEEDDRIVE_CPU_LATENCY_HOLD=0)";
+  const int f = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (f < 0)
+    return std::string("CPU wake-up latency not held (/dev/cpu_dma_latency: ") + std::strerror(errno) +
+           "; idle CPUs may sleep deeply and wake late)";
+  const std::int32_t zero = 0;
+  if (::write(f, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
+    const std::string why = std::strerror(errno);
+    ::close(f);
+    return "CPU wake-up latency not held (/dev/cpu_dma_latency: " + why + ")";
+  }
+  fd = f;
+  return "CPU wake-up latency held at 0 us";
 }
 
 void sleep_until(std::int64_t target_us, std::int64_t spin_us, const interrupt::StopToken& stop) {

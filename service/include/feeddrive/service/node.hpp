@@ -179,8 +179,19 @@ class Node {
 /// period), SCHED_FIFO at `priority` where permitted, and a 1 ns timer slack (the default 50 us
 /// would delay every timed wake-up). Returns one line saying what was granted, e.g.
 /// "SCHED_FIFO 80, memory locked" or "normal scheduling (SCHED_FIFO not permitted: needs root,
-/// CAP_SYS_NICE or an rtprio limit), memory locked"; the caller logs it.
+/// CAP_SYS_NICE or an rtprio limit), memory locked"; the caller logs it. It also holds the CPU
+/// wake-up latency at 0 (hold_cpu_latency_zero).
 std::string enter_realtime(int priority);
+
+/// Asks the kernel's PM QoS for a CPU wake-up latency of 0 us, as cyclictest does by default, by
+/// writing a 32-bit 0 to /dev/cpu_dma_latency and keeping the descriptor open for the life of the
+/// process (Linux, Documentation/power/pm_qos_interface.rst). The cpuidle governor then keeps idle
+/// CPUs in states with 0 exit latency (polling): a CPU halted in a deeper state (on a KVM guest,
+/// `haltpoll`'s HLT) takes 20-30 us to wake, measured on this project's VM (docs/lcm-contract.md,
+/// "An isolated core"). Costs power: idle CPUs spin while any process holds it. Needs root (the
+/// device is 0600); returns one line saying what was granted. FEEDDRIVE_CPU_LATENCY_HOLD=0 in the
+/// environment leaves it off (bench/realtime_bench.sh alternates the two in one invocation).
+std::string hold_cpu_latency_zero();
 
 /// Sleeps until monotonic time `target_us` [us]: an absolute clock_nanosleep to spin_us before
 /// it, then a busy wait (the wake-up latency of a timer is tens of us on a virtual machine).
