@@ -108,21 +108,117 @@ static void die(const char* what, int flag) {
   exit(2);
 }
 
+/* The inputs u_k, one number per line of `path`; *n receives their count. NULL if the file
+ * cannot be opened. */
+static double* read_inputs(const char* path, size_t* n) {
+  FILE* f = fopen(path, "r");
+  if (!f) return NULL;
+  size_t cap = 1 << 16;
+  double* u = malloc(cap * sizeof *u);
+  *n = 0;
+  while (fscanf(f, "%lf", &u[*n]) == 1)
+    if (++*n == cap) u = realloc(u, (cap *= 2) * sizeof *u);
+  fclose(f);
+  return u;
+}
+
+/* CVODE set up as plant/src/cvode_integrator.cpp (BDF or Adams, Newton, dense direct solver,
+ * analytic Jacobian, rtol = 1e-8, atol = 1e-12 m, 1e-12 m/s, 1e-13 m), for the state y. */
+typedef struct {
+  SUNContext ctx;
+  N_Vector y, atol;
+  SUNMatrix A;
+  SUNLinearSolver LS;
+  void* mem;
+} Solver;
+
+static void solver_create(Solver* s, int adams, Data* data) {
+  if (SUNContext_Create(NULL, &s->ctx)) die("SUNContext_Create", -1);
+  s->y = N_VNew_Serial(3, s->ctx), s->atol = N_VNew_Serial(3, s->ctx);
+  double* ya = N_VGetArrayPointer(s->y);
+  double* aa = N_VGetArrayPointer(s->atol);
+  aa[0] = 1e-12, aa[1] = 1e-12, aa[2] = 1e-13;
+  ya[0] = ya[1] = ya[2] = 0.0;
+  s->mem = CVodeCreate(adams ? CV_ADAMS : CV_BDF, s->ctx);
+  int flag;
+  if ((flag = CVodeInit(s->mem, rhs, 0.0, s->y))) die("CVodeInit", flag);
+  CVodeSetUserData(s->mem, data);
+  CVodeSVtolerances(s->mem, 1e-8, s->atol);
+  s->A = SUNDenseMatrix(3, 3, s->ctx);
+  s->LS = SUNLinSol_Dense(s->y, s->A, s->ctx);
+  CVodeSetLinearSolver(s->mem, s->LS, s->A);
+  CVodeSetJacFn(s->mem, jac);
+  CVodeSetMaxNumSteps(s->mem, 100000);
+}
+
+static void solver_free(Solver* s) {
+  CVodeFree(&s->mem);
+  SUNLinSolFree(s->LS);
+  SUNMatDestroy(s->A);
+  N_VDestroy(s->y);
+  N_VDestroy(s->atol);
+  SUNContext_Free(&s->ctx);
+}
+
+/* One run over the n periods of length T from rest, u[k] held over [kT, (k+1)T] and CVODE
+ * restarted at every period; prints the run's line (file comment). */
+static void run_once(Solver* s, Data* data, const double* u, size_t n, double T, const char* form) {
+  double* ya = N_VGetArrayPointer(s->y);
+  const int deviation = data->deviation;
+  double x = 0.0, v = 0.0, z = 0.0;
+  long steps = 0, rhs_evals = 0, jac_evals = 0;
+  struct timespec a, b, ca, cb;
+  int flag;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ca);
+  clock_gettime(CLOCK_MONOTONIC, &a);
+  for (size_t k = 0; k < n; ++k) {
+    const double t0 = (double)k * T, t1 = (double)(k + 1) * T;
+    data->u = u[k];
+    if (deviation) {
+      double vdot, zdot, a_vv, a_vz, a_zv, a_zz;
+      physics(v, z, u[k], &vdot, &zdot);
+      physics_jac(v, z, &a_vv, &a_vz, &a_zv, &a_zz);
+      data->t0 = t0, data->x0 = x, data->v0 = v, data->a0 = vdot, data->j0 = a_vv * vdot + a_vz * zdot;
+      ya[0] = 0.0, ya[1] = 0.0, ya[2] = z;
+    } else {
+      ya[0] = x, ya[1] = v, ya[2] = z;
+    }
+    if ((flag = CVodeReInit(s->mem, t0, s->y))) die("CVodeReInit", flag);
+    CVodeSetStopTime(s->mem, t1);
+    sunrealtype t_reached;
+    if ((flag = CVode(s->mem, t1, s->y, &t_reached, CV_NORMAL)) < 0) die("CVode", flag);
+    long c;
+    CVodeGetNumSteps(s->mem, &c), steps += c;
+    CVodeGetNumRhsEvals(s->mem, &c), rhs_evals += c;
+    CVodeGetNumJacEvals(s->mem, &c), jac_evals += c;
+    if (deviation) {
+      x = data->x0 + T * (data->v0 + T * (0.5 * data->a0 + T * data->j0 / 6.0)) + ya[0];
+      v = data->v0 + T * (data->a0 + 0.5 * data->j0 * T) + ya[1];
+    } else {
+      x = ya[0], v = ya[1];
+    }
+    z = ya[2];
+  }
+  clock_gettime(CLOCK_MONOTONIC, &b);
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cb);
+  const double sec = (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec);
+  const double cpu = (double)(cb.tv_sec - ca.tv_sec) + 1e-9 * (double)(cb.tv_nsec - ca.tv_nsec);
+  printf("%s seconds %.6f periods %zu steps %ld rhs %ld jac %ld x %.12g v %.12g z %.12g cpu %.6f\n", form, sec, n,
+         steps, rhs_evals, jac_evals, x, v, z, cpu);
+}
+
+/* Reads the arguments (file comment), then REPEATS runs. */
 int main(int argc, char** argv) {
   if (argc != 5) {
     fprintf(stderr, "usage: cvode-floor U_FILE PERIOD plain|deviation|adams REPEATS\n");
     return 2;
   }
-  FILE* f = fopen(argv[1], "r");
-  if (!f) {
+  size_t n = 0;
+  double* u = read_inputs(argv[1], &n);
+  if (!u) {
     fprintf(stderr, "cvode-floor: cannot open %s\n", argv[1]);
     return 2;
   }
-  size_t n = 0, cap = 1 << 16;
-  double* u = malloc(cap * sizeof *u);
-  while (fscanf(f, "%lf", &u[n]) == 1)
-    if (++n == cap) u = realloc(u, (cap *= 2) * sizeof *u);
-  fclose(f);
   const double T = atof(argv[2]);
   const int adams = strcmp(argv[3], "adams") == 0;
   const int deviation = adams || strcmp(argv[3], "deviation") == 0;
@@ -135,74 +231,12 @@ int main(int argc, char** argv) {
     fprintf(stderr, "cvode-floor: no inputs in %s, or PERIOD/REPEATS not positive\n", argv[1]);
     return 2;
   }
-
-  SUNContext ctx;
-  if (SUNContext_Create(NULL, &ctx)) die("SUNContext_Create", -1);
-  N_Vector y = N_VNew_Serial(3, ctx), atol = N_VNew_Serial(3, ctx);
-  double* ya = N_VGetArrayPointer(y);
-  double* aa = N_VGetArrayPointer(atol);
-  aa[0] = 1e-12, aa[1] = 1e-12, aa[2] = 1e-13;
-  ya[0] = ya[1] = ya[2] = 0.0;
   Data data = {0};
   data.deviation = deviation;
-  void* mem = CVodeCreate(adams ? CV_ADAMS : CV_BDF, ctx);
-  int flag;
-  if ((flag = CVodeInit(mem, rhs, 0.0, y))) die("CVodeInit", flag);
-  CVodeSetUserData(mem, &data);
-  CVodeSVtolerances(mem, 1e-8, atol);
-  SUNMatrix A = SUNDenseMatrix(3, 3, ctx);
-  SUNLinearSolver LS = SUNLinSol_Dense(y, A, ctx);
-  CVodeSetLinearSolver(mem, LS, A);
-  CVodeSetJacFn(mem, jac);
-  CVodeSetMaxNumSteps(mem, 100000);
-
-  for (int r = 0; r < repeats; ++r) {
-    double x = 0.0, v = 0.0, z = 0.0;
-    long steps = 0, rhs_evals = 0, jac_evals = 0;
-    struct timespec a, b, ca, cb;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ca);
-    clock_gettime(CLOCK_MONOTONIC, &a);
-    for (size_t k = 0; k < n; ++k) {
-      const double t0 = (double)k * T, t1 = (double)(k + 1) * T;
-      data.u = u[k];
-      if (deviation) {
-        double vdot, zdot, a_vv, a_vz, a_zv, a_zz;
-        physics(v, z, u[k], &vdot, &zdot);
-        physics_jac(v, z, &a_vv, &a_vz, &a_zv, &a_zz);
-        data.t0 = t0, data.x0 = x, data.v0 = v, data.a0 = vdot, data.j0 = a_vv * vdot + a_vz * zdot;
-        ya[0] = 0.0, ya[1] = 0.0, ya[2] = z;
-      } else {
-        ya[0] = x, ya[1] = v, ya[2] = z;
-      }
-      if ((flag = CVodeReInit(mem, t0, y))) die("CVodeReInit", flag);
-      CVodeSetStopTime(mem, t1);
-      sunrealtype t_reached;
-      if ((flag = CVode(mem, t1, y, &t_reached, CV_NORMAL)) < 0) die("CVode", flag);
-      long s;
-      CVodeGetNumSteps(mem, &s), steps += s;
-      CVodeGetNumRhsEvals(mem, &s), rhs_evals += s;
-      CVodeGetNumJacEvals(mem, &s), jac_evals += s;
-      if (deviation) {
-        x = data.x0 + T * (data.v0 + T * (0.5 * data.a0 + T * data.j0 / 6.0)) + ya[0];
-        v = data.v0 + T * (data.a0 + 0.5 * data.j0 * T) + ya[1];
-      } else {
-        x = ya[0], v = ya[1];
-      }
-      z = ya[2];
-    }
-    clock_gettime(CLOCK_MONOTONIC, &b);
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cb);
-    const double sec = (double)(b.tv_sec - a.tv_sec) + 1e-9 * (double)(b.tv_nsec - a.tv_nsec);
-    const double cpu = (double)(cb.tv_sec - ca.tv_sec) + 1e-9 * (double)(cb.tv_nsec - ca.tv_nsec);
-    printf("%s seconds %.6f periods %zu steps %ld rhs %ld jac %ld x %.12g v %.12g z %.12g cpu %.6f\n", argv[3], sec, n,
-           steps, rhs_evals, jac_evals, x, v, z, cpu);
-  }
-  CVodeFree(&mem);
-  SUNLinSolFree(LS);
-  SUNMatDestroy(A);
-  N_VDestroy(y);
-  N_VDestroy(atol);
-  SUNContext_Free(&ctx);
+  Solver s;
+  solver_create(&s, adams, &data);
+  for (int r = 0; r < repeats; ++r) run_once(&s, &data, u, n, T, argv[3]);
+  solver_free(&s);
   free(u);
   return 0;
 }

@@ -140,28 +140,33 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
   return t.str();
 }
 
-std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
-                                     bool plots, const interrupt::StopToken& stop) {
-  output::StagedFolder folder(out_dir, "feeddrive-sim");
-  {
-    output::CsvWriter csv(folder.path("frequency_response.csv"),
-                          {"frequency_Hz", "reference_amplitude_m", "T_dB", "T_deg", "compliance_m_per_N",
-                           "compliance_deg", "stiffness_N_per_um", "L_dB", "L_deg", "S_dB", "S_deg", "T_drift",
-                           "T_nonfundamental", "disturbance_drift", "disturbance_nonfundamental", "saturated_steps"});
-    const double nan = std::nan("");
-    const Phases ph = phases(r);
-    const auto &t_deg = ph.t, &gd_deg = ph.gd, &l_deg = ph.l, &s_deg = ph.s;
-    for (std::size_t i = 0; i < r.points.size(); ++i) {
-      const FrequencyPoint& p = r.points[i];
-      const bool a = p.has_reference, d = p.has_disturbance;
-      csv.row({p.frequency_hz, p.reference_amplitude_m, a ? db(p.closed_loop) : nan, a ? t_deg[i] : nan,
-               d ? std::abs(p.compliance) : nan, d ? gd_deg[i] : nan, d ? p.stiffness_N_per_um() : nan,
-               d ? db(p.loop) : nan, d ? l_deg[i] : nan, d ? db(p.sensitivity) : nan, d ? s_deg[i] : nan,
-               a ? p.closed_loop_drift : nan, a ? p.closed_loop_nonfundamental : nan, d ? p.disturbance_drift : nan,
-               d ? p.disturbance_nonfundamental : nan, static_cast<double>(p.saturated_steps)});
-    }
-    csv.close();
+namespace {
+
+// frequency_response.csv: one row per frequency, NaN where a run (reference or disturbance) was
+// not made.
+void write_frequency_csv(output::StagedFolder& folder, const FrequencyResponse& r) {
+  output::CsvWriter csv(folder.path("frequency_response.csv"),
+                        {"frequency_Hz", "reference_amplitude_m", "T_dB", "T_deg", "compliance_m_per_N",
+                         "compliance_deg", "stiffness_N_per_um", "L_dB", "L_deg", "S_dB", "S_deg", "T_drift",
+                         "T_nonfundamental", "disturbance_drift", "disturbance_nonfundamental", "saturated_steps"});
+  const double nan = std::nan("");
+  const Phases ph = phases(r);
+  const auto &t_deg = ph.t, &gd_deg = ph.gd, &l_deg = ph.l, &s_deg = ph.s;
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    const FrequencyPoint& p = r.points[i];
+    const bool a = p.has_reference, d = p.has_disturbance;
+    csv.row({p.frequency_hz, p.reference_amplitude_m, a ? db(p.closed_loop) : nan, a ? t_deg[i] : nan,
+             d ? std::abs(p.compliance) : nan, d ? gd_deg[i] : nan, d ? p.stiffness_N_per_um() : nan,
+             d ? db(p.loop) : nan, d ? l_deg[i] : nan, d ? db(p.sensitivity) : nan, d ? s_deg[i] : nan,
+             a ? p.closed_loop_drift : nan, a ? p.closed_loop_nonfundamental : nan, d ? p.disturbance_drift : nan,
+             d ? p.disturbance_nonfundamental : nan, static_cast<double>(p.saturated_steps)});
   }
+  csv.close();
+}
+
+// frequency_response.json: the method, the excitation and the summary figures (null where not
+// measured or not finite).
+nlohmann::ordered_json frequency_json(const sim::Scenario& s, const FrequencyResponse& r) {
   const auto num = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
   const FrequencyResponseOptions& o = r.options;
   nlohmann::ordered_json j;
@@ -206,38 +211,55 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
   j["doubtful_points"] = "left out of every summary figure (not a frequency response)";
   j["warnings"] = r.warnings;
   j["wall_time_s"] = r.wall_time_s;
+  return j;
+}
+
+// The gnuplot script of the Bode plots from frequency_response.csv: T (reference run); the
+// dynamic stiffness, L and S (disturbance run).
+std::string frequency_plot_script(const sim::Scenario& s, const FrequencyResponse& r) {
+  const FrequencyResponseOptions& o = r.options;
+  const bool a = r.points.front().has_reference, d = r.points.front().has_disturbance;
+  std::ostringstream gp;
+  gp << "data = 'frequency_response.csv'\nset logscale x\nset xlabel 'f [Hz]'\nset datafile missing 'nan'\n";
+  if (a) {
+    gp << "set output 'bode_reference.png'\nset multiplot layout 2,1 title "
+       << output::gnuplot_string(s.name + ": reference -> position T, amplitude min(" + g(o.reference_amplitude) +
+                                 " m, " + g(r.acceleration_limit) + " m/s^2 / w^2)")
+       << "\nset ylabel '|T| [dB]'\nplot data using 1:3 with linespoints title '|T|', -3.01 with lines dt 2 title "
+          "'-3 dB'\n"
+       << "set ylabel 'arg T [deg]'\nplot data using 1:4 with linespoints title 'arg T'\nunset multiplot\n";
+  }
+  if (d) {
+    gp << "set output 'bode_compliance.png'\nset multiplot layout 2,1 title "
+       << output::gnuplot_string(s.name + ": dynamic stiffness 1/|x/F_d|, force " + g(o.force_amplitude) + " N")
+       << "\nset logscale y\nset ylabel 'dynamic stiffness [N/um]'\nplot data using 1:7 with linespoints title "
+          "'k_dyn'\n"
+       << "unset logscale y\nset ylabel 'arg x/F_d [deg]'\nplot data using 1:6 with linespoints title 'arg "
+          "G_d'\nunset multiplot\n";
+    gp << "set output 'bode_loop.png'\nset multiplot layout 2,1 title "
+       << output::gnuplot_string(s.name + ": loop at the force set-point, force " + g(o.force_amplitude) + " N")
+       << "\nset ylabel 'magnitude [dB]'\nplot data using 1:8 with linespoints title '|L|', '' using 1:10 with "
+          "linespoints "
+          "title '|S|', 0 with lines dt 2 notitle\n"
+       << "set ylabel 'arg L [deg]'\nplot data using 1:9 with linespoints title 'arg L', -180 with lines dt 2 "
+          "notitle\n"
+          "unset multiplot\n";
+  }
+  return gp.str();
+}
+
+}  // namespace
+
+std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
+                                     bool plots, const interrupt::StopToken& stop) {
+  output::StagedFolder folder(out_dir, "feeddrive-sim");
+  write_frequency_csv(folder, r);
+  const nlohmann::ordered_json j = frequency_json(s, r);
   folder.write_text("frequency_response.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   std::string plot_error;
   if (plots && !r.points.empty()) {
-    const bool a = r.points.front().has_reference, d = r.points.front().has_disturbance;
-    std::ostringstream gp;
-    gp << "data = 'frequency_response.csv'\nset logscale x\nset xlabel 'f [Hz]'\nset datafile missing 'nan'\n";
-    if (a) {
-      gp << "set output 'bode_reference.png'\nset multiplot layout 2,1 title "
-         << output::gnuplot_string(s.name + ": reference -> position T, amplitude min(" + g(o.reference_amplitude) +
-                                   " m, " + g(r.acceleration_limit) + " m/s^2 / w^2)")
-         << "\nset ylabel '|T| [dB]'\nplot data using 1:3 with linespoints title '|T|', -3.01 with lines dt 2 title "
-            "'-3 dB'\n"
-         << "set ylabel 'arg T [deg]'\nplot data using 1:4 with linespoints title 'arg T'\nunset multiplot\n";
-    }
-    if (d) {
-      gp << "set output 'bode_compliance.png'\nset multiplot layout 2,1 title "
-         << output::gnuplot_string(s.name + ": dynamic stiffness 1/|x/F_d|, force " + g(o.force_amplitude) + " N")
-         << "\nset logscale y\nset ylabel 'dynamic stiffness [N/um]'\nplot data using 1:7 with linespoints title "
-            "'k_dyn'\n"
-         << "unset logscale y\nset ylabel 'arg x/F_d [deg]'\nplot data using 1:6 with linespoints title 'arg "
-            "G_d'\nunset multiplot\n";
-      gp << "set output 'bode_loop.png'\nset multiplot layout 2,1 title "
-         << output::gnuplot_string(s.name + ": loop at the force set-point, force " + g(o.force_amplitude) + " N")
-         << "\nset ylabel 'magnitude [dB]'\nplot data using 1:8 with linespoints title '|L|', '' using 1:10 with "
-            "linespoints "
-            "title '|S|', 0 with lines dt 2 notitle\n"
-         << "set ylabel 'arg L [deg]'\nplot data using 1:9 with linespoints title 'arg L', -180 with lines dt 2 "
-            "notitle\n"
-            "unset multiplot\n";
-    }
     try {
-      folder.plot(gp.str(), stop);
+      folder.plot(frequency_plot_script(s, r), stop);
     } catch (const std::runtime_error& e) {
       plot_error = e.what();
     }

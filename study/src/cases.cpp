@@ -233,43 +233,49 @@ struct Resolver::Impl {
     if (loads.size() >= kMaxLoads) loads.clear();
     return loads.emplace(std::move(text), std::move(keys)).first->second;
   }
+
+  using Values = std::vector<std::pair<std::string, std::string>>;
+  YAML::Node nominal_doc(const CaseSpec& c, const std::string& origin) const;
+  static Values variation_values(const CaseSpec& c, const sim::ResolvedKeys& nominal, const std::string& origin);
+  void keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
+                          const std::string& origin);
+  ResolvedCase result(const sim::ResolvedKeys& keys, const Values& values);
 };
 
-Resolver::Resolver(const Study& s) : impl_(std::make_unique<Impl>(s)) {}
-Resolver::~Resolver() = default;
+namespace {
 
-std::string Resolver::label(const CaseSpec& c) const {
-  const Study& s = impl_->s;
-  std::string l = "controller '" + s.controllers[c.controller].name + "', family '" + s.families[c.family].name + "'";
-  if (!s.families[c.family].grid.empty()) l += ", point " + std::to_string(c.point);
-  if (c.draw >= 0) l += ", draw " + std::to_string(c.draw);
-  return l;
+// Writes one setting of a layer into doc; its error names the case and the layer ("set",
+// "family set", "variation", ...).
+void apply_setting(YAML::Node& doc, const std::string& key, const std::string& value, const std::string& origin,
+                   const char* where) {
+  try {
+    set_key(doc, key, value);
+  } catch (const StudyError& e) {
+    throw StudyError(origin + ": " + where + ": " + e.what());
+  }
 }
 
-ResolvedCase Resolver::resolve(const CaseSpec& c) {
-  Impl& m = *impl_;
-  const Study& s = m.s;
-  const std::string origin = (s.path.empty() ? std::string("study") : s.path) + ": " + label(c);
-  const auto apply = [&](YAML::Node& doc, const std::string& key, const std::string& value, const std::string& where) {
-    try {
-      set_key(doc, key, value);
-    } catch (const StudyError& e) {
-      throw StudyError(origin + ": " + where + ": " + e.what());
-    }
-  };
-  // Layers without the variations: the nominal case of this controller and family.
-  // The study's set comes after the controller block it would otherwise be replaced by: what it
-  // sets holds for every controller (docs/study.md, "How a case is made").
-  YAML::Node doc = YAML::Clone(m.base);
-  if (!s.controllers[c.controller].block.empty()) doc["controller"] = YAML::Clone(m.controller_blocks[c.controller]);
-  for (const Setting& st : s.controllers[c.controller].block_set) apply(doc, st.key, st.value, "controllers scenario");
-  for (const Setting& st : s.set) apply(doc, st.key, st.value, "set");
-  for (const Setting& st : s.controllers[c.controller].set) apply(doc, st.key, st.value, "controllers set");
-  for (const Setting& st : s.families[c.family].set) apply(doc, st.key, st.value, "family set");
-  const sim::ResolvedKeys nominal = m.load(doc, origin + " (without its variations)");
+}  // namespace
 
-  // The variations' values: scaled ones from the nominal values.
-  std::vector<std::pair<std::string, std::string>> values;
+// The layers without the variations: the nominal case of this controller and family. The
+// study's set comes after the controller block it would otherwise be replaced by: what it sets
+// holds for every controller (docs/study.md, "How a case is made").
+YAML::Node Resolver::Impl::nominal_doc(const CaseSpec& c, const std::string& origin) const {
+  const ControllerEntry& ctl = s.controllers[c.controller];
+  YAML::Node doc = YAML::Clone(base);
+  if (!ctl.block.empty()) doc["controller"] = YAML::Clone(controller_blocks[c.controller]);
+  for (const Setting& st : ctl.block_set) apply_setting(doc, st.key, st.value, origin, "controllers scenario");
+  for (const Setting& st : s.set) apply_setting(doc, st.key, st.value, origin, "set");
+  for (const Setting& st : ctl.set) apply_setting(doc, st.key, st.value, origin, "controllers set");
+  for (const Setting& st : s.families[c.family].set) apply_setting(doc, st.key, st.value, origin, "family set");
+  return doc;
+}
+
+// The variations' values as YAML scalar text: a `scale` one is its factor times the key's
+// nominal value (its effective value in the case without variations, defaults included).
+Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const sim::ResolvedKeys& nominal,
+                                                        const std::string& origin) {
+  Values values;
   for (const Variation& v : c.variations) {
     if (!v.scale) {
       values.emplace_back(v.key, v.value);
@@ -291,29 +297,34 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
                        "distribution without scale: true)");
     values.emplace_back(v.key, validate::format_number(nominal_value * v.factor));
   }
+  return values;
+}
 
-  YAML::Node full = YAML::Clone(doc);
-  for (const auto& [k, v] : values) apply(full, k, v, "variation");
-  sim::ResolvedKeys keys = m.load_uncached(Impl::text_of(full), origin);  // one per case: not cached
-  if (s.model == ModelRule::kNominal) {
-    YAML::Node model_doc = YAML::Clone(doc);
-    bool differs = false;
-    for (const auto& [k, v] : values) {
-      if (plant_only(k)) {
-        differs = true;
-      } else {
-        apply(model_doc, k, v, "variation");
-      }
-    }
-    if (differs) {
-      const sim::ResolvedKeys& model = m.load(model_doc, origin + " (the controller's nominal model)");
-      for (auto& [k, v] : keys) {
-        if (!starts_with(k, "controller.model.")) continue;
-        const auto it = model.find(k);
-        if (it != model.end()) v = it->second;
-      }
+// The nominal model rule (cases.hpp): the controller's model (controller.model.*) of the case
+// without its plant-only variations replaces the one in keys, the case with all of them.
+void Resolver::Impl::keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
+                                        const std::string& origin) {
+  YAML::Node model_doc = YAML::Clone(doc);
+  bool differs = false;
+  for (const auto& [k, v] : values) {
+    if (plant_only(k)) {
+      differs = true;
+    } else {
+      apply_setting(model_doc, k, v, origin, "variation");
     }
   }
+  if (!differs) return;
+  const sim::ResolvedKeys& model = load(model_doc, origin + " (the controller's nominal model)");
+  for (auto& [k, v] : keys) {
+    if (!starts_with(k, "controller.model.")) continue;
+    const auto it = model.find(k);
+    if (it != model.end()) v = it->second;
+  }
+}
+
+// The case's scenario (keys written as one YAML document), its hash and the effective value of
+// every varied key of the study.
+ResolvedCase Resolver::Impl::result(const sim::ResolvedKeys& keys, const Values& values) {
   ResolvedCase r;
   r.yaml = sim::resolved_yaml(keys);
   // A plugin controller's case depends on the library's code too, which the keys (its path) do
@@ -321,17 +332,44 @@ ResolvedCase Resolver::resolve(const CaseSpec& c) {
   // cases again instead of keeping results of the old build (docs/plugins.md).
   std::string code;
   if (const auto lib = keys.find("controller.library"); lib != keys.end())  // type plugin only
-    code = "plugin library sha256 " + m.library_digest(lib->second.text) + "\n";
+    code = "plugin library sha256 " + library_digest(lib->second.text) + "\n";
   r.hash = sha256_hex(std::string(kCaseFormat) + code + r.yaml);
   // Every varied key of the study, with its effective value in this case (its nominal value
   // where this case does not vary it), so each row of results.csv places the case on every axis.
-  for (const std::string& k : m.varied) {
+  for (const std::string& k : varied) {
     const auto it = keys.find(k);
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
   for (const auto& [k, v] : values)
     if (!r.parameters.count(k)) r.parameters[k] = v;
   return r;
+}
+
+Resolver::Resolver(const Study& s) : impl_(std::make_unique<Impl>(s)) {}
+Resolver::~Resolver() = default;
+
+std::string Resolver::label(const CaseSpec& c) const {
+  const Study& s = impl_->s;
+  std::string l = "controller '" + s.controllers[c.controller].name + "', family '" + s.families[c.family].name + "'";
+  if (!s.families[c.family].grid.empty()) l += ", point " + std::to_string(c.point);
+  if (c.draw >= 0) l += ", draw " + std::to_string(c.draw);
+  return l;
+}
+
+// The case's layers are loaded by the scenario loader, which checks every key and value: the
+// nominal layers (cached), then with the variations; with the nominal model rule, the model
+// from the layers without the plant-only variations.
+ResolvedCase Resolver::resolve(const CaseSpec& c) {
+  Impl& m = *impl_;
+  const std::string origin = (m.s.path.empty() ? std::string("study") : m.s.path) + ": " + label(c);
+  const YAML::Node doc = m.nominal_doc(c, origin);
+  const sim::ResolvedKeys nominal = m.load(doc, origin + " (without its variations)");
+  const Impl::Values values = Impl::variation_values(c, nominal, origin);
+  YAML::Node full = YAML::Clone(doc);
+  for (const auto& [k, v] : values) apply_setting(full, k, v, origin, "variation");
+  sim::ResolvedKeys keys = m.load_uncached(Impl::text_of(full), origin);  // one per case: not cached
+  if (m.s.model == ModelRule::kNominal) m.keep_nominal_model(doc, values, keys, origin);
+  return m.result(keys, values);
 }
 
 }  // namespace feeddrive::study

@@ -309,22 +309,20 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
   cases_with_other_warnings += other ? 1 : 0;
 }
 
-std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d,
-                        const interrupt::StopToken& stop) {
-  const Study& s = d.s;
-  fs::create_directories(dir);
-  const std::size_t nc = s.controllers.size(), nf = s.families.size();
-  const std::string ylabel = output::gnuplot_string(metric_label(s.report.metric, s.report.unit));
-  std::ostringstream gp, md;
-  gp << "set encoding utf8\nset terminal pngcairo size 1200,650 noenhanced\nset grid ytics\n"
-     << "set key outside top center horizontal\nset logscale y\n";
-  const std::string limit_line = std::isnan(s.report.limit)
-                                     ? std::string()
-                                     : "set arrow 1 from graph 0, first " + output::number_text(s.report.limit) +
-                                           " to graph 1, first " + output::number_text(s.report.limit) +
-                                           " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
+namespace {
 
-  // Box plots: one box per family and controller, grouped by family.
+// The gnuplot script and the markdown that write_plots builds, plot by plot.
+struct PlotScript {
+  std::ostringstream gp, md;
+  std::string ylabel;      // the metric's axis label, a gnuplot string
+  std::string limit_line;  // the report's limit as a dashed line, or ""
+};
+
+// Box plots: one box per family and controller, grouped by family; each box's values (> 0, the
+// log axis) in box_<family>_<controller>.dat.
+void box_plot(const fs::path& dir, const std::string& prefix, const ReportData& d, PlotScript& ps) {
+  const Study& s = d.s;
+  const std::size_t nc = s.controllers.size(), nf = s.families.size();
   const auto& t = d.table;
   std::vector<std::string> items;
   const double width = 0.8 / static_cast<double>(nc);
@@ -346,76 +344,104 @@ std::string write_plots(const fs::path& dir, const std::string& prefix, const Re
                       ") with boxplot linecolor " + std::to_string(c + 1) + " notitle");
     }
   }
-  if (!items.empty()) {
-    gp << "set output 'box.png'\nset title "
-       << output::gnuplot_string(s.name + ": " + s.report.metric + " per family and controller") << "\nset ylabel "
-       << ylabel << "\nset style fill solid 0.35 border -1\nset style boxplot outliers pointtype 7\n"
-       << "set xrange [0.4:" << output::number_text(static_cast<double>(nf) + 0.6) << "]\nset xtics (";
-    for (std::size_t f = 0; f < nf; ++f)
-      gp << (f ? ", " : "") << output::gnuplot_string(s.families[f].name, 40) << ' ' << f + 1;
-    gp << ") rotate by -25\n" << limit_line << "plot ";
-    for (std::size_t i = 0; i < items.size(); ++i) gp << (i ? ", \\\n  " : "") << items[i];
-    // Legend entries: one invisible point per controller.
-    for (std::size_t c = 0; c < nc; ++c)
-      gp << ", \\\n  NaN with boxes linecolor " << c + 1 << " title "
-         << output::gnuplot_string(s.controllers[c].name, 60);
-    gp << "\nunset xtics\nset xtics\nunset xrange\nset autoscale x\n";
-    md << "![" << cell(s.report.metric) << " per family and controller](" << prefix << "box.png)\n\n";
-  }
+  if (items.empty()) return;
+  std::ostringstream& gp = ps.gp;
+  gp << "set output 'box.png'\nset title "
+     << output::gnuplot_string(s.name + ": " + s.report.metric + " per family and controller") << "\nset ylabel "
+     << ps.ylabel << "\nset style fill solid 0.35 border -1\nset style boxplot outliers pointtype 7\n"
+     << "set xrange [0.4:" << output::number_text(static_cast<double>(nf) + 0.6) << "]\nset xtics (";
+  for (std::size_t f = 0; f < nf; ++f)
+    gp << (f ? ", " : "") << output::gnuplot_string(s.families[f].name, 40) << ' ' << f + 1;
+  gp << ") rotate by -25\n" << ps.limit_line << "plot ";
+  for (std::size_t i = 0; i < items.size(); ++i) gp << (i ? ", \\\n  " : "") << items[i];
+  // Legend entries: one invisible point per controller.
+  for (std::size_t c = 0; c < nc; ++c)
+    gp << ", \\\n  NaN with boxes linecolor " << c + 1 << " title "
+       << output::gnuplot_string(s.controllers[c].name, 60);
+  gp << "\nunset xtics\nset xtics\nunset xrange\nset autoscale x\n";
+  ps.md << "![" << cell(s.report.metric) << " per family and controller](" << prefix << "box.png)\n\n";
+}
 
-  // The metric against each varied parameter, one series per controller.
-  const std::vector<std::string>& params = d.params;
-  for (std::size_t p = 0; p < params.size(); ++p) {
-    const AxisUnit ax = axis_unit(params[p], d.x, params.size(), p);
-    // A key whose values are not all numbers (switching: sgn, tanh): one category per value on
-    // the x-axis, at 1, 2, ... in the order given.
-    const bool categorical = is_categorical(d, p);
-    std::vector<double> xs;
-    std::vector<std::string> series;
-    for (std::size_t c = 0; c < nc; ++c) {
-      std::ostringstream data;
-      long n = 0;
-      for (std::size_t i = 0; i < d.cases; ++i) {
-        if (d.controller[i] != c) continue;
-        const std::int16_t k = d.category[i * params.size() + p];
-        const double x = categorical ? (k >= 0 ? k + 1.0 : NAN) : d.x[i * params.size() + p] * ax.factor,
-                     y = d.shown[i];
-        if (!std::isfinite(x) || !(y > 0.0)) continue;
-        xs.push_back(x);
-        data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
-        ++n;
-      }
-      if (n == 0) continue;
-      const std::string file = "param_" + std::to_string(p) + "_" + std::to_string(c) + ".dat";
-      output::write_file_atomically(dir / file, data.str());
-      series.push_back("'" + file + "' using 1:2 with points pointtype 7 pointsize 0.8 linecolor " +
-                       std::to_string(c + 1) + " title " + output::gnuplot_string(s.controllers[c].name, 60));
+// The data of the metric against varied key p, one file param_<p>_<controller>.dat per
+// controller with a positive value; returns the series' plot clauses and adds their x to xs.
+std::vector<std::string> param_series(const fs::path& dir, const ReportData& d, std::size_t p, const AxisUnit& ax,
+                                      bool categorical, std::vector<double>& xs) {
+  const Study& s = d.s;
+  const std::size_t np = d.params.size();
+  std::vector<std::string> series;
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) {
+    std::ostringstream data;
+    long n = 0;
+    for (std::size_t i = 0; i < d.cases; ++i) {
+      if (d.controller[i] != c) continue;
+      const std::int16_t k = d.category[i * np + p];
+      const double x = categorical ? (k >= 0 ? k + 1.0 : NAN) : d.x[i * np + p] * ax.factor, y = d.shown[i];
+      if (!std::isfinite(x) || !(y > 0.0)) continue;
+      xs.push_back(x);
+      data << output::number_text(x) << ' ' << output::number_text(y) << '\n';
+      ++n;
     }
-    if (series.empty()) continue;
-    const std::string png = "param_" + std::to_string(p) + ".png";
-    gp << "set output '" << png << "'\nset title " << output::gnuplot_string(s.report.metric + " against " + params[p])
-       << "\nset xlabel " << output::gnuplot_string(categorical ? params[p] : axis_label(params[p], ax))
-       << "\nset ylabel " << ylabel << "\nset xtics rotate by 0\n";
-    const bool logx = !categorical && log_axis(s, params[p], xs);
-    if (categorical) {
-      const auto& values = d.categories[p].values;
-      gp << "set xrange [0.5:" << output::number_text(static_cast<double>(values.size()) + 0.5) << "]\nset xtics (";
-      for (std::size_t k = 0; k < values.size(); ++k)
-        gp << (k ? ", " : "") << output::gnuplot_string(values[k], 40) << ' ' << k + 1;
-      gp << ")\n";
-    } else if (logx) {
-      gp << "set logscale x\n";
-    }
-    gp << limit_line << "plot ";
-    for (std::size_t i = 0; i < series.size(); ++i) gp << (i ? ", \\\n  " : "") << series[i];
-    gp << '\n';
-    if (categorical) gp << "unset xtics\nset xtics\nunset xrange\nset autoscale x\n";
-    if (logx) gp << "unset logscale x\n";
-    md << "![" << cell(s.report.metric) << " against " << cell(params[p]) << "](" << prefix << png << ")\n\n";
+    if (n == 0) continue;
+    const std::string file = "param_" + std::to_string(p) + "_" + std::to_string(c) + ".dat";
+    output::write_file_atomically(dir / file, data.str());
+    series.push_back("'" + file + "' using 1:2 with points pointtype 7 pointsize 0.8 linecolor " +
+                     std::to_string(c + 1) + " title " + output::gnuplot_string(s.controllers[c].name, 60));
   }
-  if (md.str().empty()) return "No plot: no case gave a positive " + s.report.metric + ".\n\n";
-  output::run_gnuplot(dir, gp.str(), stop);
-  return md.str();
+  return series;
+}
+
+// The metric against varied key p, one series per controller. A key whose values are not all
+// numbers (switching: sgn, tanh) has one category per value on the x-axis, at 1, 2, ... in the
+// order given.
+void param_plot(const fs::path& dir, const std::string& prefix, const ReportData& d, std::size_t p, PlotScript& ps) {
+  const Study& s = d.s;
+  const std::vector<std::string>& params = d.params;
+  const AxisUnit ax = axis_unit(params[p], d.x, params.size(), p);
+  const bool categorical = is_categorical(d, p);
+  std::vector<double> xs;
+  const std::vector<std::string> series = param_series(dir, d, p, ax, categorical, xs);
+  if (series.empty()) return;
+  std::ostringstream& gp = ps.gp;
+  const std::string png = "param_" + std::to_string(p) + ".png";
+  gp << "set output '" << png << "'\nset title " << output::gnuplot_string(s.report.metric + " against " + params[p])
+     << "\nset xlabel " << output::gnuplot_string(categorical ? params[p] : axis_label(params[p], ax))
+     << "\nset ylabel " << ps.ylabel << "\nset xtics rotate by 0\n";
+  const bool logx = !categorical && log_axis(s, params[p], xs);
+  if (categorical) {
+    const auto& values = d.categories[p].values;
+    gp << "set xrange [0.5:" << output::number_text(static_cast<double>(values.size()) + 0.5) << "]\nset xtics (";
+    for (std::size_t k = 0; k < values.size(); ++k)
+      gp << (k ? ", " : "") << output::gnuplot_string(values[k], 40) << ' ' << k + 1;
+    gp << ")\n";
+  } else if (logx) {
+    gp << "set logscale x\n";
+  }
+  gp << ps.limit_line << "plot ";
+  for (std::size_t i = 0; i < series.size(); ++i) gp << (i ? ", \\\n  " : "") << series[i];
+  gp << '\n';
+  if (categorical) gp << "unset xtics\nset xtics\nunset xrange\nset autoscale x\n";
+  if (logx) gp << "unset logscale x\n";
+  ps.md << "![" << cell(s.report.metric) << " against " << cell(params[p]) << "](" << prefix << png << ")\n\n";
+}
+
+}  // namespace
+
+std::string write_plots(const fs::path& dir, const std::string& prefix, const ReportData& d,
+                        const interrupt::StopToken& stop) {
+  const Study& s = d.s;
+  fs::create_directories(dir);
+  PlotScript ps;
+  ps.ylabel = output::gnuplot_string(metric_label(s.report.metric, s.report.unit));
+  ps.gp << "set encoding utf8\nset terminal pngcairo size 1200,650 noenhanced\nset grid ytics\n"
+        << "set key outside top center horizontal\nset logscale y\n";
+  if (!std::isnan(s.report.limit))
+    ps.limit_line = "set arrow 1 from graph 0, first " + output::number_text(s.report.limit) + " to graph 1, first " +
+                    output::number_text(s.report.limit) + " nohead dashtype 2 linewidth 2 linecolor rgb 'red'\n";
+  box_plot(dir, prefix, d, ps);
+  for (std::size_t p = 0; p < d.params.size(); ++p) param_plot(dir, prefix, d, p, ps);
+  if (ps.md.str().empty()) return "No plot: no case gave a positive " + s.report.metric + ".\n\n";
+  output::run_gnuplot(dir, ps.gp.str(), stop);
+  return ps.md.str();
 }
 
 // For every varied key with at most kMaxRows distinct values: the metric's median per value and
@@ -480,17 +506,18 @@ std::string metric_by_value(const ReportData& d) {
   return md.str();
 }
 
-std::string report_md(const ReportData& d, const std::string& command, const std::string& plots_markdown) {
+namespace {
+
+// report.md's head: the title, the command, the case counts, unfinished moves, the loader's
+// warnings and the model rule.
+void md_head(std::ostringstream& md, const ReportData& d, const std::string& command) {
   const Study& s = d.s;
-  std::ostringstream md;
-  const std::size_t failed = d.failed, cached = d.cached;
-  const std::string unit = s.report.unit;
   md << "# Study: " << cell(s.name) << "\n\n"
      << "Written by `feeddrive-study`. Command:\n\n```bash\n"
      << command << "\n```\n\n"
      << d.cases << " cases (" << s.controllers.size() << " controllers x " << s.families.size() << " families), "
-     << failed << " failed, " << cached << " reused from an earlier run into this folder. Every number below is "
-     << "`" << s.report.metric << "` in " << unit << " (one row per case in `results.csv`).\n\n";
+     << d.failed << " failed, " << d.cached << " reused from an earlier run into this folder. Every number below is "
+     << "`" << s.report.metric << "` in " << s.report.unit << " (one row per case in `results.csv`).\n\n";
   // A move cut off by `duration` has errors of part of the move only (issue 23).
   if (d.moves_unfinished > 0)
     md << "**" << d.moves_unfinished << " of " << d.moves << " cases did not finish their move** within `duration` "
@@ -501,35 +528,37 @@ std::string report_md(const ReportData& d, const std::string& command, const std
     for (const std::string& l : lines) md << "- " << cell(l) << "\n";
     md << "\n";
   }
-
   md << (s.model == ModelRule::kNominal
              ? "The controllers keep the **nominal model** (`model: nominal`): a case's `plant.*` variations (except "
                "`plant.sensor.*`) change the drive, not the controller's model of it.\n\n"
              : "Each controller's model **follows the varied plant** (`model: follows_plant`): every result is a "
                "perfect-model result unless `controller.model.*` says otherwise.\n\n");
-  const auto& t = d.table;
-  const std::size_t nc = s.controllers.size();
-  // Per controller: worst over everything.
+}
+
+// "## Worst case per controller": per controller, the worst and the median over every family,
+// with the cases over the limit and the cases that pass when the report has them.
+void md_worst_per_controller(std::ostringstream& md, const ReportData& d) {
+  const Study& s = d.s;
+  const std::string& unit = s.report.unit;
+  const bool limit = !std::isnan(s.report.limit), criterion = s.report.has_criterion();
   md << "## Worst case per controller\n\n| controller | cases | failed | worst [" << unit
      << "] | family of the worst | median [" << unit << "] |";
-  if (!std::isnan(s.report.limit)) md << " over " << num(s.report.limit) << " " << unit << " |";
-  const bool criterion = s.report.has_criterion();
+  if (limit) md << " over " << num(s.report.limit) << " " << unit << " |";
   if (criterion) md << " pass |";
-  md << "\n|---|---|---|---|---|---|" << (std::isnan(s.report.limit) ? "" : "---|") << (criterion ? "---|" : "")
-     << "\n";
-  for (std::size_t c = 0; c < nc; ++c) {
+  md << "\n|---|---|---|---|---|---|" << (limit ? "---|" : "") << (criterion ? "---|" : "") << "\n";
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) {
     std::vector<double> all;
     long total = 0, fail = 0, over = 0, passed = 0;
     double worst = NAN;
     std::string worst_family = "–";
     for (std::size_t f = 0; f < s.families.size(); ++f) {
-      const Cell& x = t[f][c];
+      const Cell& x = d.table[f][c];
       total += x.total;
       fail += x.failed;
       passed += x.passed;
       for (double v : x.values) {
         all.push_back(v);
-        if (!std::isnan(s.report.limit) && v > s.report.limit) ++over;
+        if (limit && v > s.report.limit) ++over;
         if (std::isnan(worst) || v > worst) {
           worst = v;
           worst_family = s.families[f].name;
@@ -538,64 +567,70 @@ std::string report_md(const ReportData& d, const std::string& command, const std
     }
     md << "| " << cell(s.controllers[c].name) << " | " << total << " | " << fail << " | " << num(worst) << " | "
        << cell(worst_family) << " | " << num(median(all)) << " |";
-    if (!std::isnan(s.report.limit))
-      md << " " << over + fail << (over + fail == 0 ? " (meets the limit in every case)" : "") << " |";
+    if (limit) md << " " << over + fail << (over + fail == 0 ? " (meets the limit in every case)" : "") << " |";
     if (criterion)
       md << " " << (passed == total ? "**" : "") << passed << " of " << total << (passed == total ? "**" : "") << " |";
     md << "\n";
   }
-  if (!std::isnan(s.report.limit))
-    md << "\nA failed case counts as over the limit (" << num(s.report.limit) << " " << unit << ").\n";
+  if (limit) md << "\nA failed case counts as over the limit (" << num(s.report.limit) << " " << unit << ").\n";
   if (criterion) md << "\n" << criterion_text(s) << "\n";
+}
 
-  const auto grid_table = [&](const char* title, bool worst) {
-    md << "\n## " << title << "\n\n| family |";
-    for (std::size_t c = 0; c < nc; ++c) md << " " << cell(s.controllers[c].name) << " |";
-    md << "\n|---|";
-    for (std::size_t c = 0; c < nc; ++c) md << "---|";
-    md << "\n";
-    for (std::size_t f = 0; f < s.families.size(); ++f) {
-      md << "| " << cell(s.families[f].name) << " (" << s.family_cases(f) << ") |";
-      for (std::size_t c = 0; c < nc; ++c) {
-        const Cell& x = t[f][c];
-        double v = worst ? NAN : median(x.values);
-        if (worst)
-          for (double y : x.values) v = std::isnan(v) ? y : std::max(v, y);
-        const bool over = !std::isnan(s.report.limit) && (v > s.report.limit || x.failed > 0);
-        md << " " << (over ? "**" : "") << num(v) << (over ? "**" : "");
-        if (x.failed) md << " (" << x.failed << " failed)";
-        if (x.no_value) md << " (" << x.no_value << " without a value)";
-        md << " |";
-      }
-      md << "\n";
+// The head of a table with one row per family and one column per controller.
+void md_family_table_head(std::ostringstream& md, const Study& s) {
+  md << "| family |";
+  for (const ControllerEntry& c : s.controllers) md << " " << cell(c.name) << " |";
+  md << "\n|---|";
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) md << "---|";
+  md << "\n";
+}
+
+// A table of the worst (or the median) per family and controller, bold over the limit.
+void md_family_table(std::ostringstream& md, const ReportData& d, const std::string& title, bool worst) {
+  const Study& s = d.s;
+  md << "\n## " << title << "\n\n";
+  md_family_table_head(md, s);
+  for (std::size_t f = 0; f < s.families.size(); ++f) {
+    md << "| " << cell(s.families[f].name) << " (" << s.family_cases(f) << ") |";
+    for (std::size_t c = 0; c < s.controllers.size(); ++c) {
+      const Cell& x = d.table[f][c];
+      double v = worst ? NAN : median(x.values);
+      if (worst)
+        for (double y : x.values) v = std::isnan(v) ? y : std::max(v, y);
+      const bool over = !std::isnan(s.report.limit) && (v > s.report.limit || x.failed > 0);
+      md << " " << (over ? "**" : "") << num(v) << (over ? "**" : "");
+      if (x.failed) md << " (" << x.failed << " failed)";
+      if (x.no_value) md << " (" << x.no_value << " without a value)";
+      md << " |";
     }
-  };
-  grid_table(("Worst case per family [" + unit + "]").c_str(), true);
-  if (!std::isnan(s.report.limit)) md << "\nBold: over " << num(s.report.limit) << " " << unit << " (or failed).\n";
-  if (criterion) {
-    md << "\n## Cases that pass per family\n\n" << criterion_text(s) << " Bold: not every case passes.\n\n| family |";
-    for (std::size_t c = 0; c < nc; ++c) md << " " << cell(s.controllers[c].name) << " |";
-    md << "\n|---|";
-    for (std::size_t c = 0; c < nc; ++c) md << "---|";
     md << "\n";
-    for (std::size_t f = 0; f < s.families.size(); ++f) {
-      md << "| " << cell(s.families[f].name) << " |";
-      for (std::size_t c = 0; c < nc; ++c) {
-        const Cell& x = t[f][c];
-        const bool all = x.passed == x.total;
-        md << " " << (all ? "" : "**") << x.passed << " of " << x.total << (all ? "" : "**");
-        if (!s.report.require.empty() && x.verdict_failed) md << " (" << x.verdict_failed << " fail a verdict)";
-        md << " |";
-      }
-      md << "\n";
-    }
   }
-  grid_table(("Median per family [" + unit + "]").c_str(), false);
+}
 
-  // The worst case of each controller, with its parameters.
-  md << "\n## The worst case of each controller\n\n| controller | family | case | " << unit
+// "## Cases that pass per family" (a report with a limit or required verdicts).
+void md_passes_per_family(std::ostringstream& md, const ReportData& d) {
+  const Study& s = d.s;
+  md << "\n## Cases that pass per family\n\n" << criterion_text(s) << " Bold: not every case passes.\n\n";
+  md_family_table_head(md, s);
+  for (std::size_t f = 0; f < s.families.size(); ++f) {
+    md << "| " << cell(s.families[f].name) << " |";
+    for (std::size_t c = 0; c < s.controllers.size(); ++c) {
+      const Cell& x = d.table[f][c];
+      const bool all = x.passed == x.total;
+      md << " " << (all ? "" : "**") << x.passed << " of " << x.total << (all ? "" : "**");
+      if (!s.report.require.empty() && x.verdict_failed) md << " (" << x.verdict_failed << " fail a verdict)";
+      md << " |";
+    }
+    md << "\n";
+  }
+}
+
+// "## The worst case of each controller", with its parameters.
+void md_worst_cases(std::ostringstream& md, const ReportData& d) {
+  const Study& s = d.s;
+  md << "\n## The worst case of each controller\n\n| controller | family | case | " << s.report.unit
      << " | parameters |\n|---|---|---|---|---|\n";
-  for (std::size_t c = 0; c < nc; ++c) {
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) {
     const ReportData::Worst& w = d.worst[c];
     if (!w.any) continue;
     std::string params;
@@ -603,19 +638,37 @@ std::string report_md(const ReportData& d, const std::string& command, const std
     md << "| " << cell(s.controllers[c].name) << " | " << cell(s.families[w.family].name) << " | " << w.index << " | "
        << num(w.value) << " | " << cell(params) << " |\n";
   }
+}
 
+// "## Failed cases": the first ones kept, with their errors.
+void md_failures(std::ostringstream& md, const ReportData& d) {
+  const Study& s = d.s;
+  md << "## Failed cases\n\n| case | controller | family | error |\n|---|---|---|---|\n";
+  for (const ReportData::Failure& f : d.failures)
+    md << "| " << f.index << " | " << cell(s.controllers[f.controller].name) << " | " << cell(s.families[f.family].name)
+       << " | " << cell(f.error) << " |\n";
+  if (d.failed > d.failures.size())
+    md << "\nThe first " << d.failures.size() << " of " << d.failed
+       << " failed cases; `results.csv` lists every one (ok = false).\n";
+  md << "\n";
+}
+
+}  // namespace
+
+std::string report_md(const ReportData& d, const std::string& command, const std::string& plots_markdown) {
+  const Study& s = d.s;
+  const std::string& unit = s.report.unit;
+  std::ostringstream md;
+  md_head(md, d, command);
+  md_worst_per_controller(md, d);
+  md_family_table(md, d, "Worst case per family [" + unit + "]", true);
+  if (!std::isnan(s.report.limit)) md << "\nBold: over " << num(s.report.limit) << " " << unit << " (or failed).\n";
+  if (s.report.has_criterion()) md_passes_per_family(md, d);
+  md_family_table(md, d, "Median per family [" + unit + "]", false);
+  md_worst_cases(md, d);
   md << metric_by_value(d);
   md << "\n## Plots\n\n" << plots_markdown;
-  if (failed > 0) {
-    md << "## Failed cases\n\n| case | controller | family | error |\n|---|---|---|---|\n";
-    for (const ReportData::Failure& f : d.failures)
-      md << "| " << f.index << " | " << cell(s.controllers[f.controller].name) << " | "
-         << cell(s.families[f.family].name) << " | " << cell(f.error) << " |\n";
-    if (failed > d.failures.size())
-      md << "\nThe first " << d.failures.size() << " of " << failed
-         << " failed cases; `results.csv` lists every one (ok = false).\n";
-    md << "\n";
-  }
+  if (d.failed > 0) md_failures(md, d);
   md << "Each case's complete scenario is `cases/<hash>.yaml` (the hash column of `results.csv` is its first 16 "
         "digits); "
         "`feeddrive-sim cases/<hash>.yaml --out DIR` reruns it alone.\n";
