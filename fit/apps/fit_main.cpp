@@ -143,6 +143,6 @@ int main(int argc, char** argv) {
     for (const std::string& u : r.unexplained) std::printf("  %s\n", u.c_str());
     std::printf("results: %s/{findings.json,model.fitted.yaml,report.md}\n", out_dir.c_str());
     // exit codes (docs/fit.md, "Verdicts"): 0 explained or no discrepancy, 3 unexplained, 2 bad input
-    return r.verdict == fit::Verdict::kUnexplained ? fit::kExitUnexplained : 0;
+    return fit::exit_code(r.verdict);
   });
 }
