@@ -442,4 +442,26 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
   out.commit();
 }
 
+std::string result_table(const FitResult& r, const std::string& out_dir) {
+  char buf[512];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "%-4s %-24s %14s %18s\n", "step", "model", "gap [um]", "force RMS [N]");
+  s += buf;
+  std::snprintf(buf, sizeof buf, "%-4d %-24s %14.4g %18.4g\n", 0, "as given", r.replay_initial.gap * 1e6,
+                r.force_rms_initial);
+  s += buf;
+  int k = 0;
+  for (const auto& st : r.steps) {
+    if (!st.accepted) continue;
+    std::snprintf(buf, sizeof buf, "%-4d %-24s %14.4g %18.4g", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
+                  st.force_rms_after);
+    s += buf + (st.swap.empty() ? "" : "   (swap: " + st.swap + ")") + "\n";
+  }
+  s += r.conclusion + "\n";
+  for (const auto& [name, caveat] : r.tentative) s += "tentative " + name + ": " + caveat + "\n";
+  for (const std::string& t : r.ties) s += "tie: " + t + "\n";
+  for (const std::string& u : r.unexplained) s += "  " + u + "\n";
+  return s + "results: " + out_dir + "/{findings.json,model.fitted.yaml,report.md}\n";
+}
+
 }  // namespace feeddrive::fit
