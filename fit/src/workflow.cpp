@@ -173,7 +173,7 @@ void polish(const Context& cx, Search& s) {
 std::string borderline(const Context& cx, const plant::PlantParams& p, const std::vector<std::string>& effects,
                        const Effect& e) {
   constexpr double kPitchMargin = 0.05;
-  if (e.name != "cogging_ripple" && e.name != "reluctance_ripple") return "";
+  if (!is_ripple(e.name)) return "";
   const Envelope& env = cx.env;
   const double pitch = e.parameters.at("pitch_m");
   if (pitch <= env.max_pitch() && pitch >= env.min_pitch()) return "";  // another limit failed
@@ -648,7 +648,7 @@ std::string resemblance(const Context& cx, const CandidateFit& c, bool resembles
   if (why.empty()) why = "not reached";
   std::string line = "resembles " + c.effect.name;
   if (resembles) line += fmt(" (score %.4g)", c.score);
-  if (c.effect.name == "cogging_ripple" || c.effect.name == "reluctance_ripple") {
+  if (is_ripple(c.effect.name)) {
     const auto it = c.effect.parameters.find("pitch_m");
     if (it != c.effect.parameters.end()) line += fmt(", pitch %.4g mm", it->second * 1e3);
   }
@@ -678,8 +678,7 @@ void explain_unexplained(const Context& cx, FitResult& out) {
     for (const CandidateFit& c : last->ranking) {
       if (shown >= 3) break;
       const bool resembles = std::isfinite(c.score) && c.score > 0.0;
-      const bool prerequisite_ripple = c.reason == Reason::kPrerequisite &&
-                                       (c.effect.name == "cogging_ripple" || c.effect.name == "reluctance_ripple");
+      const bool prerequisite_ripple = c.reason == Reason::kPrerequisite && is_ripple(c.effect.name);
       if (!resembles && !prerequisite_ripple) continue;
       ++shown;
       out.unexplained.push_back(resemblance(cx, c, resembles));
