@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -20,6 +21,13 @@ double MeasuredData::median_period() const {
   for (std::size_t k = 0; k + 1 < t.size(); ++k) d[k] = t[k + 1] - t[k];
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
+}
+
+double smallest_position_step(const MeasuredData& d) {
+  double q = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < d.size(); ++k)
+    if (d.x[k] != d.x[k - 1]) q = std::min(q, std::abs(d.x[k] - d.x[k - 1]));
+  return std::isfinite(q) ? q : 0.0;
 }
 
 void validate(const MeasuredData& d) {

@@ -83,7 +83,7 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
           "%.0f reversals)",
           env.stick_phases, env.stick_velocity * 1e3, env.reversals);
   }
-  if ((name == "cogging_ripple" || name == "reluctance_ripple") && env.min_pitch() > env.max_pitch())
+  if (is_ripple(name) && env.min_pitch() > env.max_pitch())
     return fmt("the travel (%.3g mm) spans no two periods of the shortest pitch the data resolves (%.3g mm)",
                env.travel * 1e3, env.min_pitch() * 1e3);
   // k (x - x_rest) + F is the spring k (x - x_rest + F/k): a spring and a constant force in one

@@ -72,6 +72,90 @@ nlohmann::json bins_json(const std::vector<Bin>& bins) {
   return a;
 }
 
+// A named effect of findings.json: its final (jointly refitted) parameters with their 95 %
+// intervals ("undetermined" where not finite), any caveat, and the evidence of the step that
+// brought it in: the step that added it, or the one whose swap move turned an earlier effect into it.
+nlohmann::json effect_json(const FitResult& r, const Effect& final) {
+  const StepResult* from = nullptr;
+  for (const StepResult& st : r.steps) {
+    if (!st.accepted) continue;
+    const std::string into = st.swap.empty() ? "" : st.swap.substr(st.swap.rfind(' ') + 1);
+    if (st.effect.name == final.name || into == final.name) from = &st;
+  }
+  nlohmann::json ci = nlohmann::json::object();
+  if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
+    for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
+  const auto tent = r.tentative.find(final.name);
+  nlohmann::json e = {{"name", final.name},
+                      {"parameters", params_json(final)},
+                      {"ci95", ci},
+                      {"tentative", tent != r.tentative.end()},
+                      {"caveat", tent != r.tentative.end() ? tent->second : std::string()}};
+  if (from) {
+    e["score"] = from->score;
+    e["gap_before"] = from->gap_before;
+    e["gap_after"] = from->gap_after;
+  }
+  return e;
+}
+
+// findings.json's "noise_floor" (verdict.hpp).
+nlohmann::json floor_json(const NoiseFloor& f) {
+  return {{"gap_m", f.gap},
+          {"force_rms_N", f.force},
+          {"quantization_m", f.quantization},
+          {"noise_m", f.noise},
+          {"position_sigma_m", f.position},
+          {"factor", kFloorFactor},
+          {"from_scenario", f.from_scenario},
+          {"source", f.source},
+          {"force_noise_N", f.force_noise},
+          {"force_discretisation_N", f.force_discretisation},
+          {"stamp_error_s", f.stamp_error}};
+}
+
+// findings.json's "record": what the record spans (the plausibility rules' envelope).
+nlohmann::json envelope_json(const Envelope& env) {
+  return {{"travel_m", env.travel},
+          {"peak_speed_mps", env.v_max},
+          {"peak_thrust_N", env.peak_thrust},
+          {"ripple_pitch_range_m", {env.min_pitch(), env.max_pitch()}},
+          {"stick_phases", env.stick_phases},
+          {"reversals", env.reversals},
+          {"stick_fraction", env.stick_fraction}};
+}
+
+// One step of findings.json's "steps": its decision, the ranking of the candidates, the
+// out-of-sample evidence and where the residual was before it.
+nlohmann::json step_json(const StepResult& st) {
+  nlohmann::json rk = nlohmann::json::array();
+  for (const CandidateFit& c : st.ranking)
+    rk.push_back({{"name", c.effect.name},
+                  {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
+                  {"parameters", params_json(c.effect)},
+                  {"k", c.parameters},
+                  {"rss_N2", c.rss},
+                  {"passed_over", c.passed_over},
+                  {"tentative", c.tentative},
+                  {"swap", c.swap},
+                  {"fit_seconds", c.seconds}});
+  return {{"accepted", st.accepted},
+          {"verdict", st.verdict},
+          {"ranking", rk},
+          {"removed", st.removed},
+          {"swap", st.swap},
+          {"caveat", st.caveat},
+          {"ties", st.ties},
+          {"cross_validation",
+           {{"held_out_sq_residual_without_N2", st.cv_without}, {"held_out_sq_residual_with_N2", st.cv_with}}},
+          {"localisation",
+           {{"summary", st.localisation.summary},
+            {"time", bins_json(st.localisation.time)},
+            {"velocity", bins_json(st.localisation.velocity)},
+            {"acceleration", bins_json(st.localisation.acceleration)},
+            {"position", bins_json(st.localisation.position)}}}};
+}
+
 }  // namespace
 
 std::string findings_json(const FitResult& r, const MeasuredData* data) {
@@ -87,45 +171,10 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["force_residual_rms_initial_N"] = r.force_rms_initial;
   j["force_residual_rms_final_N"] = r.force_rms_final;
   j["effects"] = nlohmann::json::array();
-  // the named effects with their final (jointly refitted) parameters, each with the step that
-  // brought it in: the step that added it, or the one whose swap move turned an earlier effect into it
-  for (const Effect& final : r.effects) {
-    const StepResult* from = nullptr;
-    for (const StepResult& st : r.steps) {
-      if (!st.accepted) continue;
-      const std::string into = st.swap.empty() ? "" : st.swap.substr(st.swap.rfind(' ') + 1);
-      if (st.effect.name == final.name || into == final.name) from = &st;
-    }
-    nlohmann::json ci = nlohmann::json::object();
-    if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
-      for (const auto& [k, v] : it->second)
-        ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
-    const auto tent = r.tentative.find(final.name);
-    nlohmann::json e = {{"name", final.name},
-                        {"parameters", params_json(final)},
-                        {"ci95", ci},
-                        {"tentative", tent != r.tentative.end()},
-                        {"caveat", tent != r.tentative.end() ? tent->second : std::string()}};
-    if (from) {
-      e["score"] = from->score;
-      e["gap_before"] = from->gap_before;
-      e["gap_after"] = from->gap_after;
-    }
-    j["effects"].push_back(e);
-  }
+  for (const Effect& final : r.effects) j["effects"].push_back(effect_json(r, final));
   j["verdict"] = verdict_name(r.verdict);
-  j["exit_code"] = r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0;
-  j["noise_floor"] = {{"gap_m", r.floor.gap},
-                      {"force_rms_N", r.floor.force},
-                      {"quantization_m", r.floor.quantization},
-                      {"noise_m", r.floor.noise},
-                      {"position_sigma_m", r.floor.position},
-                      {"factor", kFloorFactor},
-                      {"from_scenario", r.floor.from_scenario},
-                      {"source", r.floor.source},
-                      {"force_noise_N", r.floor.force_noise},
-                      {"force_discretisation_N", r.floor.force_discretisation},
-                      {"stamp_error_s", r.floor.stamp_error}};
+  j["exit_code"] = exit_code(r.verdict);
+  j["noise_floor"] = floor_json(r.floor);
   j["unexplained"] = r.unexplained;
   j["ties"] = r.ties;
   j["conclusion"] = r.conclusion;
@@ -134,44 +183,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
                      {"coulomb_transition_shape_initial", r.shape_initial},
                      {"coulomb_transition_shape_final", r.shape_final},
                      {"fitted", r.smoothing_fitted}};
-  const Envelope& env = r.envelope;
-  j["record"] = {{"travel_m", env.travel},
-                 {"peak_speed_mps", env.v_max},
-                 {"peak_thrust_N", env.peak_thrust},
-                 {"ripple_pitch_range_m", {env.min_pitch(), env.max_pitch()}},
-                 {"stick_phases", env.stick_phases},
-                 {"reversals", env.reversals},
-                 {"stick_fraction", env.stick_fraction}};
+  j["record"] = envelope_json(r.envelope);
   nlohmann::json steps = nlohmann::json::array();
-  for (const StepResult& st : r.steps) {
-    nlohmann::json rk = nlohmann::json::array();
-    for (const CandidateFit& c : st.ranking)
-      rk.push_back({{"name", c.effect.name},
-                    {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nlohmann::json()},
-                    {"parameters", params_json(c.effect)},
-                    {"k", c.parameters},
-                    {"rss_N2", c.rss},
-                    {"passed_over", c.passed_over},
-                    {"tentative", c.tentative},
-                    {"swap", c.swap},
-                    {"fit_seconds", c.seconds}});
-    steps.push_back(
-        {{"accepted", st.accepted},
-         {"verdict", st.verdict},
-         {"ranking", rk},
-         {"removed", st.removed},
-         {"swap", st.swap},
-         {"caveat", st.caveat},
-         {"ties", st.ties},
-         {"cross_validation",
-          {{"held_out_sq_residual_without_N2", st.cv_without}, {"held_out_sq_residual_with_N2", st.cv_with}}},
-         {"localisation",
-          {{"summary", st.localisation.summary},
-           {"time", bins_json(st.localisation.time)},
-           {"velocity", bins_json(st.localisation.velocity)},
-           {"acceleration", bins_json(st.localisation.acceleration)},
-           {"position", bins_json(st.localisation.position)}}}});
-  }
+  for (const StepResult& st : r.steps) steps.push_back(step_json(st));
   j["steps"] = steps;
   // A path that is not UTF-8 (the name is checked at load time) is written with U+FFFD, never an
   // exception after the run.
@@ -203,195 +217,251 @@ std::string params_text(const Effect& e) {
   return s;
 }
 
+// replay.csv: the measured position, the replays of the model as given and of the fitted model,
+// and their errors, per sample (the data behind replay.png).
+void write_replay_csv(const output::StagedFolder& out, const MeasuredData& d, const FitResult& r) {
+  output::CsvWriter f(out.path("replay.csv"),
+                      {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
+  for (std::size_t k = 0; k < d.size(); ++k)
+    f.row({d.t[k], d.x[k], r.replay_initial.x_sim[k], r.replay_final.x_sim[k], r.replay_initial.error[k],
+           r.replay_final.error[k]});
+  f.close();
+}
+
+// gap.csv: the replay gap and force residual RMS of the model as given and after each addition.
+void write_gap_csv(const output::StagedFolder& out, const FitResult& r) {
+  std::ofstream f(out.path("gap.csv"));
+  f << "step,label,gap_m,force_rms_N\n";
+  f << "0,initial," << r.replay_initial.gap << ',' << r.force_rms_initial << '\n';
+  int k = 1;
+  for (const StepResult& st : r.steps)
+    if (st.accepted) f << k++ << ",+" << st.effect.name << ',' << st.gap_after << ',' << st.force_rms_after << '\n';
+}
+
+// effectK.csv for the K-th addition: the filtered force residual before and after it, and the
+// effect's own filtered force, against the effect's regressor.
+void write_effect_csvs(const output::StagedFolder& out, const Record& rec, const FitResult& r) {
+  int n_eff = 0;
+  for (const StepResult& st : r.steps) {
+    if (!st.accepted) continue;
+    ++n_eff;
+    const auto [label, xs] = effect_regressor(rec, st.effect);
+    output::CsvWriter f(out.path("effect" + std::to_string(n_eff) + ".csv"),
+                        {"regressor", "residual_before", "effect_force", "residual_after"});
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+      const long li = static_cast<long>(i);
+      // r = -filtered F_extra: the effect's own filtered force is -(r_after - r_before)
+      f.row(
+          {xs[i], -st.residual_before[li], -(st.residual_before[li] - st.residual_after[li]), -st.residual_after[li]});
+    }
+    f.close();
+  }
+}
+
+// report.md's head: the inputs, the verdict and the gap after each step.
+void md_head(std::ostringstream& md, const std::string& scenario_path, const Record& rec, const FitResult& r) {
+  const MeasuredData& d = *rec.data;
+  char buf[512];
+  md << "# feeddrive-fit report\n\n"
+     << "- model: `" << scenario_path << "`\n- data: `" << d.source << "` (" << d.size() << " samples, "
+     << d.t.back() - d.t.front() << " s, median period " << rec.period * 1e3 << " ms)\n"
+     << "- filter half-width L = " << rec.bank.half_width * 1e3 << " ms, " << rec.bank.tau.size()
+     << " independent force-residual points\n";
+  for (const std::string& n : d.notes) md << "- data note: " << n << "\n";
+  md << "\n"
+     << "**Verdict: " << verdict_name(r.verdict) << "** (exit code " << exit_code(r.verdict) << ")\n\n"
+     << "**" << r.conclusion << "**\n\n"
+     << "The gap is the RMS position error of the model replayed from the measured state over windows "
+        "(docs/fit.md); the force measure is the RMS of the filtered force residual.\n\n"
+     << "## Gap after each step\n\n| step | model | gap [um] | force residual RMS [N] |\n|---|---|---|---|\n";
+  std::snprintf(buf, sizeof buf, "| 0 | as given | %.4g | %.4g |\n", r.replay_initial.gap * 1e6, r.force_rms_initial);
+  md << buf;
+  int k = 0;
+  for (const StepResult& st : r.steps) {
+    if (!st.accepted) continue;
+    const std::string label = st.effect.name + (st.swap.empty() ? "" : " (swap: " + st.swap + ")") +
+                              (st.caveat.empty() ? "" : " (tentative)");
+    std::snprintf(buf, sizeof buf, "| %d | + %s | %.4g | %.4g |\n", ++k, label.c_str(), st.gap_after * 1e6,
+                  st.force_rms_after);
+    md << buf;
+  }
+}
+
+// report.md: the noise floor, and a "## title" section with one item per line (none if empty).
+void md_floor(std::ostringstream& md, const NoiseFloor& f) {
+  char a[160], b[200];
+  std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ", f.gap * 1e6,
+                f.force, f.position * 1e9);
+  std::snprintf(b, sizeof b,
+                "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
+                "most %.0fx the floor.\n\n",
+                f.force_noise, f.force_discretisation, kFloorFactor);
+  md << a << f.source << b;
+}
+void md_list(std::ostringstream& md, const char* title, const std::vector<std::string>& items) {
+  if (items.empty()) return;
+  md << "## " << title << "\n\n";
+  for (const std::string& u : items) md << "- " << u << "\n";
+  md << "\n";
+}
+
+// report.md: the named effects with their parameters and 95 % intervals, and the model form.
+void md_effects(std::ostringstream& md, const FitResult& r) {
+  char buf[512];
+  md << "\n## Effects found\n\n";
+  if (r.effects.empty()) md << "None: no candidate is significant.\n";
+  for (const Effect& e : r.effects) {
+    md << "- `" << e.name << "`" << (r.tentative.count(e.name) ? " (**tentative**)" : "") << ": ";
+    std::string sep;
+    for (const auto& [k, v] : e.parameters) {
+      double w = std::nan("");
+      if (const auto it = r.ci95.find(e.name); it != r.ci95.end() && it->second.count(k)) w = it->second.at(k);
+      std::snprintf(buf, sizeof buf, std::isfinite(w) ? "%s%s = %.6g +- %.2g" : "%s%s = %.6g (interval undetermined)",
+                    sep.c_str(), k.c_str(), v, w);
+      md << buf;
+      sep = ", ";
+    }
+    md << " (95 % intervals)\n";
+    if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
+  }
+  if (r.smoothing_fitted) {
+    std::snprintf(
+        buf, sizeof buf,
+        "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
+        "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
+        "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
+        r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
+    md << buf;
+  }
+}
+
+// report.md: what the record spans (the plausibility rules' envelope).
+void md_envelope(std::ostringstream& md, const Envelope& env) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "\nWhat this record can show (plausibility rules, docs/fit.md): travel %.4g mm, peak speed %.4g "
+                "mm/s, peak thrust %.4g N; ripple pitches %.3g-%.3g mm; %d stick phases (%.2g %% of the samples "
+                "below %.3g mm/s), %d reversals.\n",
+                env.travel * 1e3, env.v_max * 1e3, env.peak_thrust, env.min_pitch() * 1e3, env.max_pitch() * 1e3,
+                env.stick_phases, 100 * env.stick_fraction, env.stick_velocity * 1e3, env.reversals);
+  md << buf;
+}
+
+// report.md: step s (from 0) with its verdict, out-of-sample evidence, ranking and where the
+// residual was; `plot` the number of its effect plot (0: none).
+void md_step(std::ostringstream& md, std::size_t s, const StepResult& st, int plot) {
+  char buf[512];
+  md << "\n## Step " << s + 1 << ": " << st.verdict << "\n\n" << st.localisation.summary << ".\n\n";
+  if (!st.cv_with.empty()) {
+    double a = 0, b = 0;
+    for (double v : st.cv_without) a += v;
+    for (double v : st.cv_with) b += v;
+    std::snprintf(buf, sizeof buf,
+                  "Out of sample (%zu blocks of time, each predicted by a fit to the others): held-out squared "
+                  "force residual %.4g -> %.4g N^2.\n\n",
+                  st.cv_with.size(), a, b);
+    md << buf;
+  }
+  md << "Candidates (score = BIC of the model - BIC of the model with the effect, every free parameter "
+        "refitted jointly; significant above the threshold):\n\n"
+     << "| rank | effect | score | k | parameters | passed over because |\n|---|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < st.ranking.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "| %zu | %s | %.4g | %d | ", i + 1, st.ranking[i].effect.name.c_str(),
+                  st.ranking[i].score, st.ranking[i].parameters);
+    md << buf << params_text(st.ranking[i].effect) << " | " << st.ranking[i].passed_over << " |\n";
+  }
+  md << "\nWhere the residual was (before this step):\n\n"
+     << "Velocity regimes\n\n"
+     << table(st.localisation.velocity) << "\nAcceleration phases\n\n"
+     << table(st.localisation.acceleration) << "\nPosition\n\n"
+     << table(st.localisation.position) << "\nTime\n\n"
+     << table(st.localisation.time);
+  if (plot > 0) md << "\n![residual against the regressor of " << st.effect.name << "](effect" << plot << ".png)\n";
+}
+
+// report.md: the whole report.
+std::string report_md(const std::string& scenario_path, const Record& rec, const FitResult& r, bool plots) {
+  std::ostringstream md;
+  md_head(md, scenario_path, rec, r);
+  if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
+  md_floor(md, r.floor);
+  md_list(md, "Unexplained discrepancy", r.unexplained);
+  md_list(md, "Ties", r.ties);
+  md_effects(md, r);
+  md_envelope(md, r.envelope);
+  int k = 0;
+  for (std::size_t s = 0; s < r.steps.size(); ++s) {
+    const bool plot = r.steps[s].accepted && plots;
+    md_step(md, s, r.steps[s], plot ? ++k : 0);
+  }
+  return md.str();
+}
+
+// The gnuplot script of replay.png, gap.png and effectK.png (fixed data file names; every other
+// text through output::gnuplot_string).
+std::string plot_script(const Record& rec, const FitResult& r) {
+  std::ostringstream gp;
+  gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
+        "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
+     << "plot 'replay.csv' every ::1 using 1:($2*1e3) with lines lw 2 title 'measured', '' every ::1 using "
+        "1:($3*1e3) with lines title 'model as given', '' every ::1 using 1:($4*1e3) with lines title 'fitted "
+        "model'\n"
+     << "set ylabel 'x_sim - x [um]'\nplot 'replay.csv' every ::1 using 1:($5*1e6) with lines title 'model as "
+        "given', '' every ::1 using 1:($6*1e6) with lines title 'fitted model'\nunset multiplot\n";
+  gp << "set output 'gap.png'\nset title 'replay gap after each step'\nset xlabel 'step'\nset ylabel 'gap [um]'\n"
+     << "set logscale y\nset style fill solid 0.5\nset boxwidth 0.6\nunset key\n"
+     << "plot 'gap.csv' every ::1 using 1:($3*1e6):xtic(2) with boxes\nunset logscale y\nset key\n";
+  int k = 0;
+  for (const StepResult& st : r.steps) {
+    if (!st.accepted) continue;
+    ++k;
+    const auto label = effect_regressor(rec, st.effect).first;
+    gp << "set output 'effect" << k << ".png'\nset title "
+       << output::gnuplot_string("step " + std::to_string(k) + ": " + st.effect.name +
+                                 " -- filtered force residual against its regressor")
+       << "\nset xlabel " << output::gnuplot_string(label) << "\nset ylabel 'force [N]'\nplot 'effect" << k
+       << ".csv' every ::1 using 1:2 with points pt 7 ps 0.4 title 'residual before (-r)', '' every ::1 using "
+          "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
+          "ps 0.3 title 'residual after'\n";
+  }
+  return gp.str();
+}
+
 }  // namespace
 
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
                    bool plots, const interrupt::StopToken& stop) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
-  {
-    const MeasuredData& d = *rec.data;
-    out.write_text("findings.json", findings_json(r, &d));
-    out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
-    // data behind the plots
-    {
-      output::CsvWriter f(out.path("replay.csv"),
-                          {"t", "x", "x_sim_initial", "x_sim_final", "error_initial", "error_final"});
-      for (std::size_t k = 0; k < d.size(); ++k)
-        f.row({d.t[k], d.x[k], r.replay_initial.x_sim[k], r.replay_final.x_sim[k], r.replay_initial.error[k],
-               r.replay_final.error[k]});
-      f.close();
-    }
-    {
-      std::ofstream f(out.path("gap.csv"));
-      f << "step,label,gap_m,force_rms_N\n";
-      f << "0,initial," << r.replay_initial.gap << ',' << r.force_rms_initial << '\n';
-      int k = 1;
-      for (const StepResult& st : r.steps)
-        if (st.accepted) f << k++ << ",+" << st.effect.name << ',' << st.gap_after << ',' << st.force_rms_after << '\n';
-    }
-    int n_eff = 0;
-    for (const StepResult& st : r.steps) {
-      if (!st.accepted) continue;
-      ++n_eff;
-      const auto [label, xs] = effect_regressor(rec, st.effect);
-      output::CsvWriter f(out.path("effect" + std::to_string(n_eff) + ".csv"),
-                          {"regressor", "residual_before", "effect_force", "residual_after"});
-      for (std::size_t i = 0; i < xs.size(); ++i) {
-        const long li = static_cast<long>(i);
-        // r = -filtered F_extra: the effect's own filtered force is -(r_after - r_before)
-        f.row({xs[i], -st.residual_before[li], -(st.residual_before[li] - st.residual_after[li]),
-               -st.residual_after[li]});
-      }
-      f.close();
-    }
-    // report.md
-    std::ostringstream md;
-    char buf[512];
-    md << "# feeddrive-fit report\n\n"
-       << "- model: `" << scenario_path << "`\n- data: `" << d.source << "` (" << d.size() << " samples, "
-       << d.t.back() - d.t.front() << " s, median period " << rec.period * 1e3 << " ms)\n"
-       << "- filter half-width L = " << rec.bank.half_width * 1e3 << " ms, " << rec.bank.tau.size()
-       << " independent force-residual points\n";
-    for (const std::string& n : d.notes) md << "- data note: " << n << "\n";
-    md << "\n"
-       << "**Verdict: " << verdict_name(r.verdict) << "** (exit code "
-       << (r.verdict == Verdict::kUnexplained ? kExitUnexplained : 0) << ")\n\n"
-       << "**" << r.conclusion << "**\n\n"
-       << "The gap is the RMS position error of the model replayed from the measured state over windows "
-          "(docs/fit.md); the force measure is the RMS of the filtered force residual.\n\n"
-       << "## Gap after each step\n\n| step | model | gap [um] | force residual RMS [N] |\n|---|---|---|---|\n";
-    std::snprintf(buf, sizeof buf, "| 0 | as given | %.4g | %.4g |\n", r.replay_initial.gap * 1e6, r.force_rms_initial);
-    md << buf;
-    int k = 0;
-    for (const StepResult& st : r.steps) {
-      if (!st.accepted) continue;
-      const std::string label = st.effect.name + (st.swap.empty() ? "" : " (swap: " + st.swap + ")") +
-                                (st.caveat.empty() ? "" : " (tentative)");
-      std::snprintf(buf, sizeof buf, "| %d | + %s | %.4g | %.4g |\n", ++k, label.c_str(), st.gap_after * 1e6,
-                    st.force_rms_after);
-      md << buf;
-    }
-    if (plots) md << "\n![gap after each step](gap.png)\n\n![measured and replayed](replay.png)\n";
-    {
-      char a[160], b[200];
-      std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ",
-                    r.floor.gap * 1e6, r.floor.force, r.floor.position * 1e9);
-      std::snprintf(
-          b, sizeof b,
-          "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
-          "most %.0fx the floor.\n\n",
-          r.floor.force_noise, r.floor.force_discretisation, kFloorFactor);
-      md << a << r.floor.source << b;
-    }
-    if (!r.unexplained.empty()) {
-      md << "## Unexplained discrepancy\n\n";
-      for (const std::string& u : r.unexplained) md << "- " << u << "\n";
-      md << "\n";
-    }
-    if (!r.ties.empty()) {
-      md << "## Ties\n\n";
-      for (const std::string& t : r.ties) md << "- " << t << "\n";
-      md << "\n";
-    }
-    md << "\n## Effects found\n\n";
-    if (r.effects.empty()) md << "None: no candidate is significant.\n";
-    for (const Effect& e : r.effects) {
-      md << "- `" << e.name << "`" << (r.tentative.count(e.name) ? " (**tentative**)" : "") << ": ";
-      std::string sep;
-      for (const auto& [k, v] : e.parameters) {
-        double w = std::nan("");
-        if (const auto it = r.ci95.find(e.name); it != r.ci95.end() && it->second.count(k)) w = it->second.at(k);
-        std::snprintf(buf, sizeof buf, std::isfinite(w) ? "%s%s = %.6g +- %.2g" : "%s%s = %.6g (interval undetermined)",
-                      sep.c_str(), k.c_str(), v, w);
-        md << buf;
-        sep = ", ";
-      }
-      md << " (95 % intervals)\n";
-      if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
-    }
-    if (r.smoothing_fitted) {
-      std::snprintf(
-          buf, sizeof buf,
-          "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
-          "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
-          "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
-          r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
-      md << buf;
-    }
-    {
-      const Envelope& env = r.envelope;
-      std::snprintf(buf, sizeof buf,
-                    "\nWhat this record can show (plausibility rules, docs/fit.md): travel %.4g mm, peak speed %.4g "
-                    "mm/s, peak thrust %.4g N; ripple pitches %.3g-%.3g mm; %d stick phases (%.2g %% of the samples "
-                    "below %.3g mm/s), %d reversals.\n",
-                    env.travel * 1e3, env.v_max * 1e3, env.peak_thrust, env.min_pitch() * 1e3, env.max_pitch() * 1e3,
-                    env.stick_phases, 100 * env.stick_fraction, env.stick_velocity * 1e3, env.reversals);
-      md << buf;
-    }
-    k = 0;
-    for (std::size_t s = 0; s < r.steps.size(); ++s) {
-      const StepResult& st = r.steps[s];
-      md << "\n## Step " << s + 1 << ": " << st.verdict << "\n\n" << st.localisation.summary << ".\n\n";
-      if (!st.cv_with.empty()) {
-        double a = 0, b = 0;
-        for (double v : st.cv_without) a += v;
-        for (double v : st.cv_with) b += v;
-        std::snprintf(buf, sizeof buf,
-                      "Out of sample (%zu blocks of time, each predicted by a fit to the others): held-out squared "
-                      "force residual %.4g -> %.4g N^2.\n\n",
-                      st.cv_with.size(), a, b);
-        md << buf;
-      }
-      md << "Candidates (score = BIC of the model - BIC of the model with the effect, every free parameter "
-            "refitted jointly; significant above the threshold):\n\n"
-         << "| rank | effect | score | k | parameters | passed over because |\n|---|---|---|---|---|---|\n";
-      for (std::size_t i = 0; i < st.ranking.size(); ++i) {
-        std::snprintf(buf, sizeof buf, "| %zu | %s | %.4g | %d | ", i + 1, st.ranking[i].effect.name.c_str(),
-                      st.ranking[i].score, st.ranking[i].parameters);
-        md << buf << params_text(st.ranking[i].effect) << " | " << st.ranking[i].passed_over << " |\n";
-      }
-      md << "\nWhere the residual was (before this step):\n\n"
-         << "Velocity regimes\n\n"
-         << table(st.localisation.velocity) << "\nAcceleration phases\n\n"
-         << table(st.localisation.acceleration) << "\nPosition\n\n"
-         << table(st.localisation.position) << "\nTime\n\n"
-         << table(st.localisation.time);
-      if (st.accepted && plots) {
-        ++k;
-        md << "\n![residual against the regressor of " << st.effect.name << "](effect" << k << ".png)\n";
-      }
-    }
-    out.write_text("report.md", md.str());
-    if (plots) {
-      std::ostringstream gp;
-      // Fixed data file names; every other text through output::gnuplot_string.
-      gp << "set output 'replay.png'\nset multiplot layout 2,1 title 'measured vs replayed model (windows restart "
-            "from the measured state)'\nset xlabel 't [s]'\nset ylabel 'x [mm]'\n"
-         << "plot 'replay.csv' every ::1 using 1:($2*1e3) with lines lw 2 title 'measured', '' every ::1 using "
-            "1:($3*1e3) with lines title 'model as given', '' every ::1 using 1:($4*1e3) with lines title 'fitted "
-            "model'\n"
-         << "set ylabel 'x_sim - x [um]'\nplot 'replay.csv' every ::1 using 1:($5*1e6) with lines title 'model as "
-            "given', '' every ::1 using 1:($6*1e6) with lines title 'fitted model'\nunset multiplot\n";
-      gp << "set output 'gap.png'\nset title 'replay gap after each step'\nset xlabel 'step'\nset ylabel 'gap [um]'\n"
-         << "set logscale y\nset style fill solid 0.5\nset boxwidth 0.6\nunset key\n"
-         << "plot 'gap.csv' every ::1 using 1:($3*1e6):xtic(2) with boxes\nunset logscale y\nset key\n";
-      k = 0;
-      for (const StepResult& st : r.steps) {
-        if (!st.accepted) continue;
-        ++k;
-        const auto label = effect_regressor(rec, st.effect).first;
-        gp << "set output 'effect" << k << ".png'\nset title "
-           << output::gnuplot_string("step " + std::to_string(k) + ": " + st.effect.name +
-                                     " -- filtered force residual against its regressor")
-           << "\nset xlabel " << output::gnuplot_string(label) << "\nset ylabel 'force [N]'\nplot 'effect" << k
-           << ".csv' every ::1 using 1:2 with points pt 7 ps 0.4 title 'residual before (-r)', '' every ::1 using "
-              "1:3 with points pt 7 ps 0.4 title 'fitted effect (filtered)', '' every ::1 using 1:4 with points pt 7 "
-              "ps 0.3 title 'residual after'\n";
-      }
-      out.plot(gp.str(), stop);
-    }
-  }
+  out.write_text("findings.json", findings_json(r, rec.data));
+  out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
+  write_replay_csv(out, *rec.data, r);
+  write_gap_csv(out, r);
+  write_effect_csvs(out, rec, r);
+  out.write_text("report.md", report_md(scenario_path, rec, r, plots));
+  if (plots) out.plot(plot_script(rec, r), stop);
   out.commit();
+}
+
+std::string result_table(const FitResult& r, const std::string& out_dir) {
+  char buf[512];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "%-4s %-24s %14s %18s\n", "step", "model", "gap [um]", "force RMS [N]");
+  s += buf;
+  std::snprintf(buf, sizeof buf, "%-4d %-24s %14.4g %18.4g\n", 0, "as given", r.replay_initial.gap * 1e6,
+                r.force_rms_initial);
+  s += buf;
+  int k = 0;
+  for (const auto& st : r.steps) {
+    if (!st.accepted) continue;
+    std::snprintf(buf, sizeof buf, "%-4d %-24s %14.4g %18.4g", ++k, ("+ " + st.effect.name).c_str(), st.gap_after * 1e6,
+                  st.force_rms_after);
+    s += buf + (st.swap.empty() ? "" : "   (swap: " + st.swap + ")") + "\n";
+  }
+  s += r.conclusion + "\n";
+  for (const auto& [name, caveat] : r.tentative) s += "tentative " + name + ": " + caveat + "\n";
+  for (const std::string& t : r.ties) s += "tie: " + t + "\n";
+  for (const std::string& u : r.unexplained) s += "  " + u + "\n";
+  return s + "results: " + out_dir + "/{findings.json,model.fitted.yaml,report.md}\n";
 }
 
 }  // namespace feeddrive::fit

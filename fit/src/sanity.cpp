@@ -35,13 +35,18 @@ std::string unit_name(const std::string& role, double factor) {
   return "";
 }
 
-void check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period) {
-  const std::size_t n = d.size();
-  if (n < 3) return;
-  const double T = d.median_period();
-  // 1. gaps and jumps in time: the largest step
+namespace {
+
+// The k-th smallest value of v (0-based).
+double order_statistic(std::vector<double> v, std::size_t k) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+// 1. gaps and jumps in time: the largest time step, against kMaxGap median periods T.
+void check_time_steps(const MeasuredData& d, double T) {
   std::size_t worst = 1;
-  for (std::size_t k = 1; k < n; ++k)
+  for (std::size_t k = 1; k < d.size(); ++k)
     if (d.t[k] - d.t[k - 1] > d.t[worst] - d.t[worst - 1]) worst = k;
   const double gap = d.t[worst] - d.t[worst - 1];
   if (gap > kMaxGap * T)
@@ -51,21 +56,26 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
         fmt(" to %.9g s: a gap, or two recordings joined; the fit needs one continuous recording: split the "
             "file there and fit each part",
             d.t[worst] + d.time_offset));
-  // 2. the time scale against the control period
-  if (control_period > 0 && T > 0) {
-    const int k = thousands(T / control_period);
-    if (k != 0) {
-      const double factor = d.time_factor * std::pow(1000.0, -k);
-      const std::string h = hint("t", factor);
-      if (!h.empty())
-        throw DataError(
-            d.source + ": column '" + d.time_name + "'" +
-            fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
-    }
-  }
-  // 3. the position scale: travel and speed a feed drive can have
-  // the range between the 0.1th and 99.9th percentiles: an isolated outlier is no unit (it is
-  // named by the jump check below, or by prepare()'s finiteness check)
+}
+
+// 2. the time scale: a median period T a power of 1000 away from the control period.
+void check_time_scale(const MeasuredData& d, double T, double control_period) {
+  if (!(control_period > 0 && T > 0)) return;
+  const int k = thousands(T / control_period);
+  if (k == 0) return;
+  const double factor = d.time_factor * std::pow(1000.0, -k);
+  const std::string h = hint("t", factor);
+  if (!h.empty())
+    throw DataError(
+        d.source + ": column '" + d.time_name + "'" +
+        fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
+}
+
+// 3. the position scale: travel and speed a feed drive can have (kMaxTravel, kMaxSpeed). The
+// travel is the range between the 0.1th and 99.9th percentiles and the speed the 99th percentile:
+// an isolated outlier is no unit (it is named by the jump check, or by prepare()'s finiteness check).
+void check_position_scale(const MeasuredData& d) {
+  const std::size_t n = d.size();
   std::vector<double> xs = d.x;
   std::sort(xs.begin(), xs.end());
   const double travel = xs[static_cast<std::size_t>(0.999 * static_cast<double>(n - 1))] -
@@ -73,45 +83,30 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
   std::vector<double> speed;
   speed.reserve(n);
   for (std::size_t k = 1; k < n; ++k) speed.push_back(std::abs(d.x[k] - d.x[k - 1]) / (d.t[k] - d.t[k - 1]));
-  std::vector<double> sorted = speed;
-  const std::size_t q99 = static_cast<std::size_t>(0.99 * static_cast<double>(sorted.size() - 1));
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(q99), sorted.end());
-  const double v99 = sorted[q99];
-  if (travel > kMaxTravel || v99 > kMaxSpeed) {
-    int k = 0;
-    while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
-    const std::string h = hint("x", d.position_factor * std::pow(1e-3, k));
-    throw DataError(
-        d.source + ": column '" + d.position_name + "'" +
-        fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
-            "%.3g m, %.3g m/s)",
-            travel, v99, kMaxTravel, kMaxSpeed) +
-        (h.empty() ? ": is the position in metres?" : h));
-  }
-  // 4. discontinuities in position: an acceleration no thrust of this drive gives, and beyond the
-  // sensor's own second difference (a quantum and three noise deviations per step, 50-fold)
-  const double mass = plant::effective_params(model).mass;
-  const double gain = d.input_kind == InputKind::kCommand ? model.thrust_gain() : 1.0;
-  double peak = 0.0;
-  for (double u : d.input) peak = std::max(peak, std::abs(gain * u));
-  double q = model.sensor.quantization;
-  if (q == 0.0) {  // the record's own resolution: its smallest position step
-    q = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 1; k < n; ++k)
-      if (d.x[k] != d.x[k - 1]) q = std::min(q, std::abs(d.x[k] - d.x[k - 1]));
-    if (!std::isfinite(q)) q = 0.0;
-  }
-  const double sensor = q + 3.0 * model.sensor.noise_stddev;
+  const double v99 = order_statistic(speed, static_cast<std::size_t>(0.99 * static_cast<double>(speed.size() - 1)));
+  if (!(travel > kMaxTravel || v99 > kMaxSpeed)) return;
+  int k = 0;
+  while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
+  const std::string h = hint("x", d.position_factor * std::pow(1e-3, k));
+  throw DataError(d.source + ": column '" + d.position_name + "'" +
+                  fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
+                      "%.3g m, %.3g m/s)",
+                      travel, v99, kMaxTravel, kMaxSpeed) +
+                  (h.empty() ? ": is the position in metres?" : h));
+}
+
+// The sample whose second difference |x''_k| (three-point, unequal steps) most exceeds the larger
+// of 20x what the peak thrust gives the mass, 50x the sensor's own (a quantum and three noise
+// deviations per step) and 20x the record's own 99th percentile (one jump does not move it);
+// 0 if none exceeds it.
+std::size_t find_jump(const MeasuredData& d, double peak, double mass, double sensor) {
+  const std::size_t n = d.size();
   std::vector<double> acc(n, 0.0);
   for (std::size_t k = 1; k + 1 < n; ++k) {
     const double h0 = d.t[k] - d.t[k - 1], h1 = d.t[k + 1] - d.t[k];
     acc[k] = std::abs((d.x[k + 1] - d.x[k]) / h1 - (d.x[k] - d.x[k - 1]) / h0) / (0.5 * (h0 + h1));
   }
-  // and beyond 20x the record's own 99th percentile (one jump does not move it)
-  std::vector<double> acc_sorted = acc;
-  const std::size_t a99 = static_cast<std::size_t>(0.99 * static_cast<double>(n - 1));
-  std::nth_element(acc_sorted.begin(), acc_sorted.begin() + static_cast<long>(a99), acc_sorted.end());
-  const double typical = acc_sorted[a99];
+  const double typical = order_statistic(acc, static_cast<std::size_t>(0.99 * static_cast<double>(n - 1)));
   std::size_t jump = 0;
   double jump_a = 0.0;
   for (std::size_t k = 1; k + 1 < n; ++k) {
@@ -123,29 +118,58 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
       jump_a = a / limit;
     }
   }
-  if (jump > 0) {
-    // an isolated outlier (a spike: the samples around it agree) rather than a jump
-    for (std::size_t k = std::max<std::size_t>(jump, 1) - 0; k <= jump + 1 && k + 1 < n; ++k) {
-      const double off = std::abs(d.x[k] - 0.5 * (d.x[k - 1] + d.x[k + 1]));
-      if (std::abs(d.x[k + 1] - d.x[k - 1]) < 0.1 * off)
-        throw DataError(
-            d.where(k) + ": column '" + d.position_name + "'" +
-            fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
-                "column in metres and free of outliers?",
-                d.x[k], d.t[k] + d.time_offset, off));
-    }
-    // the step of the jump is the larger of the two around sample `jump`
-    const std::size_t k = std::abs(d.x[jump + 1] - d.x[jump]) > std::abs(d.x[jump] - d.x[jump - 1]) ? jump + 1 : jump;
-    // the step less the motion around it (the mean of the neighbouring steps)
-    const double before = k >= 2 ? d.x[k - 1] - d.x[k - 2] : 0.0, after = k + 1 < n ? d.x[k + 1] - d.x[k] : 0.0;
-    const double size = d.x[k] - d.x[k - 1] - 0.5 * (before + after);
-    throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
-                    fmt(": the position jumps by %.4g mm in one sample (t = %.9g s), an acceleration beyond 20x what "
-                        "the peak thrust of %.4g N gives the %.4g kg mass",
-                        size * 1e3, d.t[k] + d.time_offset, peak, mass) +
-                    ": two recordings joined, or an encoder glitch? The fit needs one continuous recording: split the "
-                    "file there and fit each part");
+  return jump;
+}
+
+// The DataError of a discontinuity at sample `jump`: an isolated outlier (a spike: the samples
+// around it agree) or a jump of the position, named with its size less the motion around it.
+[[noreturn]] void throw_jump(const MeasuredData& d, std::size_t jump, double peak, double mass) {
+  const std::size_t n = d.size();
+  for (std::size_t k = std::max<std::size_t>(jump, 1) - 0; k <= jump + 1 && k + 1 < n; ++k) {
+    const double off = std::abs(d.x[k] - 0.5 * (d.x[k - 1] + d.x[k + 1]));
+    if (std::abs(d.x[k + 1] - d.x[k - 1]) < 0.1 * off)
+      throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
+                      fmt(": position %.6g m at t = %.6g s is an outlier (%.4g m off its neighbours): is the position "
+                          "column in metres and free of outliers?",
+                          d.x[k], d.t[k] + d.time_offset, off));
   }
+  // the step of the jump is the larger of the two around sample `jump`
+  const std::size_t k = std::abs(d.x[jump + 1] - d.x[jump]) > std::abs(d.x[jump] - d.x[jump - 1]) ? jump + 1 : jump;
+  // the step less the motion around it (the mean of the neighbouring steps)
+  const double before = k >= 2 ? d.x[k - 1] - d.x[k - 2] : 0.0, after = k + 1 < n ? d.x[k + 1] - d.x[k] : 0.0;
+  const double size = d.x[k] - d.x[k - 1] - 0.5 * (before + after);
+  throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
+                  fmt(": the position jumps by %.4g mm in one sample (t = %.9g s), an acceleration beyond 20x what "
+                      "the peak thrust of %.4g N gives the %.4g kg mass",
+                      size * 1e3, d.t[k] + d.time_offset, peak, mass) +
+                  ": two recordings joined, or an encoder glitch? The fit needs one continuous recording: split the "
+                  "file there and fit each part");
+}
+
+// 4. discontinuities in position: an acceleration no thrust of this drive gives, and beyond the
+// sensor's own second difference (find_jump); the sensor's quantum is the record's own resolution
+// when the scenario gives none.
+void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model) {
+  const double mass = plant::effective_params(model).mass;
+  const double gain = d.input_kind == InputKind::kCommand ? model.thrust_gain() : 1.0;
+  double peak = 0.0;
+  for (double u : d.input) peak = std::max(peak, std::abs(gain * u));
+  double q = model.sensor.quantization;
+  if (q == 0.0) q = smallest_position_step(d);
+  const double sensor = q + 3.0 * model.sensor.noise_stddev;
+  const std::size_t jump = find_jump(d, peak, mass, sensor);
+  if (jump > 0) throw_jump(d, jump, peak, mass);
+}
+
+}  // namespace
+
+void check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period) {
+  if (d.size() < 3) return;
+  const double T = d.median_period();
+  check_time_steps(d, T);
+  check_time_scale(d, T, control_period);
+  check_position_scale(d);
+  check_position_jumps(d, model);
 }
 
 void check_force_scale(const Record& rec, const plant::PlantParams& model) {

@@ -11,18 +11,18 @@
 namespace feeddrive::fit {
 using text::fmt;
 using text::par;
-NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt) {
-  const MeasuredData& d = *rec.data;
+namespace {
+
+// The sensor's part of the floor (header): q and sigma_n from plant.sensor, or without one q the
+// record's smallest position step and sigma_n = 0; sigma_x = sqrt(sigma_n^2 + q^2/12); the source line.
+NoiseFloor sensor_floor(const MeasuredData& d, const plant::PlantParams& model, double stamp_error) {
   NoiseFloor f;
   f.quantization = model.sensor.quantization;
   f.noise = model.sensor.noise_stddev;
-  f.stamp_error = opt.stamp_error;
+  f.stamp_error = stamp_error;
   if (model.sensor.ideal()) {
     f.from_scenario = false;
-    double q = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 1; k < d.size(); ++k)
-      if (d.x[k] != d.x[k - 1]) q = std::min(q, std::abs(d.x[k] - d.x[k - 1]));
-    f.quantization = std::isfinite(q) ? q : 0.0;
+    f.quantization = smallest_position_step(d);
     f.source =
         fmt("the scenario gives no sensor (plant.sensor): q = %.3g nm is the record's smallest position step, "
             "noise unknown (taken as 0): give plant.sensor for a floor you can trust",
@@ -33,110 +33,148 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
   f.source += f.stamp_error > 0 ? fmt("; time stamps: %.3g us (1 sigma)", f.stamp_error * 1e6)
                                 : std::string("; time-stamp error not given (--time-stamp-error): taken as 0");
   f.position = std::sqrt(f.noise * f.noise + f.quantization * f.quantization / 12.0);
-  const auto& t = d.t;
-  const long n = static_cast<long>(t.size());
-  const double mass = plant::effective_params(model).mass;
-  const double st2 = f.stamp_error * f.stamp_error;
-  // per-sample position variance: the sensor's, plus v_k^2 sigma_t^2 of a stamp error (header)
-  std::vector<double> var_x(static_cast<std::size_t>(n), f.position * f.position);
-  // thrust jumps at the samples: dF_k = F_k - F_k-1 (the thrust held over [t_k, t_k+1))
-  std::vector<double> dF(static_cast<std::size_t>(n), 0.0);
-  if (st2 > 0) {
+  return f;
+}
+
+// What each sample carries (header): its position variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2,
+// and the thrust's jump dF_k = F_k - F_k-1 there (the thrust held over [t_k, t_k+1); 0 without a
+// stamp error); with the mass and sigma_t^2 that scale them.
+struct SampleErrors {
+  std::vector<double> var_x, dF;
+  double mass{0.0}, st2{0.0};
+};
+SampleErrors sample_errors(const Record& rec, const plant::PlantParams& model, const NoiseFloor& f) {
+  const long n = static_cast<long>(rec.data->t.size());
+  SampleErrors s;
+  s.mass = plant::effective_params(model).mass;
+  s.st2 = f.stamp_error * f.stamp_error;
+  s.var_x.assign(static_cast<std::size_t>(n), f.position * f.position);
+  s.dF.assign(static_cast<std::size_t>(n), 0.0);
+  if (s.st2 > 0) {
     const double gain = thrust_per_input(rec, model);
-    for (long k = 0; k < n; ++k) var_x[static_cast<std::size_t>(k)] += rec.motion.v[k] * rec.motion.v[k] * st2;
-    for (long k = 1; k + 1 < n; ++k) dF[static_cast<std::size_t>(k)] = gain * (rec.input[k] - rec.input[k - 1]);
+    for (long k = 0; k < n; ++k) s.var_x[static_cast<std::size_t>(k)] += rec.motion.v[k] * rec.motion.v[k] * s.st2;
+    for (long k = 1; k + 1 < n; ++k) s.dF[static_cast<std::size_t>(k)] = gain * (rec.input[k] - rec.input[k - 1]);
   }
-  // gap floor: over the replay's windows (replay.hpp), the expected mean square of
-  //   sensor noise and stamp error of each sample, plus the drift of a thrust switched dt_k early
-  //   or late: a ramp dF_k dt_k (t - t_k)/m after t_k, less its least-squares line (the window's
-  //   start correction), ||P ramp_k||^2 summed over the window's samples.
-  {
-    const double W = opt.replay_window > 0 ? opt.replay_window : std::max(0.1, 20.0 * rec.period);
-    double sum = 0.0;
-    long count = 0;
-    long s = 0;
-    std::vector<double> tau;
-    while (s + 1 < n) {
-      long e = s;
-      while (e + 1 < n && t[e + 1] - t[s] <= W + 1e-12) ++e;
-      if (e == s) e = s + 1;
-      for (long k = s + 1; k <= e; ++k) sum += var_x[static_cast<std::size_t>(k)];
-      count += e - s;
-      if (st2 > 0) {
-        tau.assign(static_cast<std::size_t>(e - s + 1), 0.0);
-        double S0 = 0, S1 = 0, S2 = 0;
-        for (long l = s; l <= e; ++l) {
-          const double x = t[l] - t[s];
-          tau[static_cast<std::size_t>(l - s)] = x;
-          S0 += 1;
-          S1 += x;
-          S2 += x * x;
-        }
-        const double det = S0 * S2 - S1 * S1;
-        for (long k = s + 1; k < e; ++k) {
-          const double g = dF[static_cast<std::size_t>(k)];
-          if (g == 0.0 || !(det > 0)) continue;
-          const double tk = t[k] - t[s];
-          double E0 = 0, E1 = 0;
-          for (const double x : tau) {
-            const double y = std::max(0.0, x - tk);
-            E0 += y;
-            E1 += y * x;
-          }
-          const double a = (S2 * E0 - S1 * E1) / det, b = (S0 * E1 - S1 * E0) / det;
-          double ss = 0.0;
-          for (std::size_t l = 1; l < tau.size(); ++l) {
-            const double y = std::max(0.0, tau[l] - tk) - a - b * tau[l];
-            ss += y * y;
-          }
-          sum += st2 * g * g / (mass * mass) * ss;
-        }
-      }
-      s = e;
+  return s;
+}
+
+// Adds to `sum`, for each thrust jump inside the replay window [s, e], the squared drift of a
+// thrust switched sigma_t early or late (header): sigma_t^2 (dF_k/m)^2 ||P ramp_k||^2, ramp_k =
+// max(0, t - t_k) over the window's samples, P the projection off its least-squares line span{1, t}.
+void add_stamp_drift(const std::vector<double>& t, long s, long e, const SampleErrors& se, double& sum) {
+  std::vector<double> tau(static_cast<std::size_t>(e - s + 1), 0.0);
+  double S0 = 0, S1 = 0, S2 = 0;
+  for (long l = s; l <= e; ++l) {
+    const double x = t[l] - t[s];
+    tau[static_cast<std::size_t>(l - s)] = x;
+    S0 += 1;
+    S1 += x;
+    S2 += x * x;
+  }
+  const double det = S0 * S2 - S1 * S1;
+  for (long k = s + 1; k < e; ++k) {
+    const double g = se.dF[static_cast<std::size_t>(k)];
+    if (g == 0.0 || !(det > 0)) continue;
+    const double tk = t[k] - t[s];
+    double E0 = 0, E1 = 0;
+    for (const double x : tau) {
+      const double y = std::max(0.0, x - tk);
+      E0 += y;
+      E1 += y * x;
     }
-    f.gap = count ? std::sqrt(sum / static_cast<double>(count)) : f.position;
+    const double a = (S2 * E0 - S1 * E1) / det, b = (S0 * E1 - S1 * E0) / det;
+    double ss = 0.0;
+    for (std::size_t l = 1; l < tau.size(); ++l) {
+      const double y = std::max(0.0, tau[l] - tk) - a - b * tau[l];
+      ss += y * y;
+    }
+    sum += se.st2 * g * g / (se.mass * se.mass) * ss;
   }
-  // force floor: sensor noise and stamp errors through the filtered acceleration, a thrust switched
-  // early or late through the filtered thrust, and the filter's discretisation (header)
+}
+
+// The gap floor (header): over the replay's windows of length W (replay.hpp), the RMS of each
+// sample's sensor noise and stamp error, plus the drift of a thrust switched early or late less
+// the window's start correction (add_stamp_drift); sigma_x for a record with no window.
+double gap_floor(const Record& rec, const SampleErrors& se, double replay_window, double position) {
+  const auto& t = rec.data->t;
+  const long n = static_cast<long>(t.size());
+  const double W = replay_window > 0 ? replay_window : std::max(0.1, 20.0 * rec.period);
+  double sum = 0.0;
+  long count = 0;
+  long s = 0;
+  while (s + 1 < n) {
+    long e = s;
+    while (e + 1 < n && t[e + 1] - t[s] <= W + 1e-12) ++e;
+    if (e == s) e = s + 1;
+    for (long k = s + 1; k <= e; ++k) sum += se.var_x[static_cast<std::size_t>(k)];
+    count += e - s;
+    if (se.st2 > 0) add_stamp_drift(t, s, e, se, sum);
+    s = e;
+  }
+  return count ? std::sqrt(sum / static_cast<double>(count)) : position;
+}
+
+// At filter point tau with half-width L (header): {noise, b} with noise = m^2 sum_k c_k^2 s_k^2
+// + sigma_t^2 sum_k (h(tau - t_k) dF_k)^2, the variance of the filtered force residual from the
+// sensor and the stamps, and b = sum_j a_j h''(tau - t_mid,j) dt_j^3 / 12, the filter's
+// discretisation (b_i = m b).
+std::pair<double, double> point_floor(const Record& rec, const SampleErrors& se, double tau, double L) {
+  const auto& t = rec.data->t;
+  const long n = static_cast<long>(t.size());
+  const double mass = se.mass;
+  long j0 = static_cast<long>(std::upper_bound(t.begin(), t.end(), tau - L) - t.begin()) - 1;
+  j0 = std::max(0L, j0);
+  long j1 = std::min(n - 1, static_cast<long>(std::lower_bound(t.begin(), t.end(), tau + L) - t.begin()));
+  std::vector<double> c(static_cast<std::size_t>(j1 - j0 + 1), 0.0);
+  for (long j = j0; j < j1; ++j) {
+    const double g = (kernel(tau - t[j], L) - kernel(tau - t[j + 1], L)) / (t[j + 1] - t[j]);
+    c[static_cast<std::size_t>(j + 1 - j0)] += g;
+    c[static_cast<std::size_t>(j - j0)] -= g;
+  }
+  double s = 0.0;
+  for (long k = j0; k <= j1; ++k) {
+    const double ck = c[static_cast<std::size_t>(k - j0)];
+    s += mass * mass * ck * ck * se.var_x[static_cast<std::size_t>(k)];
+    if (se.st2 > 0) {
+      const double h = kernel(tau - t[k], L) * se.dF[static_cast<std::size_t>(k)];
+      s += se.st2 * h * h;
+    }
+  }
+  double b = 0.0;
+  for (long j = j0; j < j1; ++j) {
+    const double dt = t[j + 1] - t[j], a_mid = 0.5 * (rec.motion.a[j] + rec.motion.a[j + 1]);
+    b += a_mid * kernel_dd(tau - 0.5 * (t[j] + t[j + 1]), L) * dt * dt * dt / 12.0;
+  }
+  return {s, b};
+}
+
+// The force floor (header): sensor noise and stamp errors through the filtered acceleration, a
+// thrust switched early or late through the filtered thrust, and the filter's discretisation, as
+// RMS over the active filter points into f.force_noise, f.force_discretisation and f.force.
+void force_floor(const Record& rec, const SampleErrors& se, NoiseFloor& f) {
   const double L = rec.bank.half_width;
   double noise_sum = 0.0, bias_sum = 0.0;
   long count = 0;
-  std::vector<double> c;
   for (std::size_t i = 0; i < rec.bank.tau.size(); ++i) {
     if (i < rec.masked.size() && rec.masked[i]) continue;
-    const double tau = rec.bank.tau[i];
-    long j0 = static_cast<long>(std::upper_bound(t.begin(), t.end(), tau - L) - t.begin()) - 1;
-    j0 = std::max(0L, j0);
-    long j1 = std::min(n - 1, static_cast<long>(std::lower_bound(t.begin(), t.end(), tau + L) - t.begin()));
-    c.assign(static_cast<std::size_t>(j1 - j0 + 1), 0.0);
-    for (long j = j0; j < j1; ++j) {
-      const double g = (kernel(tau - t[j], L) - kernel(tau - t[j + 1], L)) / (t[j + 1] - t[j]);
-      c[static_cast<std::size_t>(j + 1 - j0)] += g;
-      c[static_cast<std::size_t>(j - j0)] -= g;
-    }
-    double s = 0.0;
-    for (long k = j0; k <= j1; ++k) {
-      const double ck = c[static_cast<std::size_t>(k - j0)];
-      s += mass * mass * ck * ck * var_x[static_cast<std::size_t>(k)];
-      if (st2 > 0) {
-        const double h = kernel(tau - t[k], L) * dF[static_cast<std::size_t>(k)];
-        s += st2 * h * h;
-      }
-    }
-    // the filter's own discretisation (header): b_i = m sum_j a_j h''(tau_i - t_mid,j) dt_j^3 / 12
-    double b = 0.0;
-    for (long j = j0; j < j1; ++j) {
-      const double dt = t[j + 1] - t[j], a_mid = 0.5 * (rec.motion.a[j] + rec.motion.a[j + 1]);
-      b += a_mid * kernel_dd(tau - 0.5 * (t[j] + t[j + 1]), L) * dt * dt * dt / 12.0;
-    }
+    const auto [s, b] = point_floor(rec, se, rec.bank.tau[i], L);
     noise_sum += s;
-    bias_sum += mass * mass * b * b;
+    bias_sum += se.mass * se.mass * b * b;
     ++count;
   }
   const double nc = std::max(1.0, static_cast<double>(count));
   f.force_noise = count ? std::sqrt(noise_sum / nc) : 0.0;
   f.force_discretisation = count ? std::sqrt(bias_sum / nc) : 0.0;
   f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
+}
+
+}  // namespace
+
+NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt) {
+  NoiseFloor f = sensor_floor(*rec.data, model, opt.stamp_error);
+  const SampleErrors se = sample_errors(rec, model, f);
+  f.gap = gap_floor(rec, se, opt.replay_window, f.position);
+  force_floor(rec, se, f);
   return f;
 }
 
@@ -156,7 +194,7 @@ const char* verdict_name(Verdict v) {
 std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason why) {
   const std::string& n = c.effect.name;
   const double longer = std::max(2.0 * env.duration, env.duration + 10.0);
-  if (n == "cogging_ripple" || n == "reluctance_ripple") {
+  if (is_ripple(n)) {
     const double p = par(c.effect, "pitch_m");
     if (p > 0 && p > env.max_pitch())
       return fmt(

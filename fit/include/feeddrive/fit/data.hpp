@@ -51,6 +51,10 @@ struct MeasuredData {
   double median_period() const;
 };
 
+/// The record's own position resolution: its smallest nonzero step between consecutive samples [m]
+/// (0 if the position never changes).
+double smallest_position_step(const MeasuredData& d);
+
 /// Fewest samples accepted.
 constexpr std::size_t kMinSamples = 50;
 

@@ -53,6 +53,10 @@ constexpr double kAsymmetryTolerance = 0.03;
 /// friction and of its Coulomb-type effects [N].
 double friction_level(const plant::PlantParams& model);
 
+/// A force periodic in position: cogging_ripple or reluctance_ripple (their pitch must be
+/// resolvable on the record: Envelope::min_pitch, max_pitch).
+inline bool is_ripple(const std::string& name) { return name == "cogging_ripple" || name == "reluctance_ripple"; }
+
 struct PlausibilityOptions {
   bool grinding_process{false};  ///< the scenario describes a grinding process (or the user asks for grinding_force)
 };

@@ -23,4 +23,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data = nullptr
 void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
                    bool plots, const interrupt::StopToken& stop = {});
 
+/// The tool's result table: the gap and force residual RMS of the model as given and after each
+/// addition, the conclusion, the tentative effects, the ties, the unexplained rest and where the
+/// results are (one item a line).
+std::string result_table(const FitResult& r, const std::string& out_dir);
+
 }  // namespace feeddrive::fit

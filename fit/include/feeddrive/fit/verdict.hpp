@@ -75,6 +75,8 @@ enum class Verdict { kExplained, kNoDiscrepancy, kUnexplained };
 const char* verdict_name(Verdict v);
 /// feeddrive-fit's exit code of an unexplained verdict (0: explained or no discrepancy; 2: bad input).
 constexpr int kExitUnexplained = 3;
+/// feeddrive-fit's exit code of a verdict: kExitUnexplained for an unexplained one, else 0.
+constexpr int exit_code(Verdict v) { return v == Verdict::kUnexplained ? kExitUnexplained : 0; }
 
 /// One concrete sentence: what record would settle whether `c` is in the drive, e.g. "a force
 /// periodic in position, pitch about 41 mm, seen over 2.0 periods: record a travel of at least 3
