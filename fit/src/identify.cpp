@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/fit/plausibility.hpp"
 #include "feeddrive/plant/effects.hpp"
 
 namespace feeddrive::fit {
@@ -729,7 +730,7 @@ std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, 
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = m.v[at(i)] * 1e3;
     return {"velocity [mm/s]", out};
   }
-  if (n == "cogging_ripple" || n == "reluctance_ripple") {
+  if (is_ripple(n)) {
     const double p = e.parameters.at("pitch_m");
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double q = std::fmod(m.x[at(i)], p);
