@@ -14,8 +14,10 @@
 // comes for --step-timeout (the run or the played-back log is over) it records what it can and
 // ends.
 
+#include <cmath>
 #include <map>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,6 +86,69 @@ class MonitorNode : public service::Node {
   /// Once a second: looks for stock loggers on the bus (service::stock_loggers_on) and measures
   /// the step rate of the last second (the peak is what a logger had to keep up with).
   void watch_rate_and_loggers(std::int64_t now);
+  // --- construction: what the monitor listens to ---
+  /// Subscribes to the run's state, reference and command channels (each through the conflict check).
+  void subscribe_run_channels();
+  /// A state of the run: admitted (service::Node::admit), what the plant applied, then recorded and timed.
+  void on_state(const drive_state_t& m, std::int64_t t);
+  /// A command of the run: its sender noted, admitted (a conflict keeps both commands and who
+  /// sent them, then rethrows), then recorded and timed.
+  void on_command(const control_command_t& m, std::int64_t t);
+  /// --lcm-log: opens the LCM log and taps the bus so that every message of the run goes to it.
+  void open_lcm_log(const service::NodeOptions& opt);
+  /// The run's self-description (run_info_t), published on heartbeats and on request; not when attached.
+  void serve_run_info(const service::NodeOptions& opt);
+  /// The bus events (foreign, unauthenticated, undecodable) and the peers' heartbeats, routed to their checks.
+  void watch_bus_events();
+
+  // --- the run ---
+  /// The recorder's completed rows go to the output; returns how many.
+  std::size_t flush_rows();
+  /// The steps the run is expected to have (the plant's end-of-run count once known, else the scenario's).
+  std::int64_t steps_expected() const;
+  /// Records until the run is complete; throws service::RunFailure when it cannot go on.
+  void record_until_end();
+  /// Heartbeat with the step recorded; the run's own monitor acknowledges it (the plant's flow control).
+  void heartbeat_progress();
+  /// No row for `limit`: waits for a role that still beats (it names the culprit), else throws
+  /// service::RunFailure naming the silent roles and what they did not send.
+  void check_step_timeout(std::int64_t now, double limit);
+  /// After a failure: waits briefly for the state that settles a command conflict, then records
+  /// what is still queued on the socket; returns `failure` with the applied command appended.
+  std::string record_after_failure(std::string failure);
+  /// Closes the LCM log after the run; returns `failure`, or the log's write error when there was none.
+  std::string close_lcm_log(std::string failure);
+
+  // --- the end ---
+  /// What every process of the run counted (the monitor's own counts plus the peers' heartbeats).
+  struct BusCounts {
+    std::int64_t resends{0}, duplicates{0}, invalid{0}, foreign{0}, conflicts{0}, unauthenticated{0};
+  };
+  BusCounts bus_counts();
+  /// The latency histograms recorded (period_start_lateness only in real time) and their names.
+  struct LatencyHistograms {
+    std::vector<std::string> names;
+    std::vector<Histogram> h;
+  };
+  LatencyHistograms latency_histograms() const;
+  /// Fills summary_ (run_summary_t, published at the end) from the run's summary and counts.
+  void fill_summary(bool completed, const std::string& failure, const sim::Summary& sum, double wall_time_s,
+                    const BusCounts& c);
+  /// summary.json's "lockstep" object: the counts, the conflict, the rates and the latencies.
+  nlohmann::ordered_json lockstep_json(bool completed, const std::string& failure, const sim::Summary& sum,
+                                       double wall_time_s, const BusCounts& c, const LatencyHistograms& hists);
+  /// The bytes of one step on the wire (state, command, a 16th of a reference block; with the mac if keyed).
+  int bytes_per_step();
+  /// "stock_loggers": the stock loggers seen and whether the steps went out faster than they record
+  /// (warned about then).
+  nlohmann::ordered_json stock_loggers_json(const sim::Summary& sum, double wall_time_s) const;
+  /// "latency_us", "reference_lead_us" and "latency_histogram_us" into `l` (NaN quantiles as null).
+  void add_latency_json(nlohmann::ordered_json& l, const LatencyHistograms& hists);
+  /// Writes the output folder; on failure says why, returns false and marks the run not completed
+  /// (`completed`, `why`, summary_). `where` becomes the folder the record went to.
+  /// `write_error`: the writer could not write the rows (then nothing more is tried).
+  bool write_results(const sim::Summary& sum, const std::string& write_error, const std::string& lockstep,
+                     const LatencyHistograms& hists, bool& completed, std::string& why, std::string& where);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
   /// latency_histogram.csv (and .png when `plot`; a gnuplot failure is a warning) into the
@@ -130,7 +195,11 @@ class MonitorNode : public service::Node {
     SentCommand first, second;
     bool applied_known{false};
     double applied_u{0.0};
+    /// Whether the plant applied the first command (the nearer one: the plant may clip it).
+    bool applied_first() const { return std::abs(applied_u - first.u) <= std::abs(applied_u - second.u); }
   };
+  /// "command_conflict": the step, both commands and their senders, and the one the plant applied.
+  static nlohmann::ordered_json command_conflict_json(const CommandConflict& c);
   std::optional<CommandConflict> command_conflict_;
   /// What the plant applied over each recent step (its next state's `previous`), a ring by step:
   /// the state can come before the second command of a conflict does.
