@@ -262,24 +262,17 @@ std::string Generated::csv() const {
   return out;
 }
 
-Generated generate(const CaseSpec& spec) {
-  for (const auto& h : spec.hidden)
-    if (std::find(vocabulary().begin(), vocabulary().end(), h) == vocabulary().end())
-      throw std::invalid_argument("drivegen: unknown effect '" + h + "'");
-  const auto hidden = [&](const char* n) {
-    return std::find(spec.hidden.begin(), spec.hidden.end(), n) != spec.hidden.end();
-  };
-  Rng r{std::mt19937_64(spec.seed * 0x9E3779B97F4A7C15ULL + 12345)};
-  Generated out;
-  Truth T;
-  const double m_nom = r.u(40.0, 120.0);
-  T.m = m_nom;
-  // position-dependent effects need travel: at least three ripple pitches, a contact passed often
-  const bool positional =
-      hidden("cogging_ripple") || hidden("reluctance_ripple") || hidden("spring_force") || hidden("grinding_force");
-  double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
-  const double Ts = 1.0 / spec.sample_rate;
-  T.base_static = hidden("presliding") || r.coin(0.5);
+namespace {
+
+// Whether `name` is one of the spec's hidden effects.
+bool has_hidden(const CaseSpec& spec, const char* name) {
+  return std::find(spec.hidden.begin(), spec.hidden.end(), name) != spec.hidden.end();
+}
+
+// The known drive: base friction (static, with probability 1/2, always under presliding) and,
+// with form_deviation, the friction forms that differ from the model's. Three draws either way.
+void draw_base_friction(const CaseSpec& spec, Rng& r, Truth& T) {
+  T.base_static = has_hidden(spec, "presliding") || r.coin(0.5);
   if (T.base_static) {
     T.Fc = r.u(10, 30), T.Fs = T.Fc * r.u(1.1, 1.5), T.vs = r.u(1e-3, 5e-3), T.s2 = r.u(20, 150);
   }
@@ -288,154 +281,194 @@ Generated generate(const CaseSpec& spec) {
   } else {
     r.u(0, 1), r.u(0, 1), r.u(0, 1);  // the same draws follow either way
   }
-  const bool grinding = spec.grinding_process || hidden("grinding_force");
-  const double v_typ = 0.05;  // m/s, a typical move speed of the reference below
-  // hidden effects, in the vocabulary's parametrisation
+}
+
+// The hidden effects of the spec, drawn in the vocabulary's order into T, each also into `truth`
+// in the vocabulary's parametrisation. `m_nom`: the nominal mass, `travel`: the reference's.
+void draw_hidden(const CaseSpec& spec, Rng& r, double m_nom, double travel, Truth& T, std::vector<Effect>& truth) {
+  const auto hidden = [&](const char* n) { return has_hidden(spec, n); };
+  const double v_typ = 0.05;  // m/s, a typical move speed of the reference
   if (hidden("constant_force")) {
     T.F0 = r.sign() * r.u(3, 20);
-    out.truth.push_back({"constant_force", {{"force_N", T.F0}}});
+    truth.push_back({"constant_force", {{"force_N", T.F0}}});
   }
   if (hidden("coulomb_friction")) {
     T.hc = r.u(5, 30);
-    out.truth.push_back({"coulomb_friction", {{"coulomb_N", T.hc}}});
+    truth.push_back({"coulomb_friction", {{"coulomb_N", T.hc}}});
   }
   if (hidden("viscous_friction")) {
     T.hv = r.u(50, 300);
-    out.truth.push_back({"viscous_friction", {{"viscous_Ns_per_m", T.hv}}});
+    truth.push_back({"viscous_friction", {{"viscous_Ns_per_m", T.hv}}});
   }
   if (hidden("stribeck_friction")) {
     T.strib = true;
     T.sFc = r.u(5, 20), T.sFs = T.sFc + r.u(5, 20), T.svs = r.u(1e-3, 10e-3);
-    out.truth.push_back(
+    truth.push_back(
         {"stribeck_friction", {{"static_N", T.sFs}, {"coulomb_N", T.sFc}, {"stribeck_velocity_mps", T.svs}}});
   }
   if (hidden("presliding")) {
     T.pres = true;
     T.sig0 = std::exp(r.u(std::log(1e5), std::log(1e7)));
     T.sig1 = 2 * r.u(0.05, 0.5) * std::sqrt(T.sig0 * T.m);
-    out.truth.push_back({"presliding", {{"bristle_stiffness_N_per_m", T.sig0}, {"bristle_damping_Ns_per_m", T.sig1}}});
+    truth.push_back({"presliding", {{"bristle_stiffness_N_per_m", T.sig0}, {"bristle_damping_Ns_per_m", T.sig1}}});
   }
   if (hidden("cogging_ripple")) {
     T.cp = r.u(0.01, std::min(0.04, travel / 3)), T.ca = r.u(2, 10), T.cphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.cp = travel / spec.ripple_periods;
     T.cb = T.ca * r.u(0, 0.4), T.cphi3 = r.u(-kPi, kPi);
-    out.truth.push_back({"cogging_ripple",
-                         {{"pitch_m", T.cp},
-                          {"amplitude_N", T.ca},
-                          {"phase_rad", T.cphi},
-                          {"third_harmonic_N", T.cb},
-                          {"third_phase_rad", T.cphi3}}});
+    truth.push_back({"cogging_ripple",
+                     {{"pitch_m", T.cp},
+                      {"amplitude_N", T.ca},
+                      {"phase_rad", T.cphi},
+                      {"third_harmonic_N", T.cb},
+                      {"third_phase_rad", T.cphi3}}});
   }
   if (hidden("reluctance_ripple")) {
     T.rp = r.u(0.01, std::min(0.04, travel / 3)), T.rA = r.u(0.03, 0.08), T.rphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.rp = travel / spec.ripple_periods;
-    out.truth.push_back(
-        {"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
+    truth.push_back({"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
   }
   if (hidden("grinding_force")) {
     T.grind = true;
     T.xc = r.u(0.2, 0.8) * travel;
     T.C = r.u(20, 100) / v_typ;
     T.ke = T.C / r.u(2e-3, 50e-3);
-    out.truth.push_back(
+    truth.push_back(
         {"grinding_force", {{"gain_Ns_per_m", T.C}, {"stiffness_N_per_m", T.ke}, {"contact_position_m", T.xc}}});
   }
   if (hidden("spring_force")) {
     T.k = r.u(200, 2000), T.xr = r.u(0.0, 1.0) * travel;
-    out.truth.push_back({"spring_force", {{"stiffness_N_per_m", T.k}, {"rest_position_m", T.xr}}});
+    truth.push_back({"spring_force", {{"stiffness_N_per_m", T.k}, {"rest_position_m", T.xr}}});
   }
   if (hidden("mass_error")) {
     T.m = m_nom * (1.0 + r.sign() * r.u(0.1, 0.3));
-    out.truth.push_back({"mass_error", {{"mass_kg", T.m}}});
+    truth.push_back({"mass_error", {{"mass_kg", T.m}}});
   }
   if (hidden("input_delay")) {
     T.delay = r.u(0.5e-3, 3e-3);
-    out.truth.push_back({"input_delay", {{"delay_s", T.delay}}});
+    truth.push_back({"input_delay", {{"delay_s", T.delay}}});
   }
-  // controller and sensor
-  const bool pid = r.coin(0.5);
-  const bool ff = r.coin(0.5);
-  const int cmd_delay = r.coin(0.3) ? 1 : 0;
+}
+
+constexpr double kForceMax = 1500.0;  // [N] the controller's saturation
+
+// The controller and sensor drawn for a record, and the controller's state.
+struct Loop {
+  bool pid{false}, ff{false};
+  int cmd_delay{0};  // samples of computation delay (0 or 1)
+  double bw{0.0};    // [Hz] bandwidth
+  double w{0.0}, wv{0.0}, wp{0.0}, tf{0.0};
+  double q{0.0}, noise{0.0}, jitter{0.0};  // [m] quantization, [m] noise, [s] sample jitter
+  double m_nom{0.0};
+  // state
+  double integ{0.0}, e_prev{0.0}, d_filt{0.0}, x_prev{0.0}, v_filt{0.0};
+  double pending{0.0};  // computed, waiting one sample
+};
+
+// Draws the controller (PID or cascade, feed-forward, delay, bandwidth) and the sensor.
+Loop draw_loop(const CaseSpec& spec, Rng& r, double m_nom, double Ts) {
+  Loop L;
+  L.m_nom = m_nom;
+  L.pid = r.coin(0.5);
+  L.ff = r.coin(0.5);
+  L.cmd_delay = r.coin(0.3) ? 1 : 0;
   // Bandwidths a 1 kHz loop with a differenced velocity holds without a limit cycle: the PID's
   // triple pole at 15-40 Hz; the cascade's velocity loop at 30-60 Hz (with the one-sample
   // delay: 0.4 and 0.6 of these), its position loop at a quarter of that.
-  double bw = (pid ? r.u(15, 40) : r.u(30, 60) / 4.0) * (cmd_delay ? (pid ? 0.4 : 0.6) : 1.0);
-  if (spec.bandwidth_hz > 0) bw = spec.bandwidth_hz;
-  const double w = 2 * kPi * bw;
-  const double wv = 4 * w, wp = w;
-  const double q = r.u(50e-9, 200e-9), noise = r.u(0.0, 20e-9);
-  const double jitter = 0.02 * Ts;
-  const Reference ref =
-      spec.one_direction ? make_forward_reference(r, spec.duration, travel) : make_reference(r, spec.duration, travel);
-  // closed loop
-  const long N = static_cast<long>(std::lround(spec.duration * spec.sample_rate)) + 1;
+  L.bw = (L.pid ? r.u(15, 40) : r.u(30, 60) / 4.0) * (L.cmd_delay ? (L.pid ? 0.4 : 0.6) : 1.0);
+  if (spec.bandwidth_hz > 0) L.bw = spec.bandwidth_hz;
+  L.w = 2 * kPi * L.bw;
+  L.wv = 4 * L.w, L.wp = L.w;
+  L.q = r.u(50e-9, 200e-9), L.noise = r.u(0.0, 20e-9);
+  L.jitter = 0.02 * Ts;
+  L.tf = 1.0 / (5.0 * L.w);  // derivative / velocity filter time constant
+  return L;
+}
+
+// The controller's thrust at a sample (k: its index, dt: since the previous one) for the
+// measured position xm and the reference xd, vd, ad, saturated at +-kForceMax with anti-windup.
+// PID: triple pole at -w: Kp = 3 m w^2, Ki = m w^3, Kd = 3 m w. Cascade: PI velocity loop at wv
+// (integral corner wv/4) around a P position loop at wv/4.
+double control(Loop& L, long k, double dt, double xm, double xd, double vd, double ad) {
+  const double e = xd - xm;
+  double F;
+  if (L.pid) {
+    const double de = k > 0 ? (e - L.e_prev) / dt : 0.0;
+    L.d_filt += (de - L.d_filt) * dt / (L.tf + dt);
+    F = L.m_nom * (3 * L.w * L.w * e + 3 * L.w * L.d_filt + L.w * L.w * L.w * L.integ) + (L.ff ? L.m_nom * ad : 0.0);
+    const double Fs = std::clamp(F, -kForceMax, kForceMax);
+    if (Fs == F || (F > kForceMax) != (e > 0)) L.integ += e * dt;  // anti-windup: no integration into saturation
+    F = Fs;
+  } else {
+    const double vm = k > 0 ? (xm - L.x_prev) / dt : 0.0;
+    L.v_filt += (vm - L.v_filt) * dt / (L.tf + dt);
+    const double ev = L.wp * e + vd - L.v_filt;
+    F = L.m_nom * L.wv * (ev + 0.25 * L.wv * L.integ) + (L.ff ? L.m_nom * ad : 0.0);
+    const double Fs = std::clamp(F, -kForceMax, kForceMax);
+    if (Fs == F || (F > kForceMax) != (ev > 0)) L.integ += ev * dt;
+    F = Fs;
+  }
+  L.e_prev = e;
+  L.x_prev = xm;
+  if (!L.cmd_delay) return F;
+  const double act = L.pending;
+  L.pending = F;
+  return act;
+}
+
+// Integrates the drive from sample k to k+1: the thrust acting at t is the one applied at
+// t - delay, so the interval is cut where a delayed thrust switches.
+void integrate_sample(const Truth& T, double y[4], const std::vector<double>& t_true,
+                      const std::vector<double>& applied, long k) {
+  const double tk = t_true[k];
+  const double t1 = t_true[k + 1];
+  std::vector<double> cuts{tk};
+  for (long j = std::max(0L, k - 10); j <= k + 1; ++j) {
+    const double s = t_true[j] + T.delay;
+    if (T.delay > 0 && s > tk && s < t1) cuts.push_back(s);
+  }
+  cuts.push_back(t1);
+  std::sort(cuts.begin(), cuts.end());
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+    const double mid = 0.5 * (cuts[c] + cuts[c + 1]) - T.delay;
+    double Fa = 0.0;
+    if (mid >= 0.0) {
+      const long j = std::upper_bound(t_true.begin(), t_true.begin() + k + 1, mid) - t_true.begin() - 1;
+      Fa = applied[static_cast<std::size_t>(std::max(0L, j))];
+    }
+    advance(T, y, Fa, cuts[c], cuts[c + 1], 10);
+  }
+}
+
+// The closed loop over N samples at period Ts (jittered instants): each sample's stamp (with its
+// stamp error), quantized noisy position, applied thrust and reference go to `out`.
+void simulate(const Truth& T, Loop& L, const Reference& ref, Rng& r, long N, double Ts, Generated& out) {
   std::vector<double> t_true(static_cast<std::size_t>(N));
-  for (long k = 0; k < N; ++k) t_true[k] = k * Ts + (k > 0 && k + 1 < N ? r.u(-jitter, jitter) : 0.0);
+  for (long k = 0; k < N; ++k) t_true[k] = k * Ts + (k > 0 && k + 1 < N ? r.u(-L.jitter, L.jitter) : 0.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
   double y[4] = {0.0, 0.0, 0.0, 0.0};
-  double integ = 0.0, e_prev = 0.0, d_filt = 0.0, x_prev = 0.0, v_filt = 0.0;
-  double pending = 0.0;  // computed, waiting one sample
   std::vector<double> applied(static_cast<std::size_t>(N), 0.0);
-  const double F_max = 1500.0;
-  const double tf = 1.0 / (5.0 * w);  // derivative / velocity filter time constant
   for (long k = 0; k < N; ++k) {
     const double tk = t_true[k];
     const double dt = k > 0 ? tk - t_true[k - 1] : Ts;
     double xd, vd, ad;
     ref.at(tk, xd, vd, ad);
-    const double xm = q * std::round((y[0] + noise * gauss(r.g)) / q);
-    const double e = xd - xm;
-    double F;
-    if (pid) {  // triple pole at -w: Kp = 3 m w^2, Ki = m w^3, Kd = 3 m w
-      const double de = k > 0 ? (e - e_prev) / dt : 0.0;
-      d_filt += (de - d_filt) * dt / (tf + dt);
-      F = m_nom * (3 * w * w * e + 3 * w * d_filt + w * w * w * integ) + (ff ? m_nom * ad : 0.0);
-      const double Fs = std::clamp(F, -F_max, F_max);
-      if (Fs == F || (F > F_max) != (e > 0)) integ += e * dt;  // anti-windup: no integration into saturation
-      F = Fs;
-    } else {  // PI velocity loop at wv (integral corner wv/4) around a P position loop at wv/4
-      const double vm = k > 0 ? (xm - x_prev) / dt : 0.0;
-      v_filt += (vm - v_filt) * dt / (tf + dt);
-      const double ev = wp * e + vd - v_filt;
-      F = m_nom * wv * (ev + 0.25 * wv * integ) + (ff ? m_nom * ad : 0.0);
-      const double Fs = std::clamp(F, -F_max, F_max);
-      if (Fs == F || (F > F_max) != (ev > 0)) integ += ev * dt;
-      F = Fs;
-    }
-    e_prev = e;
-    x_prev = xm;
-    double act = F;
-    if (cmd_delay) {
-      act = pending;
-      pending = F;
-    }
+    const double xm = L.q * std::round((y[0] + L.noise * gauss(r.g)) / L.q);
+    const double act = control(L, k, dt, xm, xd, vd, ad);
     applied[k] = act;
     out.t.push_back(tk + (k > 0 && k + 1 < N ? r.u(-kStampError, kStampError) : 0.0));
     out.x.push_back(xm);
     out.force_N.push_back(act);
     out.xd.push_back(xd);
     if (k + 1 == N) break;
-    // integrate to the next sample: the thrust acting at t is the one applied at t - delay
-    const double t1 = t_true[k + 1];
-    std::vector<double> cuts{tk};
-    for (long j = std::max(0L, k - 10); j <= k + 1; ++j) {
-      const double s = t_true[j] + T.delay;
-      if (T.delay > 0 && s > tk && s < t1) cuts.push_back(s);
-    }
-    cuts.push_back(t1);
-    std::sort(cuts.begin(), cuts.end());
-    for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
-      const double mid = 0.5 * (cuts[c] + cuts[c + 1]) - T.delay;
-      double Fa = 0.0;
-      if (mid >= 0.0) {
-        const long j = std::upper_bound(t_true.begin(), t_true.begin() + k + 1, mid) - t_true.begin() - 1;
-        Fa = applied[static_cast<std::size_t>(std::max(0L, j))];
-      }
-      advance(T, y, Fa, cuts[c], cuts[c + 1], 10);
-    }
+    integrate_sample(T, y, t_true, applied, k);
     if (!std::isfinite(y[0]) || !std::isfinite(y[1])) throw std::runtime_error("drivegen: the simulation diverged");
   }
-  // the model the fit starts from
+}
+
+// The model the fit starts from: the known drive (nominal mass, base friction, the encoder),
+// no hidden effect.
+std::string scenario_yaml(const CaseSpec& spec, double Ts, double m_nom, const Truth& T, const Loop& L, bool grinding) {
   std::ostringstream yaml;
   yaml << "name: drivegen_" << spec.seed << "\nduration: " << num(spec.duration) << "\ncontrol_period: " << num(Ts)
        << "\nplant:\n  mass: " << num(m_nom) << "\n";
@@ -445,21 +478,26 @@ Generated generate(const CaseSpec& spec) {
   else yaml << "  friction: {model: none}\n";
   if (grinding) yaml << "  grinding: {enabled: false}\n";
   // the encoder is known to its engineer: the fit's noise floor comes from it
-  yaml << "  sensor: {quantization: " << num(q) << ", noise_stddev: " << num(noise) << "}\n";
+  yaml << "  sensor: {quantization: " << num(L.q) << ", noise_stddev: " << num(L.noise) << "}\n";
   yaml << "controller: {type: cascade}\nreference: {type: step}\n";
-  out.scenario_yaml = yaml.str();
+  return yaml.str();
+}
+
+// Everything else that was drawn (Generated::knobs) and the one-line description.
+void describe(const CaseSpec& spec, double m_nom, double travel, const Truth& T, const Loop& L, Generated& out) {
+  const long N = static_cast<long>(out.force_N.size());
   long saturated = 0;
-  for (double f : out.force_N) saturated += std::abs(f) >= F_max ? 1 : 0;
+  for (double f : out.force_N) saturated += std::abs(f) >= kForceMax ? 1 : 0;
   out.knobs = {{"saturated_fraction", static_cast<double>(saturated) / static_cast<double>(N)},
                {"mass_nominal_kg", m_nom},
                {"travel_m", travel},
-               {"controller", pid ? 0.0 : 1.0},
-               {"bandwidth_hz", bw},
-               {"feedforward", ff ? 1.0 : 0.0},
-               {"command_delay_samples", cmd_delay},
-               {"quantization_m", q},
-               {"noise_m", noise},
-               {"jitter_s", jitter},
+               {"controller", L.pid ? 0.0 : 1.0},
+               {"bandwidth_hz", L.bw},
+               {"feedforward", L.ff ? 1.0 : 0.0},
+               {"command_delay_samples", L.cmd_delay},
+               {"quantization_m", L.q},
+               {"noise_m", L.noise},
+               {"jitter_s", L.jitter},
                {"stamp_error_s", kStampError / std::sqrt(3.0)},
                {"coulomb_transition_mps", T.vt},
                {"asymmetry", T.asym},
@@ -469,11 +507,38 @@ Generated generate(const CaseSpec& spec) {
   std::snprintf(b, sizeof b,
                 "%s: m=%.1f kg %s %.0f Hz%s%s, q=%.0f nm, travel %.0f mm%s, %s friction, vt=%.0f um/s, asym %.3f, %.1f "
                 "%% saturated",
-                spec.category.c_str(), m_nom, pid ? "PID" : "cascade", bw, ff ? " +ff" : "",
-                cmd_delay ? " +1-sample delay" : "", q * 1e9, travel * 1e3, spec.one_direction ? " one direction" : "",
-                T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
+                spec.category.c_str(), m_nom, L.pid ? "PID" : "cascade", L.bw, L.ff ? " +ff" : "",
+                L.cmd_delay ? " +1-sample delay" : "", L.q * 1e9, travel * 1e3,
+                spec.one_direction ? " one direction" : "", T.base_static ? "static" : "no", T.vt * 1e6, T.asym,
                 100.0 * static_cast<double>(saturated) / static_cast<double>(N));
   out.description = b;
+}
+
+}  // namespace
+
+Generated generate(const CaseSpec& spec) {
+  for (const auto& h : spec.hidden)
+    if (std::find(vocabulary().begin(), vocabulary().end(), h) == vocabulary().end())
+      throw std::invalid_argument("drivegen: unknown effect '" + h + "'");
+  Rng r{std::mt19937_64(spec.seed * 0x9E3779B97F4A7C15ULL + 12345)};
+  Generated out;
+  Truth T;
+  const double m_nom = r.u(40.0, 120.0);
+  T.m = m_nom;
+  // position-dependent effects need travel: at least three ripple pitches, a contact passed often
+  const bool positional = has_hidden(spec, "cogging_ripple") || has_hidden(spec, "reluctance_ripple") ||
+                          has_hidden(spec, "spring_force") || has_hidden(spec, "grinding_force");
+  const double travel = positional ? r.u(0.06, 0.15) : r.u(0.02, 0.15);
+  const double Ts = 1.0 / spec.sample_rate;
+  draw_base_friction(spec, r, T);
+  draw_hidden(spec, r, m_nom, travel, T, out.truth);
+  Loop L = draw_loop(spec, r, m_nom, Ts);
+  const Reference ref =
+      spec.one_direction ? make_forward_reference(r, spec.duration, travel) : make_reference(r, spec.duration, travel);
+  const long N = static_cast<long>(std::lround(spec.duration * spec.sample_rate)) + 1;
+  simulate(T, L, ref, r, N, Ts, out);
+  out.scenario_yaml = scenario_yaml(spec, Ts, m_nom, T, L, spec.grinding_process || has_hidden(spec, "grinding_force"));
+  describe(spec, m_nom, travel, T, L, out);
   return out;
 }
 

@@ -36,95 +36,116 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
       mopt_(mopt),
       rec_(mopt.attach),
       // Histograms: bins of T/20 up to 2T (5 us at 10 kHz).
-      hist_sc_(s.control_period * 1e6 / 20.0, 40),
-      hist_cs_(s.control_period * 1e6 / 20.0, 40),
-      hist_late_(s.control_period * 1e6 / 20.0, 40) {
+      timing_(s.control_period * 1e6 / 20.0) {
   if (mopt.attach) bus().join_first_seen();
+  subscribe_run_channels();
+  if (!mopt_.lcm_log.empty()) open_lcm_log(opt);
+  serve_run_info(opt);
+  watch_bus_events();
+  stop_ = opt.stop;
+  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_,
+                                          mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor", opt.stop);
+  out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
+}
+
+void MonitorNode::subscribe_run_channels() {
   // Every message passes the conflict check first: a second, different message for a step is
   // never recorded (service::Node::admit).
-  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) {
-    last_state_us_ = mono_us();
-    if (!admit(state_ledger_, channels().state, m.seq, m)) return;
-    last_admitted_us_["plant"] = last_state_us_;
-    if (m.previous.seq >= 0)
-      applied_[static_cast<std::uint64_t>(m.previous.seq) % applied_.size()] = {m.previous.seq, m.previous.u};
-    if (command_conflict_ && !command_conflict_->applied_known && m.previous.seq == command_conflict_->step) {
-      command_conflict_->applied_known = true;  // what the plant applied over the conflicted step
-      command_conflict_->applied_u = m.previous.u;
-    }
-    rec_.on_state(m, t);
-    on_state_timing(m, t);
-  });
+  bus().subscribe<drive_state_t>(channels().state, [this](const drive_state_t& m, std::int64_t t) { on_state(m, t); });
   bus().subscribe<reference_block_t>(channels().reference, [this](const reference_block_t& b, std::int64_t t) {
-    last_admitted_us_["trajectory"] = mono_us();
+    named_.last_admitted_us["trajectory"] = mono_us();
     for (const reference_t& m : b.refs)
-      if (admit(reference_ledger_, channels().reference, m.seq, m)) rec_.on_reference(m, t);
+      if (admit(ledgers_.reference, channels().reference, m.seq, m)) rec_.on_reference(m, t);
   });
-  bus().subscribe<control_command_t>(channels().command, [this](const control_command_t& m, std::int64_t t) {
-    SentCommand& first = first_commands_[static_cast<std::uint64_t>(m.seq) % first_commands_.size()];
-    const SentCommand sent{m.seq, m.u, bus().current_source()};
-    // The local process behind each command source, looked up when the source is first heard (a
-    // process that has exited by the time a conflict is judged can no longer be found): at most
-    // 16 sources, one /proc scan each.
-    if (!source_process_.count(sent.sender) && source_process_.size() < 16) {
-      const auto colon = sent.sender.rfind(':');
-      source_process_[sent.sender] =
-          colon == std::string::npos ? ""
-                                     : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
+  bus().subscribe<control_command_t>(channels().command,
+                                     [this](const control_command_t& m, std::int64_t t) { on_command(m, t); });
+}
+
+void MonitorNode::on_state(const drive_state_t& m, std::int64_t t) {
+  when_.last_state = mono_us();
+  if (!admit(ledgers_.state, channels().state, m.seq, m)) return;
+  named_.last_admitted_us["plant"] = when_.last_state;
+  if (m.previous.seq >= 0)
+    commands_.applied[static_cast<std::uint64_t>(m.previous.seq) % commands_.applied.size()] = {m.previous.seq,
+                                                                                                m.previous.u};
+  if (commands_.conflict && !commands_.conflict->applied_known && m.previous.seq == commands_.conflict->step) {
+    commands_.conflict->applied_known = true;  // what the plant applied over the conflicted step
+    commands_.conflict->applied_u = m.previous.u;
+  }
+  rec_.on_state(m, t);
+  on_state_timing(m, t);
+}
+
+void MonitorNode::on_command(const control_command_t& m, std::int64_t t) {
+  SentCommand& first = commands_.first[static_cast<std::uint64_t>(m.seq) % commands_.first.size()];
+  const SentCommand sent{m.seq, m.u, bus().current_source()};
+  // The local process behind each command source, looked up when the source is first heard (a
+  // process that has exited by the time a conflict is judged can no longer be found): at most
+  // 16 sources, one /proc scan each.
+  if (!commands_.source_process.count(sent.sender) && commands_.source_process.size() < 16) {
+    const auto colon = sent.sender.rfind(':');
+    commands_.source_process[sent.sender] =
+        colon == std::string::npos ? ""
+                                   : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
+  }
+  try {
+    if (!admit(ledgers_.command, channels().command, m.seq, m)) return;
+  } catch (const service::RunFailure&) {
+    // A forged command raced the controller's (or the reverse): keep both and who sent them;
+    // the step stays in the record (its state k+1 says what the plant applied).
+    if (!commands_.conflict && first.seq == m.seq) {
+      commands_.conflict = CommandConflict{m.seq, first, sent, false, 0.0};
+      const auto& a = commands_.applied[static_cast<std::uint64_t>(m.seq) % commands_.applied.size()];
+      if (a.first == m.seq) commands_.conflict->applied_known = true, commands_.conflict->applied_u = a.second;
+      for (SentCommand* c : {&commands_.conflict->first, &commands_.conflict->second}) {
+        // "IP:PORT" of its UDP source, and the local process that owns that port if any.
+        const auto known = commands_.source_process.find(c->sender);
+        if (known != commands_.source_process.end() && !known->second.empty()) c->sender += " " + known->second;
+      }
     }
+    throw;
+  }
+  if (first.seq != m.seq) first = sent;
+  named_.last_admitted_us["controller"] = mono_us();
+  rec_.on_command(m, t);
+  on_command_timing(m, t);
+}
+
+void MonitorNode::open_lcm_log(const service::NodeOptions& opt) {
+  if (!bus().batched())
+    throw std::invalid_argument("--lcm-log " + mopt_.lcm_log +
+                                ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
+                                opt.lcm_url);
+  output::check_outside(mopt_.lcm_log, "--lcm-log", mopt_.out_dir);
+  log_.writer = std::make_unique<record::LcmLogWriter>(mopt_.lcm_log);
+  const std::string run_channels = opt.prefix + "_";
+  bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
+    if (ch.compare(0, run_channels.size(), run_channels) != 0 || !log_.error.empty()) return;
     try {
-      if (!admit(command_ledger_, channels().command, m.seq, m)) return;
-    } catch (const service::RunFailure&) {
-      // A forged command raced the controller's (or the reverse): keep both and who sent them;
-      // the step stays in the record (its state k+1 says what the plant applied).
-      if (!command_conflict_ && first.seq == m.seq) {
-        command_conflict_ = CommandConflict{m.seq, first, sent, false, 0.0};
-        const auto& a = applied_[static_cast<std::uint64_t>(m.seq) % applied_.size()];
-        if (a.first == m.seq) command_conflict_->applied_known = true, command_conflict_->applied_u = a.second;
-        for (SentCommand* c : {&command_conflict_->first, &command_conflict_->second}) {
-          // "IP:PORT" of its UDP source, and the local process that owns that port if any.
-          const auto known = source_process_.find(c->sender);
-          if (known != source_process_.end() && !known->second.empty()) c->sender += " " + known->second;
-        }
-      }
-      throw;
+      log_.writer->write(ch, d, n, utime);
+    } catch (const std::exception& e) {
+      log_.error = e.what();
     }
-    if (first.seq != m.seq) first = sent;
-    last_admitted_us_["controller"] = mono_us();
-    rec_.on_command(m, t);
-    on_command_timing(m, t);
   });
-  if (!mopt_.lcm_log.empty()) {
-    if (!bus().batched())
-      throw std::invalid_argument("--lcm-log " + mopt_.lcm_log +
-                                  ": needs a udpm:// LCM URL (the monitor logs what its socket receives), not " +
-                                  opt.lcm_url);
-    output::check_outside(mopt_.lcm_log, "--lcm-log", mopt_.out_dir);
-    log_ = std::make_unique<record::LcmLogWriter>(mopt_.lcm_log);
-    const std::string run_channels = opt.prefix + "_";
-    bus().set_tap([this, run_channels](std::string_view ch, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
-      if (ch.compare(0, run_channels.size(), run_channels) != 0 || !log_error_.empty()) return;
-      try {
-        log_->write(ch, d, n, utime);
-      } catch (const std::exception& e) {
-        log_error_ = e.what();
-      }
-    });
-  }
-  // The run's self-description (run_info_t): the monitor is in every run (a hardware driver may
-  // take the plant's role, never the monitor's) and off the step's path. At the start, every
-  // second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
-  // monitor only listens.
-  if (!mopt_.attach) {
-    // The scenario's hash as the launcher read it (--scenario-hash), else of the file read here.
-    info_ = service::to_run_info(s_, opt, opt.scenario_hash);  // run_id: stamped by the bus
-    on_heartbeat = [this] {
-      if (heartbeats_++ % 10 == 0) publish_info();
-    };
-    on_resend_request = [this](const resend_request_t& r) {
-      if (r.channel == channels().info) publish_info();
-    };
-  }
+}
+
+// The run's self-description (run_info_t): the monitor is in every run (a hardware driver may
+// take the plant's role, never the monitor's) and off the step's path. At the start, every
+// second (10 heartbeats) until it exits, and on a resend request for the channel. An attached
+// monitor only listens.
+void MonitorNode::serve_run_info(const service::NodeOptions& opt) {
+  if (mopt_.attach) return;
+  // The scenario's hash as the launcher read it (--scenario-hash), else of the file read here.
+  info_ = service::to_run_info(s_, opt, opt.scenario_hash);  // run_id: stamped by the bus
+  on_heartbeat = [this] {
+    if (heartbeats_++ % 10 == 0) publish_info();
+  };
+  on_resend_request = [this](const resend_request_t& r) {
+    if (r.channel == channels().info) publish_info();
+  };
+}
+
+void MonitorNode::watch_bus_events() {
   service::BusEvents ev;
   ev.foreign = [this](const std::string& ch, std::int64_t id, const std::string& r) { on_foreign(ch, id, r); };
   ev.unauthenticated = [this](const std::string& ch, const std::uint8_t* d, std::size_t n) {
@@ -138,10 +159,6 @@ MonitorNode::MonitorNode(const sim::Scenario& s, const service::NodeOptions& opt
   on_peer_status_back = [this](const process_status_t& m) {  // "starting" after "running": a restart?
     if (m.role == "plant" && m.state != "failed") plant_went_back(m);
   };
-  stop_ = opt.stop;
-  out_ = std::make_unique<sim::RunWriter>(mopt_.out_dir, s_,
-                                          mopt_.attach ? "feeddrive-monitor --attach" : "feeddrive-monitor", opt.stop);
-  out_->keep_data_on_interrupt(true);  // what the monitor recorded cannot be made again
 }
 
 void MonitorNode::publish_info() {
@@ -158,9 +175,9 @@ void MonitorNode::fail_for(const std::string& role, const std::string& why, bool
   // a role nobody else fills: then the run could never go on.
   // Filled: its heartbeat within the last second, or its own valid messages (at the start of a
   // run an attacker's first messages can come before the role's first heartbeat reaches us).
-  const auto admitted = last_admitted_us_.find(role);
+  const auto admitted = named_.last_admitted_us.find(role);
   const bool filled =
-      peer_alive(role, 1.0) || (admitted != last_admitted_us_.end() && mono_us() - admitted->second < 1000000);
+      peer_alive(role, 1.0) || (admitted != named_.last_admitted_us.end() && mono_us() - admitted->second < 1000000);
   if (unless_role_alive && filled) return;
   if (service::is_run_role(role) && !mopt_.attach && failure_.empty()) failure_ = why;
 }
@@ -169,7 +186,7 @@ void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, co
   const std::string who_role = sender.empty() ? service::publisher_of(channels(), channel) : sender;
   // One line per sender (run id 0: per role, whatever the channel): the count is in the summary.
   const std::string key = run_id == 0 ? "run id 0 " + who_role : "foreign " + channel + " " + std::to_string(run_id);
-  if (named_[key]++ > 0) return;
+  if (named_.count[key]++ > 0) return;
   const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
   if (run_id == 0) {
     const std::string why = who + " publishes run id 0 on " + channel +
@@ -182,7 +199,7 @@ void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, co
   }
   // A plant of another run while this run's plant is silent: the drive restarted (it drew a new
   // run id). A restarted plant cannot rejoin (docs/external-plant.md, "Restarts").
-  if (who_role == "plant" && plant_seq_seen_ >= 0 && !peer_alive("plant", 0.3)) {
+  if (who_role == "plant" && named_.plant_seq_seen >= 0 && !peer_alive("plant", 0.3)) {
     const std::string why =
         "the plant restarted: a plant with a new run id " + std::to_string(run_id) + " appeared on " + channel +
         " after this run's plant (run id " + std::to_string(bus().run_id()) + ") went silent after state " +
@@ -205,9 +222,9 @@ void MonitorNode::on_unauthenticated(const std::string& channel, const std::uint
   std::string who_role = service::publisher_of(channels(), channel);
   if (channel == channels().status) who_role = service::heartbeat_role(d, n);
   const std::string key = "unauthenticated " + channel + " " + who_role + (unsigned_msg ? " unsigned" : " badmac");
-  const std::int64_t count = ++named_[key];
+  const std::int64_t count = ++named_.count[key];
   const std::int64_t now = mono_us();
-  const std::int64_t first = first_unauthenticated_us_.emplace(key, now).first->second;
+  const std::int64_t first = named_.first_unauthenticated_us.emplace(key, now).first->second;
   const std::string who = who_role.empty() ? "a participant" : "the " + who_role;
   const std::string why =
       who +
@@ -237,14 +254,14 @@ void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t*
                                  const std::string& why_invalid) {
   if (const auto older = service::older_contract(channels(), channel, d, n)) {
     const std::string key = "older " + channel + " " + older->role + " " + std::to_string(older->version);
-    if (named_[key]++ > 0) return;
+    if (named_.count[key]++ > 0) return;
     const std::string why = service::describe_older(*older, channel);
     spdlog::error("{}: {}", role(), why);
     fail_for(older->role, why);
     return;
   }
   const std::string key = "undecodable " + channel;
-  if (named_[key]++ == 0)
+  if (named_.count[key]++ == 0)
     spdlog::warn(
         "{}: dropped a message on {} that is not valid: {} ({} bytes; counted in invalid_messages, further "
         "ones on this channel silently)",
@@ -254,12 +271,12 @@ void MonitorNode::on_undecodable(const std::string& channel, const std::uint8_t*
 void MonitorNode::check_peer_status(const process_status_t& m) {
   if (m.contract_version != service::kContractVersion) {
     const std::string key = "version " + m.role + " " + std::to_string(m.contract_version);
-    if (named_[key]++ == 0 && m.contract_version == 0) {
+    if (named_.count[key]++ == 0 && m.contract_version == 0) {
       // Built from these types but never set: it decodes, so it may well work; named, not failed.
       spdlog::warn(
           "{}: the {} sends contract_version 0 in its heartbeat: set it to {} (docs/lcm-contract.md, Versions)", role(),
           m.role, service::kContractVersion);
-    } else if (named_[key] == 1) {
+    } else if (named_.count[key] == 1) {
       const std::string why = "the " + m.role + " speaks contract version " + std::to_string(m.contract_version) +
                               "; this run speaks " + std::to_string(service::kContractVersion) +
                               ": rebuild it with this feeddrive's lcmtypes/ (docs/lcm-contract.md, Versions)";
@@ -272,16 +289,16 @@ void MonitorNode::check_peer_status(const process_status_t& m) {
   // 100 steps in flight) is not the plant's: forged. It is not taken as the plant's progress,
   // so it cannot make the real heartbeats look as if they went back.
   if (plant_step_implausible(m.seq)) {
-    if (named_["implausible plant heartbeat"]++ == 0)
+    if (named_.count["implausible plant heartbeat"]++ == 0)
       spdlog::warn("{}: a heartbeat of the plant claims step {}, beyond every state recorded ({}): forged; ignored",
                    role(), m.seq, rec_.highest_state());
     return;
   }
-  if (plant_seq_seen_ > 1 && m.seq < plant_seq_seen_ - 1 && m.state != "failed") {
+  if (named_.plant_seq_seen > 1 && m.seq < named_.plant_seq_seen - 1 && m.state != "failed") {
     plant_went_back(m);
     return;
   }
-  plant_seq_seen_ = std::max(plant_seq_seen_, m.seq);
+  named_.plant_seq_seen = std::max(named_.plant_seq_seen, m.seq);
 }
 
 // A plant step beyond every state recorded by more than the flow-control window and 100 steps
@@ -300,25 +317,25 @@ bool MonitorNode::plant_step_implausible(std::int64_t seq) const {
 //   prevented). A record that joins two drives' motions must not pass as complete, so the run
 //   fails, and the line says both.
 void MonitorNode::plant_went_back(const process_status_t& m) {
-  if (plant_seq_seen_ < 0) return;  // no plant of this run heard yet: nothing to restart
+  if (named_.plant_seq_seen < 0) return;  // no plant of this run heard yet: nothing to restart
   // After the plant's own "done" or "failed" nothing restarts the run (and the Node ignored the
   // heartbeat); a step beyond every state recorded is forged (check_peer_status).
   if (const process_status_t* p = peer("plant"); p != nullptr && (p->state == "done" || p->state == "failed")) return;
   if (plant_step_implausible(m.seq)) return;
   if (!options().key_file.empty()) {
-    if (named_["plant heartbeat back"]++ == 0)
+    if (named_.count["plant heartbeat back"]++ == 0)
       spdlog::warn(
           "{}: a signed heartbeat of the plant went back (step {} '{}' after step {}): a replay of this run's "
           "own heartbeats (a restarted plant would have drawn a new nonce); ignored",
-          role(), m.seq, m.state, plant_seq_seen_);
+          role(), m.seq, m.state, named_.plant_seq_seen);
     return;
   }
   const std::string why =
-      "the plant restarted: its heartbeat went back from step " + std::to_string(plant_seq_seen_) + " to " +
+      "the plant restarted: its heartbeat went back from step " + std::to_string(named_.plant_seq_seen) + " to " +
       std::to_string(m.seq) + " (" + m.state +
       "); a restarted drive cannot rejoin a run: start a new run (docs/external-plant.md, Restarts). "
       "Without --key a forged heartbeat looks the same (docs/security.md)";
-  if (named_["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
+  if (named_.count["restart"]++ == 0) spdlog::error("{}: {}", role(), why);
   fail_for("plant", why, false);
 }
 
@@ -326,29 +343,29 @@ void MonitorNode::plant_went_back(const process_status_t& m) {
 // receive stamps of this socket): state k -> command k, command k -> state k+1, and (real time)
 // how late state k went out. Only the steps in flight are kept.
 void MonitorNode::on_state_timing(const drive_state_t& m, std::int64_t t) {
-  if (m.end_of_run || m.seq <= timing_pruned_ || state_recv_.count(m.seq)) return;
-  state_recv_[m.seq] = t;
+  if (m.end_of_run || m.seq <= timing_.pruned || timing_.state_recv.count(m.seq)) return;
+  timing_.state_recv[m.seq] = t;
   if (options().realtime && m.seq >= 1)
-    hist_late_.add(static_cast<double>(m.start_late_us));  // state 0: the start handshake
-  if (const auto c = cmd_recv_.find(m.seq - 1); c != cmd_recv_.end() && t >= c->second)
-    hist_cs_.add(static_cast<double>(t - c->second));
+    timing_.start_lateness.add(static_cast<double>(m.start_late_us));  // state 0: the start handshake
+  if (const auto c = timing_.command_recv.find(m.seq - 1); c != timing_.command_recv.end() && t >= c->second)
+    timing_.command_to_state.add(static_cast<double>(t - c->second));
   prune_timing(m.seq);
 }
 
 void MonitorNode::on_command_timing(const control_command_t& m, std::int64_t t) {
-  if (m.seq <= timing_pruned_ || cmd_recv_.count(m.seq)) return;
-  cmd_recv_[m.seq] = t;
-  if (const auto s = state_recv_.find(m.seq); s != state_recv_.end() && t >= s->second)
-    hist_sc_.add(static_cast<double>(t - s->second));
+  if (m.seq <= timing_.pruned || timing_.command_recv.count(m.seq)) return;
+  timing_.command_recv[m.seq] = t;
+  if (const auto s = timing_.state_recv.find(m.seq); s != timing_.state_recv.end() && t >= s->second)
+    timing_.state_to_command.add(static_cast<double>(t - s->second));
   prune_timing(m.seq);
 }
 
 void MonitorNode::prune_timing(std::int64_t seq) {
   constexpr std::int64_t kKeep = 4096;  // steps in flight: far more than a step's messages are apart
-  if (seq - timing_pruned_ < 2 * kKeep) return;
-  timing_pruned_ = seq - kKeep;
-  state_recv_.erase(state_recv_.begin(), state_recv_.upper_bound(timing_pruned_));
-  cmd_recv_.erase(cmd_recv_.begin(), cmd_recv_.upper_bound(timing_pruned_));
+  if (seq - timing_.pruned < 2 * kKeep) return;
+  timing_.pruned = seq - kKeep;
+  timing_.state_recv.erase(timing_.state_recv.begin(), timing_.state_recv.upper_bound(timing_.pruned));
+  timing_.command_recv.erase(timing_.command_recv.begin(), timing_.command_recv.upper_bound(timing_.pruned));
 }
 
 void MonitorNode::request_missing() {
@@ -356,16 +373,16 @@ void MonitorNode::request_missing() {
   const std::int64_t now = mono_us();
   // Something is missing if later steps are already flowing, or nothing came for a while.
   const bool behind = rec_.highest_state() > rec_.next() + 1;
-  const bool quiet = now - last_row_us_ > us(options().resend_interval_s) * 4;
+  const bool quiet = now - when_.last_row > us(options().resend_interval_s) * 4;
   if (!behind && !quiet) return;
-  if (now - last_request_us_ < us(options().resend_interval_s)) return;
-  last_request_us_ = now;
-  if (asking_seq_ != rec_.next()) {
-    asking_seq_ = rec_.next();
-    asking_since_us_ = now;
-    asking_requests_ = 0;
+  if (now - when_.last_request < us(options().resend_interval_s)) return;
+  when_.last_request = now;
+  if (asking_.seq != rec_.next()) {
+    asking_.seq = rec_.next();
+    asking_.since_us = now;
+    asking_.requests = 0;
   }
-  ++asking_requests_;
+  ++asking_.requests;
   // Only ask for what was sent already: the step after the newest state is not lost, it is not
   // there yet. A monitor far behind (an attached one whose socket overflowed) asks for up to
   // kPerRound messages of each kind a round, not one.
@@ -375,13 +392,13 @@ void MonitorNode::request_missing() {
                                  : m.what == "reference" ? channels().reference
                                                          : channels().command;
     request_resend(channel, m.seq);
-    ++lost_;
+    ++asking_.lost;
   }
 }
 
 bool MonitorNode::attached_stalled(std::int64_t now, double limit) {
   const auto sink = [this](const sim::Record& r) { out_->add(r); };
-  if (now - last_state_us_ > us(limit)) {
+  if (now - when_.last_state > us(limit)) {
     // Nothing for `limit`: the run (or the log played back) is over, or gone. Whatever can
     // still be completed is recorded, the rest is a gap.
     rec_.flush_final(sink);
@@ -392,140 +409,61 @@ bool MonitorNode::attached_stalled(std::int64_t now, double limit) {
     return true;
   }
   // States still come in: a step asked for this often and this long is not kept any more.
-  if (asking_seq_ == rec_.next() && asking_requests_ >= kLostAfterRequests &&
-      now - asking_since_us_ >= us(kLostAfter_s)) {
+  if (asking_.seq == rec_.next() && asking_.requests >= kLostAfterRequests &&
+      now - asking_.since_us >= us(kLostAfter_s)) {
     const std::size_t gaps = rec_.gaps().size();
-    if (rec_.skip_lost(sink) > 0 || rec_.gaps().size() != gaps) last_row_us_ = now;
+    if (rec_.skip_lost(sink) > 0 || rec_.gaps().size() != gaps) when_.last_row = now;
     if (rec_.gaps().size() != gaps && !options().quiet)
       spdlog::warn("{}: {} (not re-sent after {} requests)", role(), record::describe_gaps({rec_.gaps().back()}),
-                   asking_requests_);
+                   asking_.requests);
   }
   return rec_.complete();
 }
 
 void MonitorNode::progress(bool force) {
   const std::int64_t now = mono_us();
-  if (!force && now - last_progress_us_ < us(mopt_.progress_interval_s)) return;
-  last_progress_us_ = now;
+  if (!force && now - when_.last_progress < us(mopt_.progress_interval_s)) return;
+  when_.last_progress = now;
   if (options().quiet) return;
   const double sim_t = static_cast<double>(rec_.next()) * s_.control_period;
-  const double wall = static_cast<double>(now - start_us_) * 1e-6;
+  const double wall = static_cast<double>(now - when_.start) * 1e-6;
   const sim::Record& last = out_->last();
   const double err = out_->steps() == 0 ? 0.0 : (last.xd - (std::isnan(last.x) ? last.x_measured : last.x));
   std::fprintf(stderr, "\r[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um   ",
-               static_cast<long long>(rec_.next()),
-               static_cast<long long>(rec_.steps() < 0 ? s_.steps() : rec_.steps()), sim_t,
+               static_cast<long long>(rec_.next()), static_cast<long long>(steps_expected()), sim_t,
                wall > 0 ? sim_t / wall : 0.0, err * 1e6);
   if (force) std::fprintf(stderr, "\n");
 }
 
 void MonitorNode::watch_rate_and_loggers(std::int64_t now) {
-  if (rate_since_us_ >= 0 && now - rate_since_us_ < 1000000) return;
-  if (rate_since_us_ >= 0)
-    peak_rate_ = std::max(peak_rate_, static_cast<double>(rec_.next() - rate_since_step_) * 1e6 /
-                                          static_cast<double>(now - rate_since_us_));
-  rate_since_us_ = now;
-  rate_since_step_ = rec_.next();
+  if (rate_.since_us >= 0 && now - rate_.since_us < 1000000) return;
+  if (rate_.since_us >= 0)
+    rate_.peak = std::max(rate_.peak, static_cast<double>(rec_.next() - rate_.since_step) * 1e6 /
+                                          static_cast<double>(now - rate_.since_us));
+  rate_.since_us = now;
+  rate_.since_step = rec_.next();
   for (const service::StockLogger& l : service::stock_loggers_on(options().lcm_url)) {
     bool known = false;
-    for (const service::StockLogger& k : loggers_) known = known || k.pid == l.pid;
+    for (const service::StockLogger& k : rate_.loggers) known = known || k.pid == l.pid;
     if (known) continue;
-    loggers_.push_back(l);  // reported at the end with the peak rate (one line)
+    rate_.loggers.push_back(l);  // reported at the end with the peak rate (one line)
   }
 }
 
+std::size_t MonitorNode::flush_rows() {
+  return rec_.flush([this](const sim::Record& r) { out_->add(r); });
+}
+
+std::int64_t MonitorNode::steps_expected() const { return rec_.steps() < 0 ? s_.steps() : rec_.steps(); }
+
 bool MonitorNode::run() {
   set_state("running");
-  start_us_ = last_row_us_ = mono_us();
+  when_.start = when_.last_row = mono_us();
   std::string failure;
   try {
-    for (;;) {
-      // Off the critical path: the bus takes the messages in batches (Receive::kBatched), one
-      // wake-up per millisecond instead of one per message.
-      bus().poll(std::chrono::microseconds(1000));
-      const std::size_t added = rec_.flush([this](const sim::Record& r) { out_->add(r); });
-      const std::int64_t now = mono_us();
-      if (added > 0) last_row_us_ = now;
-      // Every second the rows so far go to the staged file: a SIGKILLed monitor loses at most
-      // the last second (the launcher moves the staged folder beside --out).
-      if (now - last_file_flush_us_ >= 1000000) {
-        out_->flush();
-        last_file_flush_us_ = now;
-      }
-      if (!mopt_.attach) {
-        acked_seq = rec_.next();
-        set_seq(rec_.next());
-        // Acknowledge often enough that the plant's window never closes.
-        const bool due = acked_seq - last_ack_sent_ >= std::max<long>(options().monitor_window / 4, 1);
-        heartbeat(due);
-        if (due) last_ack_sent_ = acked_seq;
-      } else {
-        set_seq(rec_.next());
-        heartbeat();  // "running": the publishers linger after the end while it still records
-      }
-      progress(false);
-      watch_rate_and_loggers(now);
-      if (!failure_.empty()) throw service::RunFailure(failure_);
-      if (!log_error_.empty()) throw service::RunFailure(log_error_);
-      if (rec_.complete()) break;
-      request_missing();
-      check_peers();
-      const double limit =
-          rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
-      if (mopt_.attach && rec_.highest_state() >= 0 && now - last_row_us_ > us(kLostAfter_s)) {
-        if (attached_stalled(now, limit)) break;
-        continue;
-      }
-      if (now - last_row_us_ > us(limit)) {
-        if (mopt_.attach && rec_.highest_state() < 0)
-          throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) +
-                                    " s");
-        // A role whose heartbeat still comes is waiting on another and runs its own timeout: it
-        // will name the culprit (check_peers above), as the trajectory and the controller do. So
-        // wait for it (at most three timeouts), then name only the roles that went silent.
-        const std::vector<record::Missing> missing = rec_.missing();
-        bool someone_waits = false;
-        for (const record::Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
-        if (someone_waits && now - last_row_us_ <= 3 * us(limit)) continue;
-        std::string silent, all;
-        for (const record::Missing& m : missing) {
-          const std::string what = m.what + " " + std::to_string(m.seq) + " from the " + m.role;
-          all += (all.empty() ? "" : ", ") + what;
-          if (!peer_alive(m.role, 0.5)) silent += (silent.empty() ? "" : ", ") + what;
-        }
-        const std::string& who = silent.empty() ? all : silent;
-        throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " +
-                                  service::seconds_text(limit) + " s: no " + who);
-      }
-    }
+    record_until_end();
   } catch (const service::RunFailure& e) {
-    failure = e.what();
-    // A command conflict: wait (at most 0.5 s) for the state that says which command the plant
-    // applied, so that the step is recorded and the summary can name it.
-    for (const std::int64_t until = mono_us() + 500000;
-         command_conflict_ && !command_conflict_->applied_known && mono_us() < until;) {
-      try {
-        bus().poll(std::chrono::microseconds(20000));
-      } catch (const std::exception&) {}
-    }
-    if (const std::string a = applied_command_text(); !a.empty()) failure += "; " + a;
-    // The record reaches the last step completed before the failure: the batch that failed was
-    // dispatched whole (Bus::poll rethrows after it), and what is still queued on the socket (a
-    // monitor behind the run when another role's failure arrives) is taken too, up to 100 batches.
-    for (int i = 0; i < 100; ++i) {
-      bool more = false;
-      try {
-        more = bus().poll(std::chrono::microseconds(0));
-      } catch (const std::exception&) {
-        more = true;  // another conflict or failure in this batch: it was dispatched all the same
-      }
-      try {
-        rec_.flush([this](const sim::Record& r) { out_->add(r); });
-      } catch (const std::exception&) {
-        break;
-      }
-      if (!more) break;
-    }
+    failure = record_after_failure(e.what());
   } catch (const interrupt::Interrupted& e) {
     // Ctrl-C: what was recorded is still written (completed: false), without plots, and a second
     // Ctrl-C stops that too; then the process exits as interrupted (128 + signal).
@@ -540,27 +478,126 @@ bool MonitorNode::run() {
     failure = e.what();
     too_big_ = true;
   }
-  if (log_) {
-    // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
-    // closed before the run is announced done.
-    bus().poll(std::chrono::microseconds(0));
-    bus().set_tap({});
-    try {
-      log_->close();
-      if (!options().quiet) spdlog::info("monitor: {} LCM events -> {}", log_->events(), log_->path());
-    } catch (const std::exception& e) {
-      if (log_error_.empty()) log_error_ = e.what();
-    }
-    if (!log_error_.empty() && failure.empty()) failure = log_error_;
-  }
+  if (log_.writer) failure = close_lcm_log(failure);
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.
   return finish(failure.empty(), failure) && failure.empty();
 }
 
+void MonitorNode::record_until_end() {
+  for (;;) {
+    // Off the critical path: the bus takes the messages in batches (Receive::kBatched), one
+    // wake-up per millisecond instead of one per message.
+    bus().poll(std::chrono::microseconds(1000));
+    const std::size_t added = flush_rows();
+    const std::int64_t now = mono_us();
+    if (added > 0) when_.last_row = now;
+    // Every second the rows so far go to the staged file: a SIGKILLed monitor loses at most
+    // the last second (the launcher moves the staged folder beside --out).
+    if (now - when_.last_file_flush >= 1000000) {
+      out_->flush();
+      when_.last_file_flush = now;
+    }
+    heartbeat_progress();
+    progress(false);
+    watch_rate_and_loggers(now);
+    if (!failure_.empty()) throw service::RunFailure(failure_);
+    if (!log_.error.empty()) throw service::RunFailure(log_.error);
+    if (rec_.complete()) return;
+    request_missing();
+    check_peers();
+    const double limit =
+        rec_.next() == 0 && rec_.highest_state() < 0 ? options().start_timeout_s : options().step_timeout_s;
+    if (mopt_.attach && rec_.highest_state() >= 0 && now - when_.last_row > us(kLostAfter_s)) {
+      if (attached_stalled(now, limit)) return;
+      continue;
+    }
+    if (now - when_.last_row > us(limit)) check_step_timeout(now, limit);
+  }
+}
+
+void MonitorNode::heartbeat_progress() {
+  set_seq(rec_.next());
+  if (mopt_.attach) {
+    heartbeat();  // "running": the publishers linger after the end while it still records
+    return;
+  }
+  acked_seq = rec_.next();
+  // Acknowledge often enough that the plant's window never closes.
+  const bool due = acked_seq - asking_.last_ack_sent >= std::max<long>(options().monitor_window / 4, 1);
+  heartbeat(due);
+  if (due) asking_.last_ack_sent = acked_seq;
+}
+
+void MonitorNode::check_step_timeout(std::int64_t now, double limit) {
+  if (mopt_.attach && rec_.highest_state() < 0)
+    throw service::RunFailure("no message on " + channels().state + " within " + service::seconds_text(limit) + " s");
+  // A role whose heartbeat still comes is waiting on another and runs its own timeout: it
+  // will name the culprit (check_peers), as the trajectory and the controller do. So wait for
+  // it (at most three timeouts), then name only the roles that went silent.
+  const std::vector<record::Missing> missing = rec_.missing();
+  bool someone_waits = false;
+  for (const record::Missing& m : missing) someone_waits = someone_waits || peer_alive(m.role, 0.5);
+  if (someone_waits && now - when_.last_row <= 3 * us(limit)) return;
+  std::string silent, all;
+  for (const record::Missing& m : missing) {
+    const std::string what = m.what + " " + std::to_string(m.seq) + " from the " + m.role;
+    all += (all.empty() ? "" : ", ") + what;
+    if (!peer_alive(m.role, 0.5)) silent += (silent.empty() ? "" : ", ") + what;
+  }
+  const std::string& who = silent.empty() ? all : silent;
+  throw service::RunFailure("step " + std::to_string(rec_.next()) + " incomplete for " + service::seconds_text(limit) +
+                            " s: no " + who);
+}
+
+std::string MonitorNode::record_after_failure(std::string failure) {
+  // A command conflict: wait (at most 0.5 s) for the state that says which command the plant
+  // applied, so that the step is recorded and the summary can name it.
+  for (const std::int64_t until = mono_us() + 500000;
+       commands_.conflict && !commands_.conflict->applied_known && mono_us() < until;) {
+    try {
+      bus().poll(std::chrono::microseconds(20000));
+    } catch (const std::exception&) {}
+  }
+  if (const std::string a = applied_command_text(); !a.empty()) failure += "; " + a;
+  // The record reaches the last step completed before the failure: the batch that failed was
+  // dispatched whole (Bus::poll rethrows after it), and what is still queued on the socket (a
+  // monitor behind the run when another role's failure arrives) is taken too, up to 100 batches.
+  for (int i = 0; i < 100; ++i) {
+    bool more = false;
+    try {
+      more = bus().poll(std::chrono::microseconds(0));
+    } catch (const std::exception&) {
+      more = true;  // another conflict or failure in this batch: it was dispatched all the same
+    }
+    try {
+      flush_rows();
+    } catch (const std::exception&) {
+      break;
+    }
+    if (!more) break;
+  }
+  return failure;
+}
+
+std::string MonitorNode::close_lcm_log(std::string failure) {
+  // Whatever else is still queued (the end-of-run state's repeats) goes in, then the file is
+  // closed before the run is announced done.
+  bus().poll(std::chrono::microseconds(0));
+  bus().set_tap({});
+  try {
+    log_.writer->close();
+    if (!options().quiet) spdlog::info("monitor: {} LCM events -> {}", log_.writer->events(), log_.writer->path());
+  } catch (const std::exception& e) {
+    if (log_.error.empty()) log_.error = e.what();
+  }
+  if (!log_.error.empty() && failure.empty()) failure = log_.error;
+  return failure;
+}
+
 std::string MonitorNode::applied_command_text() const {
-  if (!command_conflict_) return "";
-  const CommandConflict& c = *command_conflict_;
+  if (!commands_.conflict) return "";
+  const CommandConflict& c = *commands_.conflict;
   const auto from = [](const SentCommand& s) { return s.sender.empty() ? std::string("an unknown sender") : s.sender; };
   if (!c.applied_known)
     return "the plant's state after step " + std::to_string(c.step) +
@@ -568,7 +605,7 @@ std::string MonitorNode::applied_command_text() const {
            "applying either command, or that state was lost): u = " +
            service::seconds_text(c.first.u) + " V from " + from(c.first) +
            " or u = " + service::seconds_text(c.second.u) + " V from " + from(c.second);
-  const bool first = std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
+  const bool first = c.applied_first();
   const SentCommand& a = first ? c.first : c.second;
   const SentCommand& o = first ? c.second : c.first;
   return "the plant applied u = " + service::seconds_text(a.u) + " V from " + from(a) + " at step " +
@@ -576,32 +613,43 @@ std::string MonitorNode::applied_command_text() const {
          from(o) + "; the step is in the record)";
 }
 
-bool MonitorNode::finish(bool completed, const std::string& failure) {
-  const double wall_time_s = static_cast<double>(mono_us() - start_us_) * 1e-6;
-  sim::Summary sum;
-  std::string write_error;  // the writer thread could not write (disk full, ...)
-  try {
-    sum = out_->summary(wall_time_s, {});
-  } catch (const std::exception& e) {
-    write_error = e.what();
-  }
-
-  std::int64_t resends_total = resends, duplicates_total = duplicates + rec_.duplicates(),
-               invalid_total = bus().invalid();
+MonitorNode::BusCounts MonitorNode::bus_counts() {
+  BusCounts c;
+  c.resends = resends;
+  c.duplicates = duplicates + rec_.duplicates();
+  c.invalid = bus().invalid();
   // Foreign, conflicting and unauthenticated messages: the most any one process saw (each
   // process hears the same bus; the monitor hears every channel, the others fewer).
-  std::int64_t foreign = bus().foreign(), conflicts_seen = conflicts, unauthenticated = bus().unauthenticated();
+  c.foreign = bus().foreign();
+  c.conflicts = conflicts;
+  c.unauthenticated = bus().unauthenticated();
   for (const char* role : {"plant", "controller", "trajectory"}) {
     if (const process_status_t* p = peer(role)) {
-      resends_total += p->resends;
-      duplicates_total += p->duplicates;
-      invalid_total += p->invalid;
-      foreign = std::max(foreign, p->foreign);
-      conflicts_seen = std::max(conflicts_seen, p->conflicts);
-      unauthenticated = std::max(unauthenticated, p->unauthenticated);
+      c.resends += p->resends;
+      c.duplicates += p->duplicates;
+      c.invalid += p->invalid;
+      c.foreign = std::max(c.foreign, p->foreign);
+      c.conflicts = std::max(c.conflicts, p->conflicts);
+      c.unauthenticated = std::max(c.unauthenticated, p->unauthenticated);
     }
   }
-  const auto lat = [](const stats::StreamingQuantile& v, double q) { return v.quantile(q); };
+  return c;
+}
+
+// In real time a state_to_command beyond T - guard is a deadline miss, and
+// period_start_lateness is how late the plant sent each state after its period start, on its
+// own clock (drive_state_t.start_late_us: its timer wake-up and spin).
+MonitorNode::LatencyHistograms MonitorNode::latency_histograms() const {
+  LatencyHistograms l{{"state_to_command", "command_to_state"}, {timing_.state_to_command, timing_.command_to_state}};
+  if (options().realtime) {
+    l.names.push_back("period_start_lateness");
+    l.h.push_back(timing_.start_lateness);
+  }
+  return l;
+}
+
+void MonitorNode::fill_summary(bool completed, const std::string& failure, const sim::Summary& sum, double wall_time_s,
+                               const BusCounts& c) {
   summary_.scenario = wire::fit(s_.name, wire::Check<run_summary_t>::kMax_scenario);
   summary_.completed = completed;
   summary_.failure = wire::fit(failure, wire::Check<run_summary_t>::kMax_failure);
@@ -615,33 +663,38 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   summary_.control_min = sum.control_min;
   summary_.control_max = sum.control_max;
   summary_.control_total_variation = sum.control_total_variation;
-  summary_.resends = resends_total;
-  summary_.lost = lost_;
-  summary_.duplicates = duplicates_total;
-  summary_.invalid = invalid_total;
+  summary_.resends = c.resends;
+  summary_.lost = asking_.lost;
+  summary_.duplicates = c.duplicates;
+  summary_.invalid = c.invalid;
   summary_.rejected_commands = rec_.rejected_commands();
   summary_.deadline_misses = rec_.missed_deadlines();
-  summary_.foreign = foreign;
-  summary_.conflicts = conflicts_seen;
-  summary_.unauthenticated = unauthenticated;
-  summary_.latency_state_to_command_p50_us = lat(rec_.latency_state_to_command(), 0.5);
-  summary_.latency_state_to_command_p99_us = lat(rec_.latency_state_to_command(), 0.99);
-  summary_.latency_command_to_state_p50_us = lat(rec_.latency_command_to_state(), 0.5);
-  summary_.latency_command_to_state_p99_us = lat(rec_.latency_command_to_state(), 0.99);
-  summary_.reference_lead_p50_us = lat(rec_.reference_lead(), 0.5);
-  summary_.reference_lead_p1_us = lat(rec_.reference_lead(), 0.01);
+  summary_.foreign = c.foreign;
+  summary_.conflicts = c.conflicts;
+  summary_.unauthenticated = c.unauthenticated;
+  summary_.latency_state_to_command_p50_us = rec_.latency_state_to_command().quantile(0.5);
+  summary_.latency_state_to_command_p99_us = rec_.latency_state_to_command().quantile(0.99);
+  summary_.latency_command_to_state_p50_us = rec_.latency_command_to_state().quantile(0.5);
+  summary_.latency_command_to_state_p99_us = rec_.latency_command_to_state().quantile(0.99);
+  summary_.reference_lead_p50_us = rec_.reference_lead().quantile(0.5);
+  summary_.reference_lead_p1_us = rec_.reference_lead().quantile(0.01);
+}
 
-  nlohmann::ordered_json j;
-  auto& l = j["lockstep"];
+// The "lockstep" object of summary.json, key by key in its documented order (docs/lcm-contract.md);
+// the parts that are more than a key (the conflict, the loggers, the latencies) are functions.
+nlohmann::ordered_json MonitorNode::lockstep_json(bool completed, const std::string& failure, const sim::Summary& sum,
+                                                  double wall_time_s, const BusCounts& c,
+                                                  const LatencyHistograms& hists) {
+  nlohmann::ordered_json l;
   l["mode"] = options().realtime ? "realtime" : "lockstep";
   l["completed"] = completed;
   l["failure"] = failure;
-  l["steps_expected"] = rec_.steps() < 0 ? s_.steps() : rec_.steps();
+  l["steps_expected"] = steps_expected();
   l["stopped_at_step"] = rec_.next();
-  l["resends"] = resends_total;
-  l["lost"] = lost_;
-  l["duplicates"] = duplicates_total;
-  l["invalid_messages"] = invalid_total;
+  l["resends"] = c.resends;
+  l["lost"] = asking_.lost;
+  l["duplicates"] = c.duplicates;
+  l["invalid_messages"] = c.invalid;
   // The monitor hears every channel of the run: its own count per channel says where they came
   // ("" : datagrams without LCM's framing). invalid_messages adds the other processes' counts.
   l["invalid_messages_by_channel"] = nlohmann::ordered_json::object();
@@ -652,25 +705,10 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["plant_overruns"] = rec_.plant_overruns();
   l["run_id"] = bus().run_id();
   l["authenticated"] = bus().authenticated();
-  l["foreign_messages"] = foreign;
-  l["conflicts"] = conflicts_seen;
-  if (command_conflict_) {
-    // The race of issue 19: which command the plant applied, and who sent each (UDP source).
-    const CommandConflict& c = *command_conflict_;
-    auto& j = l["command_conflict"];
-    j["step"] = c.step;
-    j["first"] = {{"u", c.first.u}, {"sender", c.first.sender}};
-    j["second"] = {{"u", c.second.u}, {"sender", c.second.sender}};
-    if (c.applied_known) {
-      const bool first =
-          std::abs(c.applied_u - c.first.u) <= std::abs(c.applied_u - c.second.u);  // the plant may clip it
-      j["applied"] = {
-          {"u", c.applied_u}, {"sender", (first ? c.first : c.second).sender}, {"which", first ? "first" : "second"}};
-    } else {
-      j["applied"] = nullptr;
-    }
-  }
-  l["unauthenticated_messages"] = unauthenticated;
+  l["foreign_messages"] = c.foreign;
+  l["conflicts"] = c.conflicts;
+  if (commands_.conflict) l["command_conflict"] = command_conflict_json(*commands_.conflict);
+  l["unauthenticated_messages"] = c.unauthenticated;
   l["steps_without_command"] = rec_.commandless_rows();
   if (mopt_.attach) {  // an observer records across what it could not get (the run's monitor never does)
     l["missing_steps"] = rec_.missing_steps();
@@ -679,45 +717,73 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
       l["gaps"].push_back({{"first", g.first}, {"last", g.last}, {"why", g.why}});
   }
   l["steps_per_second"] = rec_.steps_per_second();
-  {
-    // One step on the wire: state + command + 1/16 of a block of 16 references, each an LCM
-    // datagram of an 8-byte header, the channel name and its NUL, and the encoded message (with
-    // its 32-byte mac when the run is authenticated).
-    const int mac = bus().authenticated() ? static_cast<int>(service::MessageAuth::kMacSize) : 0;
-    const auto packet = [mac](const std::string& channel, int payload) {
-      return 8 + static_cast<int>(channel.size()) + 1 + payload + mac;
-    };
-    reference_block_t block{};
-    block.count = 16;
-    block.refs.resize(16);
-    l["bytes_per_step"] = packet(channels().state, drive_state_t().getEncodedSize()) +
-                          packet(channels().reference, block.getEncodedSize()) / 16 +
-                          packet(channels().command, control_command_t().getEncodedSize());
-  }
+  l["bytes_per_step"] = bytes_per_step();
   l["safe_state"] = rec_.safe_state();
-  {
-    // Stock loggers on the bus and whether the steps went out faster than the stock lcm-logger
-    // records without loss (service::kStockLoggerSteps): the run cannot know what it dropped.
-    const double run_rate = wall_time_s > 0 ? static_cast<double>(sum.steps) / wall_time_s : 0.0;
-    const double peak = std::max(peak_rate_, run_rate);
-    const bool too_fast =
-        !loggers_.empty() && peak > service::stock_logger_pace(loggers_) * 1.02;  // 2 %: the window's clock
-    auto& sl = l["stock_loggers"];
-    sl["seen"] = nlohmann::ordered_json::array();
-    for (const service::StockLogger& g : loggers_) sl["seen"].push_back({{"name", g.name}, {"pid", g.pid}});
-    sl["max_rate"] =
-        options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
-    sl["peak_steps_per_second"] = peak;
-    sl["records_without_loss_up_to"] = loggers_.empty() ? nlohmann::ordered_json(nullptr)
-                                                        : nlohmann::ordered_json(service::stock_logger_pace(loggers_));
-    sl["faster_than_it_records"] = too_fast;
-    if (too_fast)
-      spdlog::warn(
-          "{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
-          "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
-          role(), peak, service::describe(loggers_), service::stock_logger_pace(loggers_),
-          service::stock_logger_pace(loggers_));
+  l["stock_loggers"] = stock_loggers_json(sum, wall_time_s);
+  add_latency_json(l, hists);
+  return l;
+}
+
+nlohmann::ordered_json MonitorNode::command_conflict_json(const CommandConflict& c) {
+  // The race of issue 19: which command the plant applied, and who sent each (UDP source).
+  nlohmann::ordered_json j;
+  j["step"] = c.step;
+  j["first"] = {{"u", c.first.u}, {"sender", c.first.sender}};
+  j["second"] = {{"u", c.second.u}, {"sender", c.second.sender}};
+  if (c.applied_known) {
+    const bool first = c.applied_first();
+    j["applied"] = {
+        {"u", c.applied_u}, {"sender", (first ? c.first : c.second).sender}, {"which", first ? "first" : "second"}};
+  } else {
+    j["applied"] = nullptr;
   }
+  return j;
+}
+
+int MonitorNode::bytes_per_step() {
+  // One step on the wire: state + command + 1/16 of a block of 16 references, each an LCM
+  // datagram of an 8-byte header, the channel name and its NUL, and the encoded message (with
+  // its 32-byte mac when the run is authenticated).
+  const int mac = bus().authenticated() ? static_cast<int>(service::MessageAuth::kMacSize) : 0;
+  const auto packet = [mac](const std::string& channel, int payload) {
+    return 8 + static_cast<int>(channel.size()) + 1 + payload + mac;
+  };
+  reference_block_t block{};
+  block.count = 16;
+  block.refs.resize(16);
+  return packet(channels().state, drive_state_t().getEncodedSize()) +
+         packet(channels().reference, block.getEncodedSize()) / 16 +
+         packet(channels().command, control_command_t().getEncodedSize());
+}
+
+nlohmann::ordered_json MonitorNode::stock_loggers_json(const sim::Summary& sum, double wall_time_s) const {
+  // Stock loggers on the bus and whether the steps went out faster than the stock lcm-logger
+  // records without loss (service::kStockLoggerSteps): the run cannot know what it dropped.
+  const double run_rate = wall_time_s > 0 ? static_cast<double>(sum.steps) / wall_time_s : 0.0;
+  const double peak = std::max(rate_.peak, run_rate);
+  const bool too_fast =
+      !rate_.loggers.empty() && peak > service::stock_logger_pace(rate_.loggers) * 1.02;  // 2 %: the window's clock
+  nlohmann::ordered_json sl;
+  sl["seen"] = nlohmann::ordered_json::array();
+  for (const service::StockLogger& g : rate_.loggers) sl["seen"].push_back({{"name", g.name}, {"pid", g.pid}});
+  sl["max_rate"] =
+      options().max_rate > 0 ? nlohmann::ordered_json(options().max_rate) : nlohmann::ordered_json(nullptr);
+  sl["peak_steps_per_second"] = peak;
+  sl["records_without_loss_up_to"] = rate_.loggers.empty()
+                                         ? nlohmann::ordered_json(nullptr)
+                                         : nlohmann::ordered_json(service::stock_logger_pace(rate_.loggers));
+  sl["faster_than_it_records"] = too_fast;
+  if (too_fast)
+    spdlog::warn(
+        "{}: steps went out at up to {:.0f}/s while {} recorded the bus; it records without loss up to "
+        "{:g}/s, so its log may miss steps (feeddrive-log2csv names them); pace the run with --max-rate {:g}",
+        role(), peak, service::describe(rate_.loggers), service::stock_logger_pace(rate_.loggers),
+        service::stock_logger_pace(rate_.loggers));
+  return sl;
+}
+
+void MonitorNode::add_latency_json(nlohmann::ordered_json& l, const LatencyHistograms& hists) {
+  const auto lat = [](const stats::StreamingQuantile& v, double q) { return v.quantile(q); };
   const auto hop = [&](const char* name, const stats::StreamingQuantile& v) {
     l["latency_us"][name] = {{"p50", lat(v, 0.5)}, {"p99", lat(v, 0.99)}, {"samples", v.count()}};
   };
@@ -726,29 +792,18 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
   l["reference_lead_us"] = {{"p50", lat(rec_.reference_lead(), 0.5)},
                             {"p1", lat(rec_.reference_lead(), 0.01)},
                             {"samples", rec_.reference_lead().count()}};
-  // In real time a state_to_command beyond T - guard is a deadline miss, and
-  // period_start_lateness is how late the plant sent each state after its period start, on its
-  // own clock (drive_state_t.start_late_us: its timer wake-up and spin).
-  std::vector<std::string> hist_names = {"state_to_command", "command_to_state"};
-  std::vector<Histogram> hists = {hist_sc_, hist_cs_};
-  if (options().realtime) {
-    hist_names.push_back("period_start_lateness");
-    hists.push_back(hist_late_);
-  }
-  {
-    auto& h = l["latency_histogram_us"];
-    h["bin_us"] = hist_sc_.bin_us();
-    for (std::size_t i = 0; i < hists.size(); ++i)
-      h[hist_names[i]] = {
-          {"counts", hists[i].counts()}, {"overflow", hists[i].overflow()}, {"samples", hists[i].samples()}};
-  }
+  auto& h = l["latency_histogram_us"];
+  h["bin_us"] = timing_.state_to_command.bin_us();
+  for (std::size_t i = 0; i < hists.h.size(); ++i)
+    h[hists.names[i]] = {
+        {"counts", hists.h[i].counts()}, {"overflow", hists.h[i].overflow()}, {"samples", hists.h[i].samples()}};
   for (auto* v : {&l["latency_us"]["state_to_command"], &l["latency_us"]["command_to_state"], &l["reference_lead_us"]})
     for (const char* q : {"p50", "p99", "p1"})
       if (v->contains(q) && std::isnan((*v)[q].get<double>())) (*v)[q] = nullptr;
+}
 
-  bool written = true;
-  std::string why = failure;
-  std::string where = output::shown(mopt_.out_dir);
+bool MonitorNode::write_results(const sim::Summary& sum, const std::string& write_error, const std::string& lockstep,
+                                const LatencyHistograms& hists, bool& completed, std::string& why, std::string& where) {
   try {
     if (!write_error.empty()) throw std::runtime_error(write_error);
     const bool plots = mopt_.plots && out_->steps() > 0;
@@ -759,8 +814,8 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     const bool earlier = output::is_feeddrive_output(target);
     if (!completed && !earlier) ::rmdir(target.c_str());
     const std::filesystem::path dest = out_->finish(
-        sum, mopt_.plots, j.dump(),
-        [&](const output::StagedFolder& dir) { write_histograms(dir, hist_names, hists, plots); }, completed);
+        sum, mopt_.plots, lockstep,
+        [&](const output::StagedFolder& dir) { write_histograms(dir, hists.names, hists.h, plots); }, completed);
     if (!completed && dest != target) {
       where = dest.string();
       if (!options().quiet)  // an interrupt's one line stays one line with -q
@@ -769,14 +824,35 @@ bool MonitorNode::finish(bool completed, const std::string& failure) {
     }
     if (!out_->plot_error().empty() && !stop_.stop_requested())  // an interrupt is reported once, as such
       spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
+    return true;
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());
-    written = false;
     completed = false;
     if (why.empty()) why = std::string("results not written: ") + e.what();
     summary_.completed = false;
     summary_.failure = wire::fit(why, wire::Check<run_summary_t>::kMax_failure);
+    return false;
   }
+}
+
+bool MonitorNode::finish(bool completed, const std::string& failure) {
+  const double wall_time_s = static_cast<double>(mono_us() - when_.start) * 1e-6;
+  sim::Summary sum;
+  std::string write_error;  // the writer thread could not write (disk full, ...)
+  try {
+    sum = out_->summary(wall_time_s, {});
+  } catch (const std::exception& e) {
+    write_error = e.what();
+  }
+  const BusCounts counts = bus_counts();
+  fill_summary(completed, failure, sum, wall_time_s, counts);
+  const LatencyHistograms hists = latency_histograms();
+  nlohmann::ordered_json j;
+  j["lockstep"] = lockstep_json(completed, failure, sum, wall_time_s, counts, hists);
+
+  std::string why = failure;
+  std::string where = output::shown(mopt_.out_dir);
+  const bool written = write_results(sum, write_error, j.dump(), hists, completed, why, where);
   bus().publish(channels().summary, summary_);
   if (completed) {
     set_state("done");

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,44 @@
 #include "feeddrive/service/launch.hpp"
 #include "feeddrive/sim/output.hpp"
 #include "feeddrive/sim/scenario.hpp"
+
+namespace {
+
+using namespace feeddrive;
+
+// The inode of the monitor's marker in `out` (0: none): a successful run leaves a new file.
+ino_t marker_id(const std::filesystem::path& out) {
+  struct stat st {};
+  return ::lstat((out / output::kMarkerFile).c_str(), &st) == 0 ? st.st_ino : ino_t{0};
+}
+
+// A failed run's lines: a refusal (bad input, exit 2) is the run's one line, printed once however
+// many processes gave it (the others were stopped for it and say nothing); else each failure; and
+// where a killed monitor's record went.
+void report_failure(const service::LaunchResult& r) {
+  for (const auto& line : r.refusals) std::fprintf(stderr, "%s\n", line.c_str());
+  if (r.refusals.empty())
+    for (const auto& f : r.failed) spdlog::error("failed: {}", f);
+  if (!r.partial_record.empty())
+    spdlog::error(
+        "the monitor was killed: its record up to then (it goes to the file every second: the last "
+        "second's rows may be missing; no summary.json) is in {}",
+        r.partial_record);
+}
+
+// The headline of DIR/summary.json as feeddrive-sim prints it (sim/summary.hpp), then the lockstep figures.
+void print_headline(const std::string& out_dir) {
+  std::ifstream in(out_dir + "/summary.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.contains("lockstep")) return;
+  const auto p50 = j["lockstep"]["latency_us"]["state_to_command"].value("p50", nlohmann::json());
+  spdlog::info("{} steps, {}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
+               sim::summary_headline(text), j["lockstep"].value("resends", 0L), j["lockstep"].value("lost", 0L),
+               p50.is_number() ? fmt::format("{:.4g}", p50.get<double>()) : std::string("n/a"), out_dir);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace feeddrive;
@@ -66,42 +105,19 @@ int main(int argc, char** argv) {
     sim::check_run_size(s, lo.out_dir);
     spdlog::info("{}: {} steps of {} s on {} (prefix {})", s.name, s.steps(), s.control_period, opt.lcm_url,
                  opt.prefix);
-    // The monitor's marker before the run: a successful run leaves a new one (a new file).
-    const auto marker_id = [&] {
-      struct stat st {};
-      return ::lstat((out / output::kMarkerFile).c_str(), &st) == 0 ? st.st_ino : ino_t{0};
-    };
-    const ino_t before = marker_id();
+    const ino_t before = marker_id(out);  // the monitor's marker before the run
     const service::LaunchResult r = service::launch(lo, opt);
-    // A refusal (bad input, exit 2) is the run's one line, printed once however many processes
-    // gave it; the others were stopped for it and say nothing.
-    for (const auto& line : r.refusals) std::fprintf(stderr, "%s\n", line.c_str());
-    if (r.refusals.empty())
-      for (const auto& f : r.failed) spdlog::error("failed: {}", f);
-    if (!r.partial_record.empty())
-      spdlog::error(
-          "the monitor was killed: its record up to then (it goes to the file every second: the last "
-          "second's rows may be missing; no summary.json) is in {}",
-          r.partial_record);
+    report_failure(r);
     // A failed run's record is where the monitor said (DIR, or DIR.incomplete-N beside an
     // earlier output): DIR's summary may be the earlier run's, so it is not shown as this one's.
     if (r.exit_code != 0) return r.exit_code;
     // Every process exited 0: the monitor's new results must be there.
-    if (!output::is_feeddrive_output(out) || marker_id() == before) {
+    if (!output::is_feeddrive_output(out) || marker_id(out) == before) {
       spdlog::error("--out {}: the monitor wrote no results", output::shown(lo.out_dir));
       return 1;
     }
     for (const std::string& w : s.warnings) spdlog::warn("{}", w);  // after the run, as feeddrive-sim does
-    std::ifstream in(lo.out_dir + "/summary.json");
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const auto j = nlohmann::json::parse(text, nullptr, false);
-    // The headline as feeddrive-sim prints it (sim/summary.hpp), then the lockstep figures.
-    if (!j.is_discarded() && j.contains("lockstep")) {
-      const auto p50 = j["lockstep"]["latency_us"]["state_to_command"].value("p50", nlohmann::json());
-      spdlog::info("{} steps, {}, resends {}, lost {}, state->command p50 {} us -> {}", j.value("steps", 0L),
-                   sim::summary_headline(text), j["lockstep"].value("resends", 0L), j["lockstep"].value("lost", 0L),
-                   p50.is_number() ? fmt::format("{:.4g}", p50.get<double>()) : std::string("n/a"), lo.out_dir);
-    }
+    print_headline(lo.out_dir);
     return 0;
   });
 }

@@ -190,13 +190,18 @@ void check_group_free(const NodeOptions& opt, double listen_s) {
                               "2) or --lcm-url (e.g. '" + other_port + "'), and the same to its external processes");
 }
 
-LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
-  const std::vector<std::string> roles = {"monitor", "plant", "trajectory", "controller"};
+namespace {
+
+// Each --external ROLE must be one that can run outside (the monitor cannot).
+void check_external(const LaunchOptions& lo) {
   for (const auto& r : lo.external)
     if (r != "controller" && r != "plant" && r != "trajectory")
       throw std::invalid_argument("--external " + r + ": expected one of controller, plant, trajectory");
-  const std::string bin = lo.bin_dir.empty() ? executable_dir() : lo.bin_dir;
-  if (!given.key_file.empty()) read_key_file(given.key_file);  // a bad key fails here, before any process
+}
+
+// The options every process gets: the run id (and, with a key, the nonce) drawn once the group
+// is known to be free, and the pace a stock lcm-logger on the bus needs.
+NodeOptions run_options(const LaunchOptions& lo, const NodeOptions& given) {
   NodeOptions opt = given;
   if (!lo.external.count("plant")) {
     // The group must be free: another run's plant on it means a second run (point of
@@ -210,7 +215,6 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
   } else if (opt.run_id == 0) {
     spdlog::info("the plant is external: every process joins the run id of its heartbeat (or give --run-id)");
   }
-
   // A stock lcm-logger started before the run records it only if the run is paced (loggers.hpp).
   if (lo.auto_pace && !opt.realtime && !lo.external.count("plant")) {
     const std::vector<StockLogger> loggers = stock_loggers_on(opt.lcm_url);
@@ -223,33 +227,48 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
           opt.max_rate < kStockLoggerSteps ? "; at real-time priority (chrt -f 20) it keeps up with 1000" : "");
     }
   }
+  return opt;
+}
 
-  RefusalPipe refusal_pipe;
+// The line that tells how to start an external role: its options and this run's settings.
+void describe_external(const std::string& role, const NodeOptions& opt) {
+  spdlog::info(
+      "{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
+      "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
+      "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
+      "(docs/external-{}.md)",
+      role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
+      opt.key_file.empty() ? "" : " --key " + opt.key_file,
+      opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
+      opt.scenario_hash, opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s),
+      seconds_text(opt.step_timeout_s), seconds_text(opt.resend_interval_s), opt.monitor_window,
+      role == "plant" ? "plant" : "controllers");
+}
+
+// The command line of one role's process: the scenario, the options every process gets, and the
+// monitor's output options.
+std::vector<std::string> role_args(const std::string& role, const LaunchOptions& lo, const NodeOptions& opt) {
+  std::vector<std::string> args = {lo.scenario};
+  const auto common = common_args(opt);
+  args.insert(args.end(), common.begin(), common.end());
+  if (role != "monitor" || opt.quiet) args.push_back("--quiet");
+  if (role == "monitor") {
+    args.insert(args.end(), {"--out", lo.out_dir});
+    if (!lo.plots) args.push_back("--no-plots");
+    if (!lo.lcm_log.empty()) args.insert(args.end(), {"--lcm-log", lo.lcm_log});
+  }
+  return args;
+}
+
+// Starts the roles that are not external, monitor first; returns pid -> role.
+std::map<pid_t, std::string> start_roles(const LaunchOptions& lo, const NodeOptions& opt, int refusal_fd) {
+  const std::string bin = lo.bin_dir.empty() ? executable_dir() : lo.bin_dir;
   std::map<pid_t, std::string> running;
-  for (const auto& role : roles) {
-    if (given.stop.stop_requested()) break;  // Ctrl-C while starting: start no more (the loop below forwards it)
+  for (const std::string role : {"monitor", "plant", "trajectory", "controller"}) {
+    if (opt.stop.stop_requested()) break;  // Ctrl-C while starting: start no more (the wait forwards it)
     if (lo.external.count(role)) {
-      spdlog::info(
-          "{} is external: start it yourself with --lcm-url '{}' --prefix {}{}{}{} --scenario-hash {} (this "
-          "scenario's; a participant with another scenario is refused); this run is {} (--realtime), "
-          "--start-timeout {} s, --step-timeout {} s, --resend-interval {} s, --monitor-window {}, all in run_info_t "
-          "(docs/external-{}.md)",
-          role, opt.lcm_url, opt.prefix, opt.run_id != 0 ? " --run-id " + std::to_string(opt.run_id) : "",
-          opt.key_file.empty() ? "" : " --key " + opt.key_file,
-          opt.run_nonce != 0 && !opt.key_file.empty() ? " --run-nonce " + std::to_string(opt.run_nonce) : "",
-          opt.scenario_hash, opt.realtime ? "real time" : "lockstep", seconds_text(opt.start_timeout_s),
-          seconds_text(opt.step_timeout_s), seconds_text(opt.resend_interval_s), opt.monitor_window,
-          role == "plant" ? "plant" : "controllers");
+      describe_external(role, opt);
       continue;
-    }
-    std::vector<std::string> args = {lo.scenario};
-    const auto common = common_args(opt);
-    args.insert(args.end(), common.begin(), common.end());
-    if (role != "monitor" || opt.quiet) args.push_back("--quiet");
-    if (role == "monitor") {
-      args.insert(args.end(), {"--out", lo.out_dir});
-      if (!lo.plots) args.push_back("--no-plots");
-      if (!lo.lcm_log.empty()) args.insert(args.end(), {"--lcm-log", lo.lcm_log});
     }
     const std::string exe = bin + "/feeddrive-" + role;
     if (::access(exe.c_str(), X_OK) != 0) throw std::runtime_error("cannot find " + exe);
@@ -257,65 +276,94 @@ LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
     // plant); how much they yield to it depends on the mode (launch.hpp).
     const bool off_path = role == "monitor" || role == "trajectory";
     const int niceness = off_path ? (opt.realtime ? lo.realtime_off_path_niceness : lo.off_path_niceness) : 0;
-    running[spawn(exe, args, niceness, off_path && !lo.off_path_cpus.empty() ? lo.off_path_cpus : lo.cpus,
-                  refusal_pipe.write_fd())] = role;
+    running[spawn(exe, role_args(role, lo, opt), niceness,
+                  off_path && !lo.off_path_cpus.empty() ? lo.off_path_cpus : lo.cpus, refusal_fd)] = role;
   }
+  return running;
+}
 
-  LaunchResult result;
-  bool refused = false;  // a process exited 2 (bad input, e.g. a record that cannot fit the disk)
-  int forwarded = 0;
-  std::int64_t first_failure_us = -1;
-  double grace_s = lo.grace_s;
-  bool terminated = false;
+// What the wait for the children has seen so far.
+struct Wait {
+  bool refused{false};  // a process exited 2 (bad input, e.g. a record that cannot fit the disk)
+  int forwarded{0};     // the signal forwarded to the children
+  std::int64_t first_failure_us{-1};
+  double grace_s{0.0};
+  bool terminated{false};
+};
+
+// A child exited with `status`: a killed monitor's record is rescued, a failure noted (a refusal
+// stops the others at once; a failed monitor shortens the grace period).
+void child_exited(pid_t pid, int status, const std::string& role, const LaunchOptions& lo,
+                  const std::map<pid_t, std::string>& running, Wait& w, LaunchResult& result) {
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  if (role == "monitor" && WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) {
+    // A killed monitor could not put its record in place: the launcher does, beside --out.
+    try {
+      result.partial_record = output::rescue_staging(lo.out_dir, pid).string();
+    } catch (const std::exception& e) {
+      spdlog::error("monitor killed: {}", e.what());
+    }
+  }
+  if (code == 0) return;
+  if (code == 2 && !w.refused) {
+    // Bad input: nothing to run. The others are stopped at once, quietly (they would only
+    // fail for want of this one); the refusal is the launcher's one line.
+    w.refused = true;
+    for (const auto& [p, other] : running) ::kill(p, SIGTERM);
+    w.terminated = true;
+  }
+  result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
+  if (w.first_failure_us < 0) w.first_failure_us = mono_us();
+  // The monitor is the run's record and its judge (it names what the bus drops: an older
+  // contract, an unsigned participant): without it the run is over. The others hear its
+  // failure within 0.1 s; one that never joined a run (it waited for an external plant the
+  // monitor refused) cannot, so it gets 1 s, not the whole grace period.
+  if (role == "monitor") w.grace_s = std::min(w.grace_s, 1.0);
+}
+
+// Waits until every child has exited: forwards Ctrl-C / SIGTERM to them once, and terminates
+// stragglers a grace period after the first failure. Returns whether a child refused (exit 2).
+bool wait_for_children(std::map<pid_t, std::string>& running, const LaunchOptions& lo, const interrupt::StopToken& stop,
+                       LaunchResult& result) {
+  Wait w;
+  w.grace_s = lo.grace_s;
   while (!running.empty()) {
     int status = 0;
     const pid_t pid = ::waitpid(-1, &status, WNOHANG);
     if (pid > 0) {
       const std::string role = running[pid];
       running.erase(pid);
-      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      if (role == "monitor" && WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) {
-        // A killed monitor could not put its record in place: the launcher does, beside --out.
-        try {
-          result.partial_record = output::rescue_staging(lo.out_dir, pid).string();
-        } catch (const std::exception& e) {
-          spdlog::error("monitor killed: {}", e.what());
-        }
-      }
-      if (code != 0) {
-        if (code == 2 && !refused) {
-          // Bad input: nothing to run. The others are stopped at once, quietly (they would only
-          // fail for want of this one); the refusal is the launcher's one line.
-          refused = true;
-          for (const auto& [p, other] : running) ::kill(p, SIGTERM);
-          terminated = true;
-        }
-        result.failed.push_back(role + " (exit " + std::to_string(code) + ")");
-        if (first_failure_us < 0) first_failure_us = mono_us();
-        // The monitor is the run's record and its judge (it names what the bus drops: an older
-        // contract, an unsigned participant): without it the run is over. The others hear its
-        // failure within 0.1 s; one that never joined a run (it waited for an external plant the
-        // monitor refused) cannot, so it gets 1 s, not the whole grace period.
-        if (role == "monitor") grace_s = std::min(grace_s, 1.0);
-      }
+      child_exited(pid, status, role, lo, running, w, result);
       continue;
     }
-    // Forward Ctrl-C / SIGTERM to every child once.
-    const int sig = given.stop.signal();
-    if (sig != 0 && forwarded != sig) {
-      forwarded = sig;
+    const int sig = stop.signal();
+    if (sig != 0 && w.forwarded != sig) {
+      w.forwarded = sig;
       for (const auto& [p, role] : running) ::kill(p, sig);
     }
     // One failed: the others notice (status or timeout); terminate stragglers after a grace period.
-    if (first_failure_us >= 0 && !terminated && mono_us() - first_failure_us > us(grace_s)) {
-      terminated = true;
+    if (w.first_failure_us >= 0 && !w.terminated && mono_us() - w.first_failure_us > us(w.grace_s)) {
+      w.terminated = true;
       for (const auto& [p, role] : running) {
-        spdlog::error("{} still running {} s after a failure: terminating it", role, seconds_text(grace_s));
+        spdlog::error("{} still running {} s after a failure: terminating it", role, seconds_text(w.grace_s));
         ::kill(p, SIGTERM);
       }
     }
     ::usleep(20000);
   }
+  return w.refused;
+}
+
+}  // namespace
+
+LaunchResult launch(const LaunchOptions& lo, const NodeOptions& given) {
+  check_external(lo);
+  if (!given.key_file.empty()) read_key_file(given.key_file);  // a bad key fails here, before any process
+  const NodeOptions opt = run_options(lo, given);
+  RefusalPipe refusal_pipe;
+  std::map<pid_t, std::string> running = start_roles(lo, opt, refusal_pipe.write_fd());
+  LaunchResult result;
+  const bool refused = wait_for_children(running, lo, given.stop, result);
   result.refusals = refusal_pipe.lines();
   // Interrupted: every child has stopped (the monitor kept what it had recorded); one line, 130.
   given.stop.check();

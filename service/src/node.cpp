@@ -73,125 +73,137 @@ std::string seconds_text(double s) {
 
 Node::Node(std::string role, const NodeOptions& opt, Receive receive, lcm_t* shared_lcm)
     : role_(std::move(role)), opt_(opt), bus_(opt.lcm_url, receive, shared_lcm), ch_(opt.prefix) {
-  if (!opt.key_file.empty()) bus_.set_auth(read_key_file(opt.key_file));
-  const bool keyed = !opt.key_file.empty();
-  if (keyed && opt.run_id != 0 && opt.run_nonce != 0) {
-    // The launcher gave the run's nonce: the run id on the wire is known from the start.
-    run_nonce_ = opt.run_nonce;
-    bus_.set_run_id(keyed_run_id(opt.run_id, run_nonce_));
-  } else if (keyed && role_ == "plant") {
-    // A fresh nonce binds this run's identity: a replay of an earlier run with the same
-    // --run-id carries another run id (docs/security.md, "Replays across runs").
-    run_nonce_ = opt.run_nonce != 0 ? opt.run_nonce : draw_run_id();
-    bus_.set_run_id(keyed_run_id(opt.run_id != 0 ? opt.run_id : draw_run_id(), run_nonce_));
-  } else if (opt.run_id != 0 && !keyed) {
-    bus_.set_run_id(opt.run_id);
-  }
+  set_run_identity();
   // Under feeddrive-launch the monitor names what the bus drops (one line per event); the others count.
   if (std::getenv(interrupt::kQuietEnv) != nullptr && role_ != "monitor") bus_.set_reports(false);
   bus_.subscribe<process_status_t>(
-      ch_.status,
-      [this, keyed](const process_status_t& m, std::int64_t recv_us) {
-        if (!bus_.run_known()) {
-          // Join the run of the first plant whose heartbeat is fresh (its wall clock within 5 s
-          // of ours): a log replayed by lcm-logplayer carries the old times and is not joined.
-          // Under --key the heartbeat is signed (checked before decode) and must carry the run's
-          // nonce, its run id bound to our --run-id by it.
-          if (m.role != "plant" || std::llabs(m.utime - wall_utime()) > 5000000) return;
-          if (keyed && m.run_nonce == 0) {
-            if (!warned_no_nonce_)
-              spdlog::error(
-                  "{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
-                  "contract's version 3 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
-                  role_);
-            warned_no_nonce_ = true;
-            return;
-          }
-          if (keyed && opt_.run_id != 0 && keyed_run_id(opt_.run_id, m.run_nonce) != m.run_id) {
-            bus_.count_foreign(ch_.status, m.run_id);
-            return;
-          }
-          bus_.set_run_id(m.run_id);
-          run_nonce_ = m.run_nonce;
-          spdlog::info("{}: joined run {} (taken from the plant's heartbeat{})", role_, m.run_id,
-                       keyed ? ", bound to its nonce" : "");
-        }
-        if (m.run_id != bus_.run_id()) {
-          bus_.count_foreign(ch_.status, m.run_id, m.role);
-          return;
-        }
-        if (m.role == role_) return;
-        // A run role's state only moves forward (starting, running, then done or failed): a
-        // "running" after its own "done" is a forged or replayed heartbeat, not the process. It
-        // is a conflict, and the state it claims is ignored, so no heartbeat can hold a run
-        // open (docs/security.md, "Heartbeats").
-        // Likewise, at the plant (whose flow control reads it), the monitor's acknowledgement only
-        // grows: a heartbeat that takes acked_seq back would stall the plant (a forged one held a
-        // run for as long as it was sent). And it cannot pass the plant's own step + 2 (the monitor
-        // cannot have recorded a state the plant has not sent), so a forged "acked_seq 10^9"
-        // neither raises the bar that real heartbeats must clear nor releases the flow control.
-        // All are ignored and counted as conflicts.
-        const bool a_monitor = role_ == "plant" && (m.role == "monitor" || m.role == kAttachedMonitorRole);
-        const bool implausible = a_monitor && m.acked_seq > seq_ + 2;
-        const auto it = peers_.find(m.role);
-        const bool tracked = it != peers_.end() && (is_run_role(m.role) || m.role == kAttachedMonitorRole);
-        const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
-        // With --key, a run role's own step only grows within a state too: a signed "running"
-        // heartbeat at an earlier step is a replay (the trajectory paces itself by the plant's
-        // step, so a replayed one held the references back for seconds). Signed heartbeats
-        // cannot claim a future step, so the rule cannot be poisoned; without a key anyone can
-        // forge any step (docs/security.md: detected, not prevented), and the newest one wins.
-        const bool seq_back = keyed && tracked && m.state == it->second.state && m.seq < it->second.seq;
-        if (implausible || seq_back ||
-            (tracked &&
-             (rank(m.state) < rank(it->second.state) || (a_monitor && m.acked_seq < it->second.acked_seq)))) {
-          const std::string was = tracked ? it->second.state : std::string("-");
-          const std::int64_t was_acked = tracked ? it->second.acked_seq : -1;
-          {
-            ++conflicts;
-            const std::int64_t now = mono_us();
-            if (now - last_conflict_log_us_ > 1000000) {
-              last_conflict_log_us_ = now;
-              if (implausible)
-                spdlog::warn(
-                    "{}: conflict on {}: a heartbeat of the {} acknowledges step {}, beyond this {}'s step {}; "
-                    "forged or replayed; ignored, {} conflicts so far",
-                    role_, ch_.status, m.role, m.acked_seq, role_, seq_, conflicts);
-              else
-                spdlog::warn(
-                    "{}: conflict on {}: a heartbeat of the {} goes back ('{}' at step {} after its own '{}' at "
-                    "step {}, acknowledged step {} after {}; forged or replayed; ignored, {} conflicts so far)",
-                    role_, ch_.status, m.role, m.state, m.seq, was, tracked ? it->second.seq : -1, m.acked_seq,
-                    was_acked, conflicts);
-            }
-            if (!implausible && on_peer_status_back) on_peer_status_back(m);
-            return;
-          }
-        }
-        if (m.role == kAttachedMonitorRole && m.acked_seq != attached_acked_) {
-          attached_acked_ = m.acked_seq;
-          attached_progress_us_ = recv_us;
-        }
-        peers_[m.role] = m;
-        peer_seen_us_[m.role] = recv_us;
-        if (on_peer_status) on_peer_status(m);
-      },
-      Admit::kAnyRun);
+      ch_.status, [this](const process_status_t& m, std::int64_t recv_us) { on_status(m, recv_us); }, Admit::kAnyRun);
   // One run, one scenario: a participant started by hand (an external controller, a drive
   // adapter's companion) with another scenario file than the run's is refused with exit 2 as
   // soon as the monitor's run_info_t names the run's scenario hash (docs/lcm-contract.md).
   if (role_ == "plant" || role_ == "controller" || role_ == "trajectory")
-    bus_.subscribe<run_info_t>(ch_.info, [this](const run_info_t& m, std::int64_t) {
-      if (opt_.scenario_hash.empty() || m.scenario_hash.empty() || m.scenario_hash == opt_.scenario_hash ||
-          !scenario_mismatch_.empty())
-        return;
-      scenario_mismatch_ = "this " + role_ + "'s scenario (sha256 " + opt_.scenario_hash.substr(0, 12) +
-                           "...) is not the run's (" + m.scenario + ", sha256 " + m.scenario_hash.substr(0, 12) +
-                           "... in run_info_t): start it with the run's scenario file; one run, one scenario";
-    });
+    bus_.subscribe<run_info_t>(ch_.info, [this](const run_info_t& m, std::int64_t) { on_run_info(m); });
   bus_.subscribe<resend_request_t>(ch_.resend, [this](const resend_request_t& m, std::int64_t) {
     if (on_resend_request) on_resend_request(m);
   });
+}
+
+void Node::set_run_identity() {
+  if (!opt_.key_file.empty()) bus_.set_auth(read_key_file(opt_.key_file));
+  const bool keyed = !opt_.key_file.empty();
+  if (keyed && opt_.run_id != 0 && opt_.run_nonce != 0) {
+    // The launcher gave the run's nonce: the run id on the wire is known from the start.
+    run_nonce_ = opt_.run_nonce;
+    bus_.set_run_id(keyed_run_id(opt_.run_id, run_nonce_));
+  } else if (keyed && role_ == "plant") {
+    // A fresh nonce binds this run's identity: a replay of an earlier run with the same
+    // --run-id carries another run id (docs/security.md, "Replays across runs").
+    run_nonce_ = opt_.run_nonce != 0 ? opt_.run_nonce : draw_run_id();
+    bus_.set_run_id(keyed_run_id(opt_.run_id != 0 ? opt_.run_id : draw_run_id(), run_nonce_));
+  } else if (opt_.run_id != 0 && !keyed) {
+    bus_.set_run_id(opt_.run_id);
+  }
+}
+
+void Node::on_status(const process_status_t& m, std::int64_t recv_us) {
+  if (!bus_.run_known() && !join_run(m)) return;
+  if (m.run_id != bus_.run_id()) {
+    bus_.count_foreign(ch_.status, m.run_id, m.role);
+    return;
+  }
+  if (m.role == role_) return;
+  if (goes_back(m)) return;
+  if (m.role == kAttachedMonitorRole && m.acked_seq != attached_acked_) {
+    attached_acked_ = m.acked_seq;
+    attached_progress_us_ = recv_us;
+  }
+  peers_[m.role] = m;
+  peer_seen_us_[m.role] = recv_us;
+  if (on_peer_status) on_peer_status(m);
+}
+
+bool Node::join_run(const process_status_t& m) {
+  const bool keyed = !opt_.key_file.empty();
+  // Join the run of the first plant whose heartbeat is fresh (its wall clock within 5 s
+  // of ours): a log replayed by lcm-logplayer carries the old times and is not joined.
+  // Under --key the heartbeat is signed (checked before decode) and must carry the run's
+  // nonce, its run id bound to our --run-id by it.
+  if (m.role != "plant" || std::llabs(m.utime - wall_utime()) > 5000000) return false;
+  if (keyed && m.run_nonce == 0) {
+    if (!warned_no_nonce_)
+      spdlog::error(
+          "{}: the plant's heartbeat carries no run nonce under --key: a plant older than the "
+          "contract's version 3 (docs/lcm-contract.md); update it to draw one (docs/security.md)",
+          role_);
+    warned_no_nonce_ = true;
+    return false;
+  }
+  if (keyed && opt_.run_id != 0 && keyed_run_id(opt_.run_id, m.run_nonce) != m.run_id) {
+    bus_.count_foreign(ch_.status, m.run_id);
+    return false;
+  }
+  bus_.set_run_id(m.run_id);
+  run_nonce_ = m.run_nonce;
+  spdlog::info("{}: joined run {} (taken from the plant's heartbeat{})", role_, m.run_id,
+               keyed ? ", bound to its nonce" : "");
+  return true;
+}
+
+bool Node::goes_back(const process_status_t& m) {
+  const bool keyed = !opt_.key_file.empty();
+  // A run role's state only moves forward (starting, running, then done or failed): a
+  // "running" after its own "done" is a forged or replayed heartbeat, not the process. It
+  // is a conflict, and the state it claims is ignored, so no heartbeat can hold a run
+  // open (docs/security.md, "Heartbeats").
+  // Likewise, at the plant (whose flow control reads it), the monitor's acknowledgement only
+  // grows: a heartbeat that takes acked_seq back would stall the plant (a forged one held a
+  // run for as long as it was sent). And it cannot pass the plant's own step + 2 (the monitor
+  // cannot have recorded a state the plant has not sent), so a forged "acked_seq 10^9"
+  // neither raises the bar that real heartbeats must clear nor releases the flow control.
+  // All are ignored and counted as conflicts.
+  const bool a_monitor = role_ == "plant" && (m.role == "monitor" || m.role == kAttachedMonitorRole);
+  const bool implausible = a_monitor && m.acked_seq > seq_ + 2;
+  const auto it = peers_.find(m.role);
+  const bool tracked = it != peers_.end() && (is_run_role(m.role) || m.role == kAttachedMonitorRole);
+  const auto rank = [](const std::string& s) { return s == "starting" ? 0 : s == "running" ? 1 : 2; };
+  // With --key, a run role's own step only grows within a state too: a signed "running"
+  // heartbeat at an earlier step is a replay (the trajectory paces itself by the plant's
+  // step, so a replayed one held the references back for seconds). Signed heartbeats
+  // cannot claim a future step, so the rule cannot be poisoned; without a key anyone can
+  // forge any step (docs/security.md: detected, not prevented), and the newest one wins.
+  const bool seq_back = keyed && tracked && m.state == it->second.state && m.seq < it->second.seq;
+  if (!implausible && !seq_back &&
+      !(tracked && (rank(m.state) < rank(it->second.state) || (a_monitor && m.acked_seq < it->second.acked_seq))))
+    return false;
+  const std::string was = tracked ? it->second.state : std::string("-");
+  const std::int64_t was_acked = tracked ? it->second.acked_seq : -1;
+  ++conflicts;
+  const std::int64_t now = mono_us();
+  if (now - last_conflict_log_us_ > 1000000) {
+    last_conflict_log_us_ = now;
+    if (implausible)
+      spdlog::warn(
+          "{}: conflict on {}: a heartbeat of the {} acknowledges step {}, beyond this {}'s step {}; "
+          "forged or replayed; ignored, {} conflicts so far",
+          role_, ch_.status, m.role, m.acked_seq, role_, seq_, conflicts);
+    else
+      spdlog::warn(
+          "{}: conflict on {}: a heartbeat of the {} goes back ('{}' at step {} after its own '{}' at "
+          "step {}, acknowledged step {} after {}; forged or replayed; ignored, {} conflicts so far)",
+          role_, ch_.status, m.role, m.state, m.seq, was, tracked ? it->second.seq : -1, m.acked_seq, was_acked,
+          conflicts);
+  }
+  if (!implausible && on_peer_status_back) on_peer_status_back(m);
+  return true;
+}
+
+void Node::on_run_info(const run_info_t& m) {
+  if (opt_.scenario_hash.empty() || m.scenario_hash.empty() || m.scenario_hash == opt_.scenario_hash ||
+      !scenario_mismatch_.empty())
+    return;
+  scenario_mismatch_ = "this " + role_ + "'s scenario (sha256 " + opt_.scenario_hash.substr(0, 12) +
+                       "...) is not the run's (" + m.scenario + ", sha256 " + m.scenario_hash.substr(0, 12) +
+                       "... in run_info_t): start it with the run's scenario file; one run, one scenario";
 }
 
 Node::~Node() {

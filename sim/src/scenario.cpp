@@ -334,12 +334,8 @@ void find_warnings(Scenario& s) {
   }
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
-  if (!root.IsMap())
-    throw ScenarioError(
-        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "", resolved);
-  Scenario s;
+// name, duration and control_period: required, positive, and at most kMaxSteps steps.
+void read_run_length(MapReader& top, const YAML::Node& root, Scenario& s) {
   top.string("name", s.name);
   check_name(s.name, "name");
   if (!top.has("duration")) top.fail("duration", ": missing (required)");
@@ -354,28 +350,32 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " +
                         root["control_period"].Scalar() + ": " + steps_text(n) + " steps; a run has at most " +
                         validate::format_number(kMaxSteps) + " steps (docs/scenario.md, Limits)");
+}
 
-  {
-    MapReader plant = top.child("plant");
-    s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
-    read_plant(plant, s.plant, true);
-    // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
-    // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
-    const YAML::Node pn = root["plant"];
-    const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
-                                                     {"grinding", s.plant.grinding.enabled},
-                                                     {"electrical", s.plant.electrical.enabled}};
-    for (const auto& [name, on] : sections) {
-      if (on || !pn.IsMap()) continue;
-      const YAML::Node sec = pn[name];
-      if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
-      if (sec.size() > 0)
-        s.warnings.push_back(
-            std::string("plant.") + name +
-            ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
-    }
+// plant: the plant's parameters; a section with keys but without `enabled` is warned about.
+void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
+  MapReader plant = top.child("plant");
+  s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
+  read_plant(plant, s.plant, true);
+  // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
+  // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
+  const YAML::Node pn = root["plant"];
+  const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
+                                                   {"grinding", s.plant.grinding.enabled},
+                                                   {"electrical", s.plant.electrical.enabled}};
+  for (const auto& [name, on] : sections) {
+    if (on || !pn.IsMap()) continue;
+    const YAML::Node sec = pn[name];
+    if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
+    if (sec.size() > 0)
+      s.warnings.push_back(std::string("plant.") + name +
+                           ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
   }
+}
 
+// controller: its type, its computation delay and the type's parameters (a cascade's gains from
+// its tuning rule); the model starts from the plant.
+void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const std::string& base_dir) {
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");
   c.number("computation_delay", s.controller.computation_delay);
@@ -413,38 +413,31 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   }
   s.controller.model_given = c.has("model");
   c.finish();
+}
 
-  read_reference(top.child("reference"), s.reference, base_dir);
-  {
-    MapReader o = top.child("output");
-    o.integer("every", s.output.every);
-    o.string_list("columns", s.output.columns);
-    o.finish();
-    if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
-    const auto& all = record_columns();
-    for (const std::string& c : s.output.columns) {
-      if (std::find(all.begin(), all.end(), c) == all.end()) {
-        std::string known;
-        for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
-        o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
-      }
-      if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
-        o.fail("columns", ": column '" + c + "' listed twice");
+// output: every N-th step and the columns recorded (known, each once, not an empty list).
+void read_output(MapReader& top, const YAML::Node& root, Scenario& s) {
+  MapReader o = top.child("output");
+  o.integer("every", s.output.every);
+  o.string_list("columns", s.output.columns);
+  o.finish();
+  if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
+  const auto& all = record_columns();
+  for (const std::string& c : s.output.columns) {
+    if (std::find(all.begin(), all.end(), c) == all.end()) {
+      std::string known;
+      for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
+      o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
     }
-    if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
-      o.fail("columns", ": empty list (leave the key out to record every column)");
+    if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
+      o.fail("columns", ": column '" + c + "' listed twice");
   }
-  MapReader a = top.child("analysis");
-  a.number("settled_after", s.analysis.settled_after);
-  a.number("settling_band", s.analysis.settling_band);
-  a.finish();
-  top.finish();
-  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
-  if (s.analysis.settling_band < 0.0)
-    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
-                                ": must be >= 0 (0: 2 % of the move's distance)");
+  if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
+    o.fail("columns", ": empty list (leave the key out to record every column)");
+}
 
-  // Component validation: each validate() names its key and value; tables come from the files.
+// Component validation: each validate() names its key and value; tables come from the files.
+void validate_components(Scenario& s) {
   try {
     if (s.reference.type == ReferenceType::kWaypoints)
       s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
@@ -464,6 +457,29 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(e.what());
   }
+}
+
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
+  if (!root.IsMap())
+    throw ScenarioError(
+        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
+  MapReader top(root, "", resolved);
+  Scenario s;
+  read_run_length(top, root, s);
+  read_plant_section(top, root, s);
+  read_controller(top, root, s, base_dir);
+  read_reference(top.child("reference"), s.reference, base_dir);
+  read_output(top, root, s);
+  MapReader a = top.child("analysis");
+  a.number("settled_after", s.analysis.settled_after);
+  a.number("settling_band", s.analysis.settling_band);
+  a.finish();
+  top.finish();
+  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
+  if (s.analysis.settling_band < 0.0)
+    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
+                                ": must be >= 0 (0: 2 % of the move's distance)");
+  validate_components(s);
   if (s.steps() < 1)
     throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
                         validate::format_number(s.control_period) + " s)");

@@ -14,8 +14,10 @@
 // comes for --step-timeout (the run or the played-back log is over) it records what it can and
 // ends.
 
+#include <cmath>
 #include <map>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,6 +86,69 @@ class MonitorNode : public service::Node {
   /// Once a second: looks for stock loggers on the bus (service::stock_loggers_on) and measures
   /// the step rate of the last second (the peak is what a logger had to keep up with).
   void watch_rate_and_loggers(std::int64_t now);
+  // --- construction: what the monitor listens to ---
+  /// Subscribes to the run's state, reference and command channels (each through the conflict check).
+  void subscribe_run_channels();
+  /// A state of the run: admitted (service::Node::admit), what the plant applied, then recorded and timed.
+  void on_state(const drive_state_t& m, std::int64_t t);
+  /// A command of the run: its sender noted, admitted (a conflict keeps both commands and who
+  /// sent them, then rethrows), then recorded and timed.
+  void on_command(const control_command_t& m, std::int64_t t);
+  /// --lcm-log: opens the LCM log and taps the bus so that every message of the run goes to it.
+  void open_lcm_log(const service::NodeOptions& opt);
+  /// The run's self-description (run_info_t), published on heartbeats and on request; not when attached.
+  void serve_run_info(const service::NodeOptions& opt);
+  /// The bus events (foreign, unauthenticated, undecodable) and the peers' heartbeats, routed to their checks.
+  void watch_bus_events();
+
+  // --- the run ---
+  /// The recorder's completed rows go to the output; returns how many.
+  std::size_t flush_rows();
+  /// The steps the run is expected to have (the plant's end-of-run count once known, else the scenario's).
+  std::int64_t steps_expected() const;
+  /// Records until the run is complete; throws service::RunFailure when it cannot go on.
+  void record_until_end();
+  /// Heartbeat with the step recorded; the run's own monitor acknowledges it (the plant's flow control).
+  void heartbeat_progress();
+  /// No row for `limit`: waits for a role that still beats (it names the culprit), else throws
+  /// service::RunFailure naming the silent roles and what they did not send.
+  void check_step_timeout(std::int64_t now, double limit);
+  /// After a failure: waits briefly for the state that settles a command conflict, then records
+  /// what is still queued on the socket; returns `failure` with the applied command appended.
+  std::string record_after_failure(std::string failure);
+  /// Closes the LCM log after the run; returns `failure`, or the log's write error when there was none.
+  std::string close_lcm_log(std::string failure);
+
+  // --- the end ---
+  /// What every process of the run counted (the monitor's own counts plus the peers' heartbeats).
+  struct BusCounts {
+    std::int64_t resends{0}, duplicates{0}, invalid{0}, foreign{0}, conflicts{0}, unauthenticated{0};
+  };
+  BusCounts bus_counts();
+  /// The latency histograms recorded (period_start_lateness only in real time) and their names.
+  struct LatencyHistograms {
+    std::vector<std::string> names;
+    std::vector<Histogram> h;
+  };
+  LatencyHistograms latency_histograms() const;
+  /// Fills summary_ (run_summary_t, published at the end) from the run's summary and counts.
+  void fill_summary(bool completed, const std::string& failure, const sim::Summary& sum, double wall_time_s,
+                    const BusCounts& c);
+  /// summary.json's "lockstep" object: the counts, the conflict, the rates and the latencies.
+  nlohmann::ordered_json lockstep_json(bool completed, const std::string& failure, const sim::Summary& sum,
+                                       double wall_time_s, const BusCounts& c, const LatencyHistograms& hists);
+  /// The bytes of one step on the wire (state, command, a 16th of a reference block; with the mac if keyed).
+  int bytes_per_step();
+  /// "stock_loggers": the stock loggers seen and whether the steps went out faster than they record
+  /// (warned about then).
+  nlohmann::ordered_json stock_loggers_json(const sim::Summary& sum, double wall_time_s) const;
+  /// "latency_us", "reference_lead_us" and "latency_histogram_us" into `l` (NaN quantiles as null).
+  void add_latency_json(nlohmann::ordered_json& l, const LatencyHistograms& hists);
+  /// Writes the output folder; on failure says why, returns false and marks the run not completed
+  /// (`completed`, `why`, summary_). `where` becomes the folder the record went to.
+  /// `write_error`: the writer could not write the rows (then nothing more is tried).
+  bool write_results(const sim::Summary& sum, const std::string& write_error, const std::string& lockstep,
+                     const LatencyHistograms& hists, bool& completed, std::string& why, std::string& where);
   /// Writes the results and announces the end; false if the results could not be written.
   bool finish(bool completed, const std::string& failure);
   /// latency_histogram.csv (and .png when `plot`; a gnuplot failure is a warning) into the
@@ -99,22 +164,38 @@ class MonitorNode : public service::Node {
   /// options().stop, renewed once the first interrupt is handled (the record is still written; a
   /// second signal stops that too).
   interrupt::StopToken stop_;
-  std::string open_error_;  // why out_ could not be opened
-  std::int64_t start_us_{0};
-  std::int64_t last_row_us_{0};
-  std::int64_t last_request_us_{0};
-  std::int64_t last_progress_us_{0};
-  std::int64_t last_ack_sent_{-1};
-  std::int64_t lost_{0};
-  // Attach mode: the step whose messages are being asked for, since when and how often.
+  run_summary_t summary_{};
+  run_info_t info_;
+  std::int64_t heartbeats_{0};
+  std::string failure_;  ///< set by the bus events: the run cannot go on (run() throws it)
+
+  /// When things last happened (mono_us).
+  struct Clocks {
+    std::int64_t start{0};
+    std::int64_t last_row{0};         ///< a row was completed
+    std::int64_t last_request{0};     ///< resends were asked for
+    std::int64_t last_progress{0};    ///< the progress line was printed
+    std::int64_t last_file_flush{0};  ///< the record went to its file
+    std::int64_t last_state{0};       ///< attach mode: a state arrived
+  } when_;
+
+  /// Acknowledgements and resend requests.
+  struct Asking {
+    std::int64_t last_ack_sent{-1};
+    std::int64_t lost{0};  ///< messages asked for again
+    // Attach mode: the step whose messages are being asked for, since when and how often.
+    std::int64_t seq{-1}, since_us{0}, requests{0};
+  } asking_;
   static constexpr int kLostAfterRequests = 50;
   static constexpr double kLostAfter_s = 0.5;
-  std::int64_t asking_seq_{-1}, asking_since_us_{0}, asking_requests_{0};
-  std::int64_t last_state_us_{0};  ///< attach mode: when the last state arrived (mono_us)
-  run_summary_t summary_{};
-  service::StepLedger<drive_state_t> state_ledger_;  ///< for conflicts (service::Node::admit)
-  service::StepLedger<reference_t> reference_ledger_;
-  service::StepLedger<control_command_t> command_ledger_;
+
+  /// For conflicts (service::Node::admit).
+  struct Ledgers {
+    service::StepLedger<drive_state_t> state;
+    service::StepLedger<reference_t> reference;
+    service::StepLedger<control_command_t> command;
+  } ledgers_;
+
   /// The first command of each recent step and who sent it ("IP:PORT"), to name the two sides of
   /// a command conflict (a ring indexed by step, like the ledger).
   struct SentCommand {
@@ -122,7 +203,6 @@ class MonitorNode : public service::Node {
     double u{0.0};
     std::string sender;
   };
-  std::vector<SentCommand> first_commands_ = std::vector<SentCommand>(4096);
   /// A command conflict (two different commands for one step: a forged one raced the
   /// controller's): both, and the one the plant applied (its state k+1's previous.u), once known.
   struct CommandConflict {
@@ -130,31 +210,54 @@ class MonitorNode : public service::Node {
     SentCommand first, second;
     bool applied_known{false};
     double applied_u{0.0};
+    /// Whether the plant applied the first command (the nearer one: the plant may clip it).
+    bool applied_first() const { return std::abs(applied_u - first.u) <= std::abs(applied_u - second.u); }
   };
-  std::optional<CommandConflict> command_conflict_;
-  /// What the plant applied over each recent step (its next state's `previous`), a ring by step:
-  /// the state can come before the second command of a conflict does.
-  std::vector<std::pair<std::int64_t, double>> applied_ = std::vector<std::pair<std::int64_t, double>>(4096, {-1, 0.0});
-  /// When each role's own (decoded, authenticated, admitted) message last came [mono us].
-  std::map<std::string, std::int64_t> last_admitted_us_;
+  /// "command_conflict": the step, both commands and their senders, and the one the plant applied.
+  static nlohmann::ordered_json command_conflict_json(const CommandConflict& c);
   /// "the plant applied u = ... from ..." for the failure line and summary.json, or "".
   std::string applied_command_text() const;
-  run_info_t info_;
-  std::unique_ptr<record::LcmLogWriter> log_;
-  std::string log_error_;  ///< the first write error of the LCM log (ends the run)
-  std::int64_t heartbeats_{0};
-  Histogram hist_sc_, hist_cs_, hist_late_;
-  std::string failure_;                        ///< set by the bus events: the run cannot go on (run() throws it)
-  std::map<std::string, std::int64_t> named_;  ///< what was named already (one line per sender and kind) -> count
-  std::int64_t plant_seq_seen_{-1};            ///< the highest step of the plant's heartbeats
-  std::map<std::string, std::string> source_process_;             ///< command source "IP:PORT" -> local process
-  std::map<std::string, std::int64_t> first_unauthenticated_us_;  ///< per channel and role (mono_us)
-  std::int64_t last_file_flush_us_{0};                            ///< when the record last went to its file (mono_us)
-  std::vector<service::StockLogger> loggers_;                     ///< stock loggers seen on the bus during the run
-  std::int64_t rate_since_us_{-1}, rate_since_step_{0};
-  double peak_rate_{0.0};  ///< the most steps per second recorded in one window of >= 1 s
-  std::map<std::int64_t, std::int64_t> state_recv_, cmd_recv_;  ///< first receive times of the steps in flight
-  std::int64_t timing_pruned_{-1};                              ///< steps <= this are no longer timed
+  /// What is known of the commands, to judge a command conflict.
+  struct Commands {
+    std::vector<SentCommand> first = std::vector<SentCommand>(4096);
+    std::optional<CommandConflict> conflict;
+    /// What the plant applied over each recent step (its next state's `previous`), a ring by
+    /// step: the state can come before the second command of a conflict does.
+    std::vector<std::pair<std::int64_t, double>> applied =
+        std::vector<std::pair<std::int64_t, double>>(4096, {-1, 0.0});
+    std::map<std::string, std::string> source_process;  ///< command source "IP:PORT" -> local process
+  } commands_;
+
+  /// What the bus events named, to name each once and judge who fills a role.
+  struct Named {
+    std::map<std::string, std::int64_t> count;  ///< what was named already (one line per sender and kind) -> count
+    std::map<std::string, std::int64_t> first_unauthenticated_us;  ///< per channel and role (mono_us)
+    /// When each role's own (decoded, authenticated, admitted) message last came [mono us].
+    std::map<std::string, std::int64_t> last_admitted_us;
+    std::int64_t plant_seq_seen{-1};  ///< the highest step of the plant's heartbeats
+  } named_;
+
+  /// --lcm-log.
+  struct LcmLog {
+    std::unique_ptr<record::LcmLogWriter> writer;
+    std::string error;  ///< the first write error of the LCM log (ends the run)
+  } log_;
+
+  /// The step rate and the stock loggers on the bus.
+  struct RateWatch {
+    std::vector<service::StockLogger> loggers;  ///< stock loggers seen on the bus during the run
+    std::int64_t since_us{-1}, since_step{0};
+    double peak{0.0};  ///< the most steps per second recorded in one window of >= 1 s
+  } rate_;
+
+  /// The latency histograms and the first receive times of the steps in flight.
+  struct Timing {
+    explicit Timing(double bin_us)
+        : state_to_command(bin_us, 40), command_to_state(bin_us, 40), start_lateness(bin_us, 40) {}
+    Histogram state_to_command, command_to_state, start_lateness;
+    std::map<std::int64_t, std::int64_t> state_recv, command_recv;
+    std::int64_t pruned{-1};  ///< steps <= this are no longer timed
+  } timing_;
 };
 
 }  // namespace feeddrive::monitor

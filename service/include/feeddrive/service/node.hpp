@@ -21,6 +21,7 @@
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/process_status_t.hpp"
 #include "feeddrive/resend_request_t.hpp"
+#include "feeddrive/run_info_t.hpp"
 #include "feeddrive/service/bus.hpp"
 
 namespace feeddrive::service {
@@ -151,6 +152,20 @@ class Node {
   std::function<void(const process_status_t&)> on_peer_status_back;
 
  private:
+  /// The run's identity from the options: the launcher's nonce, or (the plant under --key) a
+  /// fresh one, or the plain --run-id; else the run is joined from the plant's heartbeat.
+  void set_run_identity();
+  /// A heartbeat on the status channel: joins the run (join_run), ignores other runs, its own
+  /// and heartbeats that go back (goes_back), else records the peer and calls on_peer_status.
+  void on_status(const process_status_t& m, std::int64_t recv_us);
+  /// Before a run is known: joins the run of a fresh plant heartbeat (under --key bound to its
+  /// nonce). Returns false when `m` does not make this node join.
+  bool join_run(const process_status_t& m);
+  /// True (and counted as a conflict, logged at most once a second) when `m` goes back: a run
+  /// role's state, a monitor's acknowledgement, or (--key) a step within a state.
+  bool goes_back(const process_status_t& m);
+  /// run_info_t naming another scenario hash than this participant's: refused (scenario_mismatch_).
+  void on_run_info(const run_info_t& m);
   bool on_conflict(const std::string& channel, std::int64_t seq, const char* type, const std::string& diff);
   process_status_t status_message(const std::string& state, const std::string& message) const;
 
