@@ -140,8 +140,9 @@ std::string frequency_response_table(const sim::Scenario& s, const FrequencyResp
   return t.str();
 }
 
-std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
-                                     bool plots, const interrupt::StopToken& stop) {
+FrequencyResponseWritten write_frequency_response(const std::string& out_dir, const sim::Scenario& s,
+                                                  const FrequencyResponse& r, bool plots,
+                                                  const interrupt::StopToken& stop) {
   output::StagedFolder folder(out_dir, "feeddrive-sim");
   {
     output::CsvWriter csv(folder.path("frequency_response.csv"),
@@ -242,8 +243,8 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
       plot_error = e.what();
     }
   }
-  folder.commit();
-  return plot_error;
+  std::vector<std::string> warnings = folder.commit();
+  return {plot_error, std::move(warnings)};
 }
 
 }  // namespace feeddrive::analysis

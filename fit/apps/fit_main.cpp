@@ -129,7 +129,8 @@ int main(int argc, char** argv) {
                  scenario_path);
     const fit::FitResult r =
         fit::run_fit(rec, scenario.plant, opt, [](const std::string& s) { spdlog::info("{}", s); });
-    fit::write_outputs(out_dir, scenario_path, rec, r, !no_plots, tool::stop_token());
+    for (const std::string& w : fit::write_outputs(out_dir, scenario_path, rec, r, !no_plots, tool::stop_token()))
+      spdlog::warn("{}", w);
     std::printf("%-4s %-24s %14s %18s\n", "step", "model", "gap [um]", "force RMS [N]");
     std::printf("%-4d %-24s %14.4g %18.4g\n", 0, "as given", r.replay_initial.gap * 1e6, r.force_rms_initial);
     int k = 0;

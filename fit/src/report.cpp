@@ -205,8 +205,8 @@ std::string params_text(const Effect& e) {
 
 }  // namespace
 
-void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
-                   bool plots, const interrupt::StopToken& stop) {
+std::vector<std::string> write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
+                                       const FitResult& r, bool plots, const interrupt::StopToken& stop) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
   {
     const MeasuredData& d = *rec.data;
@@ -391,7 +391,7 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
       out.plot(gp.str(), stop);
     }
   }
-  out.commit();
+  return out.commit();
 }
 
 }  // namespace feeddrive::fit

@@ -14,6 +14,7 @@
 // comes for --step-timeout (the run or the played-back log is over) it records what it can and
 // ends.
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -40,6 +41,10 @@ struct MonitorOptions {
   bool plots{true};
   bool attach{false};
   double progress_interval_s{0.5};
+  /// Where the progress line goes, every progress_interval_s (not with --quiet): `line` without
+  /// a line end; `last` for the run's final one. The tool draws it (feeddrive-monitor: stderr,
+  /// each line over the one before); unset: no progress line. This library prints nothing.
+  std::function<void(const std::string& line, bool last)> progress;
   /// If set: every message of the run received on the bus (channels <prefix>_*, re-published
   /// ones included) also goes to this file, in the standard LCM log format (lcm_log.hpp), with
   /// the kernel's receive time: what lcm-logger writes, without another process on the group.
