@@ -49,7 +49,11 @@ int main(int argc, char** argv) {
     cases[i].duration = duration;
     if (std::getenv("FD_SWEEP_NOFORM")) cases[i].form_deviation = false;
     try {
-      const sweep::Outcome o = sweep::run_case(cases[i]);
+      // FD_SWEEP_VERBOSE=1: the fit's log on stderr (to look at one case)
+      const sweep::Outcome o =
+          sweep::run_case(cases[i], {}, [verbose = std::getenv("FD_SWEEP_VERBOSE") != nullptr](const std::string& s) {
+            if (verbose) std::fprintf(stderr, "  %s\n", s.c_str());
+          });
       std::printf("%llu\t%s\t%s\t%d\t%d\t%.2f\t%s\t%s\t%s\t%s\t%d\t%d\t%d\t%.4g\t%.4g\t%.4g\t%.4g\t%s\t%s\t%.3g\t%d\n",
                   static_cast<unsigned long long>(o.spec.seed), sweep::names(o.hidden).c_str(),
                   sweep::names(o.named).c_str(), o.right ? 1 : 0, o.spurious ? 1 : 0, o.seconds,

@@ -24,7 +24,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -92,7 +91,8 @@ inline MeasuredData measured(const fdgen::Generated& g) {
   return d;
 }
 
-inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
+// `log`: the fit's log lines (run_fit), for the caller to show; none by default.
+inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const Log& log = {}) {
   Outcome o;
   o.spec = spec;
   const fdgen::Generated g = fdgen::generate(spec);
@@ -115,11 +115,7 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}) {
   check_record(data, model.plant, model.control_period);  // the CLI's sanity checks: no false refusal
   const Record rec = prepare(data);
   check_force_scale(rec, model.plant);
-  // FD_SWEEP_VERBOSE=1: the fit's log on stderr (to look at one case)
-  const bool verbose = std::getenv("FD_SWEEP_VERBOSE") != nullptr;
-  const FitResult r = run_fit(rec, model.plant, opt, [verbose](const std::string& s) {
-    if (verbose) std::fprintf(stderr, "  %s\n", s.c_str());
-  });
+  const FitResult r = run_fit(rec, model.plant, opt, log);
   o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   o.conclusion = r.conclusion;
   std::map<std::string, std::map<std::string, double>> found;

@@ -250,8 +250,9 @@ std::string frequency_plot_script(const sim::Scenario& s, const FrequencyRespons
 
 }  // namespace
 
-std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
-                                     bool plots, const interrupt::StopToken& stop) {
+FrequencyResponseWritten write_frequency_response(const std::string& out_dir, const sim::Scenario& s,
+                                                  const FrequencyResponse& r, bool plots,
+                                                  const interrupt::StopToken& stop) {
   output::StagedFolder folder(out_dir, "feeddrive-sim");
   write_frequency_csv(folder, r);
   const nlohmann::ordered_json j = frequency_json(s, r);
@@ -264,8 +265,8 @@ std::string write_frequency_response(const std::string& out_dir, const sim::Scen
       plot_error = e.what();
     }
   }
-  folder.commit();
-  return plot_error;
+  std::vector<std::string> warnings = folder.commit();
+  return {plot_error, std::move(warnings)};
 }
 
 }  // namespace feeddrive::analysis

@@ -148,7 +148,8 @@ int fit_record(Args& a) {
                a.scenario_path);
   const fit::FitResult r =
       fit::run_fit(rec, scenario.plant, a.opt, [](const std::string& s) { spdlog::info("{}", s); });
-  fit::write_outputs(a.out_dir, a.scenario_path, rec, r, !a.no_plots, tool::stop_token());
+  for (const std::string& w : fit::write_outputs(a.out_dir, a.scenario_path, rec, r, !a.no_plots, tool::stop_token()))
+    spdlog::warn("{}", w);
   std::fputs(fit::result_table(r, a.out_dir).c_str(), stdout);
   // exit codes (docs/fit.md, "Verdicts"): 0 explained or no discrepancy, 3 unexplained, 2 bad input
   return fit::exit_code(r.verdict);

@@ -429,8 +429,8 @@ std::string plot_script(const Record& rec, const FitResult& r) {
 
 }  // namespace
 
-void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
-                   bool plots, const interrupt::StopToken& stop) {
+std::vector<std::string> write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec,
+                                       const FitResult& r, bool plots, const interrupt::StopToken& stop) {
   output::StagedFolder out(out_dir, "feeddrive-fit");
   out.write_text("findings.json", findings_json(r, rec.data));
   out.write_text("model.fitted.yaml", fitted_scenario_yaml(scenario_path, r.fitted));
@@ -439,7 +439,7 @@ void write_outputs(const std::string& out_dir, const std::string& scenario_path,
   write_effect_csvs(out, rec, r);
   out.write_text("report.md", report_md(scenario_path, rec, r, plots));
   if (plots) out.plot(plot_script(rec, r), stop);
-  out.commit();
+  return out.commit();
 }
 
 std::string result_table(const FitResult& r, const std::string& out_dir) {

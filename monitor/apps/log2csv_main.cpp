@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
     out.finish(out.summary(0.0, {}), plots, j.dump());
     if (!out.plot_error().empty())
       spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
+    for (const std::string& w : out.warnings()) spdlog::warn("{}", w);
     spdlog::info(
         "{}: {} events, {} rows, {} without their command, {} undecodable, {} non-finite, {} on other channels -> {}",
         log_path, c.events, out.steps(), rec.commandless_rows(), c.undecodable, c.non_finite, c.foreign_events,

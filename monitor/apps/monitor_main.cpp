@@ -1,5 +1,8 @@
 // feeddrive-monitor: records a run from its LCM channels into DIR/{timeseries.csv, summary.json,
 // *.png} (feeddrive-sim's format plus lockstep statistics). Wiring only: scenario -> MonitorNode.
+#include <cstdio>
+#include <string>
+
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/monitor/monitor_node.hpp"
 #include "feeddrive/output/folder.hpp"
@@ -40,6 +43,10 @@ int main(int argc, char** argv) {
     output::check_outside(mopt.lcm_log, "--lcm-log", mopt.out_dir);
     output::check_output_file(mopt.lcm_log, "--lcm-log", record::kLcmLogMagic);
     sim::check_run_size(s, mopt.out_dir);
+    // The progress line, each over the one before; the last one ends it.
+    mopt.progress = [](const std::string& line, bool last) {
+      std::fprintf(stderr, "\r%s   %s", line.c_str(), last ? "\n" : "");
+    };
     monitor::MonitorNode node(s, opt, mopt);
     const bool ok = node.run();
     opt.stop.check();  // a Ctrl-C while the plots were drawn: the data are written, the exit says interrupted

@@ -424,15 +424,16 @@ void MonitorNode::progress(bool force) {
   const std::int64_t now = mono_us();
   if (!force && now - when_.last_progress < us(mopt_.progress_interval_s)) return;
   when_.last_progress = now;
-  if (options().quiet) return;
+  if (options().quiet || !mopt_.progress) return;
   const double sim_t = static_cast<double>(rec_.next()) * s_.control_period;
   const double wall = static_cast<double>(now - when_.start) * 1e-6;
   const sim::Record& last = out_->last();
   const double err = out_->steps() == 0 ? 0.0 : (last.xd - (std::isnan(last.x) ? last.x_measured : last.x));
-  std::fprintf(stderr, "\r[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um   ",
-               static_cast<long long>(rec_.next()), static_cast<long long>(steps_expected()), sim_t,
-               wall > 0 ? sim_t / wall : 0.0, err * 1e6);
-  if (force) std::fprintf(stderr, "\n");
+  char line[200];
+  std::snprintf(line, sizeof line, "[monitor] step %lld/%lld  t = %.4f s  real-time factor %.3f  e = %+.4g um",
+                static_cast<long long>(rec_.next()), static_cast<long long>(steps_expected()), sim_t,
+                wall > 0 ? sim_t / wall : 0.0, err * 1e6);
+  mopt_.progress(line, force);
 }
 
 void MonitorNode::watch_rate_and_loggers(std::int64_t now) {
@@ -824,6 +825,7 @@ bool MonitorNode::write_results(const sim::Summary& sum, const std::string& writ
     }
     if (!out_->plot_error().empty() && !stop_.stop_requested())  // an interrupt is reported once, as such
       spdlog::warn("monitor: plots not drawn ({}); the data are in {}", out_->plot_error(), where);
+    for (const std::string& w : out_->warnings()) spdlog::warn("monitor: {}", w);
     return true;
   } catch (const std::exception& e) {
     spdlog::error("monitor: writing {} failed: {}", output::shown(mopt_.out_dir), e.what());

@@ -105,6 +105,16 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
   // fork and exec stays pending instead of being lost with the launcher's handler at exec (the
   // child then ran on to its 10 s start timeout).
   const pid_t launcher = ::getpid();
+  // What the child may say, prepared before fork: between fork and exec it makes only system
+  // calls (write(2), no stdio: another thread of the launcher may hold stdio's lock), and it has
+  // no caller to return an error to. Its exit code 127 tells the launcher that exec failed.
+  const std::string nice_failed = "warning: nice(" + std::to_string(niceness) + ") failed\n";
+  const std::string affinity_failed = "warning: sched_setaffinity failed\n";
+  const std::string exec_failed = "error: cannot execute " + exe + "\n";
+  const std::string refusal_fd_text = std::to_string(refusal_fd);
+  const auto say = [](const std::string& line) {
+    [[maybe_unused]] const auto n = ::write(2, line.data(), line.size());
+  };
   sigset_t stop, old;
   sigemptyset(&stop);
   sigaddset(&stop, SIGINT);
@@ -119,17 +129,17 @@ pid_t spawn(const std::string& exe, const std::vector<std::string>& args, int ni
     // the launcher died before this line, the parent is no longer it: stop at once.
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != launcher) ::_exit(143);
-    if (niceness != 0 && ::nice(niceness) == -1) std::fprintf(stderr, "warning: nice(%d) failed\n", niceness);
+    if (niceness != 0 && ::nice(niceness) == -1) say(nice_failed);
     if (!cpus.empty()) {
       cpu_set_t set;
       CPU_ZERO(&set);
       for (int c : cpus) CPU_SET(c, &set);
-      if (::sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "warning: sched_setaffinity failed\n");
+      if (::sched_setaffinity(0, sizeof set, &set) != 0) say(affinity_failed);
     }
     ::setenv(interrupt::kQuietEnv, "1", 1);  // an interrupt is reported once, by the launcher
-    if (refusal_fd >= 0) ::setenv(interrupt::kRefusalFdEnv, std::to_string(refusal_fd).c_str(), 1);  // and a refusal
+    if (refusal_fd >= 0) ::setenv(interrupt::kRefusalFdEnv, refusal_fd_text.c_str(), 1);  // and a refusal
     ::execv(exe.c_str(), argv.data());
-    std::fprintf(stderr, "error: cannot execute %s\n", exe.c_str());
+    say(exec_failed);
     ::_exit(127);
   }
   return pid;

@@ -51,8 +51,11 @@ void run_frequency_response(const sim::Scenario& scenario, analysis::FrequencyRe
   fr.stop = tool::stop_token();
   const auto r = analysis::measure_frequency_response(scenario, fr);
   if (!quiet) std::fputs(analysis::frequency_response_table(scenario, r).c_str(), stdout);
-  const std::string plot_error = analysis::write_frequency_response(out_dir, scenario, r, plots, tool::stop_token());
-  if (!plot_error.empty()) spdlog::warn("plots not drawn ({}); the data are in {}", plot_error, output::shown(out_dir));
+  const analysis::FrequencyResponseWritten written =
+      analysis::write_frequency_response(out_dir, scenario, r, plots, tool::stop_token());
+  if (!written.plot_error.empty())
+    spdlog::warn("plots not drawn ({}); the data are in {}", written.plot_error, output::shown(out_dir));
+  for (const std::string& w : written.warnings) spdlog::warn("{}", w);
   // as after a run: the scenario's and the options' plausibility warnings (frequency_response.json too)
   for (const std::string& w : r.warnings) spdlog::warn("{}", w);
   spdlog::info("{} frequencies in {:.1f} s -> {}", r.points.size(), r.wall_time_s, out_dir);
@@ -75,6 +78,7 @@ void run_scenario(const sim::Scenario& scenario, const std::string& out_dir, boo
   if (!out.plot_error().empty())
     spdlog::warn("plots not drawn ({}); the data are in {}", out.plot_error(), output::shown(out_dir));
   else if (plots) spdlog::info("plots drawn in {:.3f} s", out.plot_seconds());
+  for (const std::string& w : out.warnings()) spdlog::warn("{}", w);
   // After the run (a run that then fails says only why, in one line): the values that load but
   // are implausible for a linear feed drive, and a move the run cut off (summary.json too).
   for (const std::string& w : scenario.warnings) spdlog::warn("{}", w);

@@ -272,7 +272,7 @@ std::filesystem::path RunWriter::finish(const Summary& sum, bool plots, const st
   }
   if (extra_files) extra_files(folder_);
   if (!replace_earlier) return folder_.commit_keeping_earlier("incomplete");
-  folder_.commit();
+  warnings_ = folder_.commit();
   return folder_.target();
 }
 

@@ -62,13 +62,13 @@ class FolderLock {
 };
 
 // The study's output folder: reused if it is a feeddrive-study output, else made anew
-// (replacing only an empty folder or another feeddrive output).
-fs::path prepare_folder(const std::string& out) {
+// (replacing only an empty folder or another feeddrive output). `warnings`: the commit's.
+fs::path prepare_folder(const std::string& out, std::vector<std::string>& warnings) {
   const fs::path dir = fs::absolute(output::check_output_dir(out));
   if (output::output_tool(dir) != kTool) {
     output::StagedFolder staged(out, kTool);
     fs::create_directories(staged.dir() / "cases");
-    staged.commit(/*list_files=*/false);  // the study adds its cases and reports over reruns
+    warnings = staged.commit(/*list_files=*/false);  // the study adds its cases and reports over reruns
   }
   fs::create_directories(dir / "cases");
   return dir;
@@ -196,11 +196,12 @@ void list_cases(const CheckedStudy& c, const interrupt::StopToken& stop, Reporte
 struct LockedFolder {
   fs::path dir;
   std::unique_ptr<FolderLock> lock;
+  std::vector<std::string> warnings;  // for the reporter
 };
 LockedFolder open_folder(const std::string& out, Transport* t) {
   LockedFolder f;
   try {
-    f.dir = prepare_folder(out);
+    f.dir = prepare_folder(out, f.warnings);
     f.lock = std::make_unique<FolderLock>(f.dir);
   } catch (const std::invalid_argument& e) {
     if (t) t->broadcast(2);
@@ -463,6 +464,7 @@ StudyResult run_study(const Options& o, Transport* t, Reporter& reporter) {
   }
   const LockedFolder folder = open_folder(o.out, t);
   if (t) t->broadcast(0);
+  for (const std::string& w : folder.warnings) reporter.warning(w);
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1, available_cores() / (t ? t->local_size() : 1));
   const int ranks = t ? t->size() : 1;
   reporter.started(checked.study.name + ": " + std::to_string(checked.total) + " cases on " + std::to_string(jobs) +

@@ -280,7 +280,7 @@ TEST(FrequencyResponse, ScenarioAndOptionWarningsAreKeptAndWritten) {
   EXPECT_NE(r.warnings.front().find("above"), std::string::npos) << r.warnings.front();
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("fd_fr_warn_" + std::to_string(::getpid()));
-  write_frequency_response(dir.string(), s, r, false);
+  EXPECT_TRUE(write_frequency_response(dir.string(), s, r, false).warnings.empty());
   std::ifstream in(dir / "frequency_response.json");
   const auto j = nlohmann::json::parse(in);
   EXPECT_EQ(j["warnings"], nlohmann::json(s.warnings));

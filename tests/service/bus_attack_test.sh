@@ -52,13 +52,8 @@ peer() {
 }
 # child_of PID NAME: prints the pid of PID's child running NAME, waiting up to 10 s for it.
 child_of() {
-  local c
-  for _ in $(seq 200); do
-    c=$(pgrep -P "$1" -f "$2" | head -n 1 || true)
-    [ -n "$c" ] && { echo "$c"; return 0; }
-    sleep 0.05
-  done
-  fail "no $2 under process $1 within 10 s"
+  wait_until 10 "a $2 under process $1" pgrep -P "$1" -f "$2" > /dev/null
+  pgrep -P "$1" -f "$2" | head -n 1
 }
 # plant_up PID: waits until the feeddrive-launch under PID (a `launch ... &` subshell or a
 # `timeout feeddrive-launch &`) has started its plant: it passed the group check.

@@ -30,7 +30,7 @@ for n in range(100):
             + s(role) + s("running") + struct.pack(">qq", 0, -1) + s("") + struct.pack(">qqqqqq", 0, 0, 0, 0, 0, 0)
             + (struct.pack(">i", 3) if v3 else b"") + struct.pack(">h", 0))
     s_.sendto(b"LC02" + struct.pack(">I", n) + b"FD_STATUS\0" + body, ("239.255.76.67", port))
-    time.sleep(0.1)
+    time.sleep(0.1)  # a heartbeat every 100 ms: a rate, not a wait
 PY
 timeout 60 feeddrive-launch "$scen" --out "$TMP/v2" --no-plots -q --lcm-url "$URL" --run-id 77 --external controller 2> "$TMP/v2.err" & l=$!
 wait_on_bus $l feeddrive-monitor  # the run's monitor hears the heartbeats from the first one

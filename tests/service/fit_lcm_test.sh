@@ -21,12 +21,7 @@ prio=(chrt -f 20)
 "${prio[@]}" timeout 300 lcm-logger --lcm-url="$URL" --channel='FD_.*' --force "$LOGDIR/run.lcmlog" 2> "$TMP/logger.err" & lg=$!
 wait_on_bus $lg
 timeout 300 feeddrive-launch "$TMP/truth.yaml" --out "$TMP/mon" --no-plots -q --lcm-url "$URL"
-# Stays a fixed pause: the stock lcm-logger writes its file through a buffer it flushes only as
-# events come (--flush-interval) and does not drain its socket on SIGINT, so nothing outside it
-# shows that it has the run's last messages (waiting for FD_SUMMARY in its file timed out in
-# logger_test.sh: the tail sat in its buffer).
-sleep 0.5
-kill -INT $lg; wait $lg || true
+stop_logger $lg "$LOGDIR/run.lcmlog" FD  # once it has the whole run (lib.sh)
 [ -s "$LOGDIR/run.lcmlog" ] || { cat "$TMP/logger.err" >&2; fail "lcm-logger wrote no log"; }
 rows=$(( $(wc -l < "$TMP/mon/timeseries.csv") - 1 ))
 pass "recorded $(stat -c %s "$LOGDIR/run.lcmlog") bytes of LCM log; the monitor has $rows rows"

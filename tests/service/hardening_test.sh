@@ -59,23 +59,30 @@ pass "one run, one scenario: $(cat hash.log)"
 
 # running_children PID: the feeddrive processes whose parent is PID.
 running_children() { pgrep -P "$1" -f "feeddrive-(plant|controller|trajectory|monitor) " | wc -l; }
+# four_running PID: the launcher PID has started its four processes.
+four_running() { [ "$(running_children "$1")" = 4 ]; }
+# none_alive PID...: none of the processes PID... runs any more.
+none_alive() {
+  local k
+  for k in "$@"; do ! kill -0 "$k" 2> /dev/null || return 1; done
+}
+# progress FILE: the step of the monitor's last progress line in FILE ("" before the first).
+progress() { tr '\r' '\n' < "$1" | grep -o "step [0-9]*" | tail -n 1 | cut -d' ' -f2 || true; }
+# progress_at_least FILE STEP: that step is STEP or later.
+progress_at_least() {
+  local at
+  at=$(progress "$1")
+  [ "${at:-0}" -ge "$2" ]
+}
 
 # 3. SIGKILL of the launcher.
 feeddrive-launch s.yaml --out killed --no-plots -q --lcm-url "$URL" > killed.log 2>&1 & launcher=$!
-for _ in $(seq 200); do [ "$(running_children $launcher)" = 4 ] && break; sleep 0.05; done
-[ "$(running_children $launcher)" = 4 ] || fail "the launcher did not start four processes within 10 s"
+wait_until 10 "the launcher started its four processes" four_running $launcher
 kids=$(pgrep -P $launcher | tr '\n' ' ')
 sleep 1  # the fault under test: the launcher killed 1 s into the run (deliberate, not a wait)
 kill -KILL $launcher
 wait $launcher 2> /dev/null || true
-left=4
-for _ in $(seq 100); do
-  left=0
-  for k in $kids; do kill -0 "$k" 2> /dev/null && left=$((left + 1)); done
-  [ "$left" = 0 ] && break
-  sleep 0.05
-done
-[ "$left" = 0 ] || fail "$left of the launcher's processes still running 5 s after it was killed"
+wait_until 5 "the launcher's processes stopped after it was killed (still running: $kids)" none_alive $kids
 pass "SIGKILL of feeddrive-launch: its four processes stopped with it"
 
 # 4. SIGKILL of the monitor, mid-run, paced at 500 steps/s: the staged record goes beside --out
@@ -83,17 +90,12 @@ pass "SIGKILL of feeddrive-launch: its four processes stopped with it"
 # second; issue 19's review found 0 bytes after 3,000 steps).
 rc=0
 feeddrive-launch s.yaml --out mon --no-plots --lcm-url "$URL" --step-timeout 2 --max-rate 500 > mon.log 2>&1 & launcher=$!
-for _ in $(seq 200); do [ "$(running_children $launcher)" = 4 ] && break; sleep 0.05; done
+wait_until 10 "the launcher started its four processes" four_running $launcher
 monitor=$(pgrep -P $launcher -f "feeddrive-monitor " || true)
 [ -n "$monitor" ] || fail "no monitor under the launcher"
 # Killed once its progress line says step 1500 (3 s of steps), whatever the machine's load.
-at=0
-for _ in $(seq 600); do
-  at=$(tr '\r' '\n' < mon.log | grep -o "step [0-9]*" | tail -n 1 | cut -d' ' -f2 || true)
-  [ "${at:-0}" -ge 1500 ] && break
-  sleep 0.05
-done
-[ "${at:-0}" -ge 1500 ] || fail "the monitor did not reach step 1500 within 30 s"
+wait_until 30 "the monitor reached step 1500" progress_at_least mon.log 1500
+at=$(progress mon.log)
 kill -KILL "$monitor"
 wait $launcher || rc=$?
 [ "$rc" = 1 ] || { tail -5 mon.log >&2; fail "monitor killed: launch exited $rc, expected 1"; }

@@ -10,12 +10,12 @@ cd "$TMP"
 # A 1.5 s, 10 kHz run with plots: about 1 s of simulation and several of plotting.
 scen=$SRC/scenarios/paper/smc_sine.yaml
 
-# interrupt NAME PID WHEN: sends SIGINT to PID once WHEN (a shell test) holds, then checks exit
-# code, time to exit, stderr ($TMP/NAME.err) and that no staging folder remains.
+# interrupt NAME PID WHEN: sends SIGINT to PID once WHEN (a shell test) holds, within 30 s, then
+# checks exit code, time to exit, stderr ($TMP/NAME.err) and that no staging folder remains. A
+# WHEN that is only a sleep is a point in time of the phase under test, not a wait for something.
 interrupt() {
   local name=$1 pid=$2 when=$3 t0 t1 rc
-  for _ in $(seq 600); do eval "$when" && break; sleep 0.05; done
-  eval "$when" || fail "$name: the phase to interrupt never came"
+  wait_until 30 "$name: the phase to interrupt" eval "$when"
   t0=$(date +%s%N)
   kill -INT "$pid"
   rc=0
@@ -35,7 +35,7 @@ gnuplot_running() { pgrep -P "$1" gnuplot > /dev/null; }
 
 feeddrive-sim "$scen" --out sim_run -q 2> sim_run.err &
 p=$!
-interrupt sim_run $p "sleep 0.3; true"
+interrupt sim_run $p "sleep 0.3; true"  # under test: 0.3 s into the simulation (a point in time)
 [ ! -e sim_run ] || fail "sim_run: an output folder was created"
 
 feeddrive-sim "$scen" --out sim_plot -q 2> sim_plot.err &
@@ -52,7 +52,7 @@ timeout 120 feeddrive-sim truth.yaml --out fitdata --no-plots -q
 cut -d, -f1,7,13 fitdata/timeseries.csv | sed '1s/.*/t,x,u/' > fitdata.csv
 feeddrive-fit -s "$SRC/scenarios/fit/model.yaml" -d fitdata.csv --out fit_run -q > /dev/null 2> fit_run.err &
 p=$!
-interrupt fit_run $p "sleep 0.5; true"
+interrupt fit_run $p "sleep 0.5; true"  # under test: 0.5 s into the fit (a point in time)
 [ ! -e fit_run ] || fail "fit_run: an output folder was created"
 feeddrive-fit -s "$SRC/scenarios/fit/model.yaml" -d fitdata.csv --out fit_plot -q > /dev/null 2> fit_plot.err &
 p=$!
@@ -62,6 +62,7 @@ interrupt fit_plot $p "gnuplot_running $p"
 # feeddrive-launch: four processes in lockstep; SIGINT to the launcher is forwarded to each.
 feeddrive-launch "$scen" --out launch_run --lcm-url "$URL" --no-plots -q 2> launch_run.err &
 p=$!
+# Under test: 1 s after the monitor started, mid-run (a point in time, once the monitor is there).
 interrupt launch_run $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
 [ -z "$(pgrep -P $p)" ] || fail "launch_run: a child process still runs"
 [ "$(json launch_run/summary.json .lockstep.completed)" = false ] || fail "launch_run: summary does not say completed: false"
@@ -75,7 +76,7 @@ timeout 120 feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plo
 before=$(md5sum < launch_run2/timeseries.csv)
 feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plots -q 2> launch_run2.err &
 p=$!
-interrupt launch_run2 $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
+interrupt launch_run2 $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"  # as launch_run: a point in time
 [ "$(md5sum < launch_run2/timeseries.csv)" = "$before" ] || fail "launch_run2: the earlier output was changed"
 [ "$(json launch_run2/summary.json .lockstep.completed)" = true ] || fail "launch_run2: the earlier summary was replaced"
 [ "$(json launch_run2.incomplete-1/summary.json .lockstep.completed)" = false ] ||
@@ -86,7 +87,7 @@ pass "launch_run2: the earlier output kept, the interrupted record ($(json launc
 # between fork and exec was lost, and the child ran on to its 10 s start timeout.
 feeddrive-launch "$scen" --out launch_early --lcm-url "$URL" --no-plots -q 2> launch_early.err &
 p=$!
-interrupt launch_early $p "sleep 0.05; true"
+interrupt launch_early $p "sleep 0.05; true"  # under test: 50 ms in (a point in time)
 [ -z "$(pgrep -P $p)" ] || fail "launch_early: a child process still runs"
 
 # Ctrl-C while the monitor draws the plots of a complete run: what it recorded cannot be made

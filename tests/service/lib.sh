@@ -61,6 +61,24 @@ wait_on_bus() {
   port=${port%%\?*}
   wait_until 10 "${2:-process} $1 joined the LCM bus on port $port" on_bus "$port" "$1" "${2:-}"
 }
+# stop_logger PID FILE PREFIX: ends the stock lcm-logger PID (recording PREFIX_.* into FILE) once
+# FILE holds the run's last message, PREFIX_SUMMARY (the monitor sends it after every step is
+# in: a logger that wrote it has every message before it). The logger writes through a buffer
+# that it flushes only when an event comes and --flush-interval (100 ms) has passed, and it does
+# not drain its socket on SIGINT: after the run nothing would flush its tail. So fd-test-peer
+# mark sends a 5-byte marker on PREFIX_TEST_FLUSH every 20 ms (no part of the contract:
+# feeddrive-log2csv and feeddrive-fit count it among the foreign events), and the wait is on the
+# summary's channel name in FILE, within 10 s. Then SIGINT; the markers end first.
+stop_logger() {
+  local lg=$1 file=$2 prefix=$3 mk
+  "$BUILD/tests/fd-test-peer" mark --lcm-url "$URL" --prefix "$prefix" --seconds 30 > /dev/null & mk=$!
+  wait_until 10 "lcm-logger wrote ${prefix}_SUMMARY, the run's last message, to $file" \
+    grep -qaF "${prefix}_SUMMARY" "$file"
+  kill "$mk" 2> /dev/null || true
+  wait "$mk" 2> /dev/null || true
+  kill -INT "$lg"
+  wait "$lg" || true
+}
 # json FILE JQ-FILTER
 json() { jq -r "$2" "$1"; }
 # jerk_move FILE SECONDS: the paper's jerk-limited move (scenarios/paper/smc_bl_jerk_limited.yaml)

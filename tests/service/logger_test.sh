@@ -20,12 +20,7 @@ grep -q "lcm-logger (pid [0-9]*, [a-z-]* priority) on the bus: the run is paced 
   { cat "$TMP/launch.err"; fail "the launcher did not pace the run for the stock logger"; }
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.seen | length')" -ge 1 ] || fail "the monitor did not see the logger"
 [ "$(json "$TMP/mon/summary.json" '.lockstep.stock_loggers.faster_than_it_records')" = false ] || fail "paced run reported too fast"
-# Stays a fixed pause: the stock lcm-logger writes its file through a buffer it flushes only as
-# events come (--flush-interval) and does not drain its socket on SIGINT, so nothing outside it
-# shows that it has the run's last messages (waiting for FD_SUMMARY in its file timed out in
-# logger_test.sh: the tail sat in its buffer).
-sleep 0.5
-kill -INT $lg; wait $lg || true
+stop_logger $lg "$LOGDIR/run.lcmlog" FD  # once it has the whole run (lib.sh)
 timeout 120 feeddrive-log2csv "$LOGDIR/run.lcmlog" --scenario "$scen" --out "$TMP/conv" -q 2> "$TMP/conv.err"
 ! grep -q "steps missing" "$TMP/conv.err" || { cat "$TMP/conv.err" >&2; fail "the stock lcm-logger dropped messages of a paced run"; }
 same_csv "$TMP/mon/timeseries.csv" "$TMP/conv/timeseries.csv"

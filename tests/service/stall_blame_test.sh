@@ -18,7 +18,9 @@ feeddrive-controller "$scen" "${opts[@]}" 2> "$TMP/controller.err" & c=$!
 wait_on_bus $c
 sleep 1.5      # the fault under test: stopped 1.5 s into its run (a deliberate point, not a wait)
 kill -STOP $c; echo "controller stopped"
-sleep 3.5      # past the 2 s step timeout: the plant has failed meanwhile
+# Resumed once the plant has failed (its 2 s step timeout): its error line is in the launcher's
+# stderr.
+wait_until 30 "the plant failed while the controller was stopped" grep -q "feeddrive-plant\] \[error\]" "$TMP/launch.err"
 kill -CONT $c; echo "controller resumed"
 set +e; wait $l; rl=$?; wait $c; rc=$?; set -e
 [ $rl -ne 0 ] && [ $rl -ne 124 ] || fail "launch exit $rl"

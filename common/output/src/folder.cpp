@@ -472,7 +472,10 @@ fs::path StagedFolder::commit_keeping_earlier(const std::string& kind, bool list
   if (done_) throw std::logic_error("StagedFolder::commit called twice");
   std::error_code ec;
   if (!fs::exists(fs::symlink_status(target_, ec))) {
-    commit(list_files);
+    // No earlier output: a rename, nothing to remove, so no warning (one would come only from
+    // a folder put there in the instant since the check; commit() then replaces it only if it
+    // is a feeddrive output or empty).
+    (void)commit(list_files);
     return target_;
   }
   finish_marker(list_files);
@@ -480,7 +483,7 @@ fs::path StagedFolder::commit_keeping_earlier(const std::string& kind, bool list
   return move_beside(staging_, target_, kind, option_ + " " + shown(value_) + ": ");
 }
 
-void StagedFolder::commit(bool list_files) {
+std::vector<std::string> StagedFolder::commit(bool list_files) {
   if (done_) throw std::logic_error("StagedFolder::commit called twice");
   const std::string what = option_ + " " + shown(value_) + ": ";
   const std::string kept = "; the results are in " + staging_.string();
@@ -495,8 +498,14 @@ void StagedFolder::commit(bool list_files) {
     if (::rename(staging_.c_str(), target_.c_str()) != 0)
       throw std::runtime_error(what + "cannot rename the results into place: " + error_text(errno) + kept);
     sync_parent(target_);
-    return;
+    return {};
   }
+  // The results are in place; the previous output, moved to `old`, stays there when it cannot
+  // be removed: a warning for the caller, not a failure.
+  const auto removed = [&](const fs::path& old) -> std::vector<std::string> {
+    if (remove_output(old)) return {};
+    return {what + "could not remove the previous output, now in " + old.string()};
+  };
   const auto ours = [](const fs::path& d) {
     return (is_feeddrive_output(d) && foreign_entry(d).empty()) || empty_folder(d);
   };
@@ -520,10 +529,7 @@ void StagedFolder::commit(bool list_files) {
       throw std::runtime_error(what + "changed during the run; the folder found there was moved to " +
                                staging_.string() + " and could not be moved back (" + error_text(err2) + ")");
     }
-    if (!remove_output(staging_))
-      std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),
-                   staging_.c_str());
-    return;
+    return removed(staging_);
   }
   if (err != EINVAL && err != ENOSYS && err != EOPNOTSUPP)
     throw std::runtime_error(what + "cannot swap the results into place: " + error_text(err) + kept);
@@ -541,9 +547,7 @@ void StagedFolder::commit(bool list_files) {
     throw std::runtime_error(what + "cannot rename the results into place: " + error_text(e) + kept);
   }
   sync_parent(target_);
-  if (!remove_output(backup))
-    std::fprintf(stderr, "warning: %s: could not remove the previous output, now in %s\n", shown(value_).c_str(),
-                 backup.c_str());
+  return removed(backup);
 }
 
 }  // namespace feeddrive::output

@@ -25,6 +25,12 @@
 //   replay-status   records the run's own heartbeats (signed, under --key) during its first
 //                   0.3 s and sends them again, every 10 ms, until --seconds: the plant's go
 //                   back; they must not end the run as a "restart".
+//   mark            not a misbehaving peer: the flush markers of the tests that record with the
+//                   stock lcm-logger (lib.sh, stop_logger). Every 20 ms for --seconds, the 5 bytes
+//                   "flush" on <prefix>_TEST_FLUSH, a channel that is no part of the contract
+//                   (docs/lcm-contract.md) and no LCM type: feeddrive-log2csv and feeddrive-fit
+//                   count it among the foreign events. lcm-logger flushes its file only when an
+//                   event comes (--flush-interval), so the markers bring its buffered tail out.
 // Every peer joins the run of the first message it hears (or --run-id).
 #include <CLI/CLI.hpp>
 
@@ -55,8 +61,9 @@ int main(int argc, char** argv) {
   std::int64_t run_id = 0;
   app.add_option("mode", mode)
       ->required()
-      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
-                             "forge-reference", "malformed", "fake-monitor", "fake-heartbeats", "replay-status"}));
+      ->check(
+          CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
+                         "forge-reference", "malformed", "fake-monitor", "fake-heartbeats", "replay-status", "mark"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -65,6 +72,19 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds);
   CLI11_PARSE(app, argc, argv);
 
+  if (mode == "mark") {
+    lcm::LCM raw(url);
+    if (!raw.good()) return 1;
+    const std::string channel = prefix + "_TEST_FLUSH";
+    const auto end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    long n = 0;
+    for (; mono_us() < end; ++n) {
+      raw.publish(channel, "flush", 5);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a rate, not a wait
+    }
+    std::printf("mark: %ld markers on %s\n", n, channel.c_str());
+    return 0;
+  }
   Bus bus(url);
   if (run_id != 0) {
     bus.set_run_id(run_id);

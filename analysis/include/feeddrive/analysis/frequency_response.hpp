@@ -136,8 +136,13 @@ std::vector<double> unwrapped_phase_deg(const std::vector<std::complex<double>>&
 /// The table printed by the tool (one row per frequency, the amplitudes and the summary figures).
 std::string frequency_response_table(const sim::Scenario& s, const FrequencyResponse& r);
 /// Writes DIR/frequency_response.csv, frequency_response.json and (plots) bode_reference.png,
-/// bode_compliance.png, bode_loop.png through an output::StagedFolder. Returns the plot error ("" ok).
-std::string write_frequency_response(const std::string& out_dir, const sim::Scenario& s, const FrequencyResponse& r,
-                                     bool plots, const interrupt::StopToken& stop = {});
+/// bode_compliance.png, bode_loop.png through an output::StagedFolder.
+struct FrequencyResponseWritten {
+  std::string plot_error;             ///< why the plots were not drawn ("" ok); the data are in place
+  std::vector<std::string> warnings;  ///< StagedFolder::commit's, one line each, for the tool to log
+};
+[[nodiscard]] FrequencyResponseWritten write_frequency_response(const std::string& out_dir, const sim::Scenario& s,
+                                                                const FrequencyResponse& r, bool plots,
+                                                                const interrupt::StopToken& stop = {});
 
 }  // namespace feeddrive::analysis

@@ -3,6 +3,7 @@
 // place when complete): findings.json, model.fitted.yaml, report.md and its PNG plots (gnuplot).
 
 #include <string>
+#include <vector>
 
 #include "feeddrive/common/interrupt.hpp"
 #include "feeddrive/fit/workflow.hpp"
@@ -20,8 +21,10 @@ std::string findings_json(const FitResult& r, const MeasuredData* data = nullptr
 /// Writes the results into out_dir through output::StagedFolder (feeddrive/output/folder.hpp:
 /// check --out before the work with output::check_output_dir). Throws std::invalid_argument if
 /// out_dir must not be replaced, std::runtime_error if writing fails; a previous output is kept.
-void write_outputs(const std::string& out_dir, const std::string& scenario_path, const Record& rec, const FitResult& r,
-                   bool plots, const interrupt::StopToken& stop = {});
+/// Returns the warnings of putting the folder in place (StagedFolder::commit), for the tool to log.
+[[nodiscard]] std::vector<std::string> write_outputs(const std::string& out_dir, const std::string& scenario_path,
+                                                     const Record& rec, const FitResult& r, bool plots,
+                                                     const interrupt::StopToken& stop = {});
 
 /// The tool's result table: the gap and force residual RMS of the model as given and after each
 /// addition, the conclusion, the tentative effects, the ties, the unexplained rest and where the

@@ -15,6 +15,7 @@
 // ends.
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
@@ -42,6 +43,10 @@ struct MonitorOptions {
   bool plots{true};
   bool attach{false};
   double progress_interval_s{0.5};
+  /// Where the progress line goes, every progress_interval_s (not with --quiet): `line` without
+  /// a line end; `last` for the run's final one. The tool draws it (feeddrive-monitor: stderr,
+  /// each line over the one before); unset: no progress line. This library prints nothing.
+  std::function<void(const std::string& line, bool last)> progress;
   /// If set: every message of the run received on the bus (channels <prefix>_*, re-published
   /// ones included) also goes to this file, in the standard LCM log format (lcm_log.hpp), with
   /// the kernel's receive time: what lcm-logger writes, without another process on the group.

@@ -99,6 +99,10 @@ class RunWriter {
   /// Why the plots could not be drawn ("" if they were or were not asked for); the data were
   /// written all the same.
   const std::string& plot_error() const { return plot_error_; }
+  /// What finish() could not do although the results are in place (the previous output not
+  /// removed: StagedFolder::commit), one line each, for the caller to log; this library prints
+  /// nothing.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
   const Scenario& s_;
@@ -108,6 +112,7 @@ class RunWriter {
   long every_;
   double expected_steps_;
   bool keep_on_interrupt_{false};
+  std::vector<std::string> warnings_;
   interrupt::StopToken stop_token_;
   SummaryBuilder summary_;
   output::MinMaxReducer plot_;

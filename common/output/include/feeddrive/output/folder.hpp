@@ -27,6 +27,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "feeddrive/common/interrupt.hpp"
 
@@ -120,8 +121,11 @@ class StagedFolder {
   /// marker lists every entry written (see the top of this file); a folder that keeps growing
   /// after the commit (feeddrive-study's, over reruns) is committed without the list. Every file
   /// and folder in it is flushed to disk (fsync) before the rename, and the parent after it: a
-  /// power cut never leaves the target with empty or short files.
-  void commit(bool list_files = true);
+  /// power cut never leaves the target with empty or short files. Returns the warnings, one line
+  /// each, for the caller to report (this library prints nothing): the results are in place but
+  /// the previous output could not be removed ("--out DIR: could not remove the previous output,
+  /// now in PATH").
+  [[nodiscard]] std::vector<std::string> commit(bool list_files = true);
   /// Like commit(), but an earlier output in the target is kept: the folder goes to the target
   /// if there is none, else to the first free sibling "TARGET.KIND-N" (N = 1, 2, ...; never onto
   /// anything). Returns where it went. For a record that must not replace a complete one (the
