@@ -76,18 +76,21 @@ void MonitorNode::on_state(const drive_state_t& m, std::int64_t t) {
   on_state_timing(m, t);
 }
 
+// The local process that owns the UDP port of an "IP:PORT" source ("" if none is found).
+std::string MonitorNode::process_on_source(const std::string& source) {
+  const auto colon = source.rfind(':');
+  return colon == std::string::npos ? "" : service::local_process_on_udp_port(std::atoi(source.c_str() + colon + 1));
+}
+
+void MonitorNode::note_source(const std::string& source) {
+  if (commands_.source_process.count(source) || commands_.source_process.size() >= 16) return;
+  commands_.source_process[source] = process_on_source(source);
+}
+
 void MonitorNode::on_command(const control_command_t& m, std::int64_t t) {
   SentCommand& first = commands_.first[static_cast<std::uint64_t>(m.seq) % commands_.first.size()];
   const SentCommand sent{m.seq, m.u, bus().current_source()};
-  // The local process behind each command source, looked up when the source is first heard (a
-  // process that has exited by the time a conflict is judged can no longer be found): at most
-  // 16 sources, one /proc scan each.
-  if (!commands_.source_process.count(sent.sender) && commands_.source_process.size() < 16) {
-    const auto colon = sent.sender.rfind(':');
-    commands_.source_process[sent.sender] =
-        colon == std::string::npos ? ""
-                                   : service::local_process_on_udp_port(std::atoi(sent.sender.c_str() + colon + 1));
-  }
+  note_source(sent.sender);
   try {
     if (!admit(ledgers_.command, channels().command, m.seq, m)) return;
   } catch (const service::RunFailure&) {
@@ -99,7 +102,9 @@ void MonitorNode::on_command(const control_command_t& m, std::int64_t t) {
       if (a.first == m.seq) commands_.conflict->applied_known = true, commands_.conflict->applied_u = a.second;
       for (SentCommand* c : {&commands_.conflict->first, &commands_.conflict->second}) {
         // "IP:PORT" of its UDP source, and the local process that owns that port if any.
-        const auto known = commands_.source_process.find(c->sender);
+        auto known = commands_.source_process.find(c->sender);
+        if (known != commands_.source_process.end() && known->second.empty())
+          known->second = process_on_source(c->sender);  // once more: it may have bound since
         if (known != commands_.source_process.end() && !known->second.empty()) c->sender += " " + known->second;
       }
     }
@@ -155,7 +160,10 @@ void MonitorNode::watch_bus_events() {
     on_undecodable(ch, d, n, why);
   };
   bus().set_events(std::move(ev));
-  on_peer_status = [this](const process_status_t& m) { check_peer_status(m); };
+  on_peer_status = [this](const process_status_t& m) {
+    note_source(bus().current_source());  // a participant's heartbeats and commands share its socket
+    check_peer_status(m);
+  };
   on_peer_status_back = [this](const process_status_t& m) {  // "starting" after "running": a restart?
     if (m.role == "plant" && m.state != "failed") plant_went_back(m);
   };

@@ -99,6 +99,13 @@ class MonitorNode : public service::Node {
   /// A command of the run: its sender noted, admitted (a conflict keeps both commands and who
   /// sent them, then rethrows), then recorded and timed.
   void on_command(const control_command_t& m, std::int64_t t);
+  /// The local process behind a source "IP:PORT" (its UDP port's owner in /proc), looked up
+  /// once per source, at most 16, when the source is first heard: on a participant's first
+  /// heartbeat, long before its commands (one socket sends both). A process that has exited by
+  /// the time a conflict is judged can no longer be found (CI, stop 29: the controller whose
+  /// command 0 met a forged one had exited before a loaded monitor read its backlog).
+  void note_source(const std::string& source);
+  static std::string process_on_source(const std::string& source);
   /// --lcm-log: opens the LCM log and taps the bus so that every message of the run goes to it.
   void open_lcm_log(const service::NodeOptions& opt);
   /// The run's self-description (run_info_t), published on heartbeats and on request; not when attached.
@@ -230,7 +237,7 @@ class MonitorNode : public service::Node {
     /// step: the state can come before the second command of a conflict does.
     std::vector<std::pair<std::int64_t, double>> applied =
         std::vector<std::pair<std::int64_t, double>>(4096, {-1, 0.0});
-    std::map<std::string, std::string> source_process;  ///< command source "IP:PORT" -> local process
+    std::map<std::string, std::string> source_process;  ///< source "IP:PORT" -> local process (note_source)
   } commands_;
 
   /// What the bus events named, to name each once and judge who fills a role.
