@@ -96,11 +96,6 @@ void read_plant(MapReader r, PlantParams& p, bool with_effects) {
 
 // --- controller ----------------------------------------------------------------------------
 
-void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
-  read_fields(r, p);
-  read_plant(r.child("model"), p.model, true);
-}
-
 // A controller's nominal model by default: the plant itself, without the effects it does not know.
 PlantParams model_of_plant(const PlantParams& plant) {
   PlantParams m = plant;
@@ -111,7 +106,7 @@ PlantParams model_of_plant(const PlantParams& plant) {
 // type plugin (docs/plugins.md): library (resolved against the scenario's folder), parameters
 // (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
 // The library is opened here (file, symbols, ABI version), so a bad one fails at load.
-void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& base_dir) {
+void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, const std::string& base_dir) {
   p.library = r.required_string("library");
   if (fs::path(p.library).is_relative()) p.library = (fs::path(base_dir) / p.library).lexically_normal().string();
   r.record("library", p.library, true);
@@ -128,11 +123,11 @@ void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& b
   params.finish();
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), p.model, false);
+  read_plant(r.child("model"), model, false);
 }
 
 // tuning: manual (kp, kv, ki as given) or rule (kp, kv, ki must then not be given; the gains are
-// set after loading by controller::apply_tuning, not here); bandwidth_scale only with the rule.
+// set by derive() through controller::apply_tuning, not here); bandwidth_scale only with the rule.
 void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model) {
   std::string tuning = fields::enum_name(p.tuning);
   r.string("tuning", tuning);
@@ -150,10 +145,6 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model
     read_fields(r, p, {"bandwidth_scale"});
   }
   read_plant(r.child("model"), model, false);
-  p.mass = model.mass;
-  p.thrust_gain = model.thrust_gain();
-  p.friction = model.friction;
-  p.quantization = model.sensor.quantization;
 }
 
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
@@ -334,12 +325,13 @@ void find_warnings(Scenario& s) {
   }
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
-  if (!root.IsMap())
-    throw ScenarioError(
-        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "", resolved);
-  Scenario s;
+// --- read ------------------------------------------------------------------------------------
+// Reading fills the struct from the YAML and checks what only the YAML can tell (keys, types,
+// values as written); derive() then computes what one section takes from another, and
+// check_scenario() validates the whole (parse_node: read -> derive -> check).
+
+// name, duration and control_period, each error quoting the value as written.
+void read_timing(MapReader& top, const YAML::Node& root, Scenario& s) {
   top.string("name", s.name);
   check_name(s.name, "name");
   if (!top.has("duration")) top.fail("duration", ": missing (required)");
@@ -354,86 +346,92 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
     throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " +
                         root["control_period"].Scalar() + ": " + steps_text(n) + " steps; a run has at most " +
                         validate::format_number(kMaxSteps) + " steps (docs/scenario.md, Limits)");
+}
 
-  {
-    MapReader plant = top.child("plant");
-    s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
-    read_plant(plant, s.plant, true);
-    // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
-    // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
-    const YAML::Node pn = root["plant"];
-    const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
-                                                     {"grinding", s.plant.grinding.enabled},
-                                                     {"electrical", s.plant.electrical.enabled}};
-    for (const auto& [name, on] : sections) {
-      if (on || !pn.IsMap()) continue;
-      const YAML::Node sec = pn[name];
-      if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
-      if (sec.size() > 0)
-        s.warnings.push_back(
-            std::string("plant.") + name +
-            ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
-    }
+// plant: its keys, and a warning for a section given with keys but without `enabled` (off, its
+// keys do not act: a forgotten enabled: true). A section that says `enabled: false` is off on
+// purpose: no warning.
+void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
+  MapReader plant = top.child("plant");
+  s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
+  read_plant(plant, s.plant, true);
+  const YAML::Node pn = root["plant"];
+  const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
+                                                   {"grinding", s.plant.grinding.enabled},
+                                                   {"electrical", s.plant.electrical.enabled}};
+  for (const auto& [name, on] : sections) {
+    if (on || !pn.IsMap()) continue;
+    const YAML::Node sec = pn[name];
+    if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
+    if (sec.size() > 0)
+      s.warnings.push_back(std::string("plant.") + name +
+                           ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
   }
+}
 
+// controller: its type's keys; the nominal model (controller.model) into s.controller.model, on
+// top of the plant's own parameters (a model never carries the plant's effects).
+void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const std::string& base_dir) {
+  ControllerConfig& cc = s.controller;
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");
-  c.number("computation_delay", s.controller.computation_delay);
-  if (s.controller.computation_delay < 0.0)
+  c.number("computation_delay", cc.computation_delay);
+  if (cc.computation_delay < 0.0)
     c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
+  cc.model = model_of_plant(s.plant);
   if (type == "sliding_mode") {
-    s.controller.type = ControllerType::kSlidingMode;
-    s.controller.sliding_mode.model = model_of_plant(s.plant);
-    // A model never carries the plant's sensor or initial state; they are not part of it.
-    read_sliding_mode(c, s.controller.sliding_mode);
-    s.controller.sliding_mode.period = s.control_period;
-    s.controller.sliding_mode.computation_delay = s.controller.computation_delay;
+    cc.type = ControllerType::kSlidingMode;
+    read_fields(c, cc.sliding_mode);
+    read_plant(c.child("model"), cc.model, true);
   } else if (type == "cascade") {
-    s.controller.type = ControllerType::kCascade;
-    PlantParams model = s.plant;
-    read_cascade(c, s.controller.cascade, model);
-    s.controller.cascade.period = s.control_period;
-    s.controller.cascade.computation_delay = s.controller.computation_delay;
-    if (!(s.controller.cascade.bandwidth_scale > 0.0))  // before the rule divides by it
-      c.fail("bandwidth_scale",
-             " = " + validate::format_number(s.controller.cascade.bandwidth_scale) + ": must be > 0");
-    controller::apply_tuning(s.controller.cascade, model.sensor.differenced_velocity());
+    cc.type = ControllerType::kCascade;
+    read_cascade(c, cc.cascade, cc.model);
+    if (!(cc.cascade.bandwidth_scale > 0.0))  // derive()'s tuning rule divides by it
+      c.fail("bandwidth_scale", " = " + validate::format_number(cc.cascade.bandwidth_scale) + ": must be > 0");
   } else if (type == "open_loop") {
-    s.controller.type = ControllerType::kOpenLoop;
-    read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
-    s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
+    cc.type = ControllerType::kOpenLoop;
+    read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir);
   } else if (type == "plugin") {
-    s.controller.type = ControllerType::kPlugin;
-    s.controller.plugin.model = model_of_plant(s.plant);
-    read_plugin(c, s.controller.plugin, base_dir);
-    s.controller.plugin.period = s.control_period;
-    s.controller.plugin.computation_delay = s.controller.computation_delay;
+    cc.type = ControllerType::kPlugin;
+    read_plugin(c, cc.plugin, cc.model, base_dir);
   } else {
     c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
   }
-  s.controller.model_given = c.has("model");
+  cc.model_given = c.has("model");
   c.finish();
+}
 
-  read_reference(top.child("reference"), s.reference, base_dir);
-  {
-    MapReader o = top.child("output");
-    o.integer("every", s.output.every);
-    o.string_list("columns", s.output.columns);
-    o.finish();
-    if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
-    const auto& all = record_columns();
-    for (const std::string& c : s.output.columns) {
-      if (std::find(all.begin(), all.end(), c) == all.end()) {
-        std::string known;
-        for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
-        o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
-      }
-      if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
-        o.fail("columns", ": column '" + c + "' listed twice");
+void read_output(MapReader& top, const YAML::Node& root, OutputConfig& out) {
+  MapReader o = top.child("output");
+  o.integer("every", out.every);
+  o.string_list("columns", out.columns);
+  o.finish();
+  if (out.every < 1) o.fail("every", " = " + std::to_string(out.every) + ": must be an integer >= 1");
+  const auto& all = record_columns();
+  for (const std::string& c : out.columns) {
+    if (std::find(all.begin(), all.end(), c) == all.end()) {
+      std::string known;
+      for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
+      o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
     }
-    if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
-      o.fail("columns", ": empty list (leave the key out to record every column)");
+    if (std::count(out.columns.begin(), out.columns.end(), c) > 1)
+      o.fail("columns", ": column '" + c + "' listed twice");
   }
+  if (top.has("output") && root["output"]["columns"].IsDefined() && out.columns.empty())
+    o.fail("columns", ": empty list (leave the key out to record every column)");
+}
+
+Scenario read_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
+  if (!root.IsMap())
+    throw ScenarioError(
+        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
+  MapReader top(root, "", resolved);
+  Scenario s;
+  read_timing(top, root, s);
+  read_plant_section(top, root, s);
+  read_controller(top, root, s, base_dir);
+  read_reference(top.child("reference"), s.reference, base_dir);
+  read_output(top, root, s.output);
   MapReader a = top.child("analysis");
   a.number("settled_after", s.analysis.settled_after);
   a.number("settling_band", s.analysis.settling_band);
@@ -443,8 +441,45 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
   if (s.analysis.settling_band < 0.0)
     a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
                                 ": must be >= 0 (0: 2 % of the move's distance)");
+  return s;
+}
 
-  // Component validation: each validate() names its key and value; tables come from the files.
+// --- derive ----------------------------------------------------------------------------------
+
+// What one section takes from another: the controller's nominal model, control period and
+// computation delay; the cascade's model values and its tuning rule (controller::apply_tuning);
+// the open-loop command's thrust gain (the plant's Ka*Kf).
+void derive(Scenario& s) {
+  ControllerConfig& cc = s.controller;
+  switch (cc.type) {
+    case ControllerType::kSlidingMode:
+      cc.sliding_mode.model = cc.model;
+      cc.sliding_mode.period = s.control_period;
+      cc.sliding_mode.computation_delay = cc.computation_delay;
+      break;
+    case ControllerType::kCascade:
+      cc.cascade.mass = cc.model.mass;
+      cc.cascade.thrust_gain = cc.model.thrust_gain();
+      cc.cascade.friction = cc.model.friction;
+      cc.cascade.quantization = cc.model.sensor.quantization;
+      cc.cascade.period = s.control_period;
+      cc.cascade.computation_delay = cc.computation_delay;
+      controller::apply_tuning(cc.cascade, cc.model.sensor.differenced_velocity());
+      break;
+    case ControllerType::kOpenLoop: cc.open_loop.thrust_gain = s.plant.thrust_gain(); break;
+    case ControllerType::kPlugin:
+      cc.plugin.model = cc.model;
+      cc.plugin.period = s.control_period;
+      cc.plugin.computation_delay = cc.computation_delay;
+      break;
+  }
+}
+
+// --- check -----------------------------------------------------------------------------------
+
+// Component validation (each validate() names its key and value; tables come from the files),
+// the run's length, the functions of time (messages quote root's sections) and the warnings.
+void check_scenario(Scenario& s, const YAML::Node& root) {
   try {
     if (s.reference.type == ReferenceType::kWaypoints)
       s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
@@ -469,6 +504,12 @@ Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Resolve
                         validate::format_number(s.control_period) + " s)");
   check_functions_of_time(s, root);
   find_warnings(s);
+}
+
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
+  Scenario s = read_node(root, base_dir, resolved);
+  derive(s);
+  check_scenario(s, root);
   return s;
 }
 

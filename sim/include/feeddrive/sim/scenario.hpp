@@ -76,6 +76,11 @@ struct ControllerConfig {
   /// type plugin: controller.library (resolved against the scenario's folder), .parameters,
   /// .model, .u_min, .u_max (docs/plugins.md).
   controller::PluginParams plugin;
+  /// The nominal model of sliding_mode, cascade and plugin (controller.model, its keys not given
+  /// the plant's own parameters, without the plant's effects). The loader hands it to the
+  /// controller's params (sliding_mode.model, plugin.model, the cascade's mass, thrust_gain,
+  /// friction and quantization).
+  plant::PlantParams model;
   /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
   /// plant's own parameters without its effects; summary.json says so as controller_model).
   bool model_given{false};
