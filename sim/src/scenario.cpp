@@ -37,14 +37,16 @@ std::string output_shown(const std::string& s) {
 
 // plant.effects.<name>: listing an effect enables it (an optional `enabled: false` switches it
 // off again); the parameters not given keep the struct's defaults.
+// The listed ones go into `listed` by their dotted key (Scenario::listed_effects).
 class EffectsReadArchive {
  public:
-  explicit EffectsReadArchive(MapReader& r) : r_(r) {}
+  EffectsReadArchive(MapReader& r, std::set<std::string>& listed) : r_(r), listed_(listed) {}
   template <typename T>
   void Visit(const fields::Field<T>& f) {
     const bool listed = r_.has(f.meta.name);
     MapReader m = r_.child(f.meta.name);  // marks the name as known, for finish()'s hints
     if (!listed) return;
+    listed_.insert(r_.key_path(f.meta.name));
     f.value->enabled = true;
     read_fields(m, *f.value);
     m.finish();
@@ -52,6 +54,7 @@ class EffectsReadArchive {
 
  private:
   MapReader& r_;
+  std::set<std::string>& listed_;
 };
 
 // plant.ripple: a map of keys, where `preset: paper` starts from the paper's values
@@ -76,14 +79,14 @@ void read_ripple(MapReader& r, plant::RippleParams& p) {
   m.finish();
 }
 
-// The plant (with_effects) or a controller's model of it: a cascade's or plugin's model has no
-// effects, they are the plant's discrepancy from the model.
-void read_plant(MapReader r, PlantParams& p, bool with_effects) {
+// The plant (listed_effects given: the effects it lists go there) or a controller's model of it:
+// a cascade's or plugin's model has no effects, they are the plant's discrepancy from the model.
+void read_plant(MapReader r, PlantParams& p, std::set<std::string>* listed_effects) {
   read_fields(r, p, {"ripple", "effects"});
   read_ripple(r, p.ripple);
-  if (with_effects) {
+  if (listed_effects != nullptr) {
     MapReader e = r.child("effects");
-    EffectsReadArchive a(e);
+    EffectsReadArchive a(e, *listed_effects);
     p.effects.Serialize(&a);
     e.finish();
   } else if (r.has("effects")) {
@@ -109,7 +112,6 @@ PlantParams model_of_plant(const PlantParams& plant) {
 void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, const std::string& base_dir) {
   p.library = r.required_string("library");
   if (fs::path(p.library).is_relative()) p.library = (fs::path(base_dir) / p.library).lexically_normal().string();
-  r.record("library", p.library, true);
   MapReader params = r.child("parameters");
   for (const std::string& key : params.keys()) {
     const bool word = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
@@ -123,7 +125,7 @@ void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, 
   params.finish();
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), model, false);
+  read_plant(r.child("model"), model, nullptr);
 }
 
 // tuning: manual (kp, kv, ki as given) or rule (kp, kv, ki must then not be given; the gains are
@@ -144,14 +146,13 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model
     if (r.has("bandwidth_scale")) r.fail("bandwidth_scale", ": only with tuning: rule");
     read_fields(r, p, {"bandwidth_scale"});
   }
-  read_plant(r.child("model"), model, false);
+  read_plant(r.child("model"), model, nullptr);
 }
 
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_fields(r, p);
   r.string("file", file);
   if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
-  r.record("file", file, true);
   if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
@@ -175,7 +176,6 @@ void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir
     case ReferenceType::kWaypoints:
       c.waypoints_file = r.required_string("file");
       if (fs::path(c.waypoints_file).is_relative()) c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
-      r.record("file", c.waypoints_file, true);
       break;
   }
   r.finish();
@@ -354,7 +354,7 @@ void read_timing(MapReader& top, const YAML::Node& root, Scenario& s) {
 void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
   MapReader plant = top.child("plant");
   s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
-  read_plant(plant, s.plant, true);
+  read_plant(plant, s.plant, &s.listed_effects);
   const YAML::Node pn = root["plant"];
   const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
                                                    {"grinding", s.plant.grinding.enabled},
@@ -382,7 +382,7 @@ void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const 
   if (type == "sliding_mode") {
     cc.type = ControllerType::kSlidingMode;
     read_fields(c, cc.sliding_mode);
-    read_plant(c.child("model"), cc.model, true);
+    read_plant(c.child("model"), cc.model, &s.listed_effects);
   } else if (type == "cascade") {
     cc.type = ControllerType::kCascade;
     read_cascade(c, cc.cascade, cc.model);
@@ -421,11 +421,11 @@ void read_output(MapReader& top, const YAML::Node& root, OutputConfig& out) {
     o.fail("columns", ": empty list (leave the key out to record every column)");
 }
 
-Scenario read_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
+Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsMap())
     throw ScenarioError(
         "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "", resolved);
+  MapReader top(root, "");
   Scenario s;
   read_timing(top, root, s);
   read_plant_section(top, root, s);
@@ -506,8 +506,8 @@ void check_scenario(Scenario& s, const YAML::Node& root) {
   find_warnings(s);
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
-  Scenario s = read_node(root, base_dir, resolved);
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
+  Scenario s = read_node(root, base_dir);
   derive(s);
   check_scenario(s, root);
   return s;
@@ -550,12 +550,113 @@ PlantParams Scenario::drive() const {
   return p;
 }
 
+// --- the run's description from the struct (resolved_keys) -------------------------------------
+
+namespace {
+
+// plant.effects.<name>: the listed effects' keys (Scenario::listed_effects).
+class EffectsKeyArchive {
+ public:
+  EffectsKeyArchive(std::string prefix, const std::set<std::string>& listed, ResolvedKeys& out)
+      : prefix_(std::move(prefix)), listed_(listed), out_(out) {}
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    const std::string key = prefix_ + "." + f.meta.name;
+    if (listed_.count(key)) record_fields(*f.value, key, out_);
+  }
+
+ private:
+  std::string prefix_;
+  const std::set<std::string>& listed_;
+  ResolvedKeys& out_;
+};
+
+// A plant's keys (its list, the ripple included) and, with `listed`, the effects it lists.
+void plant_keys(const PlantParams& p, const std::string& prefix, const std::set<std::string>* listed,
+                ResolvedKeys& out) {
+  record_fields(p, prefix, out, {"effects"});
+  if (listed == nullptr) return;
+  EffectsKeyArchive a(prefix + ".effects", *listed, out);
+  const_cast<plant::EffectsParams&>(p.effects).Serialize(&a);  // the archive only reads
+}
+
+ResolvedValue number_value(double v) {
+  return {std::isinf(v) ? (v > 0 ? ".inf" : "-.inf") : validate::format_number(v), false};
+}
+
+// A plugin parameter as read: a number (its shortest text) or else a word.
+ResolvedValue parameter_value(const std::string& text) {
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  return {text, text.empty() || end != text.c_str() + text.size()};
+}
+
+void controller_keys(const Scenario& s, ResolvedKeys& out) {
+  const ControllerConfig& cc = s.controller;
+  out["controller.type"] = {fields::enum_name(cc.type), true};
+  out["controller.computation_delay"] = number_value(cc.computation_delay);
+  switch (cc.type) {
+    case ControllerType::kSlidingMode:
+      record_fields(cc.sliding_mode, "controller", out);
+      plant_keys(cc.model, "controller.model", &s.listed_effects, out);
+      break;
+    case ControllerType::kCascade:
+      // Under the tuning rule the gains are not keys of the run: the rule sets them.
+      record_fields(cc.cascade, "controller", out,
+                    cc.cascade.tuning == controller::CascadeTuning::kRule ? std::set<std::string>{"kp", "kv", "ki"}
+                                                                          : std::set<std::string>{"bandwidth_scale"});
+      plant_keys(cc.model, "controller.model", nullptr, out);
+      break;
+    case ControllerType::kOpenLoop:
+      record_fields(cc.open_loop, "controller", out);
+      out["controller.file"] = {cc.open_loop_file, true};
+      break;
+    case ControllerType::kPlugin:
+      out["controller.library"] = {cc.plugin.library, true};
+      for (const auto& [k, v] : cc.plugin.parameters) out["controller.parameters." + k] = parameter_value(v);
+      out["controller.u_min"] = number_value(cc.plugin.u_min);
+      out["controller.u_max"] = number_value(cc.plugin.u_max);
+      plant_keys(cc.model, "controller.model", nullptr, out);
+      break;
+  }
+}
+
+void reference_keys(const ReferenceConfig& c, ResolvedKeys& out) {
+  out["reference.type"] = {fields::enum_name(c.type), true};
+  switch (c.type) {
+    case ReferenceType::kNone: break;
+    case ReferenceType::kSine: record_fields(c.sine, "reference", out); break;
+    case ReferenceType::kStep: record_fields(c.step, "reference", out); break;
+    case ReferenceType::kAccelLimited: record_fields(c.accel_limited, "reference", out); break;
+    case ReferenceType::kSCurve: record_fields(c.scurve, "reference", out); break;
+    case ReferenceType::kRamp: record_fields(c.ramp, "reference", out); break;
+    case ReferenceType::kWaypoints: out["reference.file"] = {c.waypoints_file, true}; break;
+  }
+}
+
+}  // namespace
+
+ResolvedKeys resolved_keys(const Scenario& s) {
+  ResolvedKeys out;
+  out["name"] = {s.name, true};
+  out["duration"] = number_value(s.duration);
+  out["control_period"] = number_value(s.control_period);
+  plant_keys(s.plant, "plant", &s.listed_effects, out);
+  controller_keys(s, out);
+  reference_keys(s.reference, out);
+  out["output.every"] = {std::to_string(s.output.every), false};
+  out["analysis.settled_after"] = number_value(s.analysis.settled_after);
+  out["analysis.settling_band"] = number_value(s.analysis.settling_band);
+  return out;
+}
+
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
                         ResolvedKeys* resolved) {
   try {
     const YAML::Node root = load_yaml_strict(yaml_text);
     if (resolved) resolved->clear();
-    Scenario s = parse_node(root, base_dir, resolved);
+    Scenario s = parse_node(root, base_dir);
+    if (resolved) *resolved = resolved_keys(s);
     return s;
   } catch (const ScenarioError& e) {
     throw ScenarioError(origin + ": " + e.what());
