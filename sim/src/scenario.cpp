@@ -37,14 +37,16 @@ std::string output_shown(const std::string& s) {
 
 // plant.effects.<name>: listing an effect enables it (an optional `enabled: false` switches it
 // off again); the parameters not given keep the struct's defaults.
+// The listed ones go into `listed` by their dotted key (Scenario::listed_effects).
 class EffectsReadArchive {
  public:
-  explicit EffectsReadArchive(MapReader& r) : r_(r) {}
+  EffectsReadArchive(MapReader& r, std::set<std::string>& listed) : r_(r), listed_(listed) {}
   template <typename T>
   void Visit(const fields::Field<T>& f) {
     const bool listed = r_.has(f.meta.name);
     MapReader m = r_.child(f.meta.name);  // marks the name as known, for finish()'s hints
     if (!listed) return;
+    listed_.insert(r_.key_path(f.meta.name));
     f.value->enabled = true;
     read_fields(m, *f.value);
     m.finish();
@@ -52,6 +54,7 @@ class EffectsReadArchive {
 
  private:
   MapReader& r_;
+  std::set<std::string>& listed_;
 };
 
 // plant.ripple: a map of keys, where `preset: paper` starts from the paper's values
@@ -76,14 +79,14 @@ void read_ripple(MapReader& r, plant::RippleParams& p) {
   m.finish();
 }
 
-// The plant (with_effects) or a controller's model of it: a cascade's or plugin's model has no
-// effects, they are the plant's discrepancy from the model.
-void read_plant(MapReader r, PlantParams& p, bool with_effects) {
+// The plant (listed_effects given: the effects it lists go there) or a controller's model of it:
+// a cascade's or plugin's model has no effects, they are the plant's discrepancy from the model.
+void read_plant(MapReader r, PlantParams& p, std::set<std::string>* listed_effects) {
   read_fields(r, p, {"ripple", "effects"});
   read_ripple(r, p.ripple);
-  if (with_effects) {
+  if (listed_effects != nullptr) {
     MapReader e = r.child("effects");
-    EffectsReadArchive a(e);
+    EffectsReadArchive a(e, *listed_effects);
     p.effects.Serialize(&a);
     e.finish();
   } else if (r.has("effects")) {
@@ -96,11 +99,6 @@ void read_plant(MapReader r, PlantParams& p, bool with_effects) {
 
 // --- controller ----------------------------------------------------------------------------
 
-void read_sliding_mode(MapReader& r, controller::SlidingModeParams& p) {
-  read_fields(r, p);
-  read_plant(r.child("model"), p.model, true);
-}
-
 // A controller's nominal model by default: the plant itself, without the effects it does not know.
 PlantParams model_of_plant(const PlantParams& plant) {
   PlantParams m = plant;
@@ -111,10 +109,9 @@ PlantParams model_of_plant(const PlantParams& plant) {
 // type plugin (docs/plugins.md): library (resolved against the scenario's folder), parameters
 // (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
 // The library is opened here (file, symbols, ABI version), so a bad one fails at load.
-void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& base_dir) {
+void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, const std::string& base_dir) {
   p.library = r.required_string("library");
   if (fs::path(p.library).is_relative()) p.library = (fs::path(base_dir) / p.library).lexically_normal().string();
-  r.record("library", p.library, true);
   MapReader params = r.child("parameters");
   for (const std::string& key : params.keys()) {
     const bool word = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
@@ -128,11 +125,11 @@ void read_plugin(MapReader& r, controller::PluginParams& p, const std::string& b
   params.finish();
   r.number("u_min", p.u_min);
   r.number("u_max", p.u_max);
-  read_plant(r.child("model"), p.model, false);
+  read_plant(r.child("model"), model, nullptr);
 }
 
 // tuning: manual (kp, kv, ki as given) or rule (kp, kv, ki must then not be given; the gains are
-// set after loading by controller::apply_tuning, not here); bandwidth_scale only with the rule.
+// set by derive() through controller::apply_tuning, not here); bandwidth_scale only with the rule.
 void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model) {
   std::string tuning = fields::enum_name(p.tuning);
   r.string("tuning", tuning);
@@ -149,18 +146,13 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model
     if (r.has("bandwidth_scale")) r.fail("bandwidth_scale", ": only with tuning: rule");
     read_fields(r, p, {"bandwidth_scale"});
   }
-  read_plant(r.child("model"), model, false);
-  p.mass = model.mass;
-  p.thrust_gain = model.thrust_gain();
-  p.friction = model.friction;
-  p.quantization = model.sensor.quantization;
+  read_plant(r.child("model"), model, nullptr);
 }
 
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_fields(r, p);
   r.string("file", file);
   if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
-  r.record("file", file, true);
   if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
@@ -184,7 +176,6 @@ void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir
     case ReferenceType::kWaypoints:
       c.waypoints_file = r.required_string("file");
       if (fs::path(c.waypoints_file).is_relative()) c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
-      r.record("file", c.waypoints_file, true);
       break;
   }
   r.finish();
@@ -334,8 +325,13 @@ void find_warnings(Scenario& s) {
   }
 }
 
-// name, duration and control_period: required, positive, and at most kMaxSteps steps.
-void read_run_length(MapReader& top, const YAML::Node& root, Scenario& s) {
+// --- read ------------------------------------------------------------------------------------
+// Reading fills the struct from the YAML and checks what only the YAML can tell (keys, types,
+// values as written); derive() then computes what one section takes from another, and
+// check_scenario() validates the whole (parse_node: read -> derive -> check).
+
+// name, duration and control_period, each error quoting the value as written.
+void read_timing(MapReader& top, const YAML::Node& root, Scenario& s) {
   top.string("name", s.name);
   check_name(s.name, "name");
   if (!top.has("duration")) top.fail("duration", ": missing (required)");
@@ -352,13 +348,13 @@ void read_run_length(MapReader& top, const YAML::Node& root, Scenario& s) {
                         validate::format_number(kMaxSteps) + " steps (docs/scenario.md, Limits)");
 }
 
-// plant: the plant's parameters; a section with keys but without `enabled` is warned about.
+// plant: its keys, and a warning for a section given with keys but without `enabled` (off, its
+// keys do not act: a forgotten enabled: true). A section that says `enabled: false` is off on
+// purpose: no warning.
 void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
   MapReader plant = top.child("plant");
   s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
-  read_plant(plant, s.plant, true);
-  // A section given with keys but without `enabled`: off, its keys do not act (a forgotten
-  // enabled: true). A section that says `enabled: false` is off on purpose: no warning.
+  read_plant(plant, s.plant, &s.listed_effects);
   const YAML::Node pn = root["plant"];
   const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
                                                    {"grinding", s.plant.grinding.enabled},
@@ -373,71 +369,117 @@ void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
   }
 }
 
-// controller: its type, its computation delay and the type's parameters (a cascade's gains from
-// its tuning rule); the model starts from the plant.
+// controller: its type's keys; the nominal model (controller.model) into s.controller.model, on
+// top of the plant's own parameters (a model never carries the plant's effects).
 void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const std::string& base_dir) {
+  ControllerConfig& cc = s.controller;
   MapReader c = top.child("controller");
   std::string type = c.required_string("type");
-  c.number("computation_delay", s.controller.computation_delay);
-  if (s.controller.computation_delay < 0.0)
+  c.number("computation_delay", cc.computation_delay);
+  if (cc.computation_delay < 0.0)
     c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
+  cc.model = model_of_plant(s.plant);
   if (type == "sliding_mode") {
-    s.controller.type = ControllerType::kSlidingMode;
-    s.controller.sliding_mode.model = model_of_plant(s.plant);
-    // A model never carries the plant's sensor or initial state; they are not part of it.
-    read_sliding_mode(c, s.controller.sliding_mode);
-    s.controller.sliding_mode.period = s.control_period;
-    s.controller.sliding_mode.computation_delay = s.controller.computation_delay;
+    cc.type = ControllerType::kSlidingMode;
+    read_fields(c, cc.sliding_mode);
+    read_plant(c.child("model"), cc.model, &s.listed_effects);
   } else if (type == "cascade") {
-    s.controller.type = ControllerType::kCascade;
-    PlantParams model = s.plant;
-    read_cascade(c, s.controller.cascade, model);
-    s.controller.cascade.period = s.control_period;
-    s.controller.cascade.computation_delay = s.controller.computation_delay;
-    if (!(s.controller.cascade.bandwidth_scale > 0.0))  // before the rule divides by it
-      c.fail("bandwidth_scale",
-             " = " + validate::format_number(s.controller.cascade.bandwidth_scale) + ": must be > 0");
-    controller::apply_tuning(s.controller.cascade, model.sensor.differenced_velocity());
+    cc.type = ControllerType::kCascade;
+    read_cascade(c, cc.cascade, cc.model);
+    if (!(cc.cascade.bandwidth_scale > 0.0))  // derive()'s tuning rule divides by it
+      c.fail("bandwidth_scale", " = " + validate::format_number(cc.cascade.bandwidth_scale) + ": must be > 0");
   } else if (type == "open_loop") {
-    s.controller.type = ControllerType::kOpenLoop;
-    read_open_loop(c, s.controller.open_loop, s.controller.open_loop_file, base_dir);
-    s.controller.open_loop.thrust_gain = s.plant.thrust_gain();
+    cc.type = ControllerType::kOpenLoop;
+    read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir);
   } else if (type == "plugin") {
-    s.controller.type = ControllerType::kPlugin;
-    s.controller.plugin.model = model_of_plant(s.plant);
-    read_plugin(c, s.controller.plugin, base_dir);
-    s.controller.plugin.period = s.control_period;
-    s.controller.plugin.computation_delay = s.controller.computation_delay;
+    cc.type = ControllerType::kPlugin;
+    read_plugin(c, cc.plugin, cc.model, base_dir);
   } else {
     c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
   }
-  s.controller.model_given = c.has("model");
+  cc.model_given = c.has("model");
   c.finish();
 }
 
-// output: every N-th step and the columns recorded (known, each once, not an empty list).
-void read_output(MapReader& top, const YAML::Node& root, Scenario& s) {
+void read_output(MapReader& top, const YAML::Node& root, OutputConfig& out) {
   MapReader o = top.child("output");
-  o.integer("every", s.output.every);
-  o.string_list("columns", s.output.columns);
+  o.integer("every", out.every);
+  o.string_list("columns", out.columns);
   o.finish();
-  if (s.output.every < 1) o.fail("every", " = " + std::to_string(s.output.every) + ": must be an integer >= 1");
+  if (out.every < 1) o.fail("every", " = " + std::to_string(out.every) + ": must be an integer >= 1");
   const auto& all = record_columns();
-  for (const std::string& c : s.output.columns) {
+  for (const std::string& c : out.columns) {
     if (std::find(all.begin(), all.end(), c) == all.end()) {
       std::string known;
       for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
       o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
     }
-    if (std::count(s.output.columns.begin(), s.output.columns.end(), c) > 1)
+    if (std::count(out.columns.begin(), out.columns.end(), c) > 1)
       o.fail("columns", ": column '" + c + "' listed twice");
   }
-  if (top.has("output") && root["output"]["columns"].IsDefined() && s.output.columns.empty())
+  if (top.has("output") && root["output"]["columns"].IsDefined() && out.columns.empty())
     o.fail("columns", ": empty list (leave the key out to record every column)");
 }
 
-// Component validation: each validate() names its key and value; tables come from the files.
-void validate_components(Scenario& s) {
+Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
+  if (!root.IsMap())
+    throw ScenarioError(
+        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
+  MapReader top(root, "");
+  Scenario s;
+  read_timing(top, root, s);
+  read_plant_section(top, root, s);
+  read_controller(top, root, s, base_dir);
+  read_reference(top.child("reference"), s.reference, base_dir);
+  read_output(top, root, s.output);
+  MapReader a = top.child("analysis");
+  a.number("settled_after", s.analysis.settled_after);
+  a.number("settling_band", s.analysis.settling_band);
+  a.finish();
+  top.finish();
+  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
+  if (s.analysis.settling_band < 0.0)
+    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
+                                ": must be >= 0 (0: 2 % of the move's distance)");
+  return s;
+}
+
+// --- derive ----------------------------------------------------------------------------------
+
+// What one section takes from another: the controller's nominal model, control period and
+// computation delay; the cascade's model values and its tuning rule (controller::apply_tuning);
+// the open-loop command's thrust gain (the plant's Ka*Kf).
+void derive(Scenario& s) {
+  ControllerConfig& cc = s.controller;
+  switch (cc.type) {
+    case ControllerType::kSlidingMode:
+      cc.sliding_mode.model = cc.model;
+      cc.sliding_mode.period = s.control_period;
+      cc.sliding_mode.computation_delay = cc.computation_delay;
+      break;
+    case ControllerType::kCascade:
+      cc.cascade.mass = cc.model.mass;
+      cc.cascade.thrust_gain = cc.model.thrust_gain();
+      cc.cascade.friction = cc.model.friction;
+      cc.cascade.quantization = cc.model.sensor.quantization;
+      cc.cascade.period = s.control_period;
+      cc.cascade.computation_delay = cc.computation_delay;
+      controller::apply_tuning(cc.cascade, cc.model.sensor.differenced_velocity());
+      break;
+    case ControllerType::kOpenLoop: cc.open_loop.thrust_gain = s.plant.thrust_gain(); break;
+    case ControllerType::kPlugin:
+      cc.plugin.model = cc.model;
+      cc.plugin.period = s.control_period;
+      cc.plugin.computation_delay = cc.computation_delay;
+      break;
+  }
+}
+
+// --- check -----------------------------------------------------------------------------------
+
+// Component validation (each validate() names its key and value; tables come from the files),
+// the run's length, the functions of time (messages quote root's sections) and the warnings.
+void check_scenario(Scenario& s, const YAML::Node& root) {
   try {
     if (s.reference.type == ReferenceType::kWaypoints)
       s.reference.waypoints = read_waypoints_file(s.reference.waypoints_file);
@@ -457,34 +499,17 @@ void validate_components(Scenario& s) {
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(e.what());
   }
-}
-
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir, ResolvedKeys* resolved) {
-  if (!root.IsMap())
-    throw ScenarioError(
-        "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "", resolved);
-  Scenario s;
-  read_run_length(top, root, s);
-  read_plant_section(top, root, s);
-  read_controller(top, root, s, base_dir);
-  read_reference(top.child("reference"), s.reference, base_dir);
-  read_output(top, root, s);
-  MapReader a = top.child("analysis");
-  a.number("settled_after", s.analysis.settled_after);
-  a.number("settling_band", s.analysis.settling_band);
-  a.finish();
-  top.finish();
-  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
-  if (s.analysis.settling_band < 0.0)
-    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
-                                ": must be >= 0 (0: 2 % of the move's distance)");
-  validate_components(s);
   if (s.steps() < 1)
     throw ScenarioError("duration = " + validate::format_number(s.duration) + ": shorter than one control period (" +
                         validate::format_number(s.control_period) + " s)");
   check_functions_of_time(s, root);
   find_warnings(s);
+}
+
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
+  Scenario s = read_node(root, base_dir);
+  derive(s);
+  check_scenario(s, root);
   return s;
 }
 
@@ -525,12 +550,113 @@ PlantParams Scenario::drive() const {
   return p;
 }
 
+// --- the run's description from the struct (resolved_keys) -------------------------------------
+
+namespace {
+
+// plant.effects.<name>: the listed effects' keys (Scenario::listed_effects).
+class EffectsKeyArchive {
+ public:
+  EffectsKeyArchive(std::string prefix, const std::set<std::string>& listed, ResolvedKeys& out)
+      : prefix_(std::move(prefix)), listed_(listed), out_(out) {}
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    const std::string key = prefix_ + "." + f.meta.name;
+    if (listed_.count(key)) record_fields(*f.value, key, out_);
+  }
+
+ private:
+  std::string prefix_;
+  const std::set<std::string>& listed_;
+  ResolvedKeys& out_;
+};
+
+// A plant's keys (its list, the ripple included) and, with `listed`, the effects it lists.
+void plant_keys(const PlantParams& p, const std::string& prefix, const std::set<std::string>* listed,
+                ResolvedKeys& out) {
+  record_fields(p, prefix, out, {"effects"});
+  if (listed == nullptr) return;
+  EffectsKeyArchive a(prefix + ".effects", *listed, out);
+  const_cast<plant::EffectsParams&>(p.effects).Serialize(&a);  // the archive only reads
+}
+
+ResolvedValue number_value(double v) {
+  return {std::isinf(v) ? (v > 0 ? ".inf" : "-.inf") : validate::format_number(v), false};
+}
+
+// A plugin parameter as read: a number (its shortest text) or else a word.
+ResolvedValue parameter_value(const std::string& text) {
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  return {text, text.empty() || end != text.c_str() + text.size()};
+}
+
+void controller_keys(const Scenario& s, ResolvedKeys& out) {
+  const ControllerConfig& cc = s.controller;
+  out["controller.type"] = {fields::enum_name(cc.type), true};
+  out["controller.computation_delay"] = number_value(cc.computation_delay);
+  switch (cc.type) {
+    case ControllerType::kSlidingMode:
+      record_fields(cc.sliding_mode, "controller", out);
+      plant_keys(cc.model, "controller.model", &s.listed_effects, out);
+      break;
+    case ControllerType::kCascade:
+      // Under the tuning rule the gains are not keys of the run: the rule sets them.
+      record_fields(cc.cascade, "controller", out,
+                    cc.cascade.tuning == controller::CascadeTuning::kRule ? std::set<std::string>{"kp", "kv", "ki"}
+                                                                          : std::set<std::string>{"bandwidth_scale"});
+      plant_keys(cc.model, "controller.model", nullptr, out);
+      break;
+    case ControllerType::kOpenLoop:
+      record_fields(cc.open_loop, "controller", out);
+      out["controller.file"] = {cc.open_loop_file, true};
+      break;
+    case ControllerType::kPlugin:
+      out["controller.library"] = {cc.plugin.library, true};
+      for (const auto& [k, v] : cc.plugin.parameters) out["controller.parameters." + k] = parameter_value(v);
+      out["controller.u_min"] = number_value(cc.plugin.u_min);
+      out["controller.u_max"] = number_value(cc.plugin.u_max);
+      plant_keys(cc.model, "controller.model", nullptr, out);
+      break;
+  }
+}
+
+void reference_keys(const ReferenceConfig& c, ResolvedKeys& out) {
+  out["reference.type"] = {fields::enum_name(c.type), true};
+  switch (c.type) {
+    case ReferenceType::kNone: break;
+    case ReferenceType::kSine: record_fields(c.sine, "reference", out); break;
+    case ReferenceType::kStep: record_fields(c.step, "reference", out); break;
+    case ReferenceType::kAccelLimited: record_fields(c.accel_limited, "reference", out); break;
+    case ReferenceType::kSCurve: record_fields(c.scurve, "reference", out); break;
+    case ReferenceType::kRamp: record_fields(c.ramp, "reference", out); break;
+    case ReferenceType::kWaypoints: out["reference.file"] = {c.waypoints_file, true}; break;
+  }
+}
+
+}  // namespace
+
+ResolvedKeys resolved_keys(const Scenario& s) {
+  ResolvedKeys out;
+  out["name"] = {s.name, true};
+  out["duration"] = number_value(s.duration);
+  out["control_period"] = number_value(s.control_period);
+  plant_keys(s.plant, "plant", &s.listed_effects, out);
+  controller_keys(s, out);
+  reference_keys(s.reference, out);
+  out["output.every"] = {std::to_string(s.output.every), false};
+  out["analysis.settled_after"] = number_value(s.analysis.settled_after);
+  out["analysis.settling_band"] = number_value(s.analysis.settling_band);
+  return out;
+}
+
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
                         ResolvedKeys* resolved) {
   try {
     const YAML::Node root = load_yaml_strict(yaml_text);
     if (resolved) resolved->clear();
-    Scenario s = parse_node(root, base_dir, resolved);
+    Scenario s = parse_node(root, base_dir);
+    if (resolved) *resolved = resolved_keys(s);
     return s;
   } catch (const ScenarioError& e) {
     throw ScenarioError(origin + ": " + e.what());

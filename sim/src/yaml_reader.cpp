@@ -281,8 +281,7 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-MapReader::MapReader(const YAML::Node& node, std::string path, ResolvedKeys* resolved)
-    : node_(node), path_(std::move(path)), resolved_(resolved) {
+MapReader::MapReader(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap())
     throw ScenarioError(path_ + " = " + describe(node_) + ": expected a map of keys");
 }
@@ -305,10 +304,6 @@ YAML::Node MapReader::scalar(const std::string& key) {
   return n;
 }
 
-void MapReader::record(const std::string& key, const std::string& text, bool is_string) {
-  if (resolved_) (*resolved_)[key_path(key)] = ResolvedValue{text, is_string};
-}
-
 void MapReader::number_or_infinite(const std::string& key, double& out) {
   const YAML::Node n = scalar(key);
   if (n.IsDefined()) {
@@ -317,7 +312,6 @@ void MapReader::number_or_infinite(const std::string& key, double& out) {
     if (std::isnan(v)) fail(key, " = " + describe(n) + ": NaN is not allowed");
     out = v;
   }
-  record(key, std::isinf(out) ? (out > 0 ? ".inf" : "-.inf") : validate::format_number(out), false);
 }
 
 void MapReader::number(const std::string& key, double& out) {
@@ -341,10 +335,8 @@ void MapReader::number_or_string(const std::string& key, std::string& out) {
   if (parse_double(n.Scalar(), v)) {
     if (!std::isfinite(v)) fail(key, " = " + describe(n) + ": must be finite");
     out = validate::format_number(v);  // shortest text that reads back to the same double
-    record(key, out, false);
   } else {
     out = n.Scalar();
-    record(key, out, true);
   }
 }
 
@@ -361,7 +353,6 @@ void MapReader::integer(const std::string& key, long& out) {
                     std::to_string(LONG_MAX) + ")");
     out = v;
   }
-  record(key, std::to_string(out), false);
 }
 
 void MapReader::unsigned_integer(const std::string& key, std::uint64_t& out) {
@@ -378,7 +369,6 @@ void MapReader::unsigned_integer(const std::string& key, std::uint64_t& out) {
                     std::to_string(std::numeric_limits<std::uint64_t>::max()) + ")");
     out = v;
   }
-  record(key, std::to_string(out), false);
 }
 
 void MapReader::boolean(const std::string& key, bool& out) {
@@ -393,13 +383,11 @@ void MapReader::boolean(const std::string& key, bool& out) {
       fail(key, " = " + describe(n) + ": expected true or false");
     }
   }
-  record(key, out ? "true" : "false", false);
 }
 
 void MapReader::string(const std::string& key, std::string& out) {
   const YAML::Node n = scalar(key);
   if (n.IsDefined()) out = n.Scalar();
-  record(key, out, true);
 }
 
 void MapReader::string_list(const std::string& key, std::vector<std::string>& out) {
@@ -423,14 +411,13 @@ void MapReader::string_list(const std::string& key, std::vector<std::string>& ou
 std::string MapReader::required_string(const std::string& key) {
   const YAML::Node n = scalar(key);
   if (!n.IsDefined()) fail(key, ": missing (required)");
-  record(key, n.Scalar(), true);
   return n.Scalar();
 }
 
 MapReader MapReader::child(const std::string& key) {
   read_.insert(key);
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
-  return MapReader(n, key_path(key), resolved_);
+  return MapReader(n, key_path(key));
 }
 
 bool MapReader::scalar_text(const std::string& key, std::string& out) const {
@@ -443,7 +430,7 @@ bool MapReader::scalar_text(const std::string& key, std::string& out) const {
 
 MapReader MapReader::child_absent(const std::string& key) {
   read_.insert(key);
-  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key), resolved_);
+  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key));
 }
 
 void MapReader::finish() const {

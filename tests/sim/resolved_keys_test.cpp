@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "../support/scratch.hpp"
@@ -92,6 +93,35 @@ reference: {type: sine, amplitude: 0.1, frequency: 1.0}
   parse_scenario(resolved_yaml(keys), ".", "r.yaml", &back);
   EXPECT_EQ(back.at("name").text, "a: b, #c 'd'");
   EXPECT_EQ(keys, back);
+}
+
+// The keys are written from the struct (resolved_keys): what the YAML alone tells is kept as a
+// fact of the struct (a listed effect, even switched off), and the keys a rule sets are left out.
+TEST(ResolvedKeys, ComeFromTheStructAndItsFacts) {
+  ResolvedKeys keys;
+  const Scenario s = parse_scenario(R"(
+duration: 0.01
+control_period: 1e-4
+plant: {ripple: paper, effects: {constant_force: {enabled: false}}}
+controller: {type: cascade, tuning: rule, model: {mass: 90}}
+reference: {type: step, amplitude: 1.0e-3}
+)",
+                                    ".", "s.yaml", &keys);
+  EXPECT_EQ(keys, resolved_keys(s));
+  // Listed but off: its keys describe the run; an effect not listed has none.
+  EXPECT_EQ(s.listed_effects, std::set<std::string>{"plant.effects.constant_force"});
+  EXPECT_EQ(keys.at("plant.effects.constant_force.enabled").text, "false");
+  EXPECT_EQ(keys.count("plant.effects.spring_force.enabled"), 0u);
+  // `ripple: paper` is the preset with its values (RippleParams::paper(): ac = 3 N).
+  EXPECT_EQ(keys.at("plant.ripple.preset").text, "paper");
+  EXPECT_EQ(keys.at("plant.ripple.cogging_amplitude").text, "3");
+  // The tuning rule sets the gains: they are not keys of the run, its bandwidth_scale is.
+  EXPECT_EQ(keys.count("controller.kp"), 0u);
+  EXPECT_EQ(keys.count("controller.bandwidth_scale"), 1u);
+  // The model: the given mass, the plant's values elsewhere, never the plant's effects.
+  EXPECT_EQ(keys.at("controller.model.mass").text, "90");
+  EXPECT_EQ(keys.at("controller.model.friction.static_force").text, keys.at("plant.friction.static_force").text);
+  EXPECT_EQ(keys.count("controller.model.effects.constant_force.enabled"), 0u);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include <limits>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -76,6 +77,11 @@ struct ControllerConfig {
   /// type plugin: controller.library (resolved against the scenario's folder), .parameters,
   /// .model, .u_min, .u_max (docs/plugins.md).
   controller::PluginParams plugin;
+  /// The nominal model of sliding_mode, cascade and plugin (controller.model, its keys not given
+  /// the plant's own parameters, without the plant's effects). The loader hands it to the
+  /// controller's params (sliding_mode.model, plugin.model, the cascade's mass, thrust_gain,
+  /// friction and quantization).
+  plant::PlantParams model;
   /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
   /// plant's own parameters without its effects; summary.json says so as controller_model).
   bool model_given{false};
@@ -115,6 +121,10 @@ struct Scenario {
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};
+  /// The effects the scenario lists, by key ("plant.effects.constant_force",
+  /// "controller.model.effects.spring_force"). Listing one enables it; a listed one is part of
+  /// the run's description (resolved_keys) even when it says `enabled: false`.
+  std::set<std::string> listed_effects;
   /// Values that load but are implausible for a linear feed drive (each naming the key, the
   /// value, the bound and the likely unit: "reference.max_velocity: 500 m/s is above any linear
   /// drive (10 m/s); mm/s?"), and a move that does not finish within `duration`. The loader
@@ -157,11 +167,18 @@ void set_key(YAML::Node& root, const std::string& key, const std::string& value)
 /// receives the scenario as run: the file's bytes without settings, else the YAML with them.
 Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& sets, std::string* text = nullptr);
 /// Parses and validates YAML text; base_dir resolves relative file names; origin names the
-/// source in messages. If `resolved` is given it receives every scalar key the loader read with
-/// its effective value (given or default; file names resolved against base_dir): the complete
-/// description of the run, used by feeddrive-study to vary keys, scale them and key its cases.
+/// source in messages. If `resolved` is given it receives resolved_keys() of the scenario: every
+/// key with its effective value (given or default; file names resolved against base_dir), the
+/// complete description of the run, used by feeddrive-study to vary keys, scale them and key its
+/// cases.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
                         const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr);
+
+/// Every key that describes the run, with its effective value, from the scenario's struct: the
+/// keys of each section's list (common/fields.hpp) for its controller and reference type, the
+/// effects listed, the cascade's gains unless its tuning rule sets them, the files resolved
+/// against the scenario's folder. The same as parse_scenario's `resolved`.
+ResolvedKeys resolved_keys(const Scenario& s);
 
 /// The resolved keys as one YAML document (nested maps, keys in sorted order, so the same keys
 /// always give the same text). parse_scenario reads it back to the same scenario and the same

@@ -12,14 +12,14 @@
 
 namespace feeddrive::sim {
 
-/// The effective value of one scalar key (as given, or the default the loader kept), as YAML
-/// scalar text that reads back to the same value.
+/// The effective value of one scalar key of a scenario (as given, or the default), as YAML
+/// scalar text that reads back to the same value (sim::resolved_keys, scenario.hpp).
 struct ResolvedValue {
   std::string text;
   bool is_string{false};  ///< read as text (a name, a mode, a file), not as a number or flag
   bool operator==(const ResolvedValue& o) const { return text == o.text && is_string == o.is_string; }
 };
-/// Every scalar key a loader read, by full dotted path ("plant.friction.static_force").
+/// Every scalar key of a run's description, by full dotted path ("plant.friction.static_force").
 using ResolvedKeys = std::map<std::string, ResolvedValue>;
 
 /// Parses YAML text strictly; every error is a ScenarioError "line N: ...":
@@ -39,9 +39,7 @@ YAML::Node load_yaml_strict(const std::string& text);
 class MapReader {
  public:
   /// node must be a map (or null/absent, treated as empty); path is its dotted key ("plant").
-  /// If `resolved` is given, every scalar accessor records its key's effective value there
-  /// (the value read, or the default left in `out`), and so do the children.
-  MapReader(const YAML::Node& node, std::string path, ResolvedKeys* resolved = nullptr);
+  MapReader(const YAML::Node& node, std::string path);
 
   bool has(const std::string& key) const;
   /// Reads a finite number into out if the key is present; throws if present but invalid.
@@ -65,8 +63,8 @@ class MapReader {
   MapReader child(const std::string& key);
   /// If `key` holds a single value (not a map), its text in `out` and true.
   bool scalar_text(const std::string& key, std::string& out) const;
-  /// An empty nested map at `key` (marked as read), whatever the node holds: the defaults of a
-  /// section given in another form (`ripple: paper`) are recorded under its path.
+  /// An empty nested map at `key` (marked as read), whatever the node holds: a section given in
+  /// another form (`ripple: paper`) is read as its defaults.
   MapReader child_absent(const std::string& key);
   /// Marks `key` as known (read by the caller some other way, e.g. a list), for finish().
   void known(const std::string& key) { read_.insert(key); }
@@ -75,16 +73,12 @@ class MapReader {
 
   std::string key_path(const std::string& key) const;
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
-  /// Records (overwrites) the effective value of `key`, e.g. a file name after it was resolved
-  /// against the scenario's folder. No-op without a ResolvedKeys.
-  void record(const std::string& key, const std::string& text, bool is_string);
 
  private:
   YAML::Node scalar(const std::string& key);
   YAML::Node node_;
   std::string path_;
   std::set<std::string> read_;
-  ResolvedKeys* resolved_{nullptr};
 };
 
 /// Levenshtein distance, for "did you mean" hints.
