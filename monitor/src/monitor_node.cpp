@@ -206,8 +206,11 @@ void MonitorNode::on_foreign(const std::string& channel, std::int64_t run_id, co
     return;
   }
   // A plant of another run while this run's plant is silent: the drive restarted (it drew a new
-  // run id). A restarted plant cannot rejoin (docs/external-plant.md, "Restarts").
-  if (who_role == "plant" && named_.plant_seq_seen >= 0 && !peer_alive("plant", 0.3)) {
+  // run id). A restarted plant cannot rejoin (docs/external-plant.md, "Restarts"). Silent on
+  // the time line the messages came in (their receive times), not the monitor's: a loaded
+  // monitor reading a backlog would otherwise find the plant "silent" with its newer heartbeats
+  // still queued, and take a replayed log's first plant message for a restart (CI, stop 29).
+  if (who_role == "plant" && named_.plant_seq_seen >= 0 && !peer_alive_at("plant", 0.3, bus().current_recv_us())) {
     const std::string why =
         "the plant restarted: a plant with a new run id " + std::to_string(run_id) + " appeared on " + channel +
         " after this run's plant (run id " + std::to_string(bus().run_id()) + ") went silent after state " +

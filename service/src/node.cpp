@@ -307,10 +307,12 @@ const process_status_t* Node::peer(const std::string& role) const {
   return it == peers_.end() ? nullptr : &it->second;
 }
 
-bool Node::peer_alive(const std::string& role, double seconds) const {
+bool Node::peer_alive(const std::string& role, double seconds) const { return peer_alive_at(role, seconds, mono_us()); }
+
+bool Node::peer_alive_at(const std::string& role, double seconds, std::int64_t at_us) const {
   const process_status_t* p = peer(role);
   const auto seen = peer_seen_us_.find(role);
-  return p != nullptr && seen != peer_seen_us_.end() && p->state != "failed" && mono_us() - seen->second <= us(seconds);
+  return p != nullptr && seen != peer_seen_us_.end() && p->state != "failed" && at_us - seen->second <= us(seconds);
 }
 
 bool Node::monitor_done() const {

@@ -156,6 +156,10 @@ class Bus {
   /// Inside a handler: who sent the message being handled, "IP:PORT" of its UDP source (kDirect,
   /// kBatched), or "" (kEvent: liblcm does not say).
   std::string current_source() const { return reader_ ? reader_->current_source() : std::string(); }
+  /// Inside a handler (and the foreign/invalid events it raises): when the message being handled
+  /// was received, on the monotonic clock [us]: the kernel's time, not the dispatch's, so that a
+  /// process reading a backlog judges "silent since" on the time line the messages came in.
+  std::int64_t current_recv_us() const { return current_recv_us_; }
 
  private:
   struct Raw {
@@ -169,6 +173,7 @@ class Bus {
   std::size_t drain();
   void rethrow_handler_error();
 
+  std::int64_t current_recv_us_{0};
   std::string url_;
   bool shared_;  ///< lcm_ wraps the caller's instance: ~Bus() takes its subscriptions off it
   lcm::LCM lcm_;
@@ -274,6 +279,17 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
       count_invalid(ch, bytes, rbuf->data_size, why);
       return;
     }
+    // The receive time is when LCM read the datagram off the socket (recv_utime: the kernel's
+    // SO_TIMESTAMP where available, else LCM's clock on reading), not when handle() dispatches
+    // it: a process that drains its socket in batches (the monitor) would otherwise stamp a
+    // whole batch with one time, and the latency per hop would measure nothing. recv_utime is
+    // wall-clock; its age moves it onto the monotonic clock.
+    std::int64_t recv = now;
+    if (rbuf->recv_utime > 0) {
+      const std::int64_t age = wall_utime() - rbuf->recv_utime;
+      if (age > 0 && age < 10000000) recv = now - age;
+    }
+    current_recv_us_ = recv;
     if (admit == Admit::kRun) {
       if (!run_known_ && join_first_) {
         set_run_id(msg.run_id);
@@ -284,16 +300,6 @@ void Bus::subscribe(const std::string& channel, std::function<void(const Msg&, s
         count_foreign(ch, msg.run_id);
         return;
       }
-    }
-    // The receive time is when LCM read the datagram off the socket (recv_utime: the kernel's
-    // SO_TIMESTAMP where available, else LCM's clock on reading), not when handle() dispatches
-    // it: a process that drains its socket in batches (the monitor) would otherwise stamp a
-    // whole batch with one time, and the latency per hop would measure nothing. recv_utime is
-    // wall-clock; its age moves it onto the monotonic clock.
-    std::int64_t recv = now;
-    if (rbuf->recv_utime > 0) {
-      const std::int64_t age = wall_utime() - rbuf->recv_utime;
-      if (age > 0 && age < 10000000) recv = now - age;
     }
     // An exception must not unwind through LCM's C dispatch: keep it for poll() to rethrow.
     try {

@@ -127,6 +127,9 @@ class Node {
   /// True if `role` published a status that is not "failed" within the last `seconds`: it is
   /// alive and running its own timeouts, so a wait on it is not yet its fault to report.
   bool peer_alive(const std::string& role, double seconds) const;
+  /// The same, judged at `at_us` (monotonic [us]) rather than now: e.g. at the receive time of
+  /// the message being handled (Bus::current_recv_us), for a process reading a backlog.
+  bool peer_alive_at(const std::string& role, double seconds, std::int64_t at_us) const;
   bool monitor_done() const;
   /// After the end: state "done", then keep answering resend requests and sending heartbeats
   /// until the monitor is done (and an attached monitor heard within the last second too) or
