@@ -369,6 +369,17 @@ void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
   }
 }
 
+// The dotted keys of a map's maps and values ("friction", "friction.static_force") into out.
+void add_given_keys(const YAML::Node& map, const std::string& prefix, std::set<std::string>& out) {
+  if (!map.IsMap()) return;
+  for (const auto& kv : map) {
+    if (!kv.first.IsScalar()) continue;
+    const std::string key = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
+    out.insert(key);
+    add_given_keys(kv.second, key, out);
+  }
+}
+
 // controller: its type's keys; the nominal model (controller.model) into s.controller.model, on
 // top of the plant's own parameters (a model never carries the plant's effects).
 void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const std::string& base_dir) {
@@ -398,6 +409,7 @@ void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const 
     c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
   }
   cc.model_given = c.has("model");
+  if (cc.model_given) add_given_keys(root["controller"]["model"], "", cc.model_keys_given);
   c.finish();
 }
 
@@ -506,8 +518,9 @@ void check_scenario(Scenario& s, const YAML::Node& root) {
   find_warnings(s);
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Scenario* as_read) {
   Scenario s = read_node(root, base_dir);
+  if (as_read != nullptr) *as_read = s;
   derive(s);
   check_scenario(s, root);
   return s;
@@ -650,12 +663,154 @@ ResolvedKeys resolved_keys(const Scenario& s) {
   return out;
 }
 
+// --- one key of a scenario as read (set_read_key) -------------------------------------------
+
+namespace {
+
+// Sets the field at the dotted path `rest` of a struct's list from the value's text, read by the
+// reader's own accessor (YamlReadArchive) from a map of that one key: the same value, or the
+// same one-line error, as the key written in the file. found(): the path names a value field.
+class FieldSetArchive {
+ public:
+  FieldSetArchive(std::string parent, std::string rest, const std::string& value, std::set<std::string> skip)
+      : parent_(std::move(parent)), rest_(std::move(rest)), value_(value), skip_(std::move(skip)) {}
+  bool found() const { return found_; }
+
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    const std::size_t dot = rest_.find('.');
+    const std::string head = rest_.substr(0, dot);
+    if (found_ || head != f.meta.name || skip_.count(head)) return;
+    if constexpr (fields::is_serializable<T>::value) {
+      if (dot == std::string::npos) return;
+      FieldSetArchive a(parent_ + "." + head, rest_.substr(dot + 1), value_, {});
+      f.value->Serialize(&a);
+      found_ = a.found_;
+    } else {
+      if (dot != std::string::npos) return;
+      YAML::Node map(YAML::NodeType::Map);
+      map[head] = value_;
+      MapReader r(map, parent_);
+      YamlReadArchive a(r);
+      a.Visit(f);
+      found_ = true;
+    }
+  }
+
+ private:
+  std::string parent_;
+  std::string rest_;
+  const std::string& value_;
+  std::set<std::string> skip_;
+  bool found_{false};
+};
+
+template <typename S>
+bool set_field(S& obj, const std::string& parent, const std::string& rest, const std::string& value,
+               std::set<std::string> skip = {}) {
+  FieldSetArchive a(parent, rest, value, std::move(skip));
+  obj.Serialize(&a);
+  return a.found();
+}
+
+// A value the YAML loader reads back as the same scalar text (never null, never a flow list or
+// map): letters, digits and _ . + -, not null or ~.
+bool plain_value(const std::string& v) {
+  if (v.empty() || v == "~" || v == "null" || v == "Null" || v == "NULL") return false;
+  return std::all_of(v.begin(), v.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '+' || c == '-';
+  });
+}
+
+// plant.<rest>: the plant's list, a listed effect's list; a value the controller's model does
+// not give follows into the model (read_controller: the model starts as the plant).
+bool set_plant_key(Scenario& s, const std::string& rest, const std::string& value) {
+  const std::string head = rest.substr(0, rest.find('.'));
+  ControllerConfig& cc = s.controller;
+  if (head == "effects") {
+    const std::size_t dot = rest.find('.', 8);
+    if (dot == std::string::npos || !s.listed_effects.count("plant." + rest.substr(0, dot))) return false;
+    return set_field(s.plant.effects, "plant.effects", rest.substr(8), value);
+  }
+  if (rest == "ripple.preset") return false;                                  // read_ripple's rule
+  if (head == "grinding" && !s.grinding_process) return false;                // the section made present
+  if (head == "ripple" && cc.model_keys_given.count("ripple")) return false;  // the model's own ripple
+  if (!set_field(s.plant, "plant", rest, value, {"effects"})) return false;
+  if (!cc.model_keys_given.count(rest)) set_field(cc.model, "controller.model", rest, value, {"effects"});
+  return true;
+}
+
+// controller.<rest>: computation_delay, the model's list, the type's list but for the keys with
+// rules of their own (the cascade's tuning and gains, the open-loop kind).
+bool set_controller_key(Scenario& s, const std::string& rest, const std::string& value) {
+  ControllerConfig& cc = s.controller;
+  if (rest == "computation_delay") {
+    YAML::Node map(YAML::NodeType::Map);
+    map[rest] = value;
+    double d = 0.0;
+    MapReader(map, "controller").number(rest, d);
+    if (d < 0.0) return false;  // read_controller's message quotes the value as written
+    cc.computation_delay = d;
+    return true;
+  }
+  if (rest.rfind("model.", 0) == 0) {
+    const std::string field = rest.substr(6);
+    if (cc.type == ControllerType::kOpenLoop || field.rfind("effects", 0) == 0 || field == "ripple.preset")
+      return false;
+    if (!set_field(cc.model, "controller.model", field, value, {"effects"})) return false;
+    for (std::size_t dot = field.find('.'); dot != std::string::npos; dot = field.find('.', dot + 1))
+      cc.model_keys_given.insert(field.substr(0, dot));  // its maps, and the value below
+    cc.model_keys_given.insert(field);
+    return true;
+  }
+  switch (cc.type) {
+    case ControllerType::kSlidingMode: return set_field(cc.sliding_mode, "controller", rest, value);
+    case ControllerType::kCascade:
+      return set_field(cc.cascade, "controller", rest, value, {"tuning", "kp", "kv", "ki", "bandwidth_scale"});
+    case ControllerType::kOpenLoop: return set_field(cc.open_loop, "controller", rest, value, {"kind"});
+    case ControllerType::kPlugin: return false;
+  }
+  return false;
+}
+
+bool set_reference_key(ReferenceConfig& c, const std::string& rest, const std::string& value) {
+  switch (c.type) {
+    case ReferenceType::kSine: return set_field(c.sine, "reference", rest, value);
+    case ReferenceType::kStep: return set_field(c.step, "reference", rest, value);
+    case ReferenceType::kAccelLimited: return set_field(c.accel_limited, "reference", rest, value);
+    case ReferenceType::kSCurve: return set_field(c.scurve, "reference", rest, value);
+    case ReferenceType::kRamp: return set_field(c.ramp, "reference", rest, value);
+    case ReferenceType::kNone:
+    case ReferenceType::kWaypoints: return false;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool set_read_key(Scenario& s, const std::string& key, const std::string& value) {
+  if (!plain_value(value)) return false;
+  const std::size_t dot = key.find('.');
+  if (dot == std::string::npos) return false;  // name, duration, control_period: rules of read_timing
+  const std::string section = key.substr(0, dot);
+  const std::string rest = key.substr(dot + 1);
+  if (section == "plant") return set_plant_key(s, rest, value);
+  if (section == "controller") return set_controller_key(s, rest, value);
+  if (section == "reference") return set_reference_key(s.reference, rest, value);
+  return false;  // output, analysis: rules of their own
+}
+
+void complete_read(Scenario& s) {
+  derive(s);
+  check_scenario(s, YAML::Node());
+}
+
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
-                        ResolvedKeys* resolved) {
+                        ResolvedKeys* resolved, Scenario* as_read) {
   try {
     const YAML::Node root = load_yaml_strict(yaml_text);
     if (resolved) resolved->clear();
-    Scenario s = parse_node(root, base_dir);
+    Scenario s = parse_node(root, base_dir, as_read);
     if (resolved) *resolved = resolved_keys(s);
     return s;
   } catch (const ScenarioError& e) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -197,15 +198,26 @@ struct Resolver::Impl {
     if (!base.IsMap()) throw StudyError(s.path + ": base: the scenario must be a YAML map");
   }
 
-  sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin) const {
+  sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin,
+                                  sim::Scenario* as_read = nullptr) const {
     sim::ResolvedKeys keys;
     try {
-      sim::parse_scenario(text, s.base_dir, origin, &keys);
+      sim::parse_scenario(text, s.base_dir, origin, &keys, as_read);
     } catch (const sim::ScenarioError& e) {
       throw StudyError(e.what());
     }
     return keys;
   }
+  // The nominal case of a controller and family (its layers, read once): its keys and its
+  // scenario as read, which each of its cases copies and sets its variations in.
+  struct Nominal {
+    sim::ResolvedKeys keys;
+    sim::Scenario read;
+  };
+  std::map<std::pair<std::size_t, std::size_t>, Nominal> nominals;
+  // The controller's nominal model's keys (the nominal model rule), by the case's settings that
+  // are not plant-only.
+  std::map<std::string, sim::ResolvedKeys> models;
   // SHA-256 of a plugin library's bytes, once per path per study.
   std::map<std::string, std::string> digests;
   const std::string& library_digest(const std::string& path) {
@@ -240,6 +252,8 @@ struct Resolver::Impl {
   void keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
                           const std::string& origin);
   ResolvedCase result(const sim::ResolvedKeys& keys, const Values& values);
+  const Nominal& nominal(const CaseSpec& c, const std::string& origin);
+  std::optional<sim::ResolvedKeys> case_keys(const CaseSpec& c, const Nominal& nominal, const Values& values);
 };
 
 namespace {
@@ -300,6 +314,68 @@ Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const
   return values;
 }
 
+namespace {
+
+// The nominal model rule: the model's keys (controller.model.*) of `model` replace those in keys.
+void use_model(sim::ResolvedKeys& keys, const sim::ResolvedKeys& model) {
+  for (auto& [k, v] : keys) {
+    if (!starts_with(k, "controller.model.")) continue;
+    const auto it = model.find(k);
+    if (it != model.end()) v = it->second;
+  }
+}
+
+// The keys of a case built as a struct: the nominal scenario as read with each setting set in
+// it (sim::set_read_key; with skip_plant_only, all but the plant-only ones), derived and checked.
+// nullopt for a setting only the YAML reader decides, or an error (the caller then reads the
+// layers as YAML: the same keys, or the reader's own one-line error).
+std::optional<sim::ResolvedKeys> struct_keys(sim::Scenario s,
+                                             const std::vector<std::pair<std::string, std::string>>& values,
+                                             bool skip_plant_only) {
+  try {
+    for (const auto& [k, v] : values) {
+      if (skip_plant_only && plant_only(k)) continue;
+      if (!sim::set_read_key(s, k, v)) return std::nullopt;
+    }
+    sim::complete_read(s);
+    return sim::resolved_keys(s);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+const Resolver::Impl::Nominal& Resolver::Impl::nominal(const CaseSpec& c, const std::string& origin) {
+  const auto id = std::make_pair(c.controller, c.family);
+  auto it = nominals.find(id);
+  if (it != nominals.end()) return it->second;
+  Nominal n;
+  n.keys = load_uncached(text_of(nominal_doc(c, origin)), origin + " (without its variations)", &n.read);
+  return nominals.emplace(id, std::move(n)).first->second;
+}
+
+// The case as a struct (struct_keys), with the nominal model rule; nullopt where the YAML
+// reader must read it.
+std::optional<sim::ResolvedKeys> Resolver::Impl::case_keys(const CaseSpec& c, const Nominal& nominal,
+                                                           const Values& values) {
+  std::optional<sim::ResolvedKeys> keys = struct_keys(nominal.read, values, false);
+  if (!keys || s.model != ModelRule::kNominal) return keys;
+  if (std::none_of(values.begin(), values.end(), [](const auto& kv) { return plant_only(kv.first); })) return keys;
+  std::string id = std::to_string(c.controller) + " " + std::to_string(c.family) + "\n";
+  for (const auto& [k, v] : values)
+    if (!plant_only(k)) id += k + "=" + v + "\n";
+  auto it = models.find(id);
+  if (it == models.end()) {
+    std::optional<sim::ResolvedKeys> model = struct_keys(nominal.read, values, true);
+    if (!model) return std::nullopt;
+    if (models.size() >= kMaxLoads) models.clear();
+    it = models.emplace(std::move(id), std::move(*model)).first;
+  }
+  use_model(*keys, it->second);
+  return keys;
+}
+
 // The nominal model rule (cases.hpp): the controller's model (controller.model.*) of the case
 // without its plant-only variations replaces the one in keys, the case with all of them.
 void Resolver::Impl::keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
@@ -314,12 +390,7 @@ void Resolver::Impl::keep_nominal_model(const YAML::Node& doc, const Values& val
     }
   }
   if (!differs) return;
-  const sim::ResolvedKeys& model = load(model_doc, origin + " (the controller's nominal model)");
-  for (auto& [k, v] : keys) {
-    if (!starts_with(k, "controller.model.")) continue;
-    const auto it = model.find(k);
-    if (it != model.end()) v = it->second;
-  }
+  use_model(keys, load(model_doc, origin + " (the controller's nominal model)"));
 }
 
 // The case's scenario (keys written as one YAML document), its hash and the effective value of
@@ -356,15 +427,19 @@ std::string Resolver::label(const CaseSpec& c) const {
   return l;
 }
 
-// The case's layers are loaded by the scenario loader, which checks every key and value: the
-// nominal layers (cached), then with the variations; with the nominal model rule, the model
-// from the layers without the plant-only variations.
+// The case's nominal layers are read once per controller and family by the scenario loader,
+// which checks every key and value; a case is that scenario as read with its variations set in
+// it (a struct: case_keys), derived and checked, with the nominal model rule's model from the
+// same struct without the plant-only variations. Where a variation is one only the YAML reader
+// decides (sim::set_read_key), or the case fails a check, its layers with the variations are
+// read as YAML: the same keys, or the reader's error quoting the values as written.
 ResolvedCase Resolver::resolve(const CaseSpec& c) {
   Impl& m = *impl_;
   const std::string origin = (m.s.path.empty() ? std::string("study") : m.s.path) + ": " + label(c);
+  const Impl::Nominal& nominal = m.nominal(c, origin);
+  const Impl::Values values = Impl::variation_values(c, nominal.keys, origin);
+  if (const auto keys = m.case_keys(c, nominal, values)) return m.result(*keys, values);
   const YAML::Node doc = m.nominal_doc(c, origin);
-  const sim::ResolvedKeys nominal = m.load(doc, origin + " (without its variations)");
-  const Impl::Values values = Impl::variation_values(c, nominal, origin);
   YAML::Node full = YAML::Clone(doc);
   for (const auto& [k, v] : values) apply_setting(full, k, v, origin, "variation");
   sim::ResolvedKeys keys = m.load_uncached(Impl::text_of(full), origin);  // one per case: not cached

@@ -7,6 +7,9 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "../support/scratch.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -122,6 +125,106 @@ reference: {type: step, amplitude: 1.0e-3}
   EXPECT_EQ(keys.at("controller.model.mass").text, "90");
   EXPECT_EQ(keys.at("controller.model.friction.static_force").text, keys.at("plant.friction.static_force").text);
   EXPECT_EQ(keys.count("controller.model.effects.constant_force.enabled"), 0u);
+}
+
+// feeddrive-study builds a case as a struct: the nominal scenario as read (parse_scenario's
+// as_read), each setting set in it (set_read_key), derived and checked (complete_read). Where it
+// sets a key, the keys must be those of the YAML with the same setting (set_key, then the
+// loader), and the YAML must load; where it declines or fails, the study reads the YAML.
+ResolvedKeys yaml_with(const std::string& text, const std::string& dir, const std::string& key,
+                       const std::string& value) {
+  YAML::Node root = load_yaml_strict(text);
+  set_key(root, key, value);
+  YAML::Emitter em;
+  em << root;
+  ResolvedKeys keys;
+  parse_scenario(em.c_str(), dir, "s.yaml", &keys);
+  return keys;
+}
+
+// Sets key = value both ways; true if the struct took it (and then the two agree).
+bool struct_as_yaml(const std::string& text, const std::string& dir, const std::string& key, const std::string& value) {
+  Scenario s;
+  parse_scenario(text, dir, "s.yaml", nullptr, &s);
+  try {
+    if (!set_read_key(s, key, value)) return false;
+    complete_read(s);
+  } catch (const std::exception&) {
+    EXPECT_THROW(yaml_with(text, dir, key, value), ScenarioError) << key << " = " << value;
+    return false;
+  }
+  ResolvedKeys yaml;
+  EXPECT_NO_THROW(yaml = yaml_with(text, dir, key, value)) << key << " = " << value;
+  EXPECT_EQ(resolved_keys(s), yaml) << key << " = " << value;
+  return true;
+}
+
+// Another value of a key of the same type: a number times 1.25 (an integer plus 1), a flag
+// flipped, a name as it is.
+std::string other_value(const ResolvedValue& v) {
+  if (v.is_string) return v.text;
+  if (v.text == "true") return "false";
+  if (v.text == "false") return "true";
+  if (v.text.find_first_of(".e") == std::string::npos && v.text.find("inf") == std::string::npos)
+    return std::to_string(std::stol(v.text) + 1);
+  if (v.text.find("inf") != std::string::npos) return "1.5";
+  return std::to_string(std::strtod(v.text.c_str(), nullptr) * 1.25);
+}
+
+TEST(ResolvedKeys, ACaseSetAsAStructHasTheKeysOfItsYaml) {
+  const fs::path dir = fs::path(FEEDDRIVE_SOURCE_DIR) / "scenarios";
+  int by_struct = 0;
+  int keys_tried = 0;
+  for (const char* file : {"paper/smc_bl_jerk_limited.yaml", "fit/truth_cogging.yaml",
+                           "analysis/cascade_tuned_feedback_only.yaml", "paper/open_loop_ripple_sine_130N.yaml"}) {
+    const fs::path path = dir / file;
+    const std::string text = slurp(path);
+    ResolvedKeys keys;
+    parse_scenario(text, path.parent_path().string(), file, &keys);
+    for (const auto& [k, v] : keys) {
+      ++keys_tried;
+      if (struct_as_yaml(text, path.parent_path().string(), k, other_value(v))) ++by_struct;
+    }
+  }
+  // Most keys of a run are plain values of the lists (the rest: types, presets, files, the
+  // timing keys read_timing checks): the struct must take them, not leave every case to YAML.
+  EXPECT_GT(by_struct, keys_tried / 2) << by_struct << " of " << keys_tried;
+}
+
+TEST(ResolvedKeys, ASetStructKeyFollowsTheReadersRules) {
+  const std::string base = R"(
+duration: 0.01
+control_period: 1e-4
+plant: {ripple: paper, effects: {constant_force: {force_N: 2}}}
+controller: {type: sliding_mode, model: {friction: {static_force: 150}}}
+reference: {type: step, amplitude: 1.0e-3}
+)";
+  // A plant value the model does not give follows into the model; one it gives does not.
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.mass", "90"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.friction.static_force", "130"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.model.mass", "80"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.constant_force.force_N", "3"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.cogging_amplitude", "4"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.computation_delay", "2e-4"));
+  // What only the YAML reader decides: declined (the study then reads the YAML).
+  for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+           {"plant.ripple.preset", "none"},                // a preset sets the whole section
+           {"plant.effects.spring_force.stiffness", "1"},  // listing an effect enables it
+           {"controller.type", "cascade"},                 // another type's keys
+           {"reference.frequency", "2"},                   // not a key of a step
+           {"controller.computation_delay", "-1"},         // refused, quoting the value as written
+           {"duration", "0.02"},                           // read_timing's rules
+           {"plant.mass", "~"},                            // null in YAML
+           {"plant.mass", "[1, 2]"},                       // a flow list
+           {"plant.mas", "90"}}) {                         // unknown (did-you-mean comes from YAML)
+    Scenario s;
+    parse_scenario(base, ".", "s.yaml", nullptr, &s);
+    EXPECT_FALSE(set_read_key(s, k, v)) << k << " = " << v;
+  }
+  // A value its accessor refuses: the reader's own error.
+  Scenario s;
+  parse_scenario(base, ".", "s.yaml", nullptr, &s);
+  EXPECT_THROW(set_read_key(s, "plant.mass", "abc"), ScenarioError);
 }
 
 }  // namespace

@@ -85,6 +85,9 @@ struct ControllerConfig {
   /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
   /// plant's own parameters without its effects; summary.json says so as controller_model).
   bool model_given{false};
+  /// The dotted keys given under controller.model (its maps and values, "friction" and
+  /// "friction.static_force"): a model value not given follows the plant (set_read_key).
+  std::set<std::string> model_keys_given;
 };
 
 struct AnalysisConfig {
@@ -171,8 +174,25 @@ Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& s
 /// key with its effective value (given or default; file names resolved against base_dir), the
 /// complete description of the run, used by feeddrive-study to vary keys, scale them and key its
 /// cases.
+/// `as_read` (optional): the scenario as read, before derive() and the checks, for
+/// set_read_key.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
-                        const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr);
+                        const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr,
+                        Scenario* as_read = nullptr);
+
+/// feeddrive-study's cases as structs (study/src/cases.cpp): sets one key of a scenario as read
+/// (parse_scenario's `as_read`) through the sections' lists, its value parsed by the reader's
+/// own accessor (yaml_archive.hpp), with the reader's rules: a plant value the controller's
+/// model does not give follows into the model, an effect's key only for a listed effect.
+/// Returns false, leaving `s` as it may be, for what only the YAML reader decides (a key not in
+/// the lists of the scenario's types, a type, a preset, a tuning rule, a file, a section made
+/// present, a flow value, a value the YAML would read differently, a value a read rule refuses):
+/// the caller then reads the YAML with the setting, which gives the same scenario or the
+/// reader's own one-line error. Throws ScenarioError for a value its accessor refuses.
+bool set_read_key(Scenario& s, const std::string& key, const std::string& value);
+/// derive() and the checks of parse_scenario on a scenario as read; a ScenarioError thrown here
+/// may quote sections differently from parse_scenario's (the caller reads the YAML for it).
+void complete_read(Scenario& s);
 
 /// Every key that describes the run, with its effective value, from the scenario's struct: the
 /// keys of each section's list (common/fields.hpp) for its controller and reference type, the
