@@ -64,6 +64,20 @@ struct StepParams {
 };
 std::unique_ptr<Trajectory> make_step(const StepParams& p);
 
+/// The fields both rest-to-rest moves (acceleration- and jerk-limited) share, in one list:
+/// distance (sign = direction) [m], max_velocity [m/s], max_acceleration [m/s^2].
+template <class Archive>
+void visit_move_limits(Archive* a, double& distance, double& max_velocity, double& max_acceleration) {
+  a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
+  a->Visit(
+      FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
+  a->Visit(FD_FIELD(max_acceleration)
+               .unit("m/s^2")
+               .positive()
+               .at_most(1e5)
+               .plausible(0, 500, "mm/s^2", "", "any linear drive"));
+}
+
 /// Acceleration-limited (bang-coast-bang) rest-to-rest move of `distance` (sign = direction)
 /// with |v| <= max_velocity and |a| <= max_acceleration, time-optimal: a trapezoidal velocity
 /// profile, or a triangle when max_velocity is not reached. Jerk is 0 (acceleration steps).
@@ -76,14 +90,7 @@ struct AccelLimitedParams {
   double initial{0.0};           ///< start position [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(
-        FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration)
-                 .unit("m/s^2")
-                 .positive()
-                 .at_most(1e5)
-                 .plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    visit_move_limits(a, distance, max_velocity, max_acceleration);
     a->Visit(FD_FIELD(start_time).unit("s"));
     a->Visit(FD_FIELD(initial).unit("m").plausible(-5, 5, "mm"));
   }
@@ -104,14 +111,7 @@ struct SCurveParams {
   double initial{0.0};            ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(distance).unit("m").plausible(-5, 5, "mm", "", "the travel of any linear feed drive"));
-    a->Visit(
-        FD_FIELD(max_velocity).unit("m/s").positive().at_most(1000).plausible(0, 10, "mm/s", "", "any linear drive"));
-    a->Visit(FD_FIELD(max_acceleration)
-                 .unit("m/s^2")
-                 .positive()
-                 .at_most(1e5)
-                 .plausible(0, 500, "mm/s^2", "", "any linear drive"));
+    visit_move_limits(a, distance, max_velocity, max_acceleration);
     a->Visit(
         FD_FIELD(max_jerk).unit("m/s^3").positive().at_most(1e8).plausible(0, 1e5, "mm/s^3", "", "any linear drive"));
     a->Visit(FD_FIELD(start_time).unit("s"));
