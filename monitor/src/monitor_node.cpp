@@ -106,6 +106,10 @@ void MonitorNode::on_command(const control_command_t& m, std::int64_t t) {
         if (known != commands_.source_process.end() && known->second.empty())
           known->second = process_on_source(c->sender);  // once more: it may have bound since
         if (known != commands_.source_process.end() && !known->second.empty()) c->sender += " " + known->second;
+        // Gone before it could be looked up (the run fails at once on a conflict, and a loaded
+        // monitor reads its backlog late): the role whose heartbeats came from that socket.
+        else if (const std::string r = role_of_source(c->sender); !r.empty())
+          c->sender += " (the " + r + "'s socket, by its heartbeats; no local process owns it now)";
       }
     }
     throw;

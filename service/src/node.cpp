@@ -106,6 +106,8 @@ void Node::set_run_identity() {
 }
 
 void Node::on_status(const process_status_t& m, std::int64_t recv_us) {
+  if (const std::string src = bus_.current_source(); !src.empty())
+    if (status_sources_.size() < 64 || status_sources_.count(src)) status_sources_[src] = {m.run_id, m.role};
   if (!bus_.run_known() && !join_run(m)) return;
   if (m.run_id != bus_.run_id()) {
     bus_.count_foreign(ch_.status, m.run_id, m.role);
@@ -308,6 +310,11 @@ const process_status_t* Node::peer(const std::string& role) const {
 }
 
 bool Node::peer_alive(const std::string& role, double seconds) const { return peer_alive_at(role, seconds, mono_us()); }
+
+std::string Node::role_of_source(const std::string& source) const {
+  const auto it = status_sources_.find(source);
+  return it != status_sources_.end() && it->second.first == bus_.run_id() ? it->second.second : "";
+}
 
 bool Node::peer_alive_at(const std::string& role, double seconds, std::int64_t at_us) const {
   const process_status_t* p = peer(role);

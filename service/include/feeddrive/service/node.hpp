@@ -130,6 +130,11 @@ class Node {
   /// The same, judged at `at_us` (monotonic [us]) rather than now: e.g. at the receive time of
   /// the message being handled (Bus::current_recv_us), for a process reading a backlog.
   bool peer_alive_at(const std::string& role, double seconds, std::int64_t at_us) const;
+  /// The run role whose heartbeats came from the UDP source "IP:PORT" (Bus::current_source), ""
+  /// if none did: a participant sends its heartbeats and its messages from one socket. Recorded
+  /// from every heartbeat heard, before this node joined the run too (at most 64 sources);
+  /// only heartbeats of this run count. Under --key only signed heartbeats reach it.
+  std::string role_of_source(const std::string& source) const;
   bool monitor_done() const;
   /// After the end: state "done", then keep answering resend requests and sending heartbeats
   /// until the monitor is done (and an attached monitor heard within the last second too) or
@@ -190,6 +195,7 @@ class Node {
   static constexpr double kAttachedHoldS = 2.0;  ///< longest an attached monitor holds the linger
   std::map<std::string, process_status_t> peers_;
   std::map<std::string, std::int64_t> peer_seen_us_;
+  std::map<std::string, std::pair<std::int64_t, std::string>> status_sources_;  ///< source -> (run id, role)
 };
 
 /// Real-time setup of a process on a real-time run's critical path (plant, controller), as
