@@ -401,8 +401,14 @@ void MonitorNode::request_missing() {
   // Only ask for what was sent already: the step after the newest state is not lost, it is not
   // there yet. A monitor far behind (an attached one whose socket overflowed) asks for up to
   // kPerRound messages of each kind a round, not one.
+  // In real time, while the plant runs, two of each kind a round: every re-sent message costs the
+  // chain's processes a send or a wake-up on their core, and a monitor that lost thousands
+  // (starved on that core) would take the chain's time; the rest comes after the end, while the
+  // plant and the trajectory linger (docs/lcm-contract.md, "Real time against the machine").
   constexpr std::size_t kPerRound = 64;
-  for (const record::Missing& m : rec_.missing_until(rec_.highest_state(), kPerRound)) {
+  constexpr std::size_t kPerRoundInRealTime = 2;
+  const std::size_t per_round = options().realtime && !rec_.end_seen() ? kPerRoundInRealTime : kPerRound;
+  for (const record::Missing& m : rec_.missing_until(rec_.highest_state(), per_round)) {
     const std::string& channel = m.what == "state"       ? channels().state
                                  : m.what == "reference" ? channels().reference
                                                          : channels().command;
@@ -477,7 +483,7 @@ bool MonitorNode::run() {
   when_.start = when_.last_row = mono_us();
   std::string failure;
   try {
-    record_until_end();
+    record_in_real_time_if_asked();
   } catch (const service::RunFailure& e) {
     failure = record_after_failure(e.what());
   } catch (const interrupt::Interrupted& e) {
@@ -498,6 +504,21 @@ bool MonitorNode::run() {
   progress(true);
   // Not written (folder, disk, gnuplot): the run failed too, whatever the steps did.
   return finish(failure.empty(), failure) && failure.empty();
+}
+
+// Real time: the record is part of the run. At normal priority (it was nice 10) on the chain's
+// core, the monitor fell behind whenever anything else ran, its socket overflowed, and its resend
+// requests loaded the chain further: 5,000 of 15,000 deadlines missed in some runs (docs/lcm-
+// contract.md, "Real time against the machine"). SCHED_FIFO 78, below the trajectory (79), the
+// controller (80) and the plant (81), lets only the chain preempt it. Its memory grows with the
+// record, so it is not locked; the output is written at normal priority again.
+void MonitorNode::record_in_real_time_if_asked() {
+  if (!options().realtime || !options().realtime_scheduling || mopt_.attach) return record_until_end();
+  enter_realtime_if_asked(78, false);
+  struct Normal {
+    ~Normal() { service::leave_realtime(); }
+  } normal_after;
+  record_until_end();
 }
 
 void MonitorNode::record_until_end() {

@@ -22,11 +22,12 @@
 #include "feeddrive/service/contract.hpp"
 
 namespace feeddrive::service {
-std::string enter_realtime(int priority) {
+std::string enter_realtime(int priority, bool lock_memory) {
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-  const bool locked = ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-  const std::string lock =
-      locked ? "memory locked" : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
+  const bool locked = lock_memory && ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+  const std::string lock = !lock_memory ? "memory not locked (not asked)"
+                           : locked     ? "memory locked"
+                                        : std::string("memory not locked (mlockall: ") + std::strerror(errno) + ")";
   const std::string idle = hold_cpu_latency_zero();
   sched_param sp{};
   sp.sched_priority = priority;
@@ -34,6 +35,19 @@ std::string enter_realtime(int priority) {
     return "SCHED_FIFO " + std::to_string(priority) + ", " + lock + ", " + idle;
   return std::string("normal scheduling (SCHED_FIFO not permitted: ") + std::strerror(errno) +
          "; needs root, CAP_SYS_NICE or an rtprio limit; expect missed deadlines at high rates), " + lock + ", " + idle;
+}
+
+void Node::enter_realtime_if_asked(int priority, bool lock_memory) {
+  if (!opt_.realtime || !opt_.realtime_scheduling) return;
+  const std::string rt = enter_realtime(priority, lock_memory);
+  if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("{}: real time: {}", role_, rt);
+  else spdlog::warn("{}: real time: {}", role_, rt);
+}
+
+void leave_realtime() {
+  sched_param sp{};
+  sp.sched_priority = 0;
+  ::sched_setscheduler(0, SCHED_OTHER, &sp);  // fails only if never granted: nothing to undo
 }
 
 std::string hold_cpu_latency_zero() {

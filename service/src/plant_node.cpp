@@ -205,9 +205,7 @@ bool PlantNode::take_commands(std::int64_t k, double t_end) {
 }
 
 void PlantNode::run_realtime() {
-  const std::string rt = enter_realtime(81);  // above the controller (80): controller_node.cpp
-  if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("plant: real time: {}", rt);
-  else spdlog::warn("plant: real time: {}", rt);
+  enter_realtime_if_asked(81);  // above the controller (80): controller_node.cpp
   command_.reset();
   // Start handshake: state 0 waits for its command as in lockstep, so the clock starts only
   // when the controller, the trajectory and the monitor are all up.

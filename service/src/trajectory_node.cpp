@@ -1,6 +1,5 @@
 #include "feeddrive/service/trajectory_node.hpp"
 
-#include <spdlog/spdlog.h>
 
 #include "feeddrive/service/translate.hpp"
 
@@ -19,6 +18,9 @@ TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt, l
     }
     if (m.seq <= highest_state_) {  // repeated state: whatever it needed got lost
       ++duplicates;
+      // In real time a repeated state is the plant answering a monitor's resend request (the
+      // controller asks for a missing reference itself, on the resend channel): no blocks.
+      if (options().realtime && m.seq > 0) return;
       send_block(m.seq / kBlock, true);
       if ((m.seq + 1) % kBlock == 0) send_block((m.seq + 1) / kBlock, true);
       return;
@@ -33,8 +35,12 @@ TrajectoryNode::TrajectoryNode(const sim::Scenario& s, const NodeOptions& opt, l
     // The requester lacks block seq/kBlock, and probably the blocks published after it too (it
     // started late, or its socket overflowed): send them again, not one request each, up to
     // one lead's worth (a monitor far behind asks again as it catches up).
+    // In real time, while the plant runs, only the block asked for: a monitor on the chain's
+    // core that fell behind would otherwise have 17 blocks sent for each of its requests, at
+    // this process's real-time priority; it catches up after the end (linger()).
     const std::int64_t first = r.seq / kBlock;
     send_block(first, true);
+    if (options().realtime && !end_) return;
     for (std::int64_t b = first + 1; b < std::min(next_block_, first + 1 + kLead / kBlock); ++b) send_block(b, true);
   };
 }
@@ -68,11 +74,7 @@ void TrajectoryNode::run() {
   // the loop too; below the plant (80) and the controller (81), above everything else. At
   // normal priority, pinned next to them (--cpus 0) on a busy machine, it starved for hundreds of
   // ms and the controller, waiting for its reference, missed thousands of deadlines.
-  if (options().realtime) {
-    const std::string rt = enter_realtime(79);
-    if (rt.rfind("SCHED_FIFO", 0) == 0) spdlog::info("trajectory: real time: {}", rt);
-    else spdlog::warn("trajectory: real time: {}", rt);
-  }
+  enter_realtime_if_asked(79);
   set_state("running");
   wait_for_run();  // every block must carry the run's identity
   // Everything, block 0 included, once the plant's first state shows that the run has started:

@@ -203,6 +203,25 @@ TEST_F(ControllerProtocol, ARepeatedStateGetsTheSameCommandAgain) {
   EXPECT_EQ(node.resends, kSteps + 1);
 }
 
+// Real time: the plant has moved on when a state comes again (a monitor's resend request made the
+// plant repeat it), so the controller answers only the start handshake's state 0 again. Each
+// repeated later state answered would double the bus load of a monitor catching up on the
+// chain's core (docs/lcm-contract.md, "Real time against the machine").
+TEST_F(ControllerProtocol, InRealTimeARepeatedStateAfterTheHandshakeIsNotAnsweredAgain) {
+  service::NodeOptions opt = node_options();
+  opt.realtime = true;
+  opt.realtime_scheduling = false;  // the protocol, without SCHED_FIFO for the test process
+  ControllerNode& node = make_node(opt);
+  Trajectory traj(memq, s);
+  Plant plant(memq, s, 2);
+  run_to_end(plant);
+  std::map<std::int64_t, int> copies;
+  for (const control_command_t& c : plant.commands) ++copies[c.seq];
+  for (std::int64_t k = 0; k < kSteps; ++k) EXPECT_EQ(copies[k], k == 0 ? 2 : 1) << "step " << k;
+  EXPECT_EQ(node.duplicates, kSteps);  // every second copy, the end-of-run marker's included
+  EXPECT_EQ(node.resends, 1);          // state 0's
+}
+
 // A lost reference: the controller holds state 5 and asks for reference 5 on FD_RESEND (after
 // one resend interval); the trajectory sends it, the step is answered, the run goes on.
 TEST_F(ControllerProtocol, AsksForAMissingReference) {

@@ -136,6 +136,35 @@ TEST(TrajectoryProtocol, ARepeatedStateOrARequestRepublishesTheBlocks) {
   EXPECT_EQ(node.resends, 3);
 }
 
+// Real time: a repeated state is the plant answering a monitor's resend request, not a sign that
+// a reference got lost (the controller asks for those on FD_RESEND): no block goes out again for
+// it. A resend request while the plant runs re-publishes the block asked for, not the later ones
+// as well (a monitor starved on the chain's core catches up after the end).
+TEST(TrajectoryProtocol, InRealTimeOnlyARequestRepublishesTheBlocks) {
+  Memq memq;
+  constexpr long kSteps = 40;  // blocks 0, 16, 32: all sent at state 0
+  const sim::Scenario s = scenario(kSteps);
+  service::NodeOptions opt = node_options();
+  opt.realtime = true;
+  opt.realtime_scheduling = false;  // the protocol, without SCHED_FIFO for the test process
+  TrajectoryNode node(s, opt, memq.lcm);
+  Blocks blocks(memq);
+  auto plant = peer(memq);
+  for (std::int64_t k = 0; k <= 6; ++k) plant->publish(kCh.state, state(k, kSteps));
+  plant->publish(kCh.state, state(5, kSteps));  // again: no block
+  resend_request_t r{};
+  r.requester = "monitor";
+  r.channel = kCh.reference;
+  r.seq = 20;  // block 16 only
+  plant->publish(kCh.resend, r);
+  for (std::int64_t k = 7; k <= kSteps; ++k) plant->publish(kCh.state, state(k, kSteps));
+  node.run();
+  expect_blocks_cover_the_trajectory(s, blocks.got);
+  EXPECT_EQ(blocks.copies(), (std::map<std::int64_t, int>{{0, 1}, {16, 2}, {32, 1}}));
+  EXPECT_EQ(node.duplicates, 1);
+  EXPECT_EQ(node.resends, 1);
+}
+
 // Without --run-id the trajectory joins the run of the plant's first fresh heartbeat, then
 // takes that run's states (before, every state is dropped uncounted).
 TEST(TrajectoryProtocol, JoinsTheRunOfThePlantsHeartbeat) {

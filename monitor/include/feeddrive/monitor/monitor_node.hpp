@@ -120,6 +120,8 @@ class MonitorNode : public service::Node {
   std::int64_t steps_expected() const;
   /// Records until the run is complete; throws service::RunFailure when it cannot go on.
   void record_until_end();
+  /// record_until_end(), at SCHED_FIFO 78 for a real-time run's own monitor, normal again after.
+  void record_in_real_time_if_asked();
   /// Heartbeat with the step recorded; the run's own monitor acknowledges it (the plant's flow control).
   void heartbeat_progress();
   /// No row for `limit`: waits for a role that still beats (it names the culprit), else throws

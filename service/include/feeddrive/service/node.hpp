@@ -44,6 +44,9 @@ struct NodeOptions {
   /// wakes 20-40 us late on the development VM (measured: bench/realtime_bench.sh with 10 us
   /// gave a median 767 plant overruns and 75 misses of 15,000, with 30 us 156 and 56).
   std::int64_t realtime_spin_us{30};
+  /// Real time: take SCHED_FIFO (enter_realtime) as well as the wall-clock protocol. The memq://
+  /// protocol tests turn it off: the protocol without changing the test process's scheduling.
+  bool realtime_scheduling{true};
   bool quiet{false};
   /// Polled by the protocol loops (Ctrl-C, SIGTERM): add_node_options sets the process's token
   /// (tool::stop_token()); the default never stops.
@@ -149,6 +152,9 @@ class Node {
   std::int64_t acked_seq{-1};  ///< monitor only: every step below is recorded
 
  protected:
+  /// Real time (and realtime_scheduling): enter_realtime(priority, lock_memory), the line it
+  /// returns logged under this role (a warning when SCHED_FIFO was not granted). Else nothing.
+  void enter_realtime_if_asked(int priority, bool lock_memory = true);
   /// Called for resend requests on `channel`; re-publish `seq` if this node owns the channel.
   std::function<void(const resend_request_t&)> on_resend_request;
   /// Called each time the heartbeat goes out (every 100 ms and on changes of state).
@@ -204,8 +210,13 @@ class Node {
 /// would delay every timed wake-up). Returns one line saying what was granted, e.g.
 /// "SCHED_FIFO 80, memory locked" or "normal scheduling (SCHED_FIFO not permitted: needs root,
 /// CAP_SYS_NICE or an rtprio limit), memory locked"; the caller logs it. It also holds the CPU
-/// wake-up latency at 0 (hold_cpu_latency_zero).
-std::string enter_realtime(int priority);
+/// wake-up latency at 0 (hold_cpu_latency_zero). lock_memory = false leaves out the mlockall, for
+/// a process whose memory grows with the run (the monitor's record).
+std::string enter_realtime(int priority, bool lock_memory = true);
+
+/// Back to normal scheduling (SCHED_OTHER) after a real-time phase, e.g. the monitor once the
+/// run's messages are recorded and its output (CSV, plots) is written at normal priority.
+void leave_realtime();
 
 /// Asks the kernel's PM QoS for a CPU wake-up latency of 0 us, as cyclictest does by default, by
 /// writing a 32-bit 0 to /dev/cpu_dma_latency and keeping the descriptor open for the life of the
