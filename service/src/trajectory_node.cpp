@@ -1,6 +1,5 @@
 #include "feeddrive/service/trajectory_node.hpp"
 
-
 #include "feeddrive/service/translate.hpp"
 
 namespace feeddrive::service {
