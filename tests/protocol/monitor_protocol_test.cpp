@@ -231,6 +231,44 @@ TEST_F(MonitorProtocol, AsksForWhatIsMissingAndIgnoresDuplicates) {
   EXPECT_GE(node.summary().duplicates, 1) << "state 5 twice";
 }
 
+// Real time, states 3..12 lost: while the plant runs the monitor asks for two of a kind a round
+// (each message re-sent costs the chain's processes time on their core), so before the end it
+// asks only for states 3 and 4, again and again; after the end-of-run state it asks for the rest
+// at once, and the record is complete (docs/lcm-contract.md, "Real time against the machine").
+TEST_F(MonitorProtocol, InRealTimeItAsksForTwoOfAKindARoundUntilTheEnd) {
+  service::NodeOptions opt = node_options();
+  opt.realtime = true;
+  opt.realtime_scheduling = false;  // the protocol, without SCHED_FIFO for the test process
+  MonitorNode& node = make_node("realtime_requests", opt);
+  std::vector<drive_state_t> states = script.states;
+  for (drive_state_t& m : states) m.realtime = true;
+  const auto lost = [](std::int64_t k) { return k >= 3 && k <= 12; };
+  std::set<std::int64_t> asked_before_the_end;
+  int rounds = 0;
+  bool ended = false;
+  run->subscribe<resend_request_t>(kCh.resend, [&](const resend_request_t& r, std::int64_t) {
+    if (r.channel != kCh.state) return;
+    if (!ended) {
+      asked_before_the_end.insert(r.seq);
+      if (r.seq == 3 && ++rounds == 5) {  // five rounds of requests, then the plant ends
+        ended = true;
+        run->publish(kCh.state, states.back());
+      }
+      return;
+    }
+    run->publish(kCh.state, states.at(static_cast<std::size_t>(r.seq)));
+  });
+  for (const drive_state_t& m : states)
+    if (!lost(m.seq) && !m.end_of_run) run->publish(kCh.state, m);
+  for (const reference_t& r : script.refs) Script::send_reference(*run, r);
+  for (const control_command_t& c : script.commands) run->publish(kCh.command, c);
+  EXPECT_TRUE(node.run());
+  listener.wait_for_the_end();
+  EXPECT_EQ(rounds, 5);
+  EXPECT_EQ(asked_before_the_end, (std::set<std::int64_t>{3, 4}));
+  expect_complete_record("realtime_requests");
+}
+
 // Two different states for one step: the run fails naming it; what was recorded is kept.
 TEST_F(MonitorProtocol, TwoDifferentStatesForOneStepFailTheRun) {
   MonitorNode& node = make_node("state_conflict");
