@@ -114,24 +114,6 @@ double advance_fg(const plant::GrindingParams& g, double fg, double x, double v,
   return fss + (fg - fss) * std::exp(-g.stiffness / C * h);
 }
 
-}  // namespace
-
-namespace {
-
-bool same(const plant::FrictionParams& a, const plant::FrictionParams& b) {
-  return a.model == b.model && a.static_force == b.static_force && a.coulomb_force == b.coulomb_force &&
-         a.stribeck_velocity == b.stribeck_velocity && a.stribeck_exponent == b.stribeck_exponent &&
-         a.bristle_stiffness == b.bristle_stiffness && a.bristle_damping == b.bristle_damping &&
-         a.viscous == b.viscous && a.damping_decay_velocity == b.damping_decay_velocity &&
-         a.static_smoothing_velocity == b.static_smoothing_velocity;
-}
-
-bool same(const plant::GrindingParams& a, const plant::GrindingParams& b) {
-  return a.enabled == b.enabled && a.stiffness == b.stiffness && a.dullness == b.dullness &&
-         a.workpiece_diameter == b.workpiece_diameter && a.wheel_width == b.wheel_width &&
-         a.contact_position == b.contact_position;
-}
-
 // Friction (part 0) or grinding (part 1) force averaged over each interval, with the internal
 // state at the samples. Friction and grinding depend on v through fast internal states (and,
 // for the static model, on sgn v), so they are averaged over S sub-steps with v^ and x^
@@ -200,12 +182,12 @@ Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Int
     filtered = apply(r.bank, f);
     valid = true;
   };
-  if (!c.friction_valid || !same(c.friction, pe.friction) || c.bristle0 != pe.initial.bristle) {
+  if (!c.friction_valid || !fields::same(c.friction, pe.friction) || c.bristle0 != pe.initial.bristle) {
     refresh(0, c.friction_valid, c.friction_filtered, c.z);
     c.friction = pe.friction;
     c.bristle0 = pe.initial.bristle;
   }
-  if (!c.grinding_valid || !same(c.grinding, pe.grinding) || c.grinding0 != pe.initial.grinding) {
+  if (!c.grinding_valid || !fields::same(c.grinding, pe.grinding) || c.grinding0 != pe.initial.grinding) {
     refresh(1, c.grinding_valid, c.grinding_filtered, c.fg);
     c.grinding = pe.grinding;
     c.grinding0 = pe.initial.grinding;

@@ -260,4 +260,41 @@ std::vector<std::string> plausibility(const S& obj, const std::string& prefix) {
   return out;
 }
 
+// --- same: equality through the list --------------------------------------------------------
+
+/// Collects the bytes of every value of a list, nested structs included, in list order: two
+/// objects of one struct are the same when their collections are (doubles compared bit for bit,
+/// so NaN equals NaN and a cache keyed by it never misses a changed field).
+class BytesArchive {
+ public:
+  explicit BytesArchive(std::string* out) : out_(out) {}
+  template <typename T>
+  void Visit(const Field<T>& f) {
+    if constexpr (std::is_arithmetic_v<T> || std::is_enum_v<T>) {
+      out_->append(reinterpret_cast<const char*>(f.value), sizeof(T));
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      out_->append(*f.value);
+      out_->push_back('\0');
+    } else if constexpr (is_serializable<T>::value) {
+      f.value->Serialize(this);
+    } else {
+      static_assert(sizeof(T) == 0, "fields::same: a field type without a comparison");
+    }
+  }
+
+ private:
+  std::string* out_;
+};
+
+/// True when every field of `a`'s list equals `b`'s (BytesArchive). One list: a field added to
+/// the struct's Serialize is compared without further code (the fit's force cache, model.cpp).
+template <typename S>
+bool same(const S& a, const S& b) {
+  std::string ba, bb;
+  BytesArchive xa(&ba), xb(&bb);
+  const_cast<S&>(a).Serialize(&xa);  // the archive only reads
+  const_cast<S&>(b).Serialize(&xb);
+  return ba == bb;
+}
+
 }  // namespace feeddrive::fields
