@@ -57,7 +57,6 @@ void check_name(const std::string& name, const std::string& what) {
   }
 }
 
-
 void check_timing(const Scenario& s, const std::string& duration, const std::string& period) {
   if (s.control_period > s.duration) throw ScenarioError("control_period = " + period + ": must be <= duration");
   if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
@@ -94,19 +93,8 @@ std::string resolved_file(const std::string& base_dir, const std::string& file) 
 }
 
 bool parameter_name(const std::string& key) {
-  return !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  });
-}
-
-std::vector<std::string> split_key(const std::string& key) {
-  std::vector<std::string> parts;
-  for (std::size_t b = 0;;) {
-    const std::size_t e = key.find('.', b);
-    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) return parts;
-    b = e + 1;
-  }
+  return !key.empty() && std::all_of(key.begin(), key.end(),
+                                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
 }  // namespace detail
@@ -777,7 +765,7 @@ void emit_map(YAML::Emitter& em, const std::vector<std::pair<std::vector<std::st
 
 std::string resolved_yaml(const ResolvedKeys& keys) {
   std::vector<std::pair<std::vector<std::string>, const ResolvedValue*>> items;
-  for (const auto& [path, value] : keys) items.emplace_back(detail::split_key(path), &value);
+  for (const auto& [path, value] : keys) items.emplace_back(text::split(path, '.'), &value);
   // Sorted by parts, so every group of one prefix is contiguous ("a.b" and "a-c" interleave as
   // strings, not as part lists).
   std::sort(items.begin(), items.end(), [](const auto& x, const auto& y) { return x.first < y.first; });

@@ -35,7 +35,4 @@ bool parameter_name(const std::string& key);
 /// files it names, the functions of time, the warnings) on a scenario as read.
 void derive_and_check(Scenario& s);
 
-/// The parts of a dotted key ("plant.friction" -> plant, friction).
-std::vector<std::string> split_key(const std::string& key);
-
 }  // namespace feeddrive::sim::detail

@@ -101,7 +101,8 @@ class FieldSetArchive {
   [[noreturn]] void fail() const {
     if (!error_.empty()) throw ScenarioError(error_);
     if (found_ == Found::kBelowValue)
-      throw ScenarioError(parent_ + "." + rest_ + ": " + below_ + " is a single value in the scenario, not a map of keys");
+      throw ScenarioError(parent_ + "." + rest_ + ": " + below_ +
+                          " is a single value in the scenario, not a map of keys");
     unknown(parent_, rest_.substr(0, rest_.find('.')), names_);
   }
 
@@ -294,8 +295,9 @@ void reset_plant_part(Scenario& s, const std::string& rest) {
 
 void plant_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   const std::string head = rest.substr(0, rest.find('.'));
-  if (head == "effects") return effects_key(s, s.plant.effects, "plant.effects", rest.size() > 8 ? rest.substr(8) : "", v);
-  if (head == "grinding") s.grinding_process = true;  // the section made present
+  if (head == "effects")
+    return effects_key(s, s.plant.effects, "plant.effects", rest.size() > 8 ? rest.substr(8) : "", v);
+  if (head == "grinding") s.grinding_process = true;                                // the section made present
   if (rest == "ripple" && v.IsScalar()) return preset(s, "plant.ripple", v, true);  // the short form
   if (rest == "ripple.preset") return preset(s, "plant.ripple", v, false);
   if (set_field(s.plant, "plant", rest, v) == Found::kValue) return follow(s, rest, v);
@@ -401,7 +403,8 @@ void controller_type(Scenario& s, const YAML::Node& v) {
   const ControllerType t = read_enum<ControllerType>("controller", "type", v);
   if (t == cc.type) return;
   if (t != ControllerType::kSlidingMode && gives(s, "controller.model.effects"))
-    refuse("controller.type", v, "controller.model.effects is given: only the sliding_mode controller's model takes effects");
+    refuse("controller.type", v,
+           "controller.model.effects is given: only the sliding_mode controller's model takes effects");
   const ResolvedKeys old = controller_values(cc, cc.type);
   cc.type = t;
   switch_keys(s, "controller", v, controller_names(cc, t), old,
@@ -426,7 +429,8 @@ void plugin_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
     if (!detail::parameter_name(name)) pr.fail(name, ": a parameter name is letters, digits and _ only");
     std::string value;
     pr.number_or_string(name, value);
-    const auto it = std::find_if(p.parameters.begin(), p.parameters.end(), [&](const auto& kv) { return kv.first == name; });
+    const auto it =
+        std::find_if(p.parameters.begin(), p.parameters.end(), [&](const auto& kv) { return kv.first == name; });
     if (it != p.parameters.end()) it->second = value;
     else p.parameters.emplace_back(name, value);
   } else {
@@ -454,7 +458,8 @@ void controller_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
         throw ScenarioError("controller." + rest + ": set by tuning: rule (remove it, or use tuning: manual)");
       if (!rule && rest == "bandwidth_scale") throw ScenarioError("controller.bandwidth_scale: only with tuning: rule");
       set_value(cc.cascade, "controller", rest, v);
-      if (rest == "bandwidth_scale" && !(cc.cascade.bandwidth_scale > 0.0)) refuse("controller." + rest, v, "must be > 0");
+      if (rest == "bandwidth_scale" && !(cc.cascade.bandwidth_scale > 0.0))
+        refuse("controller." + rest, v, "must be > 0");
       if (rest == "tuning") check_tuning(s);
       return;
     }

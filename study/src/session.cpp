@@ -92,9 +92,8 @@ class CasePool {
  public:
   using Case = std::variant<std::shared_ptr<const sim::Scenario>, std::string>;
   CasePool(int jobs, const interrupt::StopToken& stop)
-      : stop_(stop), pool_(jobs, [this](std::size_t i) {
-          return std::visit([this](const auto& c) { return run(c); }, take(i));
-        }) {}
+      : stop_(stop),
+        pool_(jobs, [this](std::size_t i) { return std::visit([this](const auto& c) { return run(c); }, take(i)); }) {}
   void push(std::size_t i, Case c) {
     {
       std::lock_guard<std::mutex> g(mu_);

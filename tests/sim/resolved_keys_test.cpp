@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../support/scratch.hpp"
+#include "feeddrive/common/text.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::sim {
@@ -133,13 +134,7 @@ reference: {type: step, amplitude: 1.0e-3}
 // and --set build the scenario as a struct instead (read_scenario, set_read_key, complete_read);
 // the two must give the same keys, or both refuse.
 void yaml_set(YAML::Node& root, const std::string& key, const std::string& value) {
-  std::vector<std::string> parts;
-  for (std::size_t b = 0;;) {
-    const std::size_t e = key.find('.', b);
-    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) break;
-    b = e + 1;
-  }
+  const std::vector<std::string> parts = text::split(key, '.');
   YAML::Node cur = root;
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
     YAML::Node next = cur[parts[i]];
@@ -243,29 +238,29 @@ reference: {type: step, amplitude: 1.0e-3}
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.cogging_amplitude", "4"));
   EXPECT_TRUE(struct_as_yaml(base, ".", "controller.computation_delay", "2e-4"));
   // What the YAML reader decided alone before: now set in the struct, the same keys.
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.preset", "none"));       // a preset: the whole section
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple", "none"));              // its short form replaces it
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.preset", "none"));  // a preset: the whole section
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple", "none"));         // its short form replaces it
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force.stiffness_N_per_m", "1"));  // listed: on
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force", "{}"));  // listed with its defaults
   EXPECT_TRUE(struct_as_yaml(base, ".", "controller.type", "cascade"));        // another type's keys
   EXPECT_TRUE(struct_as_yaml(base, ".", {{"controller.kp", "50"}, {"controller.type", "cascade"}}));  // any order
   EXPECT_TRUE(struct_as_yaml(base, ".", {{"reference.type", "sine"}, {"reference.frequency", "2"}}));
-  EXPECT_TRUE(struct_as_yaml(base, ".", "duration", "0.02"));                  // read_timing's rules
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.friction", "{model: none}"));   // a flow map replaces the part
-  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.model.friction", "{}"));   // an empty map: the part at the plant's
-  EXPECT_TRUE(struct_as_yaml(base, ".", "output.columns", "[t, x, u]"));       // a flow list
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.grinding.enabled", "true"));    // a section made present
+  EXPECT_TRUE(struct_as_yaml(base, ".", "duration", "0.02"));                 // read_timing's rules
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.friction", "{model: none}"));  // a flow map replaces the part
+  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.model.friction", "{}"));  // an empty map: the part at the plant's
+  EXPECT_TRUE(struct_as_yaml(base, ".", "output.columns", "[t, x, u]"));      // a flow list
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.grinding.enabled", "true"));   // a section made present
   EXPECT_TRUE(struct_as_yaml(base, ".", {{"controller.type", "cascade"}, {"controller.tuning", "rule"}}));
   // Refused both ways, one line naming the key: the struct never falls back to YAML.
   for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
-           {"reference.frequency", "2"},                   // not a key of a step
-           {"controller.computation_delay", "-1"},         // refused, quoting the value as written
-           {"plant.mass", "~"},                            // null in YAML
-           {"plant.mass", "[1, 2]"},                       // a flow list
-           {"plant.mas", "90"},                            // unknown, with did-you-mean
-           {"plant.ripple", "pape"},                       // not a preset
-           {"reference.type", "waypoints"},                // needs its file
-           {"controller.type", "open_loop"}}) {            // the model given is not an open loop's key
+           {"reference.frequency", "2"},            // not a key of a step
+           {"controller.computation_delay", "-1"},  // refused, quoting the value as written
+           {"plant.mass", "~"},                     // null in YAML
+           {"plant.mass", "[1, 2]"},                // a flow list
+           {"plant.mas", "90"},                     // unknown, with did-you-mean
+           {"plant.ripple", "pape"},                // not a preset
+           {"reference.type", "waypoints"},         // needs its file
+           {"controller.type", "open_loop"}}) {     // the model given is not an open loop's key
     EXPECT_FALSE(struct_as_yaml(base, ".", k, v)) << k << " = " << v;
   }
   const auto error_of = [&](const std::string& k, const std::string& v) {

@@ -12,13 +12,12 @@
 //   controller block's control_period -> study set -> controller set -> family set -> variations
 // set in it through the sections' key lists (sim::set_read_keys: each value checked by the
 // loader's own accessor; a misspelt key is the loader's one-line "unknown key" error), then
-// derived and checked (sim::complete_read). No case is YAML read again. A `scale` variation multiplies the key's nominal value:
-// its effective value in the case without variations (defaults included). With the nominal model
-// rule (spec.hpp), the controller's model (controller.model.*) is taken from the case without the
-// plant.* variations except plant.sensor.*: the mismatch is in the plant, while the controller is
-// set up for the encoder it actually has. The case's scenario is then the loader's resolved keys
-// written as one YAML document (sim::resolved_yaml): every key with its effective value, loadable
-// by feeddrive-sim. Its SHA-256 keys the case in the output folder.
+// derived and checked (sim::complete_read). No case is YAML read again. A `scale` variation multiplies the key's
+// nominal value: its effective value in the case without variations (defaults included). With the nominal model rule
+// (spec.hpp), the controller's model (controller.model.*) is taken from the case without the plant.* variations except
+// plant.sensor.*: the mismatch is in the plant, while the controller is set up for the encoder it actually has. The
+// case's scenario is then the loader's resolved keys written as one YAML document (sim::resolved_yaml): every key with
+// its effective value, loadable by feeddrive-sim. Its SHA-256 keys the case in the output folder.
 
 #include <cstdint>
 #include <map>
