@@ -697,24 +697,15 @@ void detail::derive_and_check(Scenario& s) {
   check_scenario(s, YAML::Node());
 }
 
-Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin) {
+Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
+                       const std::string& controller) {
   try {
-    return read_node(load_yaml_strict(yaml_text), base_dir);
+    YAML::Node root = load_yaml_strict(yaml_text);
+    if (!controller.empty() && root.IsMap()) root["controller"] = load_yaml_strict(controller);
+    return read_node(root, base_dir);
   } catch (const std::exception& e) {
     throw ScenarioError(origin + ": " + e.what());
   }
-}
-
-void read_controller_section(Scenario& s, const std::string& block) {
-  YAML::Node root(YAML::NodeType::Map);
-  root["controller"] = load_yaml_strict(block);
-  for (auto* keys : {&s.given_keys, &s.listed_effects})
-    for (auto it = keys->lower_bound("controller"); it != keys->end() && it->rfind("controller", 0) == 0;)
-      it = keys->erase(it);
-  s.controller = {};
-  MapReader top(root, "", &s.given_keys);
-  read_controller(top, root, s, s.base_dir);
-  top.finish();
 }
 
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,

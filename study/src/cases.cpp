@@ -169,7 +169,7 @@ std::string sha256_hex(const std::string& text) {
 
 struct Resolver::Impl {
   const Study& s;
-  // The base as read once, with each controller's block read into it (read_controller_section).
+  // The base as read, once per controller, with the controller's block in place of its own.
   std::vector<sim::Scenario> bases;
   // The nominal case of a controller and family: the base with the layers' settings as read
   // (each case copies it and sets its variations in it), and its keys (a scale's nominal value).
@@ -188,19 +188,11 @@ struct Resolver::Impl {
 
   explicit Impl(const Study& st) : s(st) {
     varied = varied_keys(s);
-    sim::Scenario base;
-    try {
-      base = sim::read_scenario(s.base_yaml, s.base_dir, "base");
-    } catch (const sim::ScenarioError& e) {
-      throw StudyError(s.path + ": " + e.what());
-    }
     for (const ControllerEntry& c : s.controllers) {
-      bases.push_back(base);
-      if (c.block.empty()) continue;
       try {
-        sim::read_controller_section(bases.back(), c.block);
+        bases.push_back(sim::read_scenario(s.base_yaml, s.base_dir, "base", c.block));
       } catch (const sim::ScenarioError& e) {
-        throw StudyError(s.path + ": controller '" + c.name + "': " + e.what());
+        throw StudyError(s.path + (c.block.empty() ? "" : ": controller '" + c.name + "'") + ": " + e.what());
       }
     }
   }

@@ -184,11 +184,10 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
 /// Reads YAML text into a scenario as read: every key, type and value as the file gives it (the
 /// reader's checks), before derive() and the whole-scenario checks (complete_read). The start of
 /// a scenario built as a struct (set_read_key; feeddrive-sim --set, feeddrive-study's cases).
+/// `controller` (optional): the YAML text of a controller map, read in place of the text's own
+/// controller section (a study's controller entry). Throws ScenarioError "<origin>: ...".
 Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
-                       const std::string& origin = "scenario");
-/// Replaces the controller section of a scenario as read by the YAML map `block` (a study's
-/// controller entry), read by the same reader. Throws ScenarioError.
-void read_controller_section(Scenario& s, const std::string& block);
+                       const std::string& origin = "scenario", const std::string& controller = "");
 
 /// Sets one dotted key of a scenario as read to `value` (YAML scalar text, or a flow list or map
 /// `[t, x]`, `{model: none}`), as if the file said so, through the sections' lists: the value
