@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -16,12 +17,12 @@
 #include "feeddrive/sim/simulation.hpp"
 #include "feeddrive/sim/yaml_archive.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
+#include "scenario_rules.hpp"
 
 namespace feeddrive::sim {
-namespace {
 
-namespace fs = std::filesystem;
-using plant::PlantParams;
+namespace detail {
+namespace {
 
 // A name from the file as a message shows it: printable ASCII, at most 40 bytes.
 std::string output_shown(const std::string& s) {
@@ -29,6 +30,82 @@ std::string output_shown(const std::string& s) {
   for (char c : s.substr(0, 40)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
   return s.size() > 40 ? out + "..." : out;
 }
+
+// A step count for a message: exact up to 10^15, else 3 significant digits ("1e+304", never
+// "1.0000000000000001e+304").
+std::string steps_text(double n) {
+  if (n < 1e15) return validate::format_number(n);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", n);
+  return buf;
+}
+
+}  // namespace
+
+// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length
+// (a 50 MB name once made the plots take 4.8 GB).
+void check_name(const std::string& name, const std::string& what) {
+  if (name.size() > kMaxNameBytes)
+    throw ScenarioError(what + ": " + std::to_string(name.size()) + " bytes: too long (at most " +
+                        std::to_string(kMaxNameBytes) + ")");
+  const std::size_t bad = text::first_unprintable(name);
+  if (bad < name.size()) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(name[bad])));
+    throw ScenarioError(what + ": byte " + std::to_string(bad + 1) + " (" + hex +
+                        ") is not printable UTF-8 (control character or malformed sequence)");
+  }
+}
+
+void check_timing(const Scenario& s, const std::string& duration, const std::string& period) {
+  if (s.control_period > s.duration) throw ScenarioError("control_period = " + period + ": must be <= duration");
+  if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
+    throw ScenarioError("duration = " + duration + ", control_period = " + period + ": " + steps_text(n) +
+                        " steps; a run has at most " + validate::format_number(kMaxSteps) +
+                        " steps (docs/scenario.md, Limits)");
+}
+
+void check_output(const OutputConfig& out, bool columns_given) {
+  if (out.every < 1) throw ScenarioError("output.every = " + std::to_string(out.every) + ": must be an integer >= 1");
+  const auto& all = record_columns();
+  for (const std::string& c : out.columns) {
+    if (std::find(all.begin(), all.end(), c) == all.end()) {
+      std::string known;
+      for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
+      throw ScenarioError("output.columns: unknown column '" + output_shown(c) + "' (columns: " + known + ")");
+    }
+    if (std::count(out.columns.begin(), out.columns.end(), c) > 1)
+      throw ScenarioError("output.columns: column '" + c + "' listed twice");
+  }
+  if (columns_given && out.columns.empty())
+    throw ScenarioError("output.columns: empty list (leave the key out to record every column)");
+}
+
+plant::PlantParams model_of_plant(const plant::PlantParams& plant) {
+  plant::PlantParams m = plant;
+  m.effects = {};
+  return m;
+}
+
+std::string resolved_file(const std::string& base_dir, const std::string& file) {
+  namespace fs = std::filesystem;
+  return fs::path(file).is_relative() ? (fs::path(base_dir) / file).string() : file;
+}
+
+bool parameter_name(const std::string& key) {
+  return !key.empty() && std::all_of(key.begin(), key.end(),
+                                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::check_name;
+using detail::model_of_plant;
+
+namespace fs = std::filesystem;
+using plant::PlantParams;
 
 // --- plant ---------------------------------------------------------------------------------
 // Every section is read from its struct's one list (Serialize; sim/yaml_archive.hpp); what is
@@ -64,6 +141,7 @@ void read_ripple(MapReader& r, plant::RippleParams& p) {
   std::string preset;
   const bool scalar = r.scalar_text("ripple", preset);
   MapReader m = scalar ? r.child_absent("ripple") : r.child("ripple");
+  if (scalar) r.mark_given("ripple.preset");
   if (!scalar) m.string("preset", preset);
   if (!preset.empty()) {
     try {
@@ -99,25 +177,14 @@ void read_plant(MapReader r, PlantParams& p, std::set<std::string>* listed_effec
 
 // --- controller ----------------------------------------------------------------------------
 
-// A controller's nominal model by default: the plant itself, without the effects it does not know.
-PlantParams model_of_plant(const PlantParams& plant) {
-  PlantParams m = plant;
-  m.effects = {};
-  return m;
-}
-
 // type plugin (docs/plugins.md): library (resolved against the scenario's folder), parameters
 // (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
 // The library is opened here (file, symbols, ABI version), so a bad one fails at load.
 void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, const std::string& base_dir) {
-  p.library = r.required_string("library");
-  if (fs::path(p.library).is_relative()) p.library = (fs::path(base_dir) / p.library).lexically_normal().string();
+  p.library = fs::path(detail::resolved_file(base_dir, r.required_string("library"))).lexically_normal().string();
   MapReader params = r.child("parameters");
   for (const std::string& key : params.keys()) {
-    const bool word = !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-    });
-    if (!word) params.fail(key, ": a parameter name is letters, digits and _ only");
+    if (!detail::parameter_name(key)) params.fail(key, ": a parameter name is letters, digits and _ only");
     std::string value;
     params.number_or_string(key, value);
     p.parameters.emplace_back(key, value);
@@ -152,7 +219,7 @@ void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model
 void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& file, const std::string& base_dir) {
   read_fields(r, p);
   r.string("file", file);
-  if (!file.empty() && fs::path(file).is_relative()) file = (fs::path(base_dir) / file).string();
+  if (!file.empty()) file = detail::resolved_file(base_dir, file);
   if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
 }
 
@@ -174,8 +241,7 @@ void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir
     case ReferenceType::kSCurve: read_fields(r, c.scurve); break;
     case ReferenceType::kRamp: read_fields(r, c.ramp); break;
     case ReferenceType::kWaypoints:
-      c.waypoints_file = r.required_string("file");
-      if (fs::path(c.waypoints_file).is_relative()) c.waypoints_file = (fs::path(base_dir) / c.waypoints_file).string();
+      c.waypoints_file = detail::resolved_file(base_dir, r.required_string("file"));
       break;
   }
   r.finish();
@@ -190,21 +256,6 @@ void validate_reference(const ReferenceConfig& c) {
     case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
     case ReferenceType::kRamp: c.ramp.validate("reference"); break;
     case ReferenceType::kWaypoints: break;  // read and checked in parse_node
-  }
-}
-
-// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length
-// (a 50 MB name once made the plots take 4.8 GB).
-void check_name(const std::string& name, const std::string& what) {
-  if (name.size() > kMaxNameBytes)
-    throw ScenarioError(what + ": " + std::to_string(name.size()) + " bytes: too long (at most " +
-                        std::to_string(kMaxNameBytes) + ")");
-  const std::size_t bad = text::first_unprintable(name);
-  if (bad < name.size()) {
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(name[bad])));
-    throw ScenarioError(what + ": byte " + std::to_string(bad + 1) + " (" + hex +
-                        ") is not printable UTF-8 (control character or malformed sequence)");
   }
 }
 
@@ -223,7 +274,16 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
   };
   const auto section = [&](const char* key) {
     YAML::Emitter e;
-    e << YAML::Flow << root[key];
+    if (root.IsMap()) {
+      e << YAML::Flow << root[key];
+    } else {  // a scenario built as a struct: the keys it gives, with their values
+      const ResolvedKeys keys = resolved_keys(s);
+      e << YAML::Flow << YAML::BeginMap;
+      for (const auto& [k, v] : keys)
+        if (k.rfind(std::string(key) + ".", 0) == 0 && detail::gives(s, k))
+          e << YAML::Key << k.substr(std::strlen(key) + 1) << YAML::Value << v.text;
+      e << YAML::EndMap;
+    }
     std::string text = e.c_str();
     for (char& c : text)
       if (c == '\n') c = ' ';
@@ -255,19 +315,32 @@ void check_functions_of_time(const Scenario& s, const YAML::Node& root) {
   }
 }
 
-// A step count for a message: exact up to 10^15, else 3 significant digits ("1e+304", never
-// "1.0000000000000001e+304").
-std::string steps_text(double n) {
-  if (n < 1e15) return validate::format_number(n);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", n);
-  return buf;
+// A plant section given with keys but without `enabled` (from the presence facts, given_keys):
+// off, its keys do not act (a forgotten enabled: true). One that says `enabled: false` is off on
+// purpose, and a preset alone (`ripple: none`) says what it is: no warning.
+std::vector<std::string> off_sections(const Scenario& s) {
+  std::vector<std::string> w;
+  const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
+                                                   {"grinding", s.plant.grinding.enabled},
+                                                   {"electrical", s.plant.electrical.enabled}};
+  for (const auto& [name, on] : sections) {
+    const std::string prefix = std::string("plant.") + name + ".";
+    if (on || detail::gives(s, prefix + "enabled")) continue;
+    bool keys = false;
+    for (auto it = s.given_keys.lower_bound(prefix); it != s.given_keys.end() && it->rfind(prefix, 0) == 0; ++it)
+      keys = keys || *it != prefix + "preset";
+    if (keys)
+      w.push_back(std::string("plant.") + name +
+                  ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
+  }
+  return w;
 }
 
 // Issue 23 (unit sanity): every number of the run's lists outside its plausible range for a
 // linear feed drive (common/fields.hpp), and a move that the run cuts off.
 void find_warnings(Scenario& s) {
   std::vector<std::string>& w = s.warnings;
+  w = off_sections(s);
   const auto add = [&w](const std::vector<std::string>& more) { w.insert(w.end(), more.begin(), more.end()); };
   {
     fields::PlausibilityArchive top("", &w);
@@ -340,44 +413,13 @@ void read_timing(MapReader& top, const YAML::Node& root, Scenario& s) {
   top.number("control_period", s.control_period);
   if (!(s.duration > 0.0)) top.fail("duration", " = " + root["duration"].Scalar() + ": must be > 0");
   if (!(s.control_period > 0.0)) top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
-  if (s.control_period > s.duration)
-    top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be <= duration");
-  if (const double n = std::round(s.duration / s.control_period); !(n <= kMaxSteps))
-    throw ScenarioError("duration = " + root["duration"].Scalar() + ", control_period = " +
-                        root["control_period"].Scalar() + ": " + steps_text(n) + " steps; a run has at most " +
-                        validate::format_number(kMaxSteps) + " steps (docs/scenario.md, Limits)");
+  detail::check_timing(s, root["duration"].Scalar(), root["control_period"].Scalar());
 }
 
-// plant: its keys, and a warning for a section given with keys but without `enabled` (off, its
-// keys do not act: a forgotten enabled: true). A section that says `enabled: false` is off on
-// purpose: no warning.
-void read_plant_section(MapReader& top, const YAML::Node& root, Scenario& s) {
-  MapReader plant = top.child("plant");
-  s.grinding_process = plant.has("grinding") || plant.child("effects").has("grinding_force");
-  read_plant(plant, s.plant, &s.listed_effects);
-  const YAML::Node pn = root["plant"];
-  const std::pair<const char*, bool> sections[] = {{"ripple", s.plant.ripple.enabled},
-                                                   {"grinding", s.plant.grinding.enabled},
-                                                   {"electrical", s.plant.electrical.enabled}};
-  for (const auto& [name, on] : sections) {
-    if (on || !pn.IsMap()) continue;
-    const YAML::Node sec = pn[name];
-    if (!sec.IsMap() || sec["enabled"]) continue;  // `enabled: false` written: off on purpose
-    if (sec.size() > 0)
-      s.warnings.push_back(std::string("plant.") + name +
-                           ": keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
-  }
-}
-
-// The dotted keys of a map's maps and values ("friction", "friction.static_force") into out.
-void add_given_keys(const YAML::Node& map, const std::string& prefix, std::set<std::string>& out) {
-  if (!map.IsMap()) return;
-  for (const auto& kv : map) {
-    if (!kv.first.IsScalar()) continue;
-    const std::string key = prefix.empty() ? kv.first.Scalar() : prefix + "." + kv.first.Scalar();
-    out.insert(key);
-    add_given_keys(kv.second, key, out);
-  }
+// plant: its keys; a grinding process if it gives a grinding section or lists the grinding force.
+void read_plant_section(MapReader& top, Scenario& s) {
+  read_plant(top.child("plant"), s.plant, &s.listed_effects);
+  s.grinding_process = detail::gives(s, "plant.grinding") || s.listed_effects.count("plant.effects.grinding_force");
 }
 
 // controller: its type's keys; the nominal model (controller.model) into s.controller.model, on
@@ -409,7 +451,6 @@ void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const 
     c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
   }
   cc.model_given = c.has("model");
-  if (cc.model_given) add_given_keys(root["controller"]["model"], "", cc.model_keys_given);
   c.finish();
 }
 
@@ -418,29 +459,18 @@ void read_output(MapReader& top, const YAML::Node& root, OutputConfig& out) {
   o.integer("every", out.every);
   o.string_list("columns", out.columns);
   o.finish();
-  if (out.every < 1) o.fail("every", " = " + std::to_string(out.every) + ": must be an integer >= 1");
-  const auto& all = record_columns();
-  for (const std::string& c : out.columns) {
-    if (std::find(all.begin(), all.end(), c) == all.end()) {
-      std::string known;
-      for (const auto& k : all) known += (known.empty() ? "" : ", ") + k;
-      o.fail("columns", ": unknown column '" + output_shown(c) + "' (columns: " + known + ")");
-    }
-    if (std::count(out.columns.begin(), out.columns.end(), c) > 1)
-      o.fail("columns", ": column '" + c + "' listed twice");
-  }
-  if (top.has("output") && root["output"]["columns"].IsDefined() && out.columns.empty())
-    o.fail("columns", ": empty list (leave the key out to record every column)");
+  detail::check_output(out, top.has("output") && root["output"]["columns"].IsDefined());
 }
 
 Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsMap())
     throw ScenarioError(
         "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
-  MapReader top(root, "");
   Scenario s;
+  MapReader top(root, "", &s.given_keys);
+  s.base_dir = base_dir;
   read_timing(top, root, s);
-  read_plant_section(top, root, s);
+  read_plant_section(top, s);
   read_controller(top, root, s, base_dir);
   read_reference(top.child("reference"), s.reference, base_dir);
   read_output(top, root, s.output);
@@ -518,9 +548,8 @@ void check_scenario(Scenario& s, const YAML::Node& root) {
   find_warnings(s);
 }
 
-Scenario parse_node(const YAML::Node& root, const std::string& base_dir, Scenario* as_read) {
+Scenario parse_node(const YAML::Node& root, const std::string& base_dir) {
   Scenario s = read_node(root, base_dir);
-  if (as_read != nullptr) *as_read = s;
   derive(s);
   check_scenario(s, root);
   return s;
@@ -663,154 +692,28 @@ ResolvedKeys resolved_keys(const Scenario& s) {
   return out;
 }
 
-// --- one key of a scenario as read (set_read_key) -------------------------------------------
-
-namespace {
-
-// Sets the field at the dotted path `rest` of a struct's list from the value's text, read by the
-// reader's own accessor (YamlReadArchive) from a map of that one key: the same value, or the
-// same one-line error, as the key written in the file. found(): the path names a value field.
-class FieldSetArchive {
- public:
-  FieldSetArchive(std::string parent, std::string rest, const std::string& value, std::set<std::string> skip)
-      : parent_(std::move(parent)), rest_(std::move(rest)), value_(value), skip_(std::move(skip)) {}
-  bool found() const { return found_; }
-
-  template <typename T>
-  void Visit(const fields::Field<T>& f) {
-    const std::size_t dot = rest_.find('.');
-    const std::string head = rest_.substr(0, dot);
-    if (found_ || head != f.meta.name || skip_.count(head)) return;
-    if constexpr (fields::is_serializable<T>::value) {
-      if (dot == std::string::npos) return;
-      FieldSetArchive a(parent_ + "." + head, rest_.substr(dot + 1), value_, {});
-      f.value->Serialize(&a);
-      found_ = a.found_;
-    } else {
-      if (dot != std::string::npos) return;
-      YAML::Node map(YAML::NodeType::Map);
-      map[head] = value_;
-      MapReader r(map, parent_);
-      YamlReadArchive a(r);
-      a.Visit(f);
-      found_ = true;
-    }
-  }
-
- private:
-  std::string parent_;
-  std::string rest_;
-  const std::string& value_;
-  std::set<std::string> skip_;
-  bool found_{false};
-};
-
-template <typename S>
-bool set_field(S& obj, const std::string& parent, const std::string& rest, const std::string& value,
-               std::set<std::string> skip = {}) {
-  FieldSetArchive a(parent, rest, value, std::move(skip));
-  obj.Serialize(&a);
-  return a.found();
-}
-
-// A value the YAML loader reads back as the same scalar text (never null, never a flow list or
-// map): letters, digits and _ . + -, not null or ~.
-bool plain_value(const std::string& v) {
-  if (v.empty() || v == "~" || v == "null" || v == "Null" || v == "NULL") return false;
-  return std::all_of(v.begin(), v.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '+' || c == '-';
-  });
-}
-
-// plant.<rest>: the plant's list, a listed effect's list; a value the controller's model does
-// not give follows into the model (read_controller: the model starts as the plant).
-bool set_plant_key(Scenario& s, const std::string& rest, const std::string& value) {
-  const std::string head = rest.substr(0, rest.find('.'));
-  ControllerConfig& cc = s.controller;
-  if (head == "effects") {
-    const std::size_t dot = rest.find('.', 8);
-    if (dot == std::string::npos || !s.listed_effects.count("plant." + rest.substr(0, dot))) return false;
-    return set_field(s.plant.effects, "plant.effects", rest.substr(8), value);
-  }
-  if (rest == "ripple.preset") return false;                                  // read_ripple's rule
-  if (head == "grinding" && !s.grinding_process) return false;                // the section made present
-  if (head == "ripple" && cc.model_keys_given.count("ripple")) return false;  // the model's own ripple
-  if (!set_field(s.plant, "plant", rest, value, {"effects"})) return false;
-  if (!cc.model_keys_given.count(rest)) set_field(cc.model, "controller.model", rest, value, {"effects"});
-  return true;
-}
-
-// controller.<rest>: computation_delay, the model's list, the type's list but for the keys with
-// rules of their own (the cascade's tuning and gains, the open-loop kind).
-bool set_controller_key(Scenario& s, const std::string& rest, const std::string& value) {
-  ControllerConfig& cc = s.controller;
-  if (rest == "computation_delay") {
-    YAML::Node map(YAML::NodeType::Map);
-    map[rest] = value;
-    double d = 0.0;
-    MapReader(map, "controller").number(rest, d);
-    if (d < 0.0) return false;  // read_controller's message quotes the value as written
-    cc.computation_delay = d;
-    return true;
-  }
-  if (rest.rfind("model.", 0) == 0) {
-    const std::string field = rest.substr(6);
-    if (cc.type == ControllerType::kOpenLoop || field.rfind("effects", 0) == 0 || field == "ripple.preset")
-      return false;
-    if (!set_field(cc.model, "controller.model", field, value, {"effects"})) return false;
-    for (std::size_t dot = field.find('.'); dot != std::string::npos; dot = field.find('.', dot + 1))
-      cc.model_keys_given.insert(field.substr(0, dot));  // its maps, and the value below
-    cc.model_keys_given.insert(field);
-    return true;
-  }
-  switch (cc.type) {
-    case ControllerType::kSlidingMode: return set_field(cc.sliding_mode, "controller", rest, value);
-    case ControllerType::kCascade:
-      return set_field(cc.cascade, "controller", rest, value, {"tuning", "kp", "kv", "ki", "bandwidth_scale"});
-    case ControllerType::kOpenLoop: return set_field(cc.open_loop, "controller", rest, value, {"kind"});
-    case ControllerType::kPlugin: return false;
-  }
-  return false;
-}
-
-bool set_reference_key(ReferenceConfig& c, const std::string& rest, const std::string& value) {
-  switch (c.type) {
-    case ReferenceType::kSine: return set_field(c.sine, "reference", rest, value);
-    case ReferenceType::kStep: return set_field(c.step, "reference", rest, value);
-    case ReferenceType::kAccelLimited: return set_field(c.accel_limited, "reference", rest, value);
-    case ReferenceType::kSCurve: return set_field(c.scurve, "reference", rest, value);
-    case ReferenceType::kRamp: return set_field(c.ramp, "reference", rest, value);
-    case ReferenceType::kNone:
-    case ReferenceType::kWaypoints: return false;
-  }
-  return false;
-}
-
-}  // namespace
-
-bool set_read_key(Scenario& s, const std::string& key, const std::string& value) {
-  if (!plain_value(value)) return false;
-  const std::size_t dot = key.find('.');
-  if (dot == std::string::npos) return false;  // name, duration, control_period: rules of read_timing
-  const std::string section = key.substr(0, dot);
-  const std::string rest = key.substr(dot + 1);
-  if (section == "plant") return set_plant_key(s, rest, value);
-  if (section == "controller") return set_controller_key(s, rest, value);
-  if (section == "reference") return set_reference_key(s.reference, rest, value);
-  return false;  // output, analysis: rules of their own
-}
-
-void complete_read(Scenario& s) {
+void detail::derive_and_check(Scenario& s) {
   derive(s);
   check_scenario(s, YAML::Node());
 }
 
+Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
+                       const std::string& controller) {
+  try {
+    YAML::Node root = load_yaml_strict(yaml_text);
+    if (!controller.empty() && root.IsMap()) root["controller"] = load_yaml_strict(controller);
+    return read_node(root, base_dir);
+  } catch (const std::exception& e) {
+    throw ScenarioError(origin + ": " + e.what());
+  }
+}
+
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir, const std::string& origin,
-                        ResolvedKeys* resolved, Scenario* as_read) {
+                        ResolvedKeys* resolved) {
   try {
     const YAML::Node root = load_yaml_strict(yaml_text);
     if (resolved) resolved->clear();
-    Scenario s = parse_node(root, base_dir, as_read);
+    Scenario s = parse_node(root, base_dir);
     if (resolved) *resolved = resolved_keys(s);
     return s;
   } catch (const ScenarioError& e) {
@@ -820,93 +723,11 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
   }
 }
 
-Scenario load_scenario(const std::string& path, std::string* text_out) {
-  const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
-  if (text_out != nullptr) *text_out = text;
-  const fs::path p(path);
-  Scenario s = parse_scenario(text, p.parent_path().empty() ? "." : p.parent_path().string(), path);
-  s.path = path;
-  if (s.name.empty()) {
-    s.name = p.stem().string();
-    check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
-  }
-  return s;
-}
-
 KeySetting parse_key_setting(const std::string& text) {
   const std::size_t eq = text.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
     throw ScenarioError("--set " + text + ": expected key=value (a dotted scenario key, e.g. plant.mass=110)");
   return {text.substr(0, eq), text.substr(eq + 1)};
-}
-
-void set_key(YAML::Node& root, const std::string& key, const std::string& value) {
-  std::vector<std::string> parts;
-  for (std::size_t b = 0;;) {
-    const std::size_t e = key.find('.', b);
-    parts.push_back(key.substr(b, e == std::string::npos ? std::string::npos : e - b));
-    if (e == std::string::npos) break;
-    b = e + 1;
-  }
-  YAML::Node cur = root;
-  std::string path;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    path += (path.empty() ? "" : ".") + parts[i];
-    YAML::Node next = cur[parts[i]];
-    if (!next.IsDefined() || next.IsNull()) {
-      cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      next = cur[parts[i]];
-    } else if (path == "plant.ripple" && next.IsScalar() && next.Scalar() != "true" && next.Scalar() != "false") {
-      // `ripple: paper` is the preset's short form: a part set on top of it keeps the preset.
-      YAML::Node m(YAML::NodeType::Map);
-      m["preset"] = next.Scalar();
-      cur[parts[i]] = m;
-      next = cur[parts[i]];
-    } else if (!next.IsMap()) {
-      throw ScenarioError(key + ": " + path + " is a single value in the scenario, not a map of keys");
-    }
-    cur.reset(next);
-  }
-  // A list or a map in YAML's flow style (`[t, x, u]`, `{model: none}`) is read as YAML, as the
-  // file would read it; anything else is the scalar as written.
-  const std::size_t first = value.find_first_not_of(" \t");
-  if (first != std::string::npos && (value[first] == '[' || value[first] == '{')) {
-    YAML::Node v;
-    try {
-      v = load_yaml_strict(value);
-    } catch (const std::exception& e) {
-      throw ScenarioError(key + " = " + value + ": not a YAML list or map (" + e.what() + ")");
-    }
-    cur[parts.back()] = v;
-    return;
-  }
-  cur[parts.back()] = value;
-}
-
-Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& sets, std::string* text_out) {
-  if (sets.empty()) return load_scenario(path, text_out);
-  const std::string text = text::read_text_file<ScenarioError>(path, "scenario file");
-  const fs::path p(path);
-  const std::string origin = path + " with --set";
-  YAML::Node root;
-  try {
-    root = load_yaml_strict(text);
-    if (!root.IsMap()) throw ScenarioError("the scenario must be a YAML map");
-    for (const KeySetting& k : sets) set_key(root, k.key, k.value);
-  } catch (const ScenarioError& e) {
-    throw ScenarioError(origin + ": " + e.what());
-  }
-  YAML::Emitter em;
-  em << root;
-  const std::string yaml = std::string(em.c_str()) + "\n";
-  if (text_out != nullptr) *text_out = yaml;
-  Scenario s = parse_scenario(yaml, p.parent_path().empty() ? "." : p.parent_path().string(), origin);
-  s.path = path;
-  if (s.name.empty()) {
-    s.name = p.stem().string();
-    check_name(s.name, path + ": the name taken from the file name (set name: to choose another)");
-  }
-  return s;
 }
 
 namespace {
@@ -935,16 +756,7 @@ void emit_map(YAML::Emitter& em, const std::vector<std::pair<std::vector<std::st
 
 std::string resolved_yaml(const ResolvedKeys& keys) {
   std::vector<std::pair<std::vector<std::string>, const ResolvedValue*>> items;
-  for (const auto& [path, value] : keys) {
-    std::vector<std::string> parts;
-    for (std::size_t b = 0;;) {
-      const std::size_t e = path.find('.', b);
-      parts.push_back(path.substr(b, e == std::string::npos ? std::string::npos : e - b));
-      if (e == std::string::npos) break;
-      b = e + 1;
-    }
-    items.emplace_back(std::move(parts), &value);
-  }
+  for (const auto& [path, value] : keys) items.emplace_back(text::split(path, '.'), &value);
   // Sorted by parts, so every group of one prefix is contiguous ("a.b" and "a-c" interleave as
   // strings, not as part lists).
   std::sort(items.begin(), items.end(), [](const auto& x, const auto& y) { return x.first < y.first; });

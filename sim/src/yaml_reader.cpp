@@ -281,7 +281,8 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-MapReader::MapReader(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {
+MapReader::MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given)
+    : node_(node), path_(std::move(path)), given_(given) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap())
     throw ScenarioError(path_ + " = " + describe(node_) + ": expected a map of keys");
 }
@@ -299,6 +300,7 @@ YAML::Node MapReader::scalar(const std::string& key) {
   if (!node_.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
   const YAML::Node n = node_[key];
   if (!n.IsDefined()) return n;
+  mark_given(key);
   if (n.IsNull()) fail(key, ": missing value");
   if (!n.IsScalar()) fail(key, " = " + describe(n) + ": expected a single value");
   return n;
@@ -395,6 +397,7 @@ void MapReader::string_list(const std::string& key, std::vector<std::string>& ou
   if (!node_.IsMap()) return;
   const YAML::Node n = node_[key];
   if (!n.IsDefined()) return;
+  mark_given(key);
   if (n.IsNull()) fail(key, ": missing value");
   if (n.IsScalar()) {
     out = {n.Scalar()};
@@ -417,7 +420,8 @@ std::string MapReader::required_string(const std::string& key) {
 MapReader MapReader::child(const std::string& key) {
   read_.insert(key);
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
-  return MapReader(n, key_path(key));
+  if (n.IsDefined()) mark_given(key);
+  return MapReader(n, key_path(key), given_);
 }
 
 bool MapReader::scalar_text(const std::string& key, std::string& out) const {
@@ -430,7 +434,8 @@ bool MapReader::scalar_text(const std::string& key, std::string& out) const {
 
 MapReader MapReader::child_absent(const std::string& key) {
   read_.insert(key);
-  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key));
+  if (has(key)) mark_given(key);
+  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key), given_);
 }
 
 void MapReader::finish() const {

@@ -153,14 +153,6 @@ std::vector<std::string> varied_keys(const Study& s) {
   return out;
 }
 
-void set_key(YAML::Node& root, const std::string& key, const std::string& value) {
-  try {
-    sim::set_key(root, key, value);
-  } catch (const sim::ScenarioError& e) {
-    throw StudyError(e.what());
-  }
-}
-
 std::string sha256_hex(const std::string& text) {
   unsigned char md[EVP_MAX_MD_SIZE];
   unsigned int n = 0;
@@ -177,49 +169,34 @@ std::string sha256_hex(const std::string& text) {
 
 struct Resolver::Impl {
   const Study& s;
-  YAML::Node base;
-  std::vector<YAML::Node> controller_blocks;
-  // Loads by document text: the same layers are shared by many cases.
-  std::map<std::string, sim::ResolvedKeys> loads;
-  static constexpr std::size_t kMaxLoads = 256;
+  // The base as read, once per controller, with the controller's block in place of its own.
+  std::vector<sim::Scenario> bases;
+  // The nominal case of a controller and family: the base with the layers' settings as read
+  // (each case copies it and sets its variations in it), and its keys (a scale's nominal value).
+  struct Nominal {
+    sim::Scenario read;
+    sim::ResolvedKeys keys;
+  };
+  std::map<std::pair<std::size_t, std::size_t>, Nominal> nominals;
+  // The controller's nominal model (the nominal model rule), by the case's settings that are not
+  // plant-only; at most kMaxModels (cases come in order, so a reset costs one model per layer).
+  std::map<std::string, plant::PlantParams> models;
+  static constexpr std::size_t kMaxModels = 256;
   std::vector<std::string> varied;  // every key a grid or draw of the study varies
+  // SHA-256 of a plugin library's bytes, once per path per study.
+  std::map<std::string, std::string> digests;
 
   explicit Impl(const Study& st) : s(st) {
     varied = varied_keys(s);
-    // The one YAML loader (yaml_reader.hpp): a base file with a recursive alias or a merge key is
-    // refused here, before any copy of it is made.
-    try {
-      base = sim::load_yaml_strict(s.base_yaml);
-      for (const ControllerEntry& c : s.controllers)
-        controller_blocks.push_back(c.block.empty() ? YAML::Node() : sim::load_yaml_strict(c.block));
-    } catch (const sim::ScenarioError& e) {
-      throw StudyError(s.path + ": base: " + e.what());
+    for (const ControllerEntry& c : s.controllers) {
+      try {
+        bases.push_back(sim::read_scenario(s.base_yaml, s.base_dir, "base", c.block));
+      } catch (const sim::ScenarioError& e) {
+        throw StudyError(s.path + (c.block.empty() ? "" : ": controller '" + c.name + "'") + ": " + e.what());
+      }
     }
-    if (!base.IsMap()) throw StudyError(s.path + ": base: the scenario must be a YAML map");
   }
 
-  sim::ResolvedKeys load_uncached(const std::string& text, const std::string& origin,
-                                  sim::Scenario* as_read = nullptr) const {
-    sim::ResolvedKeys keys;
-    try {
-      sim::parse_scenario(text, s.base_dir, origin, &keys, as_read);
-    } catch (const sim::ScenarioError& e) {
-      throw StudyError(e.what());
-    }
-    return keys;
-  }
-  // The nominal case of a controller and family (its layers, read once): its keys and its
-  // scenario as read, which each of its cases copies and sets its variations in.
-  struct Nominal {
-    sim::ResolvedKeys keys;
-    sim::Scenario read;
-  };
-  std::map<std::pair<std::size_t, std::size_t>, Nominal> nominals;
-  // The controller's nominal model's keys (the nominal model rule), by the case's settings that
-  // are not plant-only.
-  std::map<std::string, sim::ResolvedKeys> models;
-  // SHA-256 of a plugin library's bytes, once per path per study.
-  std::map<std::string, std::string> digests;
   const std::string& library_digest(const std::string& path) {
     auto it = digests.find(path);
     if (it != digests.end()) return it->second;
@@ -229,44 +206,28 @@ struct Resolver::Impl {
     if (!in) throw StudyError("plugin " + path + ": cannot be read to key the study's cases");
     return digests.emplace(path, sha256_hex(bytes.str())).first->second;
   }
-  static std::string text_of(const YAML::Node& doc) {
-    YAML::Emitter em;
-    em << doc;
-    return em.c_str();
-  }
-  const sim::ResolvedKeys& load(const YAML::Node& doc, const std::string& origin) {
-    std::string text = text_of(doc);
-    auto it = loads.find(text);
-    if (it != loads.end()) return it->second;
-    sim::ResolvedKeys keys = load_uncached(text, origin);
-    // Bounded: a study that varies controller.* keys together with plant.* keys has a nominal
-    // model per case; the cache keeps at most kMaxLoads (cases come in order, so a reset costs
-    // one load per layer).
-    if (loads.size() >= kMaxLoads) loads.clear();
-    return loads.emplace(std::move(text), std::move(keys)).first->second;
-  }
 
-  using Values = std::vector<std::pair<std::string, std::string>>;
-  YAML::Node nominal_doc(const CaseSpec& c, const std::string& origin) const;
+  using Values = std::vector<sim::KeySetting>;
   static Values variation_values(const CaseSpec& c, const sim::ResolvedKeys& nominal, const std::string& origin);
-  void keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
-                          const std::string& origin);
-  ResolvedCase result(const sim::ResolvedKeys& keys, const Values& values);
   const Nominal& nominal(const CaseSpec& c, const std::string& origin);
-  std::optional<sim::ResolvedKeys> case_keys(const CaseSpec& c, const Nominal& nominal, const Values& values);
+  const plant::PlantParams& nominal_model(const CaseSpec& c, const Nominal& n, const Values& values,
+                                          const std::string& origin);
+  ResolvedCase result(std::shared_ptr<const sim::Scenario> sc, const Values& values);
 };
 
 namespace {
 
-// Writes one setting of a layer into doc; its error names the case and the layer ("set",
-// "family set", "variation", ...).
-void apply_setting(YAML::Node& doc, const std::string& key, const std::string& value, const std::string& origin,
-                   const char* where) {
+// The settings set in a scenario as read (sim::set_read_keys); with `complete`, derived and
+// checked. The error names the case (origin) and the loader's key and value.
+sim::Scenario with_settings(sim::Scenario sc, const std::vector<sim::KeySetting>& values, bool complete,
+                            const std::string& origin) {
   try {
-    set_key(doc, key, value);
-  } catch (const StudyError& e) {
-    throw StudyError(origin + ": " + where + ": " + e.what());
+    sim::set_read_keys(sc, values);
+    if (complete) sim::complete_read(sc);
+  } catch (const sim::ScenarioError& e) {
+    throw StudyError(origin + ": " + e.what());
   }
+  return sc;
 }
 
 }  // namespace
@@ -274,15 +235,19 @@ void apply_setting(YAML::Node& doc, const std::string& key, const std::string& v
 // The layers without the variations: the nominal case of this controller and family. The
 // study's set comes after the controller block it would otherwise be replaced by: what it sets
 // holds for every controller (docs/study.md, "How a case is made").
-YAML::Node Resolver::Impl::nominal_doc(const CaseSpec& c, const std::string& origin) const {
+const Resolver::Impl::Nominal& Resolver::Impl::nominal(const CaseSpec& c, const std::string& origin) {
+  const auto id = std::make_pair(c.controller, c.family);
+  auto it = nominals.find(id);
+  if (it != nominals.end()) return it->second;
   const ControllerEntry& ctl = s.controllers[c.controller];
-  YAML::Node doc = YAML::Clone(base);
-  if (!ctl.block.empty()) doc["controller"] = YAML::Clone(controller_blocks[c.controller]);
-  for (const Setting& st : ctl.block_set) apply_setting(doc, st.key, st.value, origin, "controllers scenario");
-  for (const Setting& st : s.set) apply_setting(doc, st.key, st.value, origin, "set");
-  for (const Setting& st : ctl.set) apply_setting(doc, st.key, st.value, origin, "controllers set");
-  for (const Setting& st : s.families[c.family].set) apply_setting(doc, st.key, st.value, origin, "family set");
-  return doc;
+  std::vector<sim::KeySetting> layers;
+  for (const auto* set : {&ctl.block_set, &s.set, &ctl.set, &s.families[c.family].set})
+    for (const Setting& st : *set) layers.push_back({st.key, st.value});
+  Nominal n;
+  const std::string where = origin + " (without its variations)";
+  n.read = with_settings(bases[c.controller], layers, false, where);
+  n.keys = sim::resolved_keys(with_settings(n.read, {}, true, where));
+  return nominals.emplace(id, std::move(n)).first->second;
 }
 
 // The variations' values as YAML scalar text: a `scale` one is its factor times the key's
@@ -292,7 +257,7 @@ Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const
   Values values;
   for (const Variation& v : c.variations) {
     if (!v.scale) {
-      values.emplace_back(v.key, v.value);
+      values.push_back({v.key, v.value});
       continue;
     }
     const auto it = nominal.find(v.key);
@@ -309,94 +274,35 @@ Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const
       throw StudyError(origin + ": " + v.key +
                        " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a "
                        "distribution without scale: true)");
-    values.emplace_back(v.key, validate::format_number(nominal_value * v.factor));
+    values.push_back({v.key, validate::format_number(nominal_value * v.factor)});
   }
   return values;
 }
 
-namespace {
-
-// The nominal model rule: the model's keys (controller.model.*) of `model` replace those in keys.
-void use_model(sim::ResolvedKeys& keys, const sim::ResolvedKeys& model) {
-  for (auto& [k, v] : keys) {
-    if (!starts_with(k, "controller.model.")) continue;
-    const auto it = model.find(k);
-    if (it != model.end()) v = it->second;
-  }
-}
-
-// The keys of a case built as a struct: the nominal scenario as read with each setting set in
-// it (sim::set_read_key; with skip_plant_only, all but the plant-only ones), derived and checked.
-// nullopt for a setting only the YAML reader decides, or an error (the caller then reads the
-// layers as YAML: the same keys, or the reader's own one-line error).
-std::optional<sim::ResolvedKeys> struct_keys(sim::Scenario s,
-                                             const std::vector<std::pair<std::string, std::string>>& values,
-                                             bool skip_plant_only) {
-  try {
-    for (const auto& [k, v] : values) {
-      if (skip_plant_only && plant_only(k)) continue;
-      if (!sim::set_read_key(s, k, v)) return std::nullopt;
-    }
-    sim::complete_read(s);
-    return sim::resolved_keys(s);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
-}  // namespace
-
-const Resolver::Impl::Nominal& Resolver::Impl::nominal(const CaseSpec& c, const std::string& origin) {
-  const auto id = std::make_pair(c.controller, c.family);
-  auto it = nominals.find(id);
-  if (it != nominals.end()) return it->second;
-  Nominal n;
-  n.keys = load_uncached(text_of(nominal_doc(c, origin)), origin + " (without its variations)", &n.read);
-  return nominals.emplace(id, std::move(n)).first->second;
-}
-
-// The case as a struct (struct_keys), with the nominal model rule; nullopt where the YAML
-// reader must read it.
-std::optional<sim::ResolvedKeys> Resolver::Impl::case_keys(const CaseSpec& c, const Nominal& nominal,
-                                                           const Values& values) {
-  std::optional<sim::ResolvedKeys> keys = struct_keys(nominal.read, values, false);
-  if (!keys || s.model != ModelRule::kNominal) return keys;
-  if (std::none_of(values.begin(), values.end(), [](const auto& kv) { return plant_only(kv.first); })) return keys;
+// The nominal model rule (cases.hpp): the controller's model of the case without its plant-only
+// variations.
+const plant::PlantParams& Resolver::Impl::nominal_model(const CaseSpec& c, const Nominal& n, const Values& values,
+                                                        const std::string& origin) {
   std::string id = std::to_string(c.controller) + " " + std::to_string(c.family) + "\n";
-  for (const auto& [k, v] : values)
-    if (!plant_only(k)) id += k + "=" + v + "\n";
+  Values others;
+  for (const sim::KeySetting& k : values) {
+    if (plant_only(k.key)) continue;
+    others.push_back(k);
+    id += k.key + "=" + k.value + "\n";
+  }
   auto it = models.find(id);
-  if (it == models.end()) {
-    std::optional<sim::ResolvedKeys> model = struct_keys(nominal.read, values, true);
-    if (!model) return std::nullopt;
-    if (models.size() >= kMaxLoads) models.clear();
-    it = models.emplace(std::move(id), std::move(*model)).first;
-  }
-  use_model(*keys, it->second);
-  return keys;
+  if (it != models.end()) return it->second;
+  if (models.size() >= kMaxModels) models.clear();
+  const sim::Scenario m = with_settings(n.read, others, false, origin + " (the controller's nominal model)");
+  return models.emplace(std::move(id), m.controller.model).first->second;
 }
 
-// The nominal model rule (cases.hpp): the controller's model (controller.model.*) of the case
-// without its plant-only variations replaces the one in keys, the case with all of them.
-void Resolver::Impl::keep_nominal_model(const YAML::Node& doc, const Values& values, sim::ResolvedKeys& keys,
-                                        const std::string& origin) {
-  YAML::Node model_doc = YAML::Clone(doc);
-  bool differs = false;
-  for (const auto& [k, v] : values) {
-    if (plant_only(k)) {
-      differs = true;
-    } else {
-      apply_setting(model_doc, k, v, origin, "variation");
-    }
-  }
-  if (!differs) return;
-  use_model(keys, load(model_doc, origin + " (the controller's nominal model)"));
-}
-
-// The case's scenario (keys written as one YAML document), its hash and the effective value of
-// every varied key of the study.
-ResolvedCase Resolver::Impl::result(const sim::ResolvedKeys& keys, const Values& values) {
+// The case's scenario (its keys written as one YAML document), its hash and the effective value
+// of every varied key of the study.
+ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, const Values& values) {
   ResolvedCase r;
+  const sim::ResolvedKeys keys = sim::resolved_keys(*sc);
+  r.scenario = std::move(sc);
   r.yaml = sim::resolved_yaml(keys);
   // A plugin controller's case depends on the library's code too, which the keys (its path) do
   // not show: its bytes' digest joins the hash, so a rerun after a rebuild of the plugin runs the
@@ -411,8 +317,8 @@ ResolvedCase Resolver::Impl::result(const sim::ResolvedKeys& keys, const Values&
     const auto it = keys.find(k);
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
-  for (const auto& [k, v] : values)
-    if (!r.parameters.count(k)) r.parameters[k] = v;
+  for (const sim::KeySetting& v : values)
+    if (!r.parameters.count(v.key)) r.parameters[v.key] = v.value;
   return r;
 }
 
@@ -427,24 +333,21 @@ std::string Resolver::label(const CaseSpec& c) const {
   return l;
 }
 
-// The case's nominal layers are read once per controller and family by the scenario loader,
-// which checks every key and value; a case is that scenario as read with its variations set in
-// it (a struct: case_keys), derived and checked, with the nominal model rule's model from the
-// same struct without the plant-only variations. Where a variation is one only the YAML reader
-// decides (sim::set_read_key), or the case fails a check, its layers with the variations are
-// read as YAML: the same keys, or the reader's error quoting the values as written.
+// The case's nominal layers are set in the base as read once per controller and family; a case
+// is that scenario with its variations set in it (sim::set_read_keys), with the nominal model
+// rule's model from the same struct without the plant-only variations, derived and checked
+// (sim::complete_read): a struct, never YAML read again. A setting the struct cannot take is the
+// case's one-line error naming the key and value.
 ResolvedCase Resolver::resolve(const CaseSpec& c) {
   Impl& m = *impl_;
   const std::string origin = (m.s.path.empty() ? std::string("study") : m.s.path) + ": " + label(c);
   const Impl::Nominal& nominal = m.nominal(c, origin);
   const Impl::Values values = Impl::variation_values(c, nominal.keys, origin);
-  if (const auto keys = m.case_keys(c, nominal, values)) return m.result(*keys, values);
-  const YAML::Node doc = m.nominal_doc(c, origin);
-  YAML::Node full = YAML::Clone(doc);
-  for (const auto& [k, v] : values) apply_setting(full, k, v, origin, "variation");
-  sim::ResolvedKeys keys = m.load_uncached(Impl::text_of(full), origin);  // one per case: not cached
-  if (m.s.model == ModelRule::kNominal) m.keep_nominal_model(doc, values, keys, origin);
-  return m.result(keys, values);
+  sim::Scenario sc = with_settings(nominal.read, values, false, origin);
+  if (m.s.model == ModelRule::kNominal &&
+      std::any_of(values.begin(), values.end(), [](const sim::KeySetting& k) { return plant_only(k.key); }))
+    sc.controller.model = m.nominal_model(c, nominal, values, origin);
+  return m.result(std::make_shared<const sim::Scenario>(with_settings(std::move(sc), {}, true, origin)), values);
 }
 
 }  // namespace feeddrive::study

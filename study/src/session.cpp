@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <variant>
 
 #include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
@@ -85,15 +86,18 @@ int available_cores() {
 
 namespace {
 
-// Worker threads running cases: the main thread hands each its index and scenario.
+// Worker threads running cases: the main thread hands each its index and scenario (the struct
+// on rank 0, the resolved YAML a rank received).
 class CasePool {
  public:
+  using Case = std::variant<std::shared_ptr<const sim::Scenario>, std::string>;
   CasePool(int jobs, const interrupt::StopToken& stop)
-      : stop_(stop), pool_(jobs, [this](std::size_t i) { return run_case(take(i), stop_); }) {}
-  void push(std::size_t i, std::string yaml) {
+      : stop_(stop),
+        pool_(jobs, [this](std::size_t i) { return std::visit([this](const auto& c) { return run(c); }, take(i)); }) {}
+  void push(std::size_t i, Case c) {
     {
       std::lock_guard<std::mutex> g(mu_);
-      yaml_[i] = std::move(yaml);
+      cases_[i] = std::move(c);
     }
     pool_.push(i);
   }
@@ -101,14 +105,16 @@ class CasePool {
   std::optional<std::pair<std::size_t, Outcome>> pop(std::chrono::milliseconds wait) { return pool_.pop(wait); }
 
  private:
-  std::string take(std::size_t i) {
+  Case take(std::size_t i) {
     std::lock_guard<std::mutex> g(mu_);
-    std::string text = std::move(yaml_.at(i));
-    yaml_.erase(i);
-    return text;
+    Case c = std::move(cases_.at(i));
+    cases_.erase(i);
+    return c;
   }
+  Outcome run(const std::shared_ptr<const sim::Scenario>& s) const { return run_case(*s, stop_); }
+  Outcome run(const std::string& yaml) const { return run_case(yaml, stop_); }
   std::mutex mu_;
-  std::map<std::size_t, std::string> yaml_;  // handed over, not yet taken by a thread
+  std::map<std::size_t, Case> cases_;  // handed over, not yet taken by a thread
   const interrupt::StopToken stop_;
   Pool pool_;  // last: its threads stop before the map goes
 };
@@ -285,7 +291,7 @@ class CaseStream {
            !o_.stop.stop_requested())
       prepare_next();
     while (pool.in_flight() < static_cast<std::size_t>(jobs_) && !ready_.empty()) {
-      pool.push(ready_.front(), slots_.at(ready_.front()).record.resolved.yaml);
+      pool.push(ready_.front(), slots_.at(ready_.front()).record.resolved.scenario);
       ready_.pop_front();
     }
     while (t_ && !waiting_.empty() && (!ready_.empty() || next_case_ == c_.total)) {
@@ -317,6 +323,8 @@ class CaseStream {
         if (!out)
           throw std::runtime_error("rank " + std::to_string(m->from) + " sent a malformed outcome for case " +
                                    std::to_string(i));
+        // The loader's warnings are those of the case as rank 0 built it (the struct).
+        if (out->ok) out->warnings = slots_.at(i).record.resolved.scenario->warnings;
         record(i, std::move(*out));
       }
     }

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "feeddrive/common/text.hpp"
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
@@ -460,13 +461,7 @@ GridAxis parse_sweep(const std::string& text) {
   axis.log = log;
   if (log) values = values.substr(4);
   if (values.find(':') != std::string::npos) {
-    std::vector<std::string> parts;
-    for (std::size_t b = 0;;) {
-      const std::size_t e = values.find(':', b);
-      parts.push_back(values.substr(b, e == std::string::npos ? std::string::npos : e - b));
-      if (e == std::string::npos) break;
-      b = e + 1;
-    }
+    const std::vector<std::string> parts = text::split(values, ':');
     if (parts.size() != 3) throw bad("a range is START:STOP:N");
     double a = 0, z = 0;
     char* end = nullptr;

@@ -62,23 +62,41 @@ TEST(Scenario, AStepAfterTheRunIsAMoveCutOff) {
 }
 
 // --set with a list or a map in YAML's flow style reads it as the file would; a part set on
-// `ripple: paper` keeps the preset (issue 23 review).
+// `ripple: paper` keeps the preset (issue 23 review). The settings go into the struct as read.
 TEST(Scenario, SetKeyTakesFlowListsAndMapsAndPartsOfAPreset) {
-  YAML::Node root = load_yaml_strict(kMinimal);
-  set_key(root, "output.columns", "[t, x, u]");
-  set_key(root, "plant.friction", "{model: none}");
-  root["plant"]["ripple"] = "paper";
-  set_key(root, "plant.ripple.cogging_amplitude", "6");
-  YAML::Emitter em;
-  em << root;
-  const Scenario s = parse_scenario(em.c_str());
+  Scenario s = read_scenario(kMinimal);
+  set_read_keys(s, {{"output.columns", "[t, x, u]"},
+                    {"plant.friction", "{model: none}"},
+                    {"plant.ripple", "paper"},
+                    {"plant.ripple.cogging_amplitude", "6"}});
+  complete_read(s);
   EXPECT_EQ(s.output.columns, (std::vector<std::string>{"t", "x", "u"}));
   EXPECT_EQ(s.plant.friction.model, plant::FrictionModel::kNone);
+  EXPECT_EQ(s.controller.sliding_mode.model.friction.model, plant::FrictionModel::kNone);  // the model follows
   EXPECT_TRUE(s.plant.ripple.enabled);
   EXPECT_EQ(s.plant.ripple.cogging_amplitude, 6.0);
   EXPECT_NE(s.plant.ripple.reluctance_amplitude, 0.0);  // the paper's other parts kept
-  YAML::Node bad = load_yaml_strict(kMinimal);
-  EXPECT_THROW(set_key(bad, "output.columns", "[t, x"), ScenarioError);
+  Scenario bad = read_scenario(kMinimal);
+  EXPECT_THROW(set_read_key(bad, "output.columns", "[t, x"), ScenarioError);
+}
+
+// A section written without `enabled` is off: the warning comes from the presence facts the
+// reader records (given_keys), so a section given by a setting warns the same.
+TEST(Scenario, TheOffSectionWarningComesFromThePresenceFacts) {
+  Scenario s = read_scenario(kMinimal);
+  EXPECT_EQ(s.given_keys.count("plant.ripple"), 0u);
+  set_read_key(s, "plant.grinding.stiffness", "2e6");
+  complete_read(s);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0],
+            "plant.grinding: keys given, but the section is off (no enabled: true): they do not act; enabled: true?");
+  EXPECT_TRUE(s.grinding_process);
+  Scenario on = read_scenario(kMinimal);
+  set_read_keys(on, {{"plant.grinding.stiffness", "2e6"}, {"plant.grinding.enabled", "false"}});
+  complete_read(on);
+  EXPECT_TRUE(on.warnings.empty());
+  // The short form of a preset says what it is: no warning.
+  EXPECT_TRUE(parse_scenario(with("plant: {}", "plant: {ripple: none}")).warnings.empty());
 }
 
 TEST(Scenario, MinimalUsesDefaultsAndModelEqualsPlant) {

@@ -1,12 +1,26 @@
 #pragma once
 // Text checks shared by the scenario loader and the plot writer: well-formed UTF-8 (RFC 3629,
-// Table 3-7 of the Unicode Standard: no overlong forms, no surrogates, at most U+10FFFF).
-// Header-only.
+// Table 3-7 of the Unicode Standard: no overlong forms, no surrogates, at most U+10FFFF); and the
+// one split of a text at a separator (dotted keys, ranges). Header-only.
 
 #include <cstddef>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace feeddrive::text {
+
+/// The parts of `s` between the separators ("plant.friction" at '.' -> plant, friction; "" -> one
+/// empty part).
+inline std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  for (std::size_t b = 0;;) {
+    const std::size_t e = s.find(sep, b);
+    parts.push_back(s.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) return parts;
+    b = e + 1;
+  }
+}
 
 /// Length of the well-formed UTF-8 sequence at s[i] encoding a character from U+00A0 up (so no
 /// C1 control character), or 0 (ASCII, a malformed sequence, or one cut by the end of s).

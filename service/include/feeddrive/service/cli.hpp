@@ -26,8 +26,9 @@ void add_node_options(CLI::App& app, NodeOptions& opt);
 int run_process(CLI::App& app, int argc, char** argv, const NodeOptions& opt, const std::function<int()>& body);
 
 /// The scenario of a run process: loaded once, its bytes hashed (SHA-256, FIPS 180-4, by
-/// libcrypto). With opt.scenario_hash set (--scenario-hash: feeddrive-launch sets it), a file whose bytes hash
-/// otherwise (replaced while the run started) throws std::invalid_argument, one line: exit 2.
+/// libcrypto; with --set, the scenario as run: sim::load_scenario's text). With opt.scenario_hash set (--scenario-hash:
+/// feeddrive-launch sets it), a file whose bytes hash otherwise (replaced while the run started) throws
+/// std::invalid_argument, one line: exit 2.
 struct RunScenario {
   sim::Scenario scenario;
   std::string sha256;  ///< hex

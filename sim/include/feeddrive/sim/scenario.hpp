@@ -85,9 +85,6 @@ struct ControllerConfig {
   /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
   /// plant's own parameters without its effects; summary.json says so as controller_model).
   bool model_given{false};
-  /// The dotted keys given under controller.model (its maps and values, "friction" and
-  /// "friction.static_force"): a model value not given follows the plant (set_read_key).
-  std::set<std::string> model_keys_given;
 };
 
 struct AnalysisConfig {
@@ -124,6 +121,15 @@ struct Scenario {
   /// The scenario describes a grinding process: it has a plant.grinding section (enabled or not)
   /// or lists plant.effects.grinding_force. feeddrive-fit considers a grinding force only then.
   bool grinding_process{false};
+  /// The presence facts: the dotted key of every map and value the scenario gives ("plant",
+  /// "plant.ripple", "plant.ripple.cogging_amplitude"; `ripple: paper` gives plant.ripple.preset),
+  /// recorded by the reader from the lists (MapReader) and by set_read_key. They decide what a
+  /// value not given follows (a controller model's value follows the plant's unless given), the
+  /// keys a type switch must not leave behind, and the "section given but off" warning.
+  std::set<std::string> given_keys;
+  /// The folder the scenario's file names (reference.file, controller.file, controller.library)
+  /// are resolved against.
+  std::string base_dir{"."};
   /// The effects the scenario lists, by key ("plant.effects.constant_force",
   /// "controller.model.effects.spring_force"). Listing one enables it; a listed one is part of
   /// the run's description (resolved_keys) even when it says `enabled: false`.
@@ -161,37 +167,45 @@ struct KeySetting {
 /// Parses "key=value" (the key a dotted path, the value a scalar). Throws ScenarioError
 /// "--set TEXT: expected key=value" otherwise.
 KeySetting parse_key_setting(const std::string& text);
-/// Writes `value` (a YAML scalar) at the dotted `key` of the map `root`, creating maps on the
-/// way. Throws ScenarioError "<key>: <part> is a single value in the scenario, not a map of keys".
-void set_key(YAML::Node& root, const std::string& key, const std::string& value);
-/// A scenario file with settings applied before it is read (feeddrive-sim, -launch, -fit --set):
-/// the same loader, so a setting is checked like the file's own keys (unknown key with "did you
-/// mean", type, range). Errors name the file and "--set" when a setting is at fault. `text`
-/// receives the scenario as run: the file's bytes without settings, else the YAML with them.
+/// A scenario file with settings (feeddrive-sim, -launch, -fit --set): the file read once into the
+/// struct (read_scenario), the settings set in it (set_read_keys), then derived and checked
+/// (complete_read), so a setting is checked like the file's own keys (unknown key with "did you
+/// mean", type, range). Errors name the file and "--set". `text` receives the scenario as run:
+/// the file's bytes without settings, else its resolved keys as one YAML document (resolved_yaml).
 Scenario load_scenario(const std::string& path, const std::vector<KeySetting>& sets, std::string* text = nullptr);
 /// Parses and validates YAML text; base_dir resolves relative file names; origin names the
 /// source in messages. If `resolved` is given it receives resolved_keys() of the scenario: every
 /// key with its effective value (given or default; file names resolved against base_dir), the
 /// complete description of the run, used by feeddrive-study to vary keys, scale them and key its
 /// cases.
-/// `as_read` (optional): the scenario as read, before derive() and the checks, for
-/// set_read_key.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
-                        const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr,
-                        Scenario* as_read = nullptr);
+                        const std::string& origin = "scenario", ResolvedKeys* resolved = nullptr);
 
-/// feeddrive-study's cases as structs (study/src/cases.cpp): sets one key of a scenario as read
-/// (parse_scenario's `as_read`) through the sections' lists, its value parsed by the reader's
-/// own accessor (yaml_archive.hpp), with the reader's rules: a plant value the controller's
-/// model does not give follows into the model, an effect's key only for a listed effect.
-/// Returns false, leaving `s` as it may be, for what only the YAML reader decides (a key not in
-/// the lists of the scenario's types, a type, a preset, a tuning rule, a file, a section made
-/// present, a flow value, a value the YAML would read differently, a value a read rule refuses):
-/// the caller then reads the YAML with the setting, which gives the same scenario or the
-/// reader's own one-line error. Throws ScenarioError for a value its accessor refuses.
-bool set_read_key(Scenario& s, const std::string& key, const std::string& value);
-/// derive() and the checks of parse_scenario on a scenario as read; a ScenarioError thrown here
-/// may quote sections differently from parse_scenario's (the caller reads the YAML for it).
+/// Reads YAML text into a scenario as read: every key, type and value as the file gives it (the
+/// reader's checks), before derive() and the whole-scenario checks (complete_read). The start of
+/// a scenario built as a struct (set_read_key; feeddrive-sim --set, feeddrive-study's cases).
+/// `controller` (optional): the YAML text of a controller map, read in place of the text's own
+/// controller section (a study's controller entry). Throws ScenarioError "<origin>: ...".
+Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
+                       const std::string& origin = "scenario", const std::string& controller = "");
+
+/// Sets one dotted key of a scenario as read to `value` (YAML scalar text, or a flow list or map
+/// `[t, x]`, `{model: none}`), as if the file said so, through the sections' lists: the value
+/// parsed by the reader's own accessor (yaml_archive.hpp), with the reader's rules: a plant value
+/// the controller's model does not give follows into the model, a type switch, a preset (the
+/// keys given below it keep their values), listing an effect enables it, the cascade's tuning
+/// rule, a file resolved against base_dir, a map replaces the sub-section (its keys not given
+/// take their defaults). The key is recorded in given_keys. Throws ScenarioError, one line naming
+/// the key and the value, for what the file could not say either (an unknown key with "did you
+/// mean", a value its accessor refuses, a key of another type left by a type switch) and for the
+/// one thing a setting cannot do: replace a whole section (`plant={...}`).
+void set_read_key(Scenario& s, const std::string& key, const std::string& value);
+/// Sets several keys (set_read_key): the type selectors (controller.type, reference.type,
+/// controller.tuning, a ripple preset) first, as in a file where they hold whatever the order,
+/// the others in the order given (a later value of one key wins).
+void set_read_keys(Scenario& s, const std::vector<KeySetting>& sets);
+/// derive() and the checks of parse_scenario on a scenario as read (the run's length, each
+/// component's validate(), the files it names, the functions of time, the warnings).
 void complete_read(Scenario& s);
 
 /// Every key that describes the run, with its effective value, from the scenario's struct: the

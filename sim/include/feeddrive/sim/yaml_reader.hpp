@@ -39,7 +39,9 @@ YAML::Node load_yaml_strict(const std::string& text);
 class MapReader {
  public:
   /// node must be a map (or null/absent, treated as empty); path is its dotted key ("plant").
-  MapReader(const YAML::Node& node, std::string path);
+  /// `given` (optional, handed on to child readers): receives the dotted key of every map and
+  /// value present in the node that is read (the presence facts, Scenario::given_keys).
+  MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given = nullptr);
 
   bool has(const std::string& key) const;
   /// Reads a finite number into out if the key is present; throws if present but invalid.
@@ -68,6 +70,11 @@ class MapReader {
   MapReader child_absent(const std::string& key);
   /// Marks `key` as known (read by the caller some other way, e.g. a list), for finish().
   void known(const std::string& key) { read_.insert(key); }
+  /// Records `key` (below this map) as given, for a form the accessors do not see (a preset's
+  /// short form `ripple: paper` gives ripple.preset).
+  void mark_given(const std::string& key) const {
+    if (given_ != nullptr) given_->insert(key_path(key));
+  }
   /// Throws for every key present in the node but never read.
   void finish() const;
 
@@ -79,6 +86,7 @@ class MapReader {
   YAML::Node node_;
   std::string path_;
   std::set<std::string> read_;
+  std::set<std::string>* given_{nullptr};
 };
 
 /// Levenshtein distance, for "did you mean" hints.

@@ -7,24 +7,23 @@
 // pure function of (seed, j, p) (draw_value), the same for every controller, so every controller
 // meets the same plants (common random numbers) and no order of evaluation changes a number.
 //
-// Resolution (resolve_case) builds the case's scenario YAML in layers,
-//   base -> study set -> controller block -> controller set -> family set -> variations,
-// and loads it with the scenario loader, which checks every key and value (a misspelt key is the
-// loader's one-line "unknown key" error). A `scale` variation multiplies the key's nominal value:
-// its effective value in the case without variations (defaults included). With the nominal model
-// rule (spec.hpp), the controller's model (controller.model.*) is taken from the case without the
-// plant.* variations except plant.sensor.*: the mismatch is in the plant, while the controller is
-// set up for the encoder it actually has. The case's scenario is then the loader's resolved keys
-// written as one YAML document (sim::resolved_yaml): every key with its effective value, loadable
-// by feeddrive-sim. Its SHA-256 keys the case in the output folder.
+// Resolution (Resolver::resolve) builds the case's scenario as a struct: the base read once
+// (sim::read_scenario) with each controller's block read into it, then the settings of the layers
+//   controller block's control_period -> study set -> controller set -> family set -> variations
+// set in it through the sections' key lists (sim::set_read_keys: each value checked by the
+// loader's own accessor; a misspelt key is the loader's one-line "unknown key" error), then
+// derived and checked (sim::complete_read). No case is YAML read again. A `scale` variation multiplies the key's
+// nominal value: its effective value in the case without variations (defaults included). With the nominal model rule
+// (spec.hpp), the controller's model (controller.model.*) is taken from the case without the plant.* variations except
+// plant.sensor.*: the mismatch is in the plant, while the controller is set up for the encoder it actually has. The
+// case's scenario is then the loader's resolved keys written as one YAML document (sim::resolved_yaml): every key with
+// its effective value, loadable by feeddrive-sim. Its SHA-256 keys the case in the output folder.
 
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <yaml-cpp/yaml.h>
 
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/study/spec.hpp"
@@ -79,11 +78,10 @@ double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::u
 /// appearance (the parameter columns of results.csv).
 std::vector<std::string> varied_keys(const Study& s);
 
-/// sim::set_key, with its error as a StudyError.
-void set_key(YAML::Node& root, const std::string& key, const std::string& value);
-
 struct ResolvedCase {
-  std::string yaml;  ///< the complete scenario (loads in feeddrive-sim)
+  /// The case's scenario as it runs: built as a struct, derived and checked (Resolver::resolve).
+  std::shared_ptr<const sim::Scenario> scenario;
+  std::string yaml;  ///< the complete scenario's keys (resolved_yaml; loads in feeddrive-sim)
   std::string hash;  ///< SHA-256 (hex) of the format tag and yaml
   /// Effective value of every key of varied_keys() that this case's scenario has, by key.
   std::map<std::string, std::string> parameters;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "feeddrive/common/interrupt.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::study {
 
@@ -35,9 +36,12 @@ struct Outcome {
   bool interrupted{false};  ///< stopped by Ctrl-C or SIGTERM: not an outcome, never recorded
 };
 
-/// Loads the resolved scenario YAML, runs it in-process (sim::run, streamed into the online
-/// summary: no records kept) and returns the summary.json metrics. Never throws: a failure is an
-/// Outcome with its one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
+/// Runs a case's scenario in-process (sim::run, streamed into the online summary: no records
+/// kept) and returns the summary.json metrics. Never throws: a failure is an Outcome with its
+/// one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
+Outcome run_case(const sim::Scenario& s, const interrupt::StopToken& stop = {});
+/// The same for a case that came as its resolved YAML (another MPI rank's: the text is the wire
+/// format between processes; the ranks share no memory).
 Outcome run_case(const std::string& yaml, const interrupt::StopToken& stop = {});
 
 /// The format of a case file (its "format" key). 2 (issue 23) added warnings and move_finished;

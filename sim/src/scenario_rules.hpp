@@ -1,0 +1,38 @@
+#pragma once
+// The scenario reader's rules that the reader (scenario.cpp) and the struct's setter
+// (scenario_set.cpp) share: one place each.
+
+#include <string>
+#include <vector>
+
+#include "feeddrive/sim/scenario.hpp"
+
+namespace feeddrive::sim::detail {
+
+/// The scenario gives `key` (a map or a value; Scenario::given_keys).
+inline bool gives(const Scenario& s, const std::string& key) { return s.given_keys.count(key) > 0; }
+
+/// A controller's nominal model by default: the plant itself, without the effects it does not know.
+plant::PlantParams model_of_plant(const plant::PlantParams& plant);
+
+/// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length.
+void check_name(const std::string& name, const std::string& what);
+
+/// output.every >= 1, output.columns known and each once; `columns_given`: an empty list is an error.
+void check_output(const OutputConfig& out, bool columns_given);
+
+/// control_period <= duration and the run's step count within kMaxSteps; the messages quote
+/// `duration` and `period` (the values as written, or their shortest text).
+void check_timing(const Scenario& s, const std::string& duration, const std::string& period);
+
+/// A file name of the scenario resolved against its folder (an absolute one as it is).
+std::string resolved_file(const std::string& base_dir, const std::string& file);
+
+/// A plugin parameter's name: letters, digits and _ only.
+bool parameter_name(const std::string& key);
+
+/// derive() and the whole-scenario checks of parse_scenario (each component's validate(), the
+/// files it names, the functions of time, the warnings) on a scenario as read.
+void derive_and_check(Scenario& s);
+
+}  // namespace feeddrive::sim::detail
