@@ -136,7 +136,9 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
       observer_.predict(model_acceleration(cmd.u));
     }
   }
-  if (adapt) adaptation_.update(-p_.mass * d_hat, f_model, inertial);
+  // Learn in sliding only (feedforward_adaptation.hpp); the bristles here follow the reference.
+  if (adapt && friction_ff_.transient(ahead.velocity) < kAdaptationTransient)
+    adaptation_.update(-p_.mass * d_hat, f_model, inertial);
   return cmd;
 }
 

@@ -14,6 +14,13 @@ void FrictionObserver::set_level(double level) {
   p_.coulomb_force = level * coulomb_force_;
 }
 
+double FrictionObserver::transient(double v) const {
+  if (p_.model != plant::FrictionModel::kLuGre || !std::isfinite(v)) return 0.0;
+  const double z_ss = plant::stribeck(p_, v) / p_.bristle_stiffness;
+  const double sign = (v > 0.0) - (v < 0.0);
+  return std::abs(z_ - sign * z_ss) / z_ss;
+}
+
 double FrictionObserver::estimate(double v) const { return plant::friction_force(p_, v, z_); }
 
 void FrictionObserver::advance(double v, double velocity_error) { advance(v, velocity_error, period_); }

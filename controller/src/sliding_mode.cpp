@@ -234,7 +234,10 @@ Command SlidingModeController::update(const trajectory::Sample& ref, const plant
   cmd.u_unsaturated = smc::control_input(p_, a_cmd, in.forces, disturbance);
   cmd.u = smc::limit_output(p_, cmd.u_unsaturated);
   advance_observers(est, ref, meas.t, delayed, cmd.u, now);
-  if (adapt) adaptation_.update(-p_.model.mass * motion_observer_.disturbance(), now.friction, inertial);
+  // Learn in sliding only: within a presliding transition the residual is the bristle dynamics'
+  // mismatch, which the level does not describe (feedforward_adaptation.hpp).
+  if (adapt && friction_observer_.transient(est.v) < kAdaptationTransient)
+    adaptation_.update(-p_.model.mass * motion_observer_.disturbance(), now.friction, inertial);
   return cmd;
 }
 

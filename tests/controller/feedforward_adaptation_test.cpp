@@ -126,3 +126,25 @@ TEST(FeedforwardAdaptation, ParamsNeedTheDisturbanceObserver) {
 
 }  // namespace
 }  // namespace feeddrive::controller
+
+namespace feeddrive::controller {
+namespace {
+
+// The learning gate: transient(v) = |z^ - sgn(v) g(v)/sigma0| / (g(v)/sigma0). In steady sliding
+// (2 s at 0.05 m/s: converged to rounding, friction_observer_test) it is 0 to 1e-9; right after
+// a reversal the bristles still sit at the old steady deflection, so it is 2 to 1e-9 (g is even
+// in v: the same |z_ss| on both sides). A model without bristles (static map) has none: 0.
+TEST(FeedforwardAdaptation, TransientIsZeroInSlidingAndTwoAtAReversal) {
+  const plant::FrictionParams f{};
+  FrictionObserver obs(f, 1e-4, 0.0);
+  for (int k = 0; k < 20000; ++k) obs.advance(0.05, 0.0);
+  EXPECT_NEAR(obs.transient(0.05), 0.0, 1e-9);
+  EXPECT_NEAR(obs.transient(-0.05), 2.0, 1e-9);
+  EXPECT_LT(obs.transient(0.05), kAdaptationTransient);
+  plant::FrictionParams map = f;
+  map.model = plant::FrictionModel::kStatic;
+  EXPECT_EQ(FrictionObserver(map, 1e-4, 0.0).transient(0.05), 0.0);
+}
+
+}  // namespace
+}  // namespace feeddrive::controller
