@@ -121,7 +121,7 @@ def summarise(cases):
     js = [c[1] for c in cases]
     return {"J": max(js), "mean_J": sum(js) / len(js), "worst_e_um": max(c[2] for c in cases),
             "worst_penalty": max(c[3] for c in cases), "pass": sum(1 for c in cases if c[1] <= 1.0 and c[3] == 0.0),
-            "cases": len(cases)}
+            "signal_ok": sum(1 for c in cases if c[3] == 0.0), "cases": len(cases)}
 
 
 def choose(spec, scores):
@@ -188,15 +188,16 @@ def test_study(spec, spec_path, chosen):
 def test_report(spec, scores, families):
     names = [fam["name"] for fam in spec["families"]]
     lines = [f"# Test stage: {spec['name']} (run once, the chosen candidate of each family)", "",
-             "Each cell: worst max|e| [um]; worst J_c; cases that pass (max|e| <= limit and every signal "
-             "figure within its limit).", "", "| test family | " + " | ".join(names) + " |",
+             "Each cell: worst max|e| [um]; worst J_c; cases whose command is within every signal limit; cases "
+             "that pass (max|e| <= limit as well).", "", "| test family | " + " | ".join(names) + " |",
              "|---|" + "---|" * len(names)]
     for tf in families:
         cells = []
         for name in names:
             cases = [c for c in scores.get(name, []) if c[0] == tf]
             s = summarise(cases) if cases else None
-            cells.append("–" if s is None else f"{fmt(s['worst_e_um'])}; J {fmt(s['J'])}; pass {s['pass']}/{s['cases']}")
+            cells.append("–" if s is None else f"{fmt(s['worst_e_um'])}; J {fmt(s['J'])}; "
+                         f"signal ok {s['signal_ok']}/{s['cases']}; pass {s['pass']}/{s['cases']}")
         lines.append(f"| {tf} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
