@@ -42,10 +42,15 @@ def load_spec(path):
             spec = yaml.safe_load(f)
     except (OSError, yaml.YAMLError) as e:
         fail(f"{path}: {e}")
+    if not isinstance(spec, dict):
+        fail(f"{path}: not a map")
     for key in ("objective", "budget", "design", "test", "families"):
         if key not in spec:
             fail(f"{path}: {key}: missing")
-    for fam in spec["families"]:
+    for i, fam in enumerate(spec["families"]):
+        for key in ("name", "scenario", "grid"):
+            if not isinstance(fam, dict) or key not in fam:
+                fail(f"{path}: families[{i}].{key}: missing")
         n = len(grid_points(fam["grid"]))
         if n != spec["budget"]:
             fail(f"{path}: families.{fam['name']}.grid: {n} points, the budget is {spec['budget']}")
