@@ -1,6 +1,8 @@
 // Regression bounds of the robustness study on every move (studies/robustness_moves.yaml, issue 24
-// item 7; docs/robustness.md, "Every move, wider mismatch"): the recommended controller's worst
-// case of each move, and its control-signal figures at those corners, run from the study file
+// item 7; docs/robustness.md, "Every move, wider mismatch"): robust_smc's worst case of each move
+// and its control-signal figures at those corners, and the recommended controller's
+// (cascade_recommended, docs/controllers.md "Which controller, and where it holds") worst passing
+// cases and the cases where it does not hold, run from the study file
 // itself (the same resolved scenario as the study's case: same plant, encoder seed, delay and
 // nominal model), so a change to a controller, the plant or the study shows here first.
 //
@@ -98,7 +100,7 @@ void check(const Outcome& o, const Expect& e) {
   EXPECT_EQ(metric(o, "control_signal_within_limits"), 0.0);
 }
 
-// robust_smc (the project's recommended controller for error, docs/robustness.md; it misses the
+// robust_smc (the most accurate law, docs/robustness.md, not the recommended controller: it misses the
 // direction-change limit everywhere): its worst case of each move's 24 corners (a 100 nm encoder
 // with 40 nm noise, seed 1; 500 us of delay in every one), and a Monte Carlo draw on two moves
 // with encoder-noise seeds 3 and 2.
