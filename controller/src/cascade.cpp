@@ -19,6 +19,9 @@ void CascadeParams::validate(const std::string& prefix) const {
   require_non_negative(prefix + ".model.sensor.quantization", quantization);
   require_non_negative(prefix + ".computation_delay", computation_delay);
   require_non_negative(prefix + ".velocity_filter_cutoff", velocity_filter_cutoff);
+  if (adaptation_rate > 0.0 && !(disturbance_observer_bandwidth > 0.0))
+    fail(prefix + ".adaptation_rate", adaptation_rate,
+         "needs disturbance_observer_bandwidth > 0 (the residual d^ of the observer)");
   if (motion_state == MotionSource::kObserver && !(disturbance_observer_bandwidth > 0.0))
     throw std::invalid_argument(prefix +
                                 ".motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
@@ -56,6 +59,7 @@ CascadeController::CascadeController(const CascadeParams& p)
       observer_(p.disturbance_observer_bandwidth > 0.0 ? p.disturbance_observer_bandwidth : 1.0, p.period, true,
                 p.quantization),
       delay_line_(p.compensate_delay ? p.computation_delay : 0.0, 1e-9 * p.period),
+      adaptation_(p.disturbance_observer_bandwidth > 0.0 ? p.adaptation_rate : 0.0, p.period, p.friction.coulomb_force),
       velocity_filter_gain_(p.velocity_filter_cutoff > 0.0
                                 ? -std::expm1(-2.0 * 3.14159265358979323846 * p.velocity_filter_cutoff * p.period)
                                 : 1.0) {}
@@ -79,7 +83,12 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
   const bool dob = p_.disturbance_observer_bandwidth > 0.0;
   if (dob) observer_.correct(meas.x, meas.v);
   const double d_hat = dob && observer_.initialised() ? observer_.disturbance() : 0.0;
-  const double f_ff = p_.friction_feedforward ? friction_ff_.estimate(ahead.velocity) : 0.0;
+  // The adapted feedforward (cascade.hpp): the friction at the adapted level, the inertial force.
+  const bool adapt = adaptation_.enabled() && observer_.initialised();
+  if (adapt) friction_ff_.set_level(adaptation_.friction_level());
+  const double f_model = p_.friction_feedforward ? friction_ff_.estimate(ahead.velocity) : 0.0;
+  const double inertial = p_.mass * ahead.acceleration;
+  const double f_ff = f_model + (adapt ? adaptation_.inertial_force(inertial) : 0.0);
   // Model: m^*x'' = Ka*Kf*u_acting - F^f_ff (held over the period); d^ takes up the rest.
   const auto model_acceleration = [&](double u) { return (p_.thrust_gain * u - f_ff) / p_.mass; };
 
@@ -127,6 +136,9 @@ Command CascadeController::update(const trajectory::Sample& ref_now, const plant
       observer_.predict(model_acceleration(cmd.u));
     }
   }
+  // Learn in sliding only (feedforward_adaptation.hpp); the bristles here follow the reference.
+  if (adapt && friction_ff_.transient(ahead.velocity) < kAdaptationTransient)
+    adaptation_.update(-p_.mass * d_hat, f_model, inertial);
   return cmd;
 }
 

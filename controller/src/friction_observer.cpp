@@ -7,7 +7,19 @@
 namespace feeddrive::controller {
 
 FrictionObserver::FrictionObserver(const plant::FrictionParams& p, double period, double gain)
-    : p_(p), period_(period), gain_(gain) {}
+    : p_(p), static_force_(p.static_force), coulomb_force_(p.coulomb_force), period_(period), gain_(gain) {}
+
+void FrictionObserver::set_level(double level) {
+  p_.static_force = level * static_force_;
+  p_.coulomb_force = level * coulomb_force_;
+}
+
+double FrictionObserver::transient(double v) const {
+  if (p_.model != plant::FrictionModel::kLuGre || !std::isfinite(v)) return 0.0;
+  const double z_ss = plant::stribeck(p_, v) / p_.bristle_stiffness;
+  const double sign = (v > 0.0) - (v < 0.0);
+  return std::abs(z_ - sign * z_ss) / z_ss;
+}
 
 double FrictionObserver::estimate(double v) const { return plant::friction_force(p_, v, z_); }
 

@@ -27,6 +27,9 @@ void SlidingModeParams::validate(const std::string& prefix) const {
   if (compensate_delay && motion_state != MotionSource::kObserver)
     throw std::invalid_argument(prefix +
                                 ".compensate_delay = true: needs motion_state: observer (the model predictor)");
+  if (adaptation_rate > 0.0 && (motion_state != MotionSource::kObserver || !motion_observer_disturbance))
+    fail(prefix + ".adaptation_rate", adaptation_rate,
+         "needs motion_state: observer with motion_observer_disturbance (the residual d^)");
   model.validate(prefix + ".model");
 }
 
@@ -82,7 +85,8 @@ SlidingModeController::SlidingModeController(const SlidingModeParams& given)
       motion_observer_(p_.motion_observer_bandwidth, p_.period, p_.motion_observer_disturbance,
                        p_.model.sensor.quantization),
       // snap: the plant's switch-time tolerance (plant.cpp), 1e-9 T
-      delay_line_(p_.compensate_delay ? p_.computation_delay : 0.0, 1e-9 * p_.period) {}
+      delay_line_(p_.compensate_delay ? p_.computation_delay : 0.0, 1e-9 * p_.period),
+      adaptation_(p_.adaptation_rate, p_.period, p_.model.friction.coulomb_force) {}
 
 bool SlidingModeController::needs_truth() const {
   const bool friction = p_.compensate_friction && p_.friction_state == StateSource::kTrue &&
@@ -208,7 +212,13 @@ Command SlidingModeController::update(const trajectory::Sample& ref, const plant
         "sliding_mode: friction_state/grinding_state = true needs the plant's true z and Fg, "
         "which this plant does not provide; use the observers");
   const Estimate est = estimate_state(meas);
-  const smc::ModelForces now = model_forces(est.x, est.v, truth);
+  const bool adapt = adaptation_.enabled() && est.observed;
+  // The adapted model (sliding_mode.hpp): the bristle observer at the adapted friction level,
+  // the inertial force the model's mass misses added as e0.
+  if (adapt) friction_observer_.set_level(adaptation_.friction_level());
+  smc::ModelForces now = model_forces(est.x, est.v, truth);
+  const double inertial = p_.model.mass * ref.acceleration;
+  if (adapt) now.e0 += adaptation_.inertial_force(inertial);
   const bool delayed = p_.compensate_delay && p_.computation_delay > 0.0 && std::isfinite(meas.t);
   // The state and reference the law acts on: now, or predicted to when the command acts.
   const LawInput in =
@@ -224,6 +234,10 @@ Command SlidingModeController::update(const trajectory::Sample& ref, const plant
   cmd.u_unsaturated = smc::control_input(p_, a_cmd, in.forces, disturbance);
   cmd.u = smc::limit_output(p_, cmd.u_unsaturated);
   advance_observers(est, ref, meas.t, delayed, cmd.u, now);
+  // Learn in sliding only: within a presliding transition the residual is the bristle dynamics'
+  // mismatch, which the level does not describe (feedforward_adaptation.hpp).
+  if (adapt && friction_observer_.transient(est.v) < kAdaptationTransient)
+    adaptation_.update(-p_.model.mass * motion_observer_.disturbance(), now.friction, inertial);
   return cmd;
 }
 

@@ -1,6 +1,8 @@
 // Regression bounds of the robustness study on every move (studies/robustness_moves.yaml, issue 24
-// item 7; docs/robustness.md, "Every move, wider mismatch"): the recommended controller's worst
-// case of each move, and its control-signal figures at those corners, run from the study file
+// item 7; docs/robustness.md, "Every move, wider mismatch"): robust_smc's worst case of each move
+// and its control-signal figures at those corners, and the recommended controller's
+// (cascade_recommended, docs/controllers.md "Which controller, and where it holds") worst passing
+// cases and the cases where it does not hold, run from the study file
 // itself (the same resolved scenario as the study's case: same plant, encoder seed, delay and
 // nominal model), so a change to a controller, the plant or the study shows here first.
 //
@@ -14,6 +16,7 @@
 // measured figure with the same 10 %: it must not get worse while the docs say how far over the limit it is.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -97,7 +100,7 @@ void check(const Outcome& o, const Expect& e) {
   EXPECT_EQ(metric(o, "control_signal_within_limits"), 0.0);
 }
 
-// robust_smc (the project's recommended controller for error, docs/robustness.md; it misses the
+// robust_smc (the most accurate law, docs/robustness.md, not the recommended controller: it misses the
 // direction-change limit everywhere): its worst case of each move's 24 corners (a 100 nm encoder
 // with 40 nm noise, seed 1; 500 us of delay in every one), and a Monte Carlo draw on two moves
 // with encoder-noise seeds 3 and 2.
@@ -158,6 +161,72 @@ TEST(CascadeObserverFiltered, WithinTheSignalLimitsWhereStableAndTheCornerThatBr
   EXPECT_GT(metric(broken, "position_error_max_abs_m") * 1e6, 0.8);
   EXPECT_GT(metric(broken, "control_saturated_fraction"), 0.01);
   EXPECT_EQ(metric(broken, "control_signal_within_limits"), 0.0);
+}
+
+}  // namespace
+}  // namespace feeddrive::study
+
+namespace feeddrive::study {
+namespace {
+
+// The recommended controller (docs/controllers.md, "Which controller, and where it holds"): the
+// cascade on the observer with the Smith predictor, a 2 kHz velocity filter and the rule's
+// bandwidth x 0.6, chosen by the tuning procedure (docs/tuning.md) on a design set this study
+// does not contain. Its worst passing case of a few families (within 0.8 um and every signal
+// limit), and the cases where it does not hold, each run from studies/robustness_moves.yaml.
+// Tolerances: the measured figure + 10 % as a bound on the error (the header: room for another
+// libm or compiler moving CVODE's steps, a regression of a tenth fails); the verdicts exactly;
+// the 0.8 um goal itself where the measured figure is within 10 % of it (0.721 um: the bound is
+// then 0.793 um, so "passes" stays true); a failing case bounded from below (more than 0.8 um,
+// or saturated), so that a fix shows here and the docs change with it.
+void expect_passes(const Outcome& o, double measured_um) {
+  const double e_um = metric(o, "position_error_max_abs_m") * 1e6;
+  EXPECT_LE(e_um, std::min(1.1 * measured_um, 0.8));
+  EXPECT_GE(e_um, 0.5 * measured_um);  // half of it: no longer the family's worst passing case
+  EXPECT_EQ(metric(o, "control_signal_within_limits"), 1.0);
+}
+
+class RecommendedCascade : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { study_ = new Study(load_study(kStudy)); }
+  static void TearDownTestSuite() {
+    delete study_;
+    study_ = nullptr;
+  }
+  static Study* study_;
+};
+Study* RecommendedCascade::study_ = nullptr;
+
+// The worst passing corner of the jerk-limited move (mass -30 %, Fs/Fc +50 %, sigma +50 %,
+// 200 us: 0.561 um, 0.085 V, 1,274 /s, 15.4 N) and of the fast S-curve (mass -30 %, Fs/Fc and
+// sigma -50 %, 200 us: 0.721 um), a move the tuner never saw.
+TEST_F(RecommendedCascade, WorstPassingCorners) {
+  expect_passes(run(*study_, "cascade_recommended", "jerk_limited_corners", corner(0.7, 1.5, 1.5, 2e-4)), 0.561);
+  expect_passes(run(*study_, "cascade_recommended", "scurve_fast_corners", corner(0.7, 0.5, 0.5, 2e-4)), 0.721);
+}
+
+// Both grinding moves pass in every case; their worst draw (mass x0.77, Fs/Fc x0.58, 442 us)
+// with noise seeds 3 and 2: 0.667 and 0.648 um, step RMS 0.142 and 0.135 V (limit 0.2 V).
+TEST_F(RecommendedCascade, GrindingMonteCarloWorstDraw) {
+  expect_passes(run(*study_, "cascade_recommended", "grinding_ramp_mc", {{"plant.sensor.seed", 3}}, 2), 0.667);
+  expect_passes(run(*study_, "cascade_recommended", "grinding_infeed_mc", {{"plant.sensor.seed", 2}}, 2), 0.648);
+}
+
+// Where it does not hold. (1) The plant 30 % lighter than the model with 500 us of delay: the
+// Smith predictor runs on the model's mass and the loop limit-cycles in saturation (measured
+// 11.4 um, 19.5 % of the run saturated, 1.51 V step RMS on the jerk-limited move).
+// (2) The sine: its worst corner (mass +50 %, Fs/Fc -50 %, sigma +50 %, 500 us) 3.39 um within
+// every signal limit: the start's acceleration step and the reversals (docs/controllers.md).
+TEST_F(RecommendedCascade, WhereItDoesNotHold) {
+  const Outcome light = run(*study_, "cascade_recommended", "jerk_limited_corners", corner(0.7, 1.5, 1.5, 5e-4));
+  EXPECT_GT(metric(light, "position_error_max_abs_m") * 1e6, 0.8);
+  EXPECT_GT(metric(light, "control_saturated_fraction"), 0.01);
+  EXPECT_EQ(metric(light, "control_signal_within_limits"), 0.0);
+  const Outcome sine = run(*study_, "cascade_recommended", "sine_corners", corner(1.5, 0.5, 1.5, 5e-4));
+  const double e_um = metric(sine, "position_error_max_abs_m") * 1e6;
+  EXPECT_GT(e_um, 0.8);
+  EXPECT_LE(e_um, 1.1 * 3.394);
+  EXPECT_EQ(metric(sine, "control_signal_within_limits"), 1.0);
 }
 
 }  // namespace

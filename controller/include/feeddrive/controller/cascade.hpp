@@ -31,6 +31,10 @@
 // * Velocity filter (velocity_filter_cutoff f_v > 0 [Hz]): the velocity fed back passes a
 //   first-order low-pass 1/(1 + s/(2 pi f_v)), discretised exactly for a sample held over T:
 //   v_f,k = v_f,k-1 + (1 - exp(-2 pi f_v T))*(v_k - v_f,k-1), started at the first finite v.
+// * Adapted feedforward (adaptation_rate gamma > 0; needs w_d > 0): the friction feedforward's
+//   bristle observer runs at the adapted level theta (Fs, Fc times theta) and delta_m*m^*xd''(t_k
+//   + d) is added to the feedforward force (and so to the observer's model force); theta and
+//   delta_m are updated once per period from the residual -m^*d^ (feedforward_adaptation.hpp).
 //
 // The tuning rule (cascade_tuning()) sets kv, ki, kp from the sample period, the computation
 // delay and the sensor; see docs/controllers.md ("Cascade tuning rule").
@@ -40,6 +44,7 @@
 
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/delay_line.hpp"
+#include "feeddrive/controller/feedforward_adaptation.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
 #include "feeddrive/controller/state_observer.hpp"
 #include "feeddrive/plant/params.hpp"
@@ -71,6 +76,7 @@ struct CascadeParams {
   /// measurement (measured, the default); with compensate_delay: predicted to t_k + d.
   MotionSource motion_state{MotionSource::kMeasured};
   double velocity_filter_cutoff{0.0};  ///< f_v [Hz] of the velocity low-pass; 0 = none
+  double adaptation_rate{0.0};         ///< gamma [1/s] of the adapted feedforward; 0 = off
   double mass{102.04};                 ///< m^ [kg]
   double thrust_gain{260.0};           ///< (Ka*Kf)^ [N/V]
   plant::FrictionParams friction;      ///< the model's friction (friction feedforward)
@@ -112,6 +118,12 @@ struct CascadeParams {
                  .non_negative()
                  .plausible(0, 1e5)
                  .doc("first-order low-pass on the velocity fed back; 0: none"));
+    a->Visit(FD_FIELD(adaptation_rate)
+                 .unit("1/s")
+                 .non_negative()
+                 .plausible(0, 1000)
+                 .doc("rate of the friction and inertia feedforward adapted from the disturbance observer (needs "
+                      "disturbance_observer_bandwidth > 0); 0: off"));
     a->Visit(
         FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
     a->Visit(
@@ -155,6 +167,7 @@ class CascadeController final : public Controller {
   FrictionObserver friction_ff_;
   StateObserver observer_;
   DelayLine delay_line_;
+  FeedforwardAdaptation adaptation_;
   double velocity_filter_gain_{1.0};  // 1 - exp(-2 pi f_v T); 1 = no filter
   double v_filtered_{0.0};
   bool v_filter_started_{false};

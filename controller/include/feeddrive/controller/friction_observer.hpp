@@ -26,9 +26,18 @@ class FrictionObserver {
   void advance(double v, double velocity_error);
   /// The same over a duration dt [s] instead of one period (the delay predictor's pieces).
   void advance(double v, double velocity_error, double dt);
+  /// Sets the model's Fs and Fc to level x their given values (g(v) -> level*g(v) for sigma2 = 0;
+  /// the adapted friction level of feedforward_adaptation.hpp). 1: the given model.
+  void set_level(double level);
+  /// How far the bristles are from their steady state at v, in units of the steady deflection:
+  /// |z^ - sgn(v)*g(v)/sigma0| / (g(v)/sigma0); 0 in steady sliding, up to 2 just after a
+  /// velocity reversal (the presliding transition), 0 for a model without bristles.
+  double transient(double v) const;
 
  private:
   plant::FrictionParams p_;
+  double static_force_;  // Fs, Fc as given
+  double coulomb_force_;
   double period_;
   double gain_;
   double z_{0.0};

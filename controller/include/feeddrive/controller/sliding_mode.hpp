@@ -39,6 +39,12 @@
 // i.e. a Smith-predictor structure (Smith 1957): with an exact model the loop is the delay-free
 // loop shifted by d; model errors enter through the observer's d^ and correction.
 //
+// Adapted model (adaptation_rate gamma > 0, feedforward_adaptation.hpp): the bristle observer
+// runs with the adapted friction level theta (its Fs, Fc times theta), and the inertial force the
+// model's mass misses, delta_m*m*xd'', is added to the model forces as an additive force e0 (so
+// the law and the observer's prediction both carry it; over the predictor's interval it is held
+// at its t_k value); theta and delta_m are updated once per period from the residual -m*d^ at t_k.
+//
 // Order within one period: (optionally) correct the x,v observer with the new sample; compute
 // u from the estimates at t_k; then advance the force observers and predict x,v over [t_k, t_k+T]
 // with u held (so nothing uses information from after t_k).
@@ -50,6 +56,7 @@
 
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/delay_line.hpp"
+#include "feeddrive/controller/feedforward_adaptation.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
 #include "feeddrive/controller/state_observer.hpp"
 #include "feeddrive/plant/params.hpp"
@@ -107,6 +114,10 @@ struct SlidingModeParams {
   /// the command that actually acts (DelayLine), and the law acts on the state predicted to
   /// t_k + d through the commands already issued, with the reference previewed to t_k + d.
   bool compensate_delay{false};
+  /// gamma [1/s] of the friction and inertia feedforward adapted online from the x,v,d observer's
+  /// residual (feedforward_adaptation.hpp; needs motion_state = observer with the disturbance
+  /// state); 0: off, the model's feedforward as it is.
+  double adaptation_rate{0.0};
   double u_min{-10.0};       ///< [V]
   double u_max{10.0};        ///< [V]
   plant::PlantParams model;  ///< the controller's model of the drive
@@ -149,6 +160,12 @@ struct SlidingModeParams {
                  .doc("with motion_state observer: estimate a disturbance acceleration and add m*d^"));
     a->Visit(
         FD_FIELD(compensate_delay).doc("predict the state to t_k + computation_delay (needs motion_state observer)"));
+    a->Visit(FD_FIELD(adaptation_rate)
+                 .unit("1/s")
+                 .non_negative()
+                 .plausible(0, 1000)
+                 .doc("rate of the friction and inertia feedforward adapted from the observer's disturbance (needs "
+                      "motion_state observer with motion_observer_disturbance); 0: off"));
     a->Visit(
         FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
     a->Visit(
@@ -199,6 +216,7 @@ class SlidingModeController final : public Controller {
   GrindingObserver grinding_observer_;
   StateObserver motion_observer_;
   DelayLine delay_line_;
+  FeedforwardAdaptation adaptation_;
   std::optional<double> last_true_z_;
 };
 

@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Unit tests of scripts/tune.py's pure logic (docs/tuning.md): the objective of one case, the
+grid's order, the choice, and the budget check's one-line error (exit 2).
+Usage: python3 tests/study/tune_test.py SOURCE_DIR"""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+SRC = sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..")
+sys.path.insert(0, os.path.join(SRC, "scripts"))
+import tune  # noqa: E402
+
+OBJECTIVE = {"error_limit_um": 0.8, "signal_limits": {"control_step_rms_V": 0.2,
+                                                      "control_direction_changes_per_s": 2000.0,
+                                                      "force_hf_rms_N": 52.0, "control_saturated_fraction": 0.01}}
+
+
+def row(e_m, step=0.1, changes=1000.0, hf=10.0, sat=0.0, ok="true"):
+    return {"ok": ok, "position_error_max_abs_m": repr(e_m), "control_step_rms_V": repr(step),
+            "control_direction_changes_per_s": repr(changes), "force_hf_rms_N": repr(hf),
+            "control_saturated_fraction": repr(sat)}
+
+
+class Objective(unittest.TestCase):
+    def test_error_alone_within_the_limits(self):
+        # 0.4 um against 0.8 um, every signal figure within its limit: J_c = 0.5, no penalty.
+        j, e, p = tune.case_score(row(0.4e-6), OBJECTIVE)
+        self.assertAlmostEqual(j, 0.5, places=12)
+        self.assertAlmostEqual(e, 0.4, places=12)
+        self.assertEqual(p, 0.0)
+
+    def test_each_figure_over_its_limit_adds_its_relative_excess(self):
+        # 3,000 /s against 2,000: +0.5; 0.3 V against 0.2 V: +0.5; 2 % saturated against 1 %: +1.
+        j, _, p = tune.case_score(row(0.4e-6, step=0.3, changes=3000.0, sat=0.02), OBJECTIVE)
+        self.assertAlmostEqual(p, 2.0, places=12)
+        self.assertAlmostEqual(j, 2.5, places=12)
+
+    def test_a_null_figure_is_not_checked_and_a_failed_case_is_infinite(self):
+        r = row(0.4e-6)
+        r["force_hf_rms_N"] = "null"
+        self.assertAlmostEqual(tune.case_score(r, OBJECTIVE)[0], 0.5, places=12)
+        self.assertTrue(math.isinf(tune.case_score(row(0.4e-6, ok="false"), OBJECTIVE)[0]))
+
+    def test_pass_means_j_at_most_one_and_no_penalty(self):
+        s = tune.summarise([("f", 0.9, 0.72, 0.0), ("f", 1.2, 0.4, 0.7), ("f", 1.1, 0.88, 0.0)])
+        self.assertEqual((s["pass"], s["signal_ok"], s["cases"]), (1, 2, 3))
+        self.assertAlmostEqual(s["J"], 1.2, places=12)
+
+
+class Grid(unittest.TestCase):
+    def test_cartesian_product_last_axis_fastest(self):
+        pts = tune.grid_points({"a": [1, 2], "b": ["x", "y", "z"]})
+        self.assertEqual(len(pts), 6)
+        self.assertEqual(pts[0], {"a": 1, "b": "x"})
+        self.assertEqual(pts[1], {"a": 1, "b": "y"})
+        self.assertEqual(pts[3], {"a": 2, "b": "x"})
+
+    def test_the_budget_is_checked_with_a_one_line_error(self):
+        spec = ("name: t\nobjective: {error_limit_um: 0.8, signal_limits: {}}\nbudget: 4\n"
+                "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
+                "families:\n  - {name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2, 3]}}\n")
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "spec.yaml")
+            with open(path, "w") as f:
+                f.write(spec)
+            out = subprocess.run([sys.executable, os.path.join(SRC, "scripts", "tune.py"), path, "--out",
+                                  os.path.join(d, "out")], capture_output=True, text=True)
+        self.assertEqual(out.returncode, 2)
+        self.assertEqual(out.stderr.strip(), f"error: {path}: families.smc.grid: 3 points, the budget is 4")
+
+    def test_the_projects_specs_have_equal_budgets(self):
+        for name in ("tuning.yaml", "tuning_long.yaml"):
+            spec = tune.load_spec(os.path.join(SRC, "studies", name))
+            self.assertTrue(all(len(tune.grid_points(f["grid"])) == spec["budget"] for f in spec["families"]))
+
+
+if __name__ == "__main__":
+    unittest.main()
