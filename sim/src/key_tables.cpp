@@ -196,7 +196,7 @@ std::vector<std::string> listed_keys() {
 std::string record_column_table() {
   std::string t = "| Column | Unit | Meaning |\n|---|---|---|\n";
   Record r;
-  visit_record_columns(r, [&t](const char* name, const char* unit, const char* meaning, double&) {
+  visit_record_columns(r, [&t](const char* name, const char* unit, const char* meaning, ColumnSource, double&) {
     t += std::string("| `") + name + "` | " + unit + " | " + escape(meaning) + " |\n";
   });
   return t;

@@ -14,7 +14,8 @@ const std::vector<std::string>& record_columns() {
   static const std::vector<std::string> kColumns = [] {
     std::vector<std::string> c;
     Record r;
-    visit_record_columns(r, [&](const char* name, const char*, const char*, double&) { c.emplace_back(name); });
+    visit_record_columns(
+        r, [&](const char* name, const char*, const char*, ColumnSource, double&) { c.emplace_back(name); });
     return c;
   }();
   return kColumns;
@@ -22,7 +23,7 @@ const std::vector<std::string>& record_columns() {
 
 void record_values(const Record& r, double* out) {
   std::size_t c = 0;
-  visit_record_columns(r, [&](const char*, const char*, const char*, const double& v) { out[c++] = v; });
+  visit_record_columns(r, [&](const char*, const char*, const char*, ColumnSource, const double& v) { out[c++] = v; });
 }
 
 std::vector<double> record_values(const Record& r) {
@@ -60,43 +61,31 @@ Record make_record(double t, const trajectory::Sample& ref, const plant::State& 
 void check_finite_step(const Scenario& s, long k, const Record& r, double command) {
   // The sources are named only when a value fails: building their text (a number formatted, the
   // plant's time scales) every step cost ~5 % of a period (docs/performance.md).
-  enum class Source { kController, kReference, kSensor, kPlant };
-  const auto source = [&](Source src) -> std::string {
-    static const char* const kControllers[] = {"sliding_mode", "cascade", "open_loop", "plugin"};
+  const auto source = [&](ColumnSource src) -> std::string {
     switch (src) {
-      case Source::kController:
-        return std::string("from the controller (controller.type = ") +
-               kControllers[static_cast<int>(s.controller.type)] + "; its gains or model make it diverge)";
-      case Source::kReference: return "from the reference (the reference section)";
-      case Source::kSensor:
+      case ColumnSource::kController:
+        return std::string("from the controller (controller.type = ") + fields::enum_name(s.controller.type) +
+               "; its gains or model make it diverge)";
+      case ColumnSource::kReference: return "from the reference (the reference section)";
+      case ColumnSource::kSensor:
         return "from the sensor (plant.sensor.quantization = " + validate::format_number(s.plant.sensor.quantization) +
                ", noise_stddev = " + validate::format_number(s.plant.sensor.noise_stddev) + ")";
-      case Source::kPlant: return "from the plant, driven to it (" + s.plant.fastest_time_scales(1) + ")";
+      case ColumnSource::kPlant: return "from the plant, driven to it (" + s.plant.fastest_time_scales(1) + ")";
+      case ColumnSource::kTime: break;
     }
     return "";
   };
-  const auto fail = [&](const std::string& what, double v, Source src) {
+  const auto fail = [&](const std::string& what, double v, ColumnSource src) {
     throw ScenarioError("step " + std::to_string(k) + " (t = " + validate::format_number(r.t) + " s): " + what + " = " +
                         validate::format_number(v) + ": " + source(src));
   };
-  if (!std::isfinite(command)) fail("the command u", command, Source::kController);
-  const std::pair<const char*, double> ref[] = {{"xd", r.xd}, {"vd", r.vd}, {"ad", r.ad}, {"jd", r.jd}};
-  for (const auto& [what, v] : ref)
-    if (!std::isfinite(v)) fail(what, v, Source::kReference);
-  const std::pair<const char*, double> meas[] = {{"x_measured", r.x_measured}, {"v_measured", r.v_measured}};
-  for (const auto& [what, v] : meas)
-    if (!std::isfinite(v)) fail(what, v, Source::kSensor);
-  const std::pair<const char*, double> state[] = {{"x", r.x},
-                                                  {"v", r.v},
-                                                  {"z", r.z},
-                                                  {"fg", r.fg},
-                                                  {"i", r.i},
-                                                  {"f_thrust", r.f_thrust},
-                                                  {"f_friction", r.f_friction},
-                                                  {"f_ripple", r.f_ripple},
-                                                  {"f_grinding", r.f_grinding}};
-  for (const auto& [what, v] : state)
-    if (!std::isfinite(v)) fail(what, v, Source::kPlant);
+  if (!std::isfinite(command)) fail("the command u", command, ColumnSource::kController);
+  // The record's columns by source (visit_record_columns), the reference's first, then the
+  // sensor's, then the plant's; the controller's own columns may be NaN (sliding, z_estimate).
+  for (const ColumnSource want : {ColumnSource::kReference, ColumnSource::kSensor, ColumnSource::kPlant})
+    visit_record_columns(r, [&](const char* name, const char*, const char*, ColumnSource src, const double& v) {
+      if (src == want && !std::isfinite(v)) fail(name, v, src);
+    });
 }
 
 RunStats run(const Scenario& s, const RecordSink& sink, const interrupt::StopToken& stop) {

@@ -37,31 +37,37 @@ struct Record {
   double sliding{0.0}, z_estimate{0.0};                                   ///< controller diagnostics (NaN if none)
 };
 
+/// Where a column's value comes from: a non-finite value is named by its source
+/// (check_finite_step: "from the reference", "from the sensor (...)", "from the plant").
+enum class ColumnSource { kTime, kReference, kPlant, kSensor, kController };
+
 /// The one list of the record's columns, in timeseries.csv's order: f(name, unit, meaning,
-/// member) for each. The column names, the row's values and the column table of
-/// docs/scenario.md (feeddrive-keys, ctest docs.key_tables) all come from it.
+/// source, member) for each. The column names, the row's values, the non-finite checks of a step
+/// and the column table of docs/scenario.md (feeddrive-keys, ctest docs.key_tables) all come
+/// from it.
 template <class R, class F>
 constexpr void visit_record_columns(R& r, F&& f) {
-  f("t", "s", "k·T", r.t);
-  f("xd", "m", "reference position", r.xd);
-  f("vd", "m/s", "reference velocity", r.vd);
-  f("ad", "m/s²", "reference acceleration", r.ad);
-  f("jd", "m/s³", "reference jerk", r.jd);
-  f("x", "m", "true position", r.x);
-  f("x_measured", "m", "measured position: what the controller saw (sensor model)", r.x_measured);
-  f("v", "m/s", "true velocity", r.v);
-  f("v_measured", "m/s", "measured velocity: what the controller saw (sensor model)", r.v_measured);
-  f("z", "m", "LuGre bristle deflection", r.z);
-  f("fg", "N", "grinding-force state", r.fg);
-  f("i", "A", "armature current (electrical option; 0 otherwise)", r.i);
-  f("u", "V", "the command the drive applied (saturated, delayed)", r.u);
-  f("u_unsaturated", "V", "the controller's command before saturation", r.u_unsaturated);
-  f("f_thrust", "N", "Ka·Kf·u (or Kf·i)", r.f_thrust);
-  f("f_friction", "N", "friction force opposing the thrust", r.f_friction);
-  f("f_ripple", "N", "force ripple opposing the thrust", r.f_ripple);
-  f("f_grinding", "N", "grinding force opposing the thrust", r.f_grinding);
-  f("sliding", "m/s", "the SMC sliding variable S (NaN for other controllers)", r.sliding);
-  f("z_estimate", "m", "the z used by the SMC friction compensation (NaN if none)", r.z_estimate);
+  using S = ColumnSource;
+  f("t", "s", "k·T", S::kTime, r.t);
+  f("xd", "m", "reference position", S::kReference, r.xd);
+  f("vd", "m/s", "reference velocity", S::kReference, r.vd);
+  f("ad", "m/s²", "reference acceleration", S::kReference, r.ad);
+  f("jd", "m/s³", "reference jerk", S::kReference, r.jd);
+  f("x", "m", "true position", S::kPlant, r.x);
+  f("x_measured", "m", "measured position: what the controller saw (sensor model)", S::kSensor, r.x_measured);
+  f("v", "m/s", "true velocity", S::kPlant, r.v);
+  f("v_measured", "m/s", "measured velocity: what the controller saw (sensor model)", S::kSensor, r.v_measured);
+  f("z", "m", "LuGre bristle deflection", S::kPlant, r.z);
+  f("fg", "N", "grinding-force state", S::kPlant, r.fg);
+  f("i", "A", "armature current (electrical option; 0 otherwise)", S::kPlant, r.i);
+  f("u", "V", "the command the drive applied (saturated, delayed)", S::kController, r.u);
+  f("u_unsaturated", "V", "the controller's command before saturation", S::kController, r.u_unsaturated);
+  f("f_thrust", "N", "Ka·Kf·u (or Kf·i)", S::kPlant, r.f_thrust);
+  f("f_friction", "N", "friction force opposing the thrust", S::kPlant, r.f_friction);
+  f("f_ripple", "N", "force ripple opposing the thrust", S::kPlant, r.f_ripple);
+  f("f_grinding", "N", "grinding force opposing the thrust", S::kPlant, r.f_grinding);
+  f("sliding", "m/s", "the SMC sliding variable S (NaN for other controllers)", S::kController, r.sliding);
+  f("z_estimate", "m", "the z used by the SMC friction compensation (NaN if none)", S::kController, r.z_estimate);
 }
 
 /// Column names of timeseries.csv, in order.
@@ -70,7 +76,7 @@ const std::vector<std::string>& record_columns();
 constexpr std::size_t record_column_count() {
   Record r;
   std::size_t n = 0;
-  visit_record_columns(r, [&n](const char*, const char*, const char*, double&) { ++n; });
+  visit_record_columns(r, [&n](const char*, const char*, const char*, ColumnSource, double&) { ++n; });
   return n;
 }
 inline constexpr std::size_t kRecordColumns = record_column_count();
