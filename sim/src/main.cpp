@@ -82,8 +82,7 @@ void run_scenario(const sim::Scenario& scenario, const std::string& out_dir, boo
   // After the run (a run that then fails says only why, in one line): the values that load but
   // are implausible for a linear feed drive, and a move the run cut off (summary.json too).
   for (const std::string& w : scenario.warnings) spdlog::warn("{}", w);
-  spdlog::info("{}, wall {:.3f} s -> {}", sim::summary_headline(sim::summary_json(summary, scenario)),
-               summary.wall_time_s, out_dir);
+  spdlog::info("{}, wall {:.3f} s -> {}", sim::summary_headline(summary, scenario), summary.wall_time_s, out_dir);
 }
 
 }  // namespace

@@ -323,13 +323,15 @@ Summary summarize(const RunResult& r, const Scenario& s) {
   return b.summary(r.wall_time_s, r.integrator);
 }
 
-std::string summary_headline(const std::string& text) {
-  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return "no summary";
+namespace {
+nlohmann::ordered_json summary_object(const Summary& m, const Scenario& s);
+
+template <class Json>
+std::string headline_of(const Json& j) {
   const auto num = [&](const char* key) -> std::string {
     if (!j.contains(key) || !j[key].is_number()) return "n/a";
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", j[key].get<double>());
+    std::snprintf(buf, sizeof buf, "%.4g", j[key].template get<double>());
     return buf;
   };
   // The true-state error where the plant has one, else the measured one (a hardware plant).
@@ -343,7 +345,7 @@ std::string summary_headline(const std::string& text) {
     line += ", settles to " + num("settling_band_m") + " m in " + num("settling_time_s") + " s";
   else if (j.contains("move_start_s") && j["move_start_s"].is_number() && j.contains("settling_band_m") &&
            j["settling_band_m"].is_number() && j.contains("move_end_s") && j["move_end_s"].is_number() &&
-           j["move_end_s"].get<double>() <= j.value("sim_time_s", 0.0))  // a move that ended within the run
+           j["move_end_s"].template get<double>() <= j.value("sim_time_s", 0.0))  // a move that ended within the run
     line += ", NOT SETTLED to " + num("settling_band_m") + " m";
   if (j.contains("move_finished") && j["move_finished"] == false) line += ", MOVE CUT OFF at the end of the run";
   if (j.value("control_chattering", false))
@@ -355,9 +357,18 @@ std::string summary_headline(const std::string& text) {
             " N above 1 kHz, saturated " + num("control_saturated_fraction") + ")";
   if (j.contains("controller_model") &&
       (j["controller_model"] == "plant" || j["controller_model"] == "plant_without_effects"))
-    line += ", model = " + j["controller_model"].get<std::string>();
+    line += ", model = " + j["controller_model"].template get<std::string>();
   return line;
 }
+}  // namespace
+
+std::string summary_headline(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return "no summary";
+  return headline_of(j);
+}
+
+std::string summary_headline(const Summary& m, const Scenario& s) { return headline_of(summary_object(m, s)); }
 
 namespace {
 // long-function: a flat list, one line per field of summary.json in its documented order (docs/scenario.md).

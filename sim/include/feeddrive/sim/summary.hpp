@@ -144,6 +144,8 @@ std::string controller_model_source(const Scenario& s);
 /// ", CONTROL CHATTERS (n reversals/s)" when control_chattering, ", CONTROL SIGNAL OUTSIDE LIMITS
 /// (...)" when control_signal_within_limits is false. feeddrive-sim and -launch print it.
 std::string summary_headline(const std::string& summary_json_text);
+/// The same headline from the run's summary itself, without a JSON text (feeddrive-sim).
+std::string summary_headline(const Summary& m, const Scenario& s);
 
 /// The metrics of a stream of records.
 class SummaryBuilder {
