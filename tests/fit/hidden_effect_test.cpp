@@ -148,3 +148,35 @@ TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
 
 }  // namespace
 }  // namespace feeddrive::fit
+
+namespace feeddrive::fit {
+namespace {
+
+// Model form (docs/fit.md, "Naming the effects", step 0): the drive's Stribeck curve has the
+// exponent 1.3 where the model says 2 (the paper's static friction: 120 N static, 80 N Coulomb,
+// vs = 0.1 m/s, so the 40 N hump spans the reference's speeds). No effect is missing: the fit
+// refits the exponent as model form and names nothing; held at 2, the hump's other shape was
+// patched by a named effect (a Stribeck curve or viscous friction).
+TEST(ModelForm, StribeckExponentIsRefittedNotNamedAsAnEffect) {
+  plant::PlantParams model = test::base_model();
+  model.friction.model = plant::FrictionModel::kStatic;
+  plant::PlantParams truth = model;
+  truth.friction.stribeck_exponent = 1.3;
+  test::Recording ro;
+  ro.seed = 31;
+  const MeasuredData data = test::record(truth, ro, test::temp_dir());
+  const FitResult r = run_fit(prepare(data), model, FitOptions{});
+  std::string named;
+  for (const auto& e : r.effects) named += " " + e.name;
+  EXPECT_TRUE(r.effects.empty()) << "named:" << named << "; " << r.conclusion;
+  EXPECT_DOUBLE_EQ(r.exponent_initial, 2.0);
+  // 1.3 +- 0.15: the exponent trades off against the fitted transition (eps, b) only below
+  // |v| of a few eps (<= 2 % of the peak speed), far below vs = 0.1 m/s where the hump's shape
+  // is seen; the tolerance is half the distance to the model's 2 / 2.3 (what 2.3 -> 1.3 would
+  // leave unexplained is what a patch effect took before), so a fit that stayed near 2 fails.
+  EXPECT_NEAR(r.exponent_final, 1.3, 0.15) << r.conclusion;
+  EXPECT_NE(r.conclusion.find("Stribeck exponent"), std::string::npos) << r.conclusion;
+}
+
+}  // namespace
+}  // namespace feeddrive::fit
