@@ -528,12 +528,11 @@ bool has_coulomb_term(const plant::PlantParams& model) {
 }
 
 bool has_stribeck_hump(const plant::PlantParams& model) {
-  // presliding makes the friction LuGre, whose exponent also shapes the bristles' steady state:
-  // held there (a LuGre model is its own form)
-  if (model.effects.presliding.enabled) return false;
+  // a static friction's hump, also once presliding made it LuGre (its g(v) has the same
+  // exponent); a scenario's own LuGre friction is a dynamic model its engineer identified whole
   const plant::FrictionParams& f = model.friction;
-  return (f.model == plant::FrictionModel::kStatic && f.static_force > f.coulomb_force) ||
-         model.effects.stribeck_friction.enabled;
+  const bool static_base = f.model == plant::FrictionModel::kStatic || model.effects.presliding.enabled;
+  return (static_base && f.static_force > f.coulomb_force) || model.effects.stribeck_friction.enabled;
 }
 
 int FreeSet::parameters(const plant::PlantParams& model) const {

@@ -117,7 +117,7 @@ plant::PlantParams recalibrate(const Context& cx, const FreeSet& free, const pla
   // a friction's direction asymmetry, carried as a bounded constant force (model form)
   if (!contains(free.effects, "constant_force") && !p.effects.spring_force.enabled)
     f.offset_bound = kAsymmetryTolerance * friction_level(p);
-  if (!has_coulomb_term(p) && f.offset_bound == 0.0) return p;
+  if (!has_coulomb_term(p) && !has_stribeck_hump(p) && f.offset_bound == 0.0) return p;
   plant::PlantParams q = fit_jointly(cx.rec, p, f, nullptr, 200, cx.opt.stop).params;
   try {
     q.validate();

@@ -83,8 +83,8 @@ struct FreeSet {
 };
 bool has_coulomb_term(const plant::PlantParams& model);
 /// Whether the model has a Stribeck hump whose exponent delta (friction.stribeck_exponent) a
-/// joint fit with `form` refits as model form: a static friction with static level above
-/// Coulomb, or a stribeck_friction effect; never with presliding (LuGre).
+/// joint fit with `form` refits as model form: a static friction (also once presliding made it
+/// LuGre) with static level above Coulomb, or a stribeck_friction effect.
 bool has_stribeck_hump(const plant::PlantParams& model);
 
 struct JointFit {
