@@ -330,7 +330,7 @@ void md_effects(std::ostringstream& md, const FitResult& r) {
     md << " (95 % intervals)\n";
     if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
   }
-  if (r.smoothing_fitted) {
+  if (r.smoothing_final != r.smoothing_initial || r.shape_final != r.shape_initial) {
     std::snprintf(
         buf, sizeof buf,
         "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
@@ -338,12 +338,13 @@ void md_effects(std::ostringstream& md, const FitResult& r) {
         "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
         r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
     md << buf;
-    if (r.exponent_final != r.exponent_initial) {
-      std::snprintf(buf, sizeof buf,
-                    "The Stribeck exponent was refitted: %.3g -> %.3g (plant.friction.stribeck_exponent).\n",
-                    r.exponent_initial, r.exponent_final);
-      md << buf;
-    }
+  }
+  if (r.exponent_final != r.exponent_initial) {
+    std::snprintf(buf, sizeof buf,
+                  "\nModel form (not an effect): the Stribeck exponent delta of exp(-|v/vs|^delta) was refitted: "
+                  "%.3g -> %.3g (plant.friction.stribeck_exponent).\n",
+                  r.exponent_initial, r.exponent_final);
+    md << buf;
   }
 }
 

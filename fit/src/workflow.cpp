@@ -772,7 +772,7 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
   if (out.asymmetry_offset != 0.0)
     out.conclusion +=
         fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
-  if (out.smoothing_fitted)
+  if (out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial)
     out.conclusion +=
         fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
             out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
