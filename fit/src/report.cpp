@@ -42,6 +42,10 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
     root["plant"]["friction"]["static_smoothing_velocity"] = fitted.friction.static_smoothing_velocity;
     root["plant"]["friction"]["static_smoothing_shape"] = fitted.friction.static_smoothing_shape;
   }
+  if (has_stribeck_hump(fitted)) {
+    if (!root["plant"]["friction"]) root["plant"]["friction"] = YAML::Node(YAML::NodeType::Map);
+    root["plant"]["friction"]["stribeck_exponent"] = fitted.friction.stribeck_exponent;
+  }
   YAML::Emitter em;
   em.SetDoublePrecision(15);
   em << root;
@@ -182,6 +186,8 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
                      {"coulomb_transition_velocity_final_mps", r.smoothing_final},
                      {"coulomb_transition_shape_initial", r.shape_initial},
                      {"coulomb_transition_shape_final", r.shape_final},
+                     {"stribeck_exponent_initial", r.exponent_initial},
+                     {"stribeck_exponent_final", r.exponent_final},
                      {"fitted", r.smoothing_fitted}};
   j["record"] = envelope_json(r.envelope);
   nlohmann::json steps = nlohmann::json::array();
@@ -324,13 +330,20 @@ void md_effects(std::ostringstream& md, const FitResult& r) {
     md << " (95 % intervals)\n";
     if (r.tentative.count(e.name)) md << "  - caveat: " << r.tentative.at(e.name) << "\n";
   }
-  if (r.smoothing_fitted) {
+  if (r.smoothing_final != r.smoothing_initial || r.shape_final != r.shape_initial) {
     std::snprintf(
         buf, sizeof buf,
         "\nModel form (not an effect): the Coulomb transition of sgn_eps(v) = (1 - b) tanh(v/eps) + "
         "b v/sqrt(v^2 + eps^2) was refitted: eps %.3g -> %.3g mm/s (plant.friction.static_smoothing_velocity), "
         "b %.2g -> %.2g (plant.friction.static_smoothing_shape).\n",
         r.smoothing_initial * 1e3, r.smoothing_final * 1e3, r.shape_initial, r.shape_final);
+    md << buf;
+  }
+  if (r.exponent_final != r.exponent_initial) {
+    std::snprintf(buf, sizeof buf,
+                  "\nModel form (not an effect): the Stribeck exponent delta of exp(-|v/vs|^delta) was refitted: "
+                  "%.3g -> %.3g (plant.friction.stribeck_exponent).\n",
+                  r.exponent_initial, r.exponent_final);
     md << buf;
   }
 }

@@ -117,7 +117,7 @@ plant::PlantParams recalibrate(const Context& cx, const FreeSet& free, const pla
   // a friction's direction asymmetry, carried as a bounded constant force (model form)
   if (!contains(free.effects, "constant_force") && !p.effects.spring_force.enabled)
     f.offset_bound = kAsymmetryTolerance * friction_level(p);
-  if (!has_coulomb_term(p) && f.offset_bound == 0.0) return p;
+  if (!has_coulomb_term(p) && !has_stribeck_hump(p) && f.offset_bound == 0.0) return p;
   plant::PlantParams q = fit_jointly(cx.rec, p, f, nullptr, 200, cx.opt.stop).params;
   try {
     q.validate();
@@ -402,6 +402,21 @@ struct Choice {
   std::string why_not;
 };
 
+// A ripple passed over only because the record spans fewer than two of its periods (but at least
+// one), scoring above every eligible candidate by more than the threshold: the position-dependent
+// force is there, and a spring is then a stand-in for it (a sinusoid over 1-2 periods has a slope
+// over most of the travel). Returns the ripple, or nullptr.
+const CandidateFit* short_ripple(const Context& cx, const std::vector<CandidateFit>& ranking) {
+  const CandidateFit* best = nullptr;
+  for (const CandidateFit& c : ranking) {
+    if (!is_ripple(c.effect.name) || c.reason != Reason::kImplausible || !std::isfinite(c.score)) continue;
+    const auto it = c.effect.parameters.find("pitch_m");
+    if (it == c.effect.parameters.end() || !(it->second > cx.env.max_pitch() && it->second <= cx.env.travel)) continue;
+    if (!best || c.score > best->score) best = &c;
+  }
+  return best;
+}
+
 // Stage 2: the best candidate (in ranking order) that is significant (score >= threshold),
 // confirmed out of sample (cv_verdict) and by the replay (the gap shrinks by min_gap_reduction).
 // The others are marked with the reason; st gets the winner's out-of-sample evidence.
@@ -420,6 +435,17 @@ Choice choose(const Context& cx, const Search& s, StepResult& st) {
     if (!c.passed_over.empty()) continue;
     if (!(c.score >= cx.opt.score_threshold)) {
       c.reason = Reason::kBelowThreshold;
+      continue;
+    }
+    if (const CandidateFit* rip = short_ripple(cx, st.ranking);
+        rip && c.effect.name == "spring_force" && rip->score >= c.score + cx.opt.score_threshold) {
+      const double pitch = rip->effect.parameters.at("pitch_m");
+      pass_over(c, Reason::kImplausible,
+                "stands in for a force periodic in position: " + rip->effect.name +
+                    fmt(", pitch %.4g mm, scores %.4g against %.4g", pitch * 1e3, rip->score, c.score) +
+                    fmt(", but the record spans only %.2g of its periods; record a travel of at least 3 periods "
+                        "(%.3g mm)",
+                        cx.env.travel / pitch, 3e3 * pitch));
       continue;
     }
     if (cv_without.empty()) cv_without = cross_validate(cx.rec, s.current, s.free, cx.opt.cv_folds, cx.opt.stop);
@@ -619,7 +645,9 @@ void collect(const Context& cx, const plant::PlantParams& model, Search& s, FitR
   out.fitted = s.current;
   out.smoothing_final = s.current.friction.static_smoothing_velocity;
   out.shape_final = s.current.friction.static_smoothing_shape;
-  out.smoothing_fitted = out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial;
+  out.exponent_final = s.current.friction.stribeck_exponent;
+  out.smoothing_fitted = out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial ||
+                         out.exponent_final != out.exponent_initial;
   out.replay_final = s.rp;
   out.force_rms_final = rms(s.r, cx.n);
   out.final_localisation = localise(cx.rec, s.r, s.rp);
@@ -744,10 +772,12 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
   if (out.asymmetry_offset != 0.0)
     out.conclusion +=
         fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
-  if (out.smoothing_fitted)
+  if (out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial)
     out.conclusion +=
         fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
             out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
+  if (out.exponent_final != out.exponent_initial)
+    out.conclusion += fmt("; model form: Stribeck exponent %.3g -> %.3g", out.exponent_initial, out.exponent_final);
   cx.say(out.conclusion);
 }
 
@@ -765,6 +795,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   out.envelope = envelope(rec, model);
   out.smoothing_initial = model.friction.static_smoothing_velocity;
   out.shape_initial = model.friction.static_smoothing_shape;
+  out.exponent_initial = model.friction.stribeck_exponent;
   const Context cx{rec, opt, out.envelope, rec.active_points(), mean_position(rec), log};
   Search s = start(cx, model, out);
   int additions = 0;

@@ -71,7 +71,8 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
 /// What a joint fit refits: the named effects (enabled in the model) and, if `form` and the model
 /// has a Coulomb-type term (static friction, coulomb_friction or stribeck_friction), the
 /// smoothing velocity eps of sgn_eps(v) = tanh(v/eps) (friction.static_smoothing_velocity), a
-/// model-form parameter: real friction changes sign over a finite velocity band.
+/// model-form parameter: real friction changes sign over a finite velocity band; and, if the
+/// model has a Stribeck hump, its exponent delta in [1, 3] (has_stribeck_hump).
 struct FreeSet {
   std::vector<std::string> effects;
   bool form{false};
@@ -81,6 +82,10 @@ struct FreeSet {
   int parameters(const plant::PlantParams& model) const;  ///< k of the BIC
 };
 bool has_coulomb_term(const plant::PlantParams& model);
+/// Whether the model has a Stribeck hump whose exponent delta (friction.stribeck_exponent) a
+/// joint fit with `form` refits as model form: a static friction (also once presliding made it
+/// LuGre) with static level above Coulomb, or a stribeck_friction effect.
+bool has_stribeck_hump(const plant::PlantParams& model);
 
 struct JointFit {
   plant::PlantParams params;  ///< the refitted model

@@ -70,7 +70,8 @@ struct FitResult {
   Envelope envelope;                                    ///< what the record spans (plausibility rules)
   double smoothing_initial{0.0}, smoothing_final{0.0};  ///< eps of sgn_eps [m/s], before and after
   double shape_initial{0.0}, shape_final{0.0};          ///< b of sgn_eps [-] (0 tanh, 1 algebraic), before and after
-  bool smoothing_fitted{false};                         ///< eps or b was refitted
+  double exponent_initial{2.0}, exponent_final{2.0};    ///< Stribeck exponent delta [-], before and after
+  bool smoothing_fitted{false};                         ///< eps, b or delta was refitted
   /// The model-form offset of a friction direction asymmetry (within kAsymmetryTolerance of the
   /// friction level), carried by constant_force in `fitted` but not named as an effect [N].
   double asymmetry_offset{0.0};
