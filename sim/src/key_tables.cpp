@@ -235,8 +235,8 @@ std::string with_key_tables(const std::string& doc) {
   for (const auto& [n, t] : tables)
     if (std::find(seen.begin(), seen.end(), n) == seen.end()) missing += (missing.empty() ? "" : ", ") + n;
   if (!missing.empty())
-    throw std::invalid_argument("key table(s) " + missing + ": no marker '" + kOpen + "NAME ... -->' ... '" +
-                                kClose + "' in the file; add one where the table belongs");
+    throw std::invalid_argument("key table(s) " + missing + ": no marker '" + kOpen + "NAME ... -->' ... '" + kClose +
+                                "' in the file; add one where the table belongs");
   return out + doc.substr(pos);
 }
 
