@@ -1,5 +1,5 @@
 // The detection-rate sweep of feeddrive-fit on data it was not built against (run by
-// bench/fit_bench.sh): N seeded records of the independent generator (tests/fit/indepgen: its
+// bench/fit_bench.sh): N seeded records of the independent generator (drivegen/, fd_drivegen: its
 // own RK4 integrator, PID or cascade loop, dwells, reversals and creeping moves, friction forms
 // that differ from the model's, 50-200 nm quantization, jitter, a random nominal mass), covering
 // every effect alone, pairs of effects and effect-free records (MIX standard), or issue 20's mix

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# A robustness study of the example controller plugin (examples/plugin/smc_bl.c, built in-tree as
-# tests/plugins/libfd_example_smc_bl.so) against the same study of the built-in boundary-layer
-# sliding-mode law (issue 25, point 5; docs/performance.md): the paper's jerk-limited move at
+# A robustness study of the example controller plugin (examples/plugin/smc_bl.c, built in-tree by
+# examples/CMakeLists.txt as <build>/examples/plugin/libfd_example_smc_bl.so) against the same
+# study of the built-in boundary-layer sliding-mode law (issue 25, point 5; docs/performance.md): the paper's jerk-limited move at
 # 10 kHz (15,000 periods per case), CASES Monte Carlo plants (mass +-20 %, Fs/Fc and sigma0/sigma1
 # +-30 %, seed 1), all cores. ROUNDS rounds, each runs both studies in turn (alternating which goes
 # first); per study the wall time and the CPU time (user + system, /usr/bin/time) of the whole
@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 CASES=${2:-200}
 ROUNDS=${3:-5}
-LIB=$PWD/$BUILD/tests/plugins/libfd_example_smc_bl.so
+LIB=$PWD/$BUILD/examples/plugin/libfd_example_smc_bl.so
 for f in "$BUILD/bin/feeddrive-study" "$LIB"; do
   [ -e "$f" ] || { echo "plugin_study_bench: $f is missing (cmake --build $BUILD --target feeddrive-study fd_example_smc_bl)"; exit 2; }
 done

@@ -36,3 +36,16 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/feeddriveConfigVersion.cm
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/feeddriveConfig.cmake ${PROJECT_BINARY_DIR}/feeddriveConfigVersion.cmake
   DESTINATION ${FEEDDRIVE_CMAKE_DIR})
+
+# The tools (docs/cli.md) into <prefix>/bin, side by side (feeddrive-launch finds its siblings
+# next to itself). Static builds only: a tool links libraries the SDK does not install
+# (feeddrive::sim, feeddrive::service, ...), which a shared build would leave it without.
+# OPTIONAL: a tree built only in part (a consumer's SDK targets) installs the tools it has.
+if(NOT BUILD_SHARED_LIBS)
+  set(feeddrive_tools feeddrive-sim feeddrive-keys feeddrive-monitor feeddrive-log2csv feeddrive-plant
+      feeddrive-controller feeddrive-trajectory feeddrive-launch feeddrive-study)
+  if(FEEDDRIVE_WITH_FIT)
+    list(APPEND feeddrive_tools feeddrive-fit)
+  endif()
+  install(TARGETS ${feeddrive_tools} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} OPTIONAL)
+endif()

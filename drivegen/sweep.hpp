@@ -91,40 +91,31 @@ inline MeasuredData measured(const fdgen::Generated& g) {
   return d;
 }
 
-// `log`: the fit's log lines (run_fit), for the caller to show; none by default.
-inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const Log& log = {}) {
-  Outcome o;
-  o.spec = spec;
-  const fdgen::Generated g = fdgen::generate(spec);
-  o.description = g.description;
-  std::map<std::string, std::map<std::string, double>> truth;
+/// Parameters by effect name, then by parameter name.
+using EffectParameters = std::map<std::string, std::map<std::string, double>>;
+
+/// The hidden effects' parameters, with a constant force and a spring folded into the one spring
+/// no data can tell from them (k (x - (x_rest - F/k)), see the top of this file).
+inline EffectParameters true_parameters(const fdgen::Generated& g) {
+  EffectParameters truth;
   for (const auto& e : g.truth) truth[e.name] = e.parameters;
   if (truth.count("constant_force") && truth.count("spring_force")) {
     auto& s = truth["spring_force"];
     s["rest_position_m"] -= truth["constant_force"]["force_N"] / s["stiffness_N_per_m"];
     truth.erase("constant_force");
   }
-  for (const auto& [n, p] : truth) o.hidden.insert(n);
-  const sim::Scenario model = sim::parse_scenario(g.scenario_yaml, ".", "indepgen model");
-  opt.plausibility.grinding_process = model.grinding_process;
-  // the logger's time-stamp error is known to the engineer, as the encoder is (plant.sensor)
-  opt.stamp_error = g.knobs.at("stamp_error_s");
-  const MeasuredData data = measured(g);
-  o.category = spec.category;
-  const auto t0 = std::chrono::steady_clock::now();
-  check_record(data, model.plant, model.control_period);  // the CLI's sanity checks: no false refusal
-  const Record rec = prepare(data);
-  check_force_scale(rec, model.plant);
-  const FitResult r = run_fit(rec, model.plant, opt, log);
-  o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return truth;
+}
+
+/// What the fit said, into `o`: the named effects (their parameters into `found`), the verdict,
+/// the final gap and force residual and their floors, the tentative ones, the tie partners and
+/// whether an unexplained line says what would settle it.
+inline void take_result(const FitResult& r, Outcome& o, EffectParameters& found) {
   o.conclusion = r.conclusion;
-  std::map<std::string, std::map<std::string, double>> found;
   for (const auto& e : r.effects) {
     o.named.insert(e.name);
     found[e.name] = e.parameters;
   }
-  for (const auto& n : o.named)
-    if (!o.hidden.count(n)) o.spurious = true;
   o.verdict = verdict_name(r.verdict);
   o.gap_final = r.replay_final.gap;
   o.force_final = r.force_rms_final;
@@ -138,10 +129,11 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const 
   for (const auto& u : r.unexplained)
     o.suggestion =
         o.suggestion || u.find("to settle it") != std::string::npos || u.find("--max-effects") != std::string::npos;
-  const double range = *std::max_element(g.x.begin(), g.x.end()) - *std::min_element(g.x.begin(), g.x.end());
-  for (const char* rip : {"cogging_ripple", "reluctance_ripple"})
-    if (truth.count(rip)) o.periods = range / truth[rip]["pitch_m"];
-  // ties: a named effect with the hidden one as its reported partner stands for it
+}
+
+/// The named effects with ties resolved: a named effect with the hidden one as its reported partner
+/// stands for it (the partner gets no parameters of its own in `found`).
+inline std::set<std::string> effective_effects(const Outcome& o, EffectParameters& found) {
   std::set<std::string> effective = o.named;
   for (const auto& n : o.named)
     if (!o.hidden.count(n))
@@ -152,6 +144,29 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const 
           found[p] = {};
           break;
         }
+  return effective;
+}
+
+/// The first main parameter outside its tolerance (tolerances()), "" if none.
+inline std::string parameter_miss(const EffectParameters& truth, const EffectParameters& found) {
+  for (const auto& [n, want] : truth)
+    for (const auto& [k, tol] : tolerances().at(n)) {
+      const auto f = found.find(n);
+      if (f == found.end() || f->second.empty()) continue;  // a tie partner stands for it
+      const double w = want.at(k), got = f->second.count(k) ? f->second.at(k) : 0.0;
+      if (!(std::abs(got - w) <= tol * std::abs(w))) {
+        std::ostringstream s;
+        s << n << "." << k << " = " << got << " (true " << w << ", tolerance " << tol * 100 << " %)";
+        return s.str();
+      }
+    }
+  return "";
+}
+
+/// Judges `o` against the truth (the rules at the top of this file): spurious, right (a short
+/// ripple honestly left unexplained included), false all-clear and its two stricter readings.
+inline void judge(const FitResult& r, const EffectParameters& truth, EffectParameters found, Outcome& o) {
+  const std::set<std::string> effective = effective_effects(o, found);
   o.spurious = false;
   for (const auto& n : effective)
     if (!o.hidden.count(n)) o.spurious = true;
@@ -174,19 +189,38 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const 
   o.nothing_there = all_clear && !o.hidden.empty() && o.named.empty();
   o.above_floor_all_clear = all_clear && !within_floor(r.floor, o.gap_final, o.force_final);
   if (o.right) {
-    for (const auto& [n, want] : truth)
-      for (const auto& [k, tol] : tolerances().at(n)) {
-        if (found[n].empty()) continue;  // a tie partner stands for it: no parameters of its own
-        const double w = want.at(k), got = found[n][k];
-        if (!(std::abs(got - w) <= tol * std::abs(w)) && o.parameter_miss.empty()) {
-          std::ostringstream s;
-          s << n << "." << k << " = " << got << " (true " << w << ", tolerance " << tol * 100 << " %)";
-          o.parameter_miss = s.str();
-        }
-      }
+    o.parameter_miss = parameter_miss(truth, found);
     o.right = o.parameter_miss.empty();
   }
   if (short_ripple_ok) o.right = true;
+}
+
+// `log`: the fit's log lines (run_fit), for the caller to show; none by default.
+inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const Log& log = {}) {
+  Outcome o;
+  o.spec = spec;
+  const fdgen::Generated g = fdgen::generate(spec);
+  o.description = g.description;
+  const EffectParameters truth = true_parameters(g);
+  for (const auto& [n, p] : truth) o.hidden.insert(n);
+  const sim::Scenario model = sim::parse_scenario(g.scenario_yaml, ".", "indepgen model");
+  opt.plausibility.grinding_process = model.grinding_process;
+  // the logger's time-stamp error is known to the engineer, as the encoder is (plant.sensor)
+  opt.stamp_error = g.knobs.at("stamp_error_s");
+  const MeasuredData data = measured(g);
+  o.category = spec.category;
+  const auto t0 = std::chrono::steady_clock::now();
+  check_record(data, model.plant, model.control_period);  // the CLI's sanity checks: no false refusal
+  const Record rec = prepare(data);
+  check_force_scale(rec, model.plant);
+  const FitResult r = run_fit(rec, model.plant, opt, log);
+  o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EffectParameters found;
+  take_result(r, o, found);
+  const double range = *std::max_element(g.x.begin(), g.x.end()) - *std::min_element(g.x.begin(), g.x.end());
+  for (const char* rip : {"cogging_ripple", "reluctance_ripple"})
+    if (truth.count(rip)) o.periods = range / truth.at(rip).at("pitch_m");
+  judge(r, truth, std::move(found), o);
   return o;
 }
 

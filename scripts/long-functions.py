@@ -12,7 +12,9 @@ without a reason stated above it).
 
 The scan is a brace-counting heuristic, not a parser: comments, string and character literals and
 preprocessor lines are blanked first; a brace at namespace or class scope whose header holds a
-parameter list opens a function body. Lambdas are counted as part of the function around them.
+parameter list opens a function body. A brace inside a parameter list (a default argument `= {}`,
+`= T{...}`, a lambda) belongs to the header. Lambdas are counted as part of the function around
+them. tests/lint/long_functions_test.py checks it on tests/lint/long_functions_fixture.cpp.
 """
 import argparse
 import os
@@ -94,11 +96,16 @@ def functions(path):
                 continue
             header = text[header_start:i]
             h = header.strip()
+            if header.count("(") > header.count(")"):
+                # Inside a parameter list: a default argument `= {}`, `= T{...}` or `= [] {...}`,
+                # not a body; the header goes on after it.
+                stack.append(("nested", None))
+                continue
             if SCOPE_RE.match(re.sub(r"^template\s*<.*?>\s*", "", h, flags=re.S)):
                 stack.append("scope")
                 header_start = i + 1
-            elif "(" in h and "=" not in h.split("(")[0] and not _brace_init_in_ctor(h):
-                name = re.findall(r"([~\w:]+(?:operator\s*\S+?)?)\s*\(", h)
+            elif "(" in h and "=" not in _before_params(h) and not _brace_init_in_ctor(h):
+                name = re.findall(r"([~\w:]*operator\s*(?:\(\)|[^\s\w(]+)|[~\w:]+)\s*\(", h)
                 first = header_start + (len(header) - len(header.lstrip()))
                 stack.append(("func", (name[0] if name else "?", raw.count("\n", 0, first) + 1)))
             else:
@@ -119,6 +126,12 @@ def functions(path):
         elif c == ";" and (not stack or stack[-1] == "scope"):
             header_start = i + 1
     return found
+
+
+def _before_params(h):
+    """The header before its first '(', with an operator's name (operator==, operator=) removed: an
+    '=' there is an initialization (int x = f(...) {...}), not a function."""
+    return re.sub(r"operator\s*[^\s(]+", "operator", h.replace("operator()", "operator")).split("(")[0]
 
 
 def _brace_init_in_ctor(h):

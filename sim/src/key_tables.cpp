@@ -1,5 +1,6 @@
 #include "feeddrive/sim/key_tables.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -209,6 +210,7 @@ std::string with_key_tables(const std::string& doc) {
   tables.emplace_back("columns", record_column_table());  // not keys: not in key_tables()
   std::string out;
   std::size_t pos = 0;
+  std::vector<std::string> seen;
   for (;;) {
     const std::size_t b = doc.find(kOpen, pos);
     if (b == std::string::npos) break;
@@ -222,9 +224,19 @@ std::string with_key_tables(const std::string& doc) {
     for (const auto& [n, t] : tables)
       if (n == name) text = &t;
     if (!text) throw std::invalid_argument("key table '" + name + "': no such table (feeddrive-keys --list)");
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw std::invalid_argument("key table '" + name + "': marked twice");
+    seen.push_back(name);
     out += doc.substr(pos, line_end + 1 - pos) + *text;
     pos = e;
   }
+  // Every list has its table: a table deleted with its marker is drift too, not a smaller document.
+  std::string missing;
+  for (const auto& [n, t] : tables)
+    if (std::find(seen.begin(), seen.end(), n) == seen.end()) missing += (missing.empty() ? "" : ", ") + n;
+  if (!missing.empty())
+    throw std::invalid_argument("key table(s) " + missing + ": no marker '" + kOpen + "NAME ... -->' ... '" + kClose +
+                                "' in the file; add one where the table belongs");
   return out + doc.substr(pos);
 }
 

@@ -2,8 +2,9 @@
 // (common/fields.hpp, sim/key_tables.hpp).
 //
 //   feeddrive-keys                      prints every table
-//   feeddrive-keys --check FILE.md      exit 1 if FILE's marked tables differ from the lists
-//   feeddrive-keys --write FILE.md      rewrites FILE's marked tables
+//   feeddrive-keys --check FILE.md      exit 1 if FILE's marked tables differ from the lists,
+//                                       2 if a list's table is not marked in FILE
+//   feeddrive-keys --write FILE.md      rewrites FILE's marked tables (docs/cli.md)
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -20,7 +21,8 @@ int main(int argc, char** argv) {
   CLI::App app{"feeddrive-keys: the scenario key tables of docs/scenario.md, from the params structs"};
   std::string check, write;
   app.add_option("--check", check,
-                 "a Markdown file whose marked tables must equal the generated ones (exit 1 otherwise)");
+                 "a Markdown file whose marked tables must equal the generated ones (exit 1 otherwise; 2 if "
+                 "a table is not marked)");
   app.add_option("--write", write, "a Markdown file whose marked tables are rewritten");
   tool::Options opt;
   opt.name = "feeddrive-keys";

@@ -3,17 +3,22 @@
 section of docs/cli.md, in both directions. An option the tool prints and its section (or, for a
 run process, the shared "Options of every run process" section) lacks fails; so does an option
 the page lists that the tool no longer has. Options are read from the option lines of `--help`
-("  -o,--out TEXT ...", "  --no-plots ..."), not from descriptions.
+("  -o,--out TEXT ...", "  --no-plots ..."), not from descriptions. The tools are every
+feeddrive-* executable in BIN_DIR, so a new tool cannot be left out; each must have its section,
+and each "## feeddrive-..." section of the page its executable.
 
 Usage: cli_docs_test.py SRC_DIR BIN_DIR
 """
+import os
 import re
 import subprocess
 import sys
 from pathlib import Path
 
 RUN_PROCESSES = {"plant", "controller", "trajectory", "monitor", "launch"}
-TOOLS = ["sim", "launch", "plant", "controller", "trajectory", "monitor", "log2csv", "fit", "study"]
+# At least these (the check that the build dir is the right one: a build without them is no
+# build of feeddrive); the list checked is every feeddrive-* executable in BIN_DIR.
+KNOWN = {"sim", "launch", "plant", "controller", "trajectory", "monitor", "log2csv", "fit", "study", "keys"}
 SHARED = "Options of every run process"
 
 
@@ -48,12 +53,16 @@ def main():
     page = src / "docs" / "cli.md"
     sections = doc_sections(page)
     failures = []
-    for tool in TOOLS:
+    tools = sorted(p.name[len("feeddrive-"):] for p in bindir.glob("feeddrive-*")
+                   if p.is_file() and os.access(p, os.X_OK))
+    for t in sorted(KNOWN - set(tools)):
+        failures.append(f"{bindir}/feeddrive-{t} does not exist")
+    for heading in sorted(h for h in sections if h.startswith("feeddrive-")):
+        if heading[len("feeddrive-"):] not in tools:
+            failures.append(f"docs/cli.md '## {heading}': no such executable in {bindir}")
+    for tool in tools:
         name = f"feeddrive-{tool}"
         exe = bindir / name
-        if not exe.exists():
-            failures.append(f"{exe} does not exist")
-            continue
         have = help_options(exe)
         if name not in sections:
             failures.append(f"docs/cli.md has no section '## {name}'")

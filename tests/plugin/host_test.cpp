@@ -105,7 +105,7 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
     const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
     ASSERT_EQ(smc.switching, controller::Switching::kSaturation);
     sim::Scenario plugin = builtin;
-    sim::use_plugin(plugin, module("fd_example_smc_bl"));
+    sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
     plugin.controller.plugin.model = smc.model;
     plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
                                            {"k", validate::format_number(smc.k)},
@@ -129,7 +129,7 @@ namespace {
 std::string plugin_scenario(const std::string& controller_extra) {
   return "duration: 0.01\ncontrol_period: 1e-4\nplant: {friction: {model: lugre}}\n"
          "controller:\n  type: plugin\n  library: " +
-         module("fd_example_smc_bl") + "\n" + controller_extra + "reference: {type: step, amplitude: 1.0e-6}\n";
+         std::string(FEEDDRIVE_EXAMPLE_PLUGIN) + "\n" + controller_extra + "reference: {type: step, amplitude: 1.0e-6}\n";
 }
 
 std::string load_error(const std::string& yaml) {
@@ -183,7 +183,7 @@ TEST(PluginScenario, ResolvedKeysRoundTrip) {
   EXPECT_EQ(first.at("controller.parameters.eta").text, "5");
   EXPECT_FALSE(first.at("controller.parameters.eta").is_string);
   EXPECT_TRUE(first.at("controller.parameters.switching").is_string);
-  EXPECT_EQ(first.at("controller.library").text, module("fd_example_smc_bl"));
+  EXPECT_EQ(first.at("controller.library").text, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
   EXPECT_TRUE(first.count("controller.model.mass"));
   const std::string yaml = sim::resolved_yaml(first);
   sim::ResolvedKeys second;

@@ -4,8 +4,9 @@
 # exit non-zero, never hang, and the monitor must write what it recorded, with the step where the
 # run stopped.
 source "$(dirname "$0")/lib.sh" "$@"
-# The jerk-limited move held for 10 s (100,000 steps, ~10 s of lockstep): still running when a
-# process is killed after 1.5 s, however fast the machine.
+# The jerk-limited move held for 10 s (100,000 steps, about 3 s of lockstep unpaced): a process
+# is killed once the monitor has recorded step 20,000 (its progress line in the launcher's
+# stderr), mid-run however fast the machine.
 scen=$TMP/long.yaml
 jerk_move "$scen" 10.0
 opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
@@ -15,9 +16,9 @@ for role in controller plant trajectory; do
   timeout 60 feeddrive-launch "$scen" --out "$out" --no-plots --external "$role" "${opts[@]}" 2> "$TMP/launch-$role.err" & l=$!
   "feeddrive-$role" "$scen" "${opts[@]}" -q & p=$!   # no timeout wrapper: $p must be the process itself
   wait_on_bus $p
-  # The fault under test: the process dies 1.5 s into its run (the run takes about 3 s), a
-  # deliberate point in time, not a wait for something.
-  sleep 1.5
+  # The fault under test: the process dies at step 20,000 or a little later (the progress line
+  # comes every 0.5 s), a point of the run, not of the clock.
+  wait_step "$TMP/launch-$role.err" 20000
   kill -9 $p; echo "killed $role"
   set +e; wait $l; rc=$?; set -e
   elapsed=$(( $(date +%s) - start ))

@@ -66,20 +66,12 @@ none_alive() {
   local k
   for k in "$@"; do ! kill -0 "$k" 2> /dev/null || return 1; done
 }
-# progress FILE: the step of the monitor's last progress line in FILE ("" before the first).
-progress() { tr '\r' '\n' < "$1" | grep -o "step [0-9]*" | tail -n 1 | cut -d' ' -f2 || true; }
-# progress_at_least FILE STEP: that step is STEP or later.
-progress_at_least() {
-  local at
-  at=$(progress "$1")
-  [ "${at:-0}" -ge "$2" ]
-}
 
 # 3. SIGKILL of the launcher.
-feeddrive-launch s.yaml --out killed --no-plots -q --lcm-url "$URL" > killed.log 2>&1 & launcher=$!
+feeddrive-launch s.yaml --out killed --no-plots --lcm-url "$URL" > killed.log 2>&1 & launcher=$!
 wait_until 10 "the launcher started its four processes" four_running $launcher
 kids=$(pgrep -P $launcher | tr '\n' ' ')
-sleep 1  # the fault under test: the launcher killed 1 s into the run (deliberate, not a wait)
+wait_step killed.log 1000  # the fault under test: the launcher killed mid-run, once step 1000 is recorded
 kill -KILL $launcher
 wait $launcher 2> /dev/null || true
 wait_until 5 "the launcher's processes stopped after it was killed (still running: $kids)" none_alive $kids
@@ -94,8 +86,8 @@ wait_until 10 "the launcher started its four processes" four_running $launcher
 monitor=$(pgrep -P $launcher -f "feeddrive-monitor " || true)
 [ -n "$monitor" ] || fail "no monitor under the launcher"
 # Killed once its progress line says step 1500 (3 s of steps), whatever the machine's load.
-wait_until 30 "the monitor reached step 1500" progress_at_least mon.log 1500
-at=$(progress mon.log)
+wait_step mon.log 1500
+at=$(monitor_step mon.log)
 kill -KILL "$monitor"
 wait $launcher || rc=$?
 [ "$rc" = 1 ] || { tail -5 mon.log >&2; fail "monitor killed: launch exited $rc, expected 1"; }

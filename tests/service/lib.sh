@@ -38,6 +38,21 @@ wait_until() {
   done
   fail "$what: not within $seconds s"
 }
+# monitor_step FILE: the step of the monitor's last progress line ("[monitor] step N/M ...", every
+# 0.5 s, not with -q) in FILE, a stderr the monitor or feeddrive-launch writes; 0 before the first.
+monitor_step() {
+  local at
+  at=$(tr '\r' '\n' < "$1" 2> /dev/null | grep -o "step [0-9]*" | tail -n 1 | cut -d' ' -f2 || true)
+  echo "${at:-0}"
+}
+# monitor_step_at_least FILE STEP: the monitor's progress line in FILE says STEP or later.
+monitor_step_at_least() { [ "$(monitor_step "$1")" -ge "$2" ]; }
+# wait_step FILE STEP: waits until the monitor's progress line in FILE says step STEP or later,
+# within 30 s: the point of a fault injection is a step of the run, not a time, so it falls
+# mid-run on a machine of any speed. Fails naming FILE and STEP.
+wait_step() {
+  wait_until 30 "the monitor's progress in $1 reached step $2" monitor_step_at_least "$1" "$2"
+}
 # descendants PID: the processes below PID (its children, theirs, ...).
 descendants() {
   local c

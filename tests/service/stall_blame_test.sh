@@ -16,7 +16,7 @@ opts=(--lcm-url "$URL" --step-timeout 2 --linger 1)
 timeout 60 feeddrive-launch "$scen" --out "$TMP/stall" --no-plots --external controller "${opts[@]}" 2> "$TMP/launch.err" & l=$!
 feeddrive-controller "$scen" "${opts[@]}" 2> "$TMP/controller.err" & c=$!
 wait_on_bus $c
-sleep 1.5      # the fault under test: stopped 1.5 s into its run (a deliberate point, not a wait)
+wait_step "$TMP/launch.err" 20000  # the fault under test: stopped mid-run, at step 20,000 (of 100,000)
 kill -STOP $c; echo "controller stopped"
 # Resumed once the plant has failed (its 2 s step timeout): its error line is in the launcher's
 # stderr.
@@ -44,7 +44,7 @@ pass "stalled controller: every process names it"
 timeout 60 feeddrive-launch "$scen" --out "$TMP/kill" --no-plots --external controller "${opts[@]}" 2> "$TMP/kill.err" & l=$!
 feeddrive-controller "$scen" "${opts[@]}" 2> /dev/null & c=$!
 wait_on_bus $c
-sleep 1.5      # the fault under test: killed 1.5 s into its run (a deliberate point, not a wait)
+wait_step "$TMP/kill.err" 20000  # the fault under test: killed mid-run, at step 20,000 (of 100,000)
 kill -KILL $c
 set +e; wait $l; rl=$?; wait $c; set -e
 [ $rl -ne 0 ] || fail "launch exited 0 with its controller killed"

@@ -123,11 +123,35 @@ TEST(Fields, KeyTablesListEverySection) {
   ASSERT_FALSE(tables.empty());
   EXPECT_EQ(tables.front().first, "plant");
   EXPECT_NE(tables.front().second.find("| `mass` | kg | 102.04 | > 0 | 0.5 … 5000 |"), std::string::npos);
-  const std::string doc = "a\n<!-- keys: reference.ramp (x) -->\nold\n<!-- /keys -->\nb\n";
-  const std::string out = with_key_tables(doc);
+  // A document with every table marked, each holding stale text.
+  auto marked = [&](const std::string& skip) {
+    std::string doc = "a\n";
+    auto names = tables;
+    names.emplace_back("columns", "");
+    for (const auto& [name, text] : names)
+      if (name != skip) doc += "<!-- keys: " + name + " (x) -->\nold\n<!-- /keys -->\n";
+    return doc + "b\n";
+  };
+  const std::string out = with_key_tables(marked(""));
   EXPECT_EQ(out.find("old"), std::string::npos);
   EXPECT_NE(out.find("| `velocity` | m/s |"), std::string::npos);
   EXPECT_EQ(with_key_tables(out), out);
+}
+
+// A table deleted with its marker is drift, not a smaller document (the review of issue 22).
+TEST(Fields, KeyTablesMissingTableIsAnError) {
+  std::string doc = "a\n";
+  for (const auto& [name, text] : key_tables())
+    if (name != "reference.step") doc += "<!-- keys: " + name + " (x) -->\nold\n<!-- /keys -->\n";
+  try {
+    with_key_tables(doc);
+    FAIL() << "no error for the missing tables";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("key table(s) reference.step, columns: no marker"), std::string::npos)
+        << e.what();
+  }
+  const std::string twice = doc + "<!-- keys: reference.ramp (x) -->\n<!-- /keys -->\n";
+  EXPECT_THROW(with_key_tables(twice), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include <unistd.h>
-// The one mapping from errors to exit codes of every tool (common/tool/main.hpp): pure logic.
+// The one mapping from errors to exit codes of every tool (common/tool/include/feeddrive/tool/main.hpp):
+// pure logic.
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -84,6 +85,29 @@ TEST(ToolParse, HelpIsZeroAndAParseErrorIsTwoInOneLine) {
   testing::internal::CaptureStdout();
   EXPECT_EQ(parse(app, 2, help_argv), 0);
   testing::internal::GetCapturedStdout();
+}
+
+// An unknown option is named even when a required option is missing too (CLI11 reports the
+// required one first: `feeddrive-sim --bogus-opt` once said only "scenario is required").
+TEST(ToolParse, AnUnknownOptionIsNamedBeforeAMissingRequiredOne) {
+  CLI::App app{"t", "t"};
+  std::string scenario, out;
+  app.add_option("scenario", scenario)->required();
+  app.add_option("--out", out);
+  char name[] = "t", bad[] = "--bogus-opt", file[] = "s.yaml";
+  char* only_bad[] = {name, bad};
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(parse(app, 2, only_bad), kExitBadInput);
+  std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err, "error: --bogus-opt: no such option (see --help)\n");
+  CLI::App app2{"t", "t"};
+  app2.add_option("scenario", scenario)->required();
+  char* with_file[] = {name, file, bad};
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(parse(app2, 3, with_file), kExitBadInput);
+  err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("--bogus-opt"), std::string::npos) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << err;  // one line
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // Waypoint references: a natural cubic spline through (t_i, x_i). The points come from the
-// scenario layer (sim/scenario.cpp reads the CSV with feeddrive::csv).
+// scenario layer (sim/src/scenario.cpp, read_waypoints_file, reads the CSV with feeddrive::csv).
 //
 // Spline: e.g. Burden & Faires, "Numerical Analysis", 9th ed., Sec. 3.5 "Cubic Spline
 // Interpolation"; de Boor, "A Practical Guide to Splines", Ch. IV. Knots t_0 < ... < t_n, h_i =

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
@@ -19,8 +20,8 @@ namespace {
 // The process's one stop flag: written only by on_signal, read through stop_token().
 interrupt::StopFlag g_stop;
 extern "C" void on_signal(int sig) {
-  g_stop.signal = sig;
-  g_stop.count = g_stop.count + 1;
+  g_stop.signal.store(sig);  // lock-free (static_assert in interrupt.hpp): safe in a handler
+  g_stop.count.fetch_add(1);
 }
 }  // namespace
 
@@ -88,6 +89,15 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {  // one line, as for every bad input
+    // CLI11 checks the required options before the unknown ones: a misspelt option would only
+    // read "scenario is required". The arguments it could not place name the real mistake.
+    const std::vector<std::string> extra = app.remaining(true);
+    if (!extra.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr) {
+      const std::string& a = extra.front();
+      if (a.size() > 1 && a[0] == '-') std::fprintf(stderr, "error: %s: no such option (see --help)\n", a.c_str());
+      else std::fprintf(stderr, "error: %s: unexpected argument; %s (see --help)\n", a.c_str(), e.what());
+      return kExitBadInput;
+    }
     std::fprintf(stderr, "error: %s (see --help)\n", e.what());
     return kExitBadInput;
   }

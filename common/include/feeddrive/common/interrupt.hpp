@@ -7,6 +7,7 @@
 // (tool::install_interrupt_handlers) and hands the process's token (tool::stop_token()) to the
 // libraries; tool::report turns the Interrupted a library threw into the exit 128 + signal.
 
+#include <atomic>
 #include <csignal>
 #include <stdexcept>
 #include <string>
@@ -34,11 +35,15 @@ class Interrupted : public std::runtime_error {
 };
 
 /// The flag a StopToken reads: the signal that asked to stop (0: none) and how many came. Written
-/// only by the process's signal handler (tool::install_interrupt_handlers) or by a test.
+/// only by the process's signal handler (tool::install_interrupt_handlers) or by a test, read by
+/// any thread (feeddrive-study's workers too). Lock-free std::atomic, not volatile sig_atomic_t:
+/// a signal handler may touch a lock-free atomic ([support.signal]), and the readers on other
+/// threads need the atomic's ordering (volatile sig_atomic_t is a data race there).
 struct StopFlag {
-  volatile std::sig_atomic_t signal{0};
-  volatile std::sig_atomic_t count{0};
+  std::atomic<int> signal{0};
+  std::atomic<int> count{0};
 };
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs a lock-free std::atomic<int>");
 
 /// A read-only view of a StopFlag: what a library polls. A default-made token never stops (a
 /// library used without a tool, a unit test); tools hand in tool::stop_token().
@@ -48,7 +53,7 @@ class StopToken {
   /// A token that sees every signal that came to the flag.
   explicit StopToken(const StopFlag* flag) : flag_(flag) {}
   /// The signal that asked to stop, or 0.
-  int signal() const { return flag_ != nullptr && flag_->count != seen_ ? static_cast<int>(flag_->signal) : 0; }
+  int signal() const { return flag_ != nullptr && flag_->count.load() != seen_ ? flag_->signal.load() : 0; }
   bool stop_requested() const { return signal() != 0; }
   /// Throws Interrupted if a stop was asked for.
   void check() const {
@@ -59,13 +64,13 @@ class StopToken {
   /// recorded); a second signal then stops that too.
   StopToken renewed() const {
     StopToken t(flag_);
-    t.seen_ = flag_ != nullptr ? flag_->count : 0;
+    t.seen_ = flag_ != nullptr ? flag_->count.load() : 0;
     return t;
   }
 
  private:
   const StopFlag* flag_{nullptr};
-  std::sig_atomic_t seen_{0};
+  int seen_{0};
 };
 
 /// Set (to "1") by feeddrive-launch for the processes it starts: the launcher reports the

@@ -20,8 +20,9 @@ std::vector<std::pair<std::string, std::string>> key_tables();
 /// The column table of timeseries.csv (marker name `columns`), from visit_record_columns.
 std::string record_column_table();
 
-/// `doc` with every marked table replaced by its generated text. Throws std::invalid_argument
-/// naming a marker without its end or a table name that does not exist.
+/// `doc` with every marked table replaced by its generated text. Every table of key_tables() and
+/// `columns` must be marked exactly once. Throws std::invalid_argument naming a marker without its
+/// end, a table name that does not exist, a table marked twice, or the tables with no marker.
 std::string with_key_tables(const std::string& doc);
 
 /// The unit a params list gives `key` (a dotted scenario key; controller.model.* as plant.*),
