@@ -22,6 +22,10 @@ void CascadeParams::validate(const std::string& prefix) const {
   if (adaptation_rate > 0.0 && !(disturbance_observer_bandwidth > 0.0))
     fail(prefix + ".adaptation_rate", adaptation_rate,
          "needs disturbance_observer_bandwidth > 0 (the residual d^ of the observer)");
+  if (adaptation_rate > 0.0 && !friction_feedforward)
+    fail(prefix + ".adaptation_rate", adaptation_rate,
+         "needs friction_feedforward: true (the level scales the model friction, whose bristles gate the "
+         "learning; without it it never acts)");
   if (motion_state == MotionSource::kObserver && !(disturbance_observer_bandwidth > 0.0))
     throw std::invalid_argument(prefix +
                                 ".motion_state = observer: needs disturbance_observer_bandwidth > 0 (the observer)");
@@ -30,6 +34,7 @@ void CascadeParams::validate(const std::string& prefix) const {
   if (friction_feedforward) friction.validate(prefix + ".model.friction");
   require_range(prefix, u_min, u_max);
   require_positive(prefix + ".period", period);
+  require_adaptation_stable(prefix + ".adaptation_rate", adaptation_rate, period);
 }
 
 void apply_tuning(CascadeParams& p, bool differenced_velocity) {

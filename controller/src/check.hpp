@@ -18,4 +18,16 @@ inline void require_range(const std::string& prefix, double lo, double hi) {
   if (!(lo < hi)) fail(prefix + ".u_max", hi, "must be > u_min");
 }
 
+/// The normalised gradient step of feedforward_adaptation.hpp is theta += gamma*T*r*phi/(F0^2 +
+/// phi.phi); with r ~ (theta* - theta)*phi its error contracts by (1 - gamma*T*phi^2/(F0^2 +
+/// phi.phi)) per period, which is stable only for gamma*T < 2 (Astrom & Wittenmark, "Adaptive
+/// Control", 2nd ed., ch. 2, the normalised projection algorithm's 0 < gamma*T < 2).
+inline void require_adaptation_stable(const std::string& key, double rate, double period) {
+  if (rate * period >= 2.0)
+    fail(key, rate,
+         "rate * control period = " + validate::format_number(rate * period) +
+             " must be < 2 (the normalised gradient update diverges); max " + validate::format_number(2.0 / period) +
+             " 1/s at this period");
+}
+
 }  // namespace feeddrive::controller::detail

@@ -30,6 +30,11 @@ void SlidingModeParams::validate(const std::string& prefix) const {
   if (adaptation_rate > 0.0 && (motion_state != MotionSource::kObserver || !motion_observer_disturbance))
     fail(prefix + ".adaptation_rate", adaptation_rate,
          "needs motion_state: observer with motion_observer_disturbance (the residual d^)");
+  if (adaptation_rate > 0.0 && friction_state != StateSource::kObserver)
+    fail(prefix + ".adaptation_rate", adaptation_rate,
+         "needs friction_state: observer (the level scales the bristle observer's friction; with the true z it "
+         "never acts)");
+  require_adaptation_stable(prefix + ".adaptation_rate", adaptation_rate, period);
   model.validate(prefix + ".model");
 }
 

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
+#include "feeddrive/common/validate.hpp"
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/feedforward_adaptation.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
@@ -114,6 +116,7 @@ TEST(FeedforwardAdaptation, ParamsNeedTheDisturbanceObserver) {
         << e.what();
   }
   s.motion_state = MotionSource::kObserver;
+  s.friction_state = StateSource::kObserver;
   EXPECT_NO_THROW(s.validate("controller"));
   s.adaptation_rate = -1.0;
   EXPECT_THROW(s.validate("controller"), std::invalid_argument);
@@ -121,7 +124,66 @@ TEST(FeedforwardAdaptation, ParamsNeedTheDisturbanceObserver) {
   c.adaptation_rate = 10.0;
   EXPECT_THROW(c.validate("controller"), std::invalid_argument);  // w_d = 0: no observer
   c.disturbance_observer_bandwidth = 2000.0;
+  c.friction_feedforward = true;
   EXPECT_NO_THROW(c.validate("controller"));
+}
+
+template <class Params>
+std::string validate_error(const Params& params) {
+  try {
+    params.validate("controller");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Where the level can never act, the setting is refused: the SMC with the plant's true z
+// (friction_state: true) uses no bristle observer to scale, and the cascade without
+// friction_feedforward has no model friction to scale and no bristles to open the learning gate.
+TEST(FeedforwardAdaptation, RefusedWhereItCannotAct) {
+  SlidingModeParams s;
+  s.adaptation_rate = 50.0;
+  s.motion_state = MotionSource::kObserver;
+  s.friction_state = StateSource::kTrue;
+  EXPECT_NE(validate_error(s).find("controller.adaptation_rate = 50: needs friction_state: observer"),
+            std::string::npos)
+      << validate_error(s);
+  CascadeParams c;
+  c.adaptation_rate = 50.0;
+  c.disturbance_observer_bandwidth = 2000.0;
+  c.friction_feedforward = false;
+  EXPECT_NE(validate_error(c).find("controller.adaptation_rate = 50: needs friction_feedforward: true"),
+            std::string::npos)
+      << validate_error(c);
+}
+
+// The normalised gradient step contracts the level's error by (1 - gamma*T*phi^2/(F0^2+phi.phi))
+// per period: stable only for gamma*T < 2. At T = 100 us the bound is 20000 1/s: 19999 passes,
+// 20000 and 1e9 are one-line errors naming the key, the value and the bound.
+TEST(FeedforwardAdaptation, RateAboveTheStabilityBoundIsAnError) {
+  SlidingModeParams s;
+  s.motion_state = MotionSource::kObserver;
+  s.friction_state = StateSource::kObserver;
+  s.period = 1e-4;
+  CascadeParams c;
+  c.disturbance_observer_bandwidth = 2000.0;
+  c.friction_feedforward = true;
+  c.period = 1e-4;
+  s.adaptation_rate = c.adaptation_rate = 19999.0;
+  EXPECT_EQ(validate_error(s), "");
+  EXPECT_EQ(validate_error(c), "");
+  for (double rate : {20000.0, 1e9}) {
+    s.adaptation_rate = c.adaptation_rate = rate;
+    for (const std::string& what : {validate_error(s), validate_error(c)}) {
+      EXPECT_EQ(what.find("controller.adaptation_rate = " + validate::format_number(rate) + ": rate * control period"),
+                0u)
+          << what;
+      EXPECT_NE(what.find("must be < 2"), std::string::npos) << what;
+      EXPECT_NE(what.find("max 20000 1/s"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace

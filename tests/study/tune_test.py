@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Unit tests of scripts/tune.py's pure logic (docs/tuning.md): the objective of one case, the
-grid's order, the choice, and the budget check's one-line error (exit 2).
+grid's order, the choice, and the spec checks' one-line errors (exit 2): the budget, a grid
+written as a list, families not a list, a bad or misspelt signal limit; nan/empty figures.
 Usage: python3 tests/study/tune_test.py SOURCE_DIR"""
 import math
 import os
@@ -44,6 +45,34 @@ class Objective(unittest.TestCase):
         self.assertAlmostEqual(tune.case_score(r, OBJECTIVE)[0], 0.5, places=12)
         self.assertTrue(math.isinf(tune.case_score(row(0.4e-6, ok="false"), OBJECTIVE)[0]))
 
+    def test_a_nan_or_empty_figure_is_an_infinite_penalty(self):
+        # Unknown is never within a limit: a nan or empty figure must not score 0 (a false all-clear).
+        for bad in ("nan", "", "inf"):
+            r = row(0.4e-6)
+            r["control_step_rms_V"] = bad
+            j, _, p = tune.case_score(r, OBJECTIVE)
+            self.assertTrue(math.isinf(p) and math.isinf(j), bad)
+        r = row(0.4e-6)
+        r["position_error_max_abs_m"] = "nan"
+        self.assertTrue(math.isinf(tune.case_score(r, OBJECTIVE)[0]))
+
+    def test_a_misspelt_limit_is_an_error_not_a_zero_penalty(self):
+        objective = {"error_limit_um": 0.8, "signal_limits": {"control_step_rms": 0.2}}
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "results.csv")
+            with open(path, "w") as f:
+                f.write("controller,family,ok,position_error_max_abs_m,control_step_rms_V\n"
+                        "a,f,true,4e-7,0.1\n")
+            code = "import sys, tune; tune.read_scores(sys.argv[1], {'error_limit_um': 0.8, " \
+                   "'signal_limits': {'control_step_rms': 0.2}})"
+            out = subprocess.run([sys.executable, "-c", code, path], capture_output=True, text=True,
+                                 env={**os.environ, "PYTHONPATH": os.path.join(SRC, "scripts")})
+        self.assertEqual(out.returncode, 2)
+        self.assertEqual(out.stderr.strip(),
+                         f"error: objective.signal_limits.control_step_rms: no such column in {path}")
+        with self.assertRaises(SystemExit):
+            tune.case_score(row(0.4e-6), objective)
+
     def test_pass_means_j_at_most_one_and_no_penalty(self):
         s = tune.summarise([("f", 0.9, 0.72, 0.0), ("f", 1.2, 0.4, 0.7), ("f", 1.1, 0.88, 0.0)])
         self.assertEqual((s["pass"], s["signal_ok"], s["cases"]), (1, 2, 3))
@@ -70,6 +99,34 @@ class Grid(unittest.TestCase):
                                   os.path.join(d, "out")], capture_output=True, text=True)
         self.assertEqual(out.returncode, 2)
         self.assertEqual(out.stderr.strip(), f"error: {path}: families.smc.grid: 3 points, the budget is 4")
+
+    def run_spec(self, families, limits="{}"):
+        spec = (f"name: t\nobjective: {{error_limit_um: 0.8, signal_limits: {limits}}}\nbudget: 2\n"
+                f"design: {{base: {{}}, families: []}}\ntest: {{study: x.yaml}}\nfamilies: {families}\n")
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "spec.yaml")
+            with open(path, "w") as f:
+                f.write(spec)
+            out = subprocess.run([sys.executable, os.path.join(SRC, "scripts", "tune.py"), path, "--out",
+                                  os.path.join(d, "out")], capture_output=True, text=True)
+        return out.returncode, out.stderr.strip().replace(path, "SPEC")
+
+    def test_a_grid_written_as_a_list_is_a_one_line_error(self):
+        # Study files write grids as lists of points; tune.py's grid is a map {key: [values]}.
+        rc, err = self.run_spec("[{name: smc, scenario: s.yaml, "
+                                "grid: [{controller.lambda: 1}, {controller.lambda: 2}]}]")
+        self.assertEqual(rc, 2)
+        self.assertEqual(err, "error: SPEC: families.smc.grid = [{'controller.lambda': 1}, {'controller.lambda': 2}]: "
+                              "must be a map {key: [values]}")
+        rc, err = self.run_spec("[{name: smc, scenario: s.yaml, grid: {controller.lambda: 3}}]")
+        self.assertEqual((rc, err), (2, "error: SPEC: families.smc.grid.controller.lambda = 3: "
+                                        "must be a non-empty list of values"))
+
+    def test_families_not_a_list_and_bad_limits_are_one_line_errors(self):
+        self.assertEqual(self.run_spec("3"), (2, "error: SPEC: families = 3: must be a list of families"))
+        fam = "[{name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2]}}]"
+        self.assertEqual(self.run_spec(fam, "{control_step_rms_V: -1}"),
+                         (2, "error: SPEC: objective.signal_limits.control_step_rms_V = -1: must be a number > 0"))
 
     def test_the_projects_specs_have_equal_budgets(self):
         for name in ("tuning.yaml", "tuning_long.yaml"):
