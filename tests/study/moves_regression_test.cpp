@@ -105,7 +105,8 @@ void check(const Outcome& o, const Expect& e) {
 // with 40 nm noise, seed 1; 500 us of delay in every one), and a Monte Carlo draw on two moves
 // with encoder-noise seeds 3 and 2.
 // Measured by `feeddrive-study studies/robustness_moves.yaml` (the figures of the docs' table).
-class RobustSmcWorstCase : public ::testing::Test {
+// The robustness study, loaded once per test suite (each suite below names its fixture).
+class MovesStudy : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { study_ = new Study(load_study(kStudy)); }
   static void TearDownTestSuite() {
@@ -114,7 +115,8 @@ class RobustSmcWorstCase : public ::testing::Test {
   }
   static Study* study_;
 };
-Study* RobustSmcWorstCase::study_ = nullptr;
+Study* MovesStudy::study_ = nullptr;
+using RobustSmcWorstCase = MovesStudy;
 
 TEST_F(RobustSmcWorstCase, JerkLimited) {  // mass -30 %, Fs/Fc -50 %, sigma0/sigma1 +50 %
   check(run(*study_, "robust_smc", "jerk_limited_corners", corner(0.7, 0.5, 1.5, 5e-4)), {0.269, 0.148, 4215, 23.7});
@@ -216,16 +218,7 @@ void expect_passes(const Outcome& o, double measured_um, const Signal& signal) {
   expect_signal(o, signal);
 }
 
-class RecommendedCascade : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { study_ = new Study(load_study(kStudy)); }
-  static void TearDownTestSuite() {
-    delete study_;
-    study_ = nullptr;
-  }
-  static Study* study_;
-};
-Study* RecommendedCascade::study_ = nullptr;
+using RecommendedCascade = MovesStudy;
 
 // The worst passing corner of the jerk-limited move (mass -30 %, Fs/Fc +50 %, sigma +50 %,
 // 200 us: 0.561 um, 0.085 V, 1,274 /s, 15.4 N) and of the fast S-curve (mass -30 %, Fs/Fc and
