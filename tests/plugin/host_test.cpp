@@ -129,7 +129,8 @@ namespace {
 std::string plugin_scenario(const std::string& controller_extra) {
   return "duration: 0.01\ncontrol_period: 1e-4\nplant: {friction: {model: lugre}}\n"
          "controller:\n  type: plugin\n  library: " +
-         std::string(FEEDDRIVE_EXAMPLE_PLUGIN) + "\n" + controller_extra + "reference: {type: step, amplitude: 1.0e-6}\n";
+         std::string(FEEDDRIVE_EXAMPLE_PLUGIN) + "\n" + controller_extra +
+         "reference: {type: step, amplitude: 1.0e-6}\n";
 }
 
 std::string load_error(const std::string& yaml) {
