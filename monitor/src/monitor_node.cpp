@@ -513,7 +513,7 @@ bool MonitorNode::run() {
 // controller (80) and the plant (81), lets only the chain preempt it. Its memory grows with the
 // record, so it is not locked; the output is written at normal priority again.
 void MonitorNode::record_in_real_time_if_asked() {
-  if (!options().realtime || !options().realtime_scheduling || mopt_.attach) return record_until_end();
+  if (!options().realtime || mopt_.attach) return record_until_end();
   enter_realtime_if_asked(78, false);
   struct Normal {
     ~Normal() { service::leave_realtime(); }

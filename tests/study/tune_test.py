@@ -88,20 +88,12 @@ class Grid(unittest.TestCase):
         self.assertEqual(pts[3], {"a": 2, "b": "x"})
 
     def test_the_budget_is_checked_with_a_one_line_error(self):
-        spec = ("name: t\nobjective: {error_limit_um: 0.8, signal_limits: {}}\nbudget: 4\n"
-                "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
-                "families:\n  - {name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2, 3]}}\n")
-        with tempfile.TemporaryDirectory() as d:
-            path = os.path.join(d, "spec.yaml")
-            with open(path, "w") as f:
-                f.write(spec)
-            out = subprocess.run([sys.executable, os.path.join(SRC, "scripts", "tune.py"), path, "--out",
-                                  os.path.join(d, "out")], capture_output=True, text=True)
-        self.assertEqual(out.returncode, 2)
-        self.assertEqual(out.stderr.strip(), f"error: {path}: families.smc.grid: 3 points, the budget is 4")
+        code, err = self.run_spec("\n  - {name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2, 3]}}", budget=4)
+        self.assertEqual(code, 2)
+        self.assertEqual(err, "error: SPEC: families.smc.grid: 3 points, the budget is 4")
 
-    def run_spec(self, families, limits="{}"):
-        spec = (f"name: t\nobjective: {{error_limit_um: 0.8, signal_limits: {limits}}}\nbudget: 2\n"
+    def run_spec(self, families, limits="{}", budget=2):
+        spec = (f"name: t\nobjective: {{error_limit_um: 0.8, signal_limits: {limits}}}\nbudget: {budget}\n"
                 f"design: {{base: {{}}, families: []}}\ntest: {{study: x.yaml}}\nfamilies: {families}\n")
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, "spec.yaml")
