@@ -8,7 +8,20 @@
  *   lcm-pingpong-raw server URL PREFIX
  *   lcm-pingpong-raw client URL PREFIX COUNT     -> prints "pingpong_rate <round trips per s>"
  * A ping with step -2 ends the server. Loss is recovered as in lcm-pingpong: the client sends the
- * ping again after 2 ms without an answer. */
+ * ping again after 2 ms without an answer.
+ *   lcm-pingpong-raw client URL PREFIX COUNT PERIOD_US [GUARD_US [WORK_US]]   -> paced: the
+ * real-time floor of liblcm with the plant's rule. It sends ping k at t0 + k*PERIOD_US
+ * (clock_nanosleep on an absolute CLOCK_MONOTONIC time, as the plant's period timer does), counts
+ * a deadline miss when pong k has not arrived by t0 + (k+1)*PERIOD_US - GUARD_US (the plant's
+ * guard, service/src/plant_node.cpp: min(T/5, 25 us)), then busy-works WORK_US (the plant's
+ * integration of the period, about 16 us for the paper's plant) before it sleeps to the next
+ * period. A missed pong is not waited for (it is late, as a late command is). Prints "paced_misses M of COUNT" and the
+ * round-trip p50/p99 in us. The bench runs it on the chain's CPUs at the chain's priority.
+ *   lcm-pingpong-raw listen URL PREFIX   -> a passive participant: subscribes to every channel
+ * and only reads, as the run's monitor and trajectory do with the plant's states and the
+ * controller's commands; ends on the stop ping. The bench adds two to show what a participant
+ * that only listens costs the round trip (the kernel copies each datagram to every socket). */
+#define _GNU_SOURCE /* ppoll */
 #include <lcm/lcm.h>
 #include <poll.h>
 #include <stdint.h>
@@ -45,6 +58,14 @@ static void on_ping(const lcm_recv_buf_t* rbuf, const char* channel, void* user)
   lcm_publish(lc, pong_channel, pong, sizeof pong);
 }
 
+static void on_any(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+  (void)user;
+  int64_t k;
+  if (rbuf->data_size < sizeof k || strstr(channel, "_PING") == NULL) return;
+  memcpy(&k, rbuf->data, sizeof k);
+  if (k == -2) stop = 1;
+}
+
 static void on_pong(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
   (void)channel;
   (void)user;
@@ -57,13 +78,51 @@ static void on_pong(const lcm_recv_buf_t* rbuf, const char* channel, void* user)
 /* Waits up to timeout_us for a message and handles one; 1 if one was handled. */
 static int handle_within(int64_t timeout_us) {
   struct pollfd p = {lcm_get_fileno(lc), POLLIN, 0};
-  if (poll(&p, 1, (int)((timeout_us + 999) / 1000)) <= 0) return 0;
+  const struct timespec ts = {(time_t)(timeout_us / 1000000), (long)(timeout_us % 1000000) * 1000};
+  if (ppoll(&p, 1, &ts, NULL) <= 0) return 0;
   return lcm_handle(lc) == 0;
+}
+
+static int cmp_i64(const void* a, const void* b) {
+  const int64_t x = *(const int64_t*)a, y = *(const int64_t*)b;
+  return (x > y) - (x < y);
+}
+
+/* Paced client: ping k at t0 + k*period; a miss when pong k is not in by t0 + (k+1)*period. */
+static int run_paced(const char* ping_channel, long count, long period_us, long guard_us, long work_us) {
+  uint8_t ping[kPingBytes] = {0};
+  int64_t* rtt = calloc((size_t)count, sizeof *rtt);
+  if (!rtt) return 1;
+  long misses = 0, n_rtt = 0;
+  struct timespec next;
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  for (int64_t k = 0; k < count; ++k) {
+    next.tv_nsec += period_us * 1000;
+    while (next.tv_nsec >= 1000000000) {
+      next.tv_nsec -= 1000000000;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL);
+    const int64_t start = mono_us();
+    memcpy(ping, &k, sizeof k);
+    lcm_publish(lc, ping_channel, ping, sizeof ping);
+    const int64_t budget = period_us - guard_us;
+    while (answered < k && mono_us() - start < budget) handle_within(budget - (mono_us() - start));
+    const int64_t took = mono_us() - start;
+    if (answered >= k) rtt[n_rtt++] = took;
+    if (answered < k || took > budget) ++misses;
+    for (const int64_t w = mono_us(); mono_us() - w < work_us;) {}
+  }
+  qsort(rtt, (size_t)n_rtt, sizeof *rtt, cmp_i64);
+  printf("paced_misses %ld of %ld; rtt_p50_us %lld; rtt_p99_us %lld\n", misses, count,
+         n_rtt ? (long long)rtt[n_rtt / 2] : -1LL, n_rtt ? (long long)rtt[(n_rtt * 99) / 100] : -1LL);
+  free(rtt);
+  return 0;
 }
 
 int main(int argc, char** argv) {
   if (argc < 4 || (strcmp(argv[1], "client") == 0 && argc < 5)) {
-    fprintf(stderr, "usage: lcm-pingpong-raw server|client URL PREFIX [COUNT]\n");
+    fprintf(stderr, "usage: lcm-pingpong-raw server|listen|client URL PREFIX [COUNT [PERIOD_US]]\n");
     return 2;
   }
   lc = lcm_create(argv[2]);
@@ -76,6 +135,14 @@ int main(int argc, char** argv) {
   snprintf(pong_channel, sizeof pong_channel, "%s_PONG", argv[3]);
   if (strcmp(argv[1], "server") == 0) {
     lcm_subscribe(lc, ping_channel, on_ping, NULL);
+    int64_t last = mono_us();
+    while (!stop && mono_us() - last < 30000000)
+      if (handle_within(100000)) last = mono_us();
+    lcm_destroy(lc);
+    return 0;
+  }
+  if (strcmp(argv[1], "listen") == 0) {
+    lcm_subscribe(lc, ".*", on_any, NULL);
     int64_t last = mono_us();
     while (!stop && mono_us() - last < 30000000)
       if (handle_within(100000)) last = mono_us();
@@ -95,6 +162,22 @@ int main(int argc, char** argv) {
     memcpy(ping, &k, sizeof k);
     lcm_publish(lc, ping_channel, ping, sizeof ping);
     handle_within(10000);
+  }
+  if (argc > 5) {
+    const long period_us = strtol(argv[5], NULL, 10);
+    const long guard_us = argc > 6 ? strtol(argv[6], NULL, 10) : 0;
+    const long work_us = argc > 7 ? strtol(argv[7], NULL, 10) : 0;
+    if (count <= 0 || period_us <= 0 || guard_us < 0 || work_us < 0 || guard_us + work_us >= period_us) {
+      fprintf(stderr, "error: need COUNT > 0, PERIOD_US > GUARD_US + WORK_US >= 0; got %s %s %ld %ld\n", argv[4],
+              argv[5], guard_us, work_us);
+      return 2;
+    }
+    const int rc = run_paced(ping_channel, count, period_us, guard_us, work_us);
+    k = -2;
+    memcpy(ping, &k, sizeof k);
+    for (int i = 0; i < 3; ++i) lcm_publish(lc, ping_channel, ping, sizeof ping);
+    lcm_destroy(lc);
+    return rc;
   }
   const int64_t t0 = mono_us();
   for (k = 0; k < count; ++k) {

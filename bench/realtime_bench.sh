@@ -21,6 +21,14 @@
 # a CPU stay), and puts them back at the end: what an isolated core gives the same chain
 # (docs/lcm-contract.md, "An isolated core"). OFF_PATH_CPUS=LIST passes --off-path-cpus LIST: the
 # monitor and the trajectory there, the plant and controller on CPUS.
+# The library's own floor in the same invocation: right after cyclictest, bench/lcm_pingpong_raw.c
+# (liblcm only: lcm_publish, lcm_handle) runs the same exchange with the plant's rule: ping k at
+# k*T on an absolute timer, pong k due T - guard later (guard = min(T/5, 25 us), as
+# service/src/plant_node.cpp), then WORK_US (default 16 us, the paper plant's integration per step)
+# of work; client at SCHED_FIFO 81 and server at 80 on CPUS, plus two listeners (the monitor's and
+# the trajectory's sockets: each datagram is copied to four sockets) at 79 and 78 on CPUS, or on
+# OFF_PATH_CPUS when given. It prints the raw misses, raw / machine and feeddrive / raw: whether a
+# miss comes from the chain or from liblcm and the kernel on this machine.
 # The plant and the controller hold the CPU wake-up latency at 0 (/dev/cpu_dma_latency, as
 # cyclictest does). LATENCY_HOLD=alternate runs the odd rounds with it and the even ones without
 # (FEEDDRIVE_CPU_LATENCY_HOLD=0) and prints the medians of each: what the hold changes, same run.
@@ -78,10 +86,25 @@ print(','.join(map(str, rest)))" "$ALL" "$CPUS")
   echo $$ > "$CPUSET/tasks"  # this bench (and what it starts) stays where it can reach CPUS
   echo "ISOLATE: $moved tasks moved to CPUs $REST for the bench; CPUs $CPUS keep the run, cyclictest and per-CPU kernel threads"
 fi
-misses=(); overruns=(); lates=(); ratios=(); held_misses=(); held_ratios=(); free_misses=(); free_ratios=()
+WORK_US=${WORK_US:-16}
+# Misses of the raw liblcm exchange with the plant's rule (see above), one round.
+raw_floor() {
+  local tag=$1 lst=${OFF_PATH_CPUS:-$CPUS} pids=() out
+  taskset -c "$lst" chrt -f 79 "$BUILD/bin/lcm-pingpong-raw" listen "$URL" "$tag" & pids+=($!)
+  taskset -c "$lst" chrt -f 78 "$BUILD/bin/lcm-pingpong-raw" listen "$URL" "$tag" & pids+=($!)
+  taskset -c "$CPUS" chrt -f 80 "$BUILD/bin/lcm-pingpong-raw" server "$URL" "$tag" & pids+=($!)
+  sleep 0.2  # the server's first pong is awaited by the client's warm-up; this only spares it resends
+  out=$(taskset -c "$CPUS" chrt -f 81 "$BUILD/bin/lcm-pingpong-raw" client "$URL" "$tag" 15000 100 20 "$WORK_US")
+  wait "${pids[@]}" || true
+  echo "$out" | awk '/paced_misses/ { print $2 }'
+}
+misses=(); overruns=(); lates=(); ratios=(); raws=(); raw_ratios=(); chain_ratios=(); held_misses=(); held_ratios=(); free_misses=(); free_ratios=()
 for r in $(seq "$ROUNDS"); do
   late=$(machine_late)
   lates+=("$late")
+  raw=$(raw_floor "RAW$r")
+  raws+=("$raw")
+  raw_ratios+=("$(awk -v m="$raw" -v l="$late" 'BEGIN { printf "%.2f", m / (l > 0 ? l : 1) }')")
   hold=held
   if [ "${LATENCY_HOLD:-}" = alternate ] && [ $((r % 2)) = 0 ]; then hold="not held"; export FEEDDRIVE_CPU_LATENCY_HOLD=0
   else unset FEEDDRIVE_CPU_LATENCY_HOLD; fi
@@ -102,13 +125,15 @@ for r in $(seq "$ROUNDS"); do
   misses+=("$(jq -r .lockstep.deadline_misses "$j")")
   overruns+=("$(jq -r .lockstep.plant_overruns "$j")")
   ratios+=("$(awk -v m="${misses[-1]}" -v l="$late" 'BEGIN { printf "%.2f", m / (l > 0 ? l : 1) }')")
+  chain_ratios+=("$(awk -v m="${misses[-1]}" -v l="$raw" 'BEGIN { printf "%.2f", m / (l > 0 ? l : 1) }')")
   if [ "$hold" = held ]; then held_misses+=("${misses[-1]}"); held_ratios+=("${ratios[-1]}")
   else free_misses+=("${misses[-1]}"); free_ratios+=("${ratios[-1]}"); fi
-  echo "round $r (CPU wake-up latency $hold): machine (cyclictest, CPUs $CPUS): $late of 15000 wake-ups later than 50 us; feeddrive misses / machine = ${ratios[-1]}"
+  echo "round $r (CPU wake-up latency $hold): machine (cyclictest, CPUs $CPUS): $late of 15000 wake-ups later than 50 us; feeddrive misses / machine = ${ratios[-1]}; raw liblcm (same rule) $raw misses, raw / machine = ${raw_ratios[-1]}, feeddrive / raw = ${chain_ratios[-1]}"
   echo "round $r: $(jq -r "$hist_p99"' .lockstep as $l | "\($l.deadline_misses) of \($l.steps_expected) deadlines missed, \($l.plant_overruns) plant overruns; state->command p50 \($l.latency_us.state_to_command.p50) us, p99 \($l.latency_us.state_to_command.p99) us; period-start lateness p99 <= \(p99($l.latency_histogram_us.period_start_lateness; $l.latency_histogram_us.bin_us)) us"' "$j"); max |e| $(jq -r "(.position_error_max_abs_m // .measured_position_error_max_abs_m)" "$j") m (measured where no true state); $sched"
 done
 echo "median deadline misses: $(median "${misses[@]}") of 15000 (target < 15, 0.1 %); median plant overruns (periods the plant itself started more than its guard late): $(median "${overruns[@]}")"
 echo "machine (cyclictest on CPUs $CPUS): median $(median "${lates[@]}") of 15000 wake-ups later than 50 us; RATIO feeddrive misses / machine's late wake-ups: median $(median "${ratios[@]}") (per round: ${ratios[*]}; goal <= 2)"
+echo "raw liblcm, the plant's rule, same CPUs (the library's floor): median $(median "${raws[@]}") of 15000 missed; RATIO raw / machine: median $(median "${raw_ratios[@]}") (per round: ${raw_ratios[*]}); RATIO feeddrive / raw: median $(median "${chain_ratios[@]}") (per round: ${chain_ratios[*]})"
 if [ "${#free_misses[@]}" -gt 0 ] && [ "${#held_misses[@]}" -gt 0 ]; then
   echo "CPU wake-up latency held at 0: median misses $(median "${held_misses[@]}") (${held_misses[*]}), ratio $(median "${held_ratios[@]}"); not held: median misses $(median "${free_misses[@]}") (${free_misses[*]}), ratio $(median "${free_ratios[@]}")"
 fi
