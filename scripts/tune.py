@@ -15,11 +15,12 @@ procedure, the same for every family:
      after the analysis window, position_error_max_abs_settled_m); a candidate's J is the largest
      J_c of its cases (a failed case, or an error without a value: infinity); J <= 1 exactly when
      every design case passes. Each family keeps its candidate of lowest J (ties: lower mean J_c):
-     DIR/chosen.yaml, DIR/design.md;
+     DIR/chosen.yaml, DIR/design.md, DIR/design_cases.csv (every case, for the record);
   3. the test study (the SPEC's test.study with its controllers replaced by the chosen ones,
-     DIR/test.yaml) is run once (DIR/test/results.csv); DIR/test.md tables, per test family and
-     family, the worst error (objective.error_metric), the worst max |e| over the whole run, the
-     cases within the signal limits and the passing ones, and the worst of each signal figure.
+     DIR/test.yaml) is run once (DIR/test/results.csv, DIR/test_cases.csv); DIR/test.md tables,
+     per test family and family, the worst error (objective.error_metric), the worst max |e|
+     over the whole run, the cases within the signal limits and the passing ones, and the worst
+     of each signal figure.
 Every grid must have exactly `budget` points (else exit 2): the same effort for every family.
 Bad input: one line on stderr naming the key, exit 2 (a grid that is not a map {key: [values]},
 families that are not a list, a limit that is not a number > 0 or names no results column, an
@@ -245,11 +246,28 @@ def design_report(spec, table):
     return "\n".join(lines)
 
 
+def write_case_table(results, path, objective):
+    """The record of a stage to commit (DIR/design_cases.csv, DIR/test_cases.csv): every case's
+    varied keys, the objective's error, the whole run's max |e| and the signal figures, copied
+    from feeddrive-study's results.csv (the full table stays there)."""
+    fixed = ["ok", error_metric(objective), FULL_RUN_ERROR, *objective["signal_limits"], "control_signal_within_limits"]
+    with open(results, newline="") as f:
+        reader = csv.DictReader(f)
+        varied = [k for k in reader.fieldnames if k.startswith(("plant.", "controller.", "reference."))]
+        columns = ["case", "controller", "family", "draw", *varied, *dict.fromkeys(fixed)]
+        with open(path, "w", newline="") as out:
+            writer = csv.DictWriter(out, fieldnames=columns, extrasaction="ignore", lineterminator="\n")
+            writer.writeheader()
+            writer.writerows(reader)
+
+
 def stage_design(spec, spec_path, args):
     study = os.path.join(args.out, "design.yaml")
     write_yaml(study, design_study(spec, spec_path))
     run_study(args.bin, study, os.path.join(args.out, "design"), args.jobs)
-    table = choose(spec, read_scores(os.path.join(args.out, "design", "results.csv"), spec["objective"]))
+    results = os.path.join(args.out, "design", "results.csv")
+    table = choose(spec, read_scores(results, spec["objective"]))
+    write_case_table(results, os.path.join(args.out, "design_cases.csv"), spec["objective"])
     with open(os.path.join(args.out, "design.md"), "w") as f:
         f.write(design_report(spec, table))
     chosen = {name: {"point": rows[best][0], "design": rows[best][1]} for name, (rows, best) in table.items()}
@@ -303,7 +321,9 @@ def stage_test(spec, spec_path, args, chosen):
     path = os.path.join(args.out, "test.yaml")
     write_yaml(path, study)
     run_study(args.bin, path, os.path.join(args.out, "test"), args.jobs)
-    scores = read_scores(os.path.join(args.out, "test", "results.csv"), spec["objective"])
+    results = os.path.join(args.out, "test", "results.csv")
+    scores = read_scores(results, spec["objective"])
+    write_case_table(results, os.path.join(args.out, "test_cases.csv"), spec["objective"])
     with open(os.path.join(args.out, "test.md"), "w") as f:
         f.write(test_report(spec, scores, [fam["name"] for fam in study["families"]]))
 
