@@ -9,18 +9,23 @@ scenario file, optional fixed keys `set`, and `grid`: {key: [values]}). The
 procedure, the same for every family:
   1. every grid point of every family is a controller of ONE design study (DIR/design.yaml), run
      by feeddrive-study on every design case (DIR/design/results.csv);
-  2. each case c gets J_c = max|e|_c/e_lim + sum_k max(0, s_k,c/L_k - 1) (the error against its
-     limit plus the hinge penalty of each control-signal figure over its limit); a candidate's J
-     is the largest J_c of its cases (a failed case: infinity); J <= 1 exactly when every design
-     case passes. Each family keeps its candidate of lowest J (ties: lower mean J_c):
-     DIR/chosen.yaml, DIR/design.md;
+  2. each case c gets J_c = e_c/e_lim + sum_k max(0, s_k,c/L_k - 1) (the error against its limit
+     plus the hinge penalty of each control-signal figure over its limit), e_c the results column
+     objective.error_metric (default position_error_max_abs_m; studies/tuning.yaml: the max |e|
+     after the analysis window, position_error_max_abs_settled_m); a candidate's J is the largest
+     J_c of its cases (a failed case, or an error without a value: infinity); J <= 1 exactly when
+     every design case passes. Each family keeps its candidate of lowest J (ties: lower mean J_c):
+     DIR/chosen.yaml, DIR/design.md, DIR/design_cases.csv (every case, for the record);
   3. the test study (the SPEC's test.study with its controllers replaced by the chosen ones,
-     DIR/test.yaml) is run once (DIR/test/results.csv); DIR/test.md tables the worst max|e|, the
-     worst J_c and the passing cases per test family and family.
+     DIR/test.yaml) is run once (DIR/test/results.csv, DIR/test_cases.csv); DIR/test.md tables,
+     per test family and family, the worst error (objective.error_metric), the worst max |e|
+     over the whole run, the cases within the signal limits and the passing ones, and the worst
+     of each signal figure.
 Every grid must have exactly `budget` points (else exit 2): the same effort for every family.
 Bad input: one line on stderr naming the key, exit 2 (a grid that is not a map {key: [values]},
-families that are not a list, a limit that is not a number > 0 or names no results column). A
-signal figure that is empty or nan scores an infinite penalty, never 0. A failed feeddrive-study: its exit status.
+families that are not a list, a limit that is not a number > 0 or names no results column, an
+error_metric that is not a results column). A signal figure that is empty or nan scores an
+infinite penalty, never 0. A failed feeddrive-study: its exit status.
 """
 import argparse
 import csv
@@ -67,11 +72,21 @@ def positive_number(x):
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x > 0
 
 
+FULL_RUN_ERROR = "position_error_max_abs_m"
+
+
+def error_metric(objective):
+    """The results column J's error term reads (objective.error_metric; default the whole run's max |e|)."""
+    return objective.get("error_metric", FULL_RUN_ERROR)
+
+
 def check_objective(path, objective):
-    """error_limit_um > 0 and signal_limits {column: limit > 0}; the columns are checked against
-    the results (read_scores)."""
+    """error_limit_um > 0, error_metric a column name, and signal_limits {column: limit > 0}; the
+    columns are checked against the results (read_scores)."""
     if not isinstance(objective, dict):
         fail(f"{path}: objective = {objective!r}: must be a map")
+    if not isinstance(error_metric(objective), str) or not error_metric(objective):
+        fail(f"{path}: objective.error_metric = {objective.get('error_metric')!r}: must be a results column name")
     if not positive_number(objective.get("error_limit_um")):
         fail(f"{path}: objective.error_limit_um = {objective.get('error_limit_um')!r}: must be a number > 0")
     limits = objective.get("signal_limits")
@@ -121,7 +136,7 @@ def design_study(spec, spec_path):
     d = spec["design"]
     return {"name": spec["name"] + "_design", "base": d["base"], "model": d.get("model", "nominal"),
             "controllers": controllers, "families": d["families"],
-            "report": {"metric": "position_error_max_abs_m", "scale": 1.0e6, "unit": "um",
+            "report": {"metric": error_metric(spec["objective"]), "scale": 1.0e6, "unit": "um",
                        "limit": spec["objective"]["error_limit_um"], "require": ["control_signal_within_limits"]}}
 
 
@@ -133,50 +148,66 @@ def run_study(binary, study_path, out, jobs):
         sys.exit(rc)
 
 
+def figure(row, key):
+    """A results cell as a float: nan when empty or not a number (never 0)."""
+    try:
+        return float(row[key])
+    except (KeyError, ValueError):
+        return math.nan
+
+
 def case_score(row, objective):
-    """(J_c, max|e| [um], signal penalty) of one results.csv row; J_c = inf for a failed case. A
-    figure that is empty or not finite (nan, inf) counts as an infinite penalty: unknown is never
-    within the limit. `null` is the summary's "not measurable at this period" (force_hf_rms_N when
-    f_c >= 1/(2T), docs/scenario.md) and is not checked. A limit on a column the row lacks: exit 2."""
-    if row["ok"] != "true" or not row["position_error_max_abs_m"]:
-        return math.inf, math.inf, math.inf
-    e_um = float(row["position_error_max_abs_m"]) * 1e6
-    if not math.isfinite(e_um):
+    """(J_c, e [um], signal penalty) of one results.csv row, e the objective's error column; J_c =
+    inf for a failed case or an error without a finite value (an empty analysis window has none:
+    unknown never passes). A figure that is empty or not finite (nan, inf) counts as an infinite
+    penalty: unknown is never within the limit. `null` is the summary's "not measurable at this
+    period" (force_hf_rms_N when f_c >= 1/(2T), docs/scenario.md) and is not checked. A limit on a
+    column the row lacks: exit 2."""
+    e_um = figure(row, error_metric(objective)) * 1e6
+    if row["ok"] != "true" or not math.isfinite(e_um):
         return math.inf, math.inf, math.inf
     penalty = 0.0
     for key, limit in objective["signal_limits"].items():
         if key not in row:
             fail(f"objective.signal_limits.{key}: no such column in the results")
-        value = row[key]
-        if value == "null":
+        if row[key] == "null":
             continue
-        try:
-            x = float(value)
-        except ValueError:
-            x = math.nan
+        x = figure(row, key)
         penalty += max(0.0, x / limit - 1.0) if math.isfinite(x) else math.inf
     return e_um / objective["error_limit_um"] + penalty, e_um, penalty
 
 
 def read_scores(results, objective):
-    """{controller: [(family, J_c, e_um, penalty), ...]} from a results.csv."""
+    """{controller: [(family, J_c, e_um, penalty, figures), ...]} from a results.csv; figures: the
+    whole run's max |e| [um] and each signal figure, for the reports."""
     scores = {}
     with open(results, newline="") as f:
         reader = csv.DictReader(f)
-        for key in objective["signal_limits"]:
+        for key in [error_metric(objective), *objective["signal_limits"]]:
             if key not in (reader.fieldnames or []):
-                fail(f"objective.signal_limits.{key}: no such column in {results}")
+                what = "error_metric" if key == error_metric(objective) else f"signal_limits.{key}"
+                fail(f"objective.{what}: no such column in {results}")
         for row in reader:
             j, e, p = case_score(row, objective)
-            scores.setdefault(row["controller"], []).append((row["family"], j, e, p))
+            figures = {key: figure(row, key) for key in objective["signal_limits"]}
+            figures["full_run_um"] = figure(row, FULL_RUN_ERROR) * 1e6 if FULL_RUN_ERROR in row else math.nan
+            scores.setdefault(row["controller"], []).append((row["family"], j, e, p, figures))
     return scores
+
+
+def worst(values):
+    """The largest value; nan if any is nan (an unknown figure is never hidden by a max)."""
+    values = list(values)
+    return math.nan if any(math.isnan(v) for v in values) else max(values)
 
 
 def summarise(cases):
     js = [c[1] for c in cases]
-    return {"J": max(js), "mean_J": sum(js) / len(js), "worst_e_um": max(c[2] for c in cases),
-            "worst_penalty": max(c[3] for c in cases), "pass": sum(1 for c in cases if c[1] <= 1.0 and c[3] == 0.0),
-            "signal_ok": sum(1 for c in cases if c[3] == 0.0), "cases": len(cases)}
+    s = {"J": max(js), "mean_J": sum(js) / len(js), "worst_e_um": max(c[2] for c in cases),
+         "worst_penalty": max(c[3] for c in cases), "pass": sum(1 for c in cases if c[1] <= 1.0 and c[3] == 0.0),
+         "signal_ok": sum(1 for c in cases if c[3] == 0.0), "cases": len(cases)}
+    s["worst"] = {key: worst(c[4][key] for c in cases) for key in cases[0][4]}
+    return s
 
 
 def choose(spec, scores):
@@ -195,7 +226,7 @@ def choose(spec, scores):
 
 
 def fmt(x, digits=3):
-    return "inf" if math.isinf(x) else f"{x:.{digits}g}"
+    return "inf" if math.isinf(x) else "nan" if math.isnan(x) else f"{x:.{digits}g}"
 
 
 def design_report(spec, table):
@@ -215,11 +246,28 @@ def design_report(spec, table):
     return "\n".join(lines)
 
 
+def write_case_table(results, path, objective):
+    """The record of a stage to commit (DIR/design_cases.csv, DIR/test_cases.csv): every case's
+    varied keys, the objective's error, the whole run's max |e| and the signal figures, copied
+    from feeddrive-study's results.csv (the full table stays there)."""
+    fixed = ["ok", error_metric(objective), FULL_RUN_ERROR, *objective["signal_limits"], "control_signal_within_limits"]
+    with open(results, newline="") as f:
+        reader = csv.DictReader(f)
+        varied = [k for k in reader.fieldnames if k.startswith(("plant.", "controller.", "reference."))]
+        columns = ["case", "controller", "family", "draw", *varied, *dict.fromkeys(fixed)]
+        with open(path, "w", newline="") as out:
+            writer = csv.DictWriter(out, fieldnames=columns, extrasaction="ignore", lineterminator="\n")
+            writer.writeheader()
+            writer.writerows(reader)
+
+
 def stage_design(spec, spec_path, args):
     study = os.path.join(args.out, "design.yaml")
     write_yaml(study, design_study(spec, spec_path))
     run_study(args.bin, study, os.path.join(args.out, "design"), args.jobs)
-    table = choose(spec, read_scores(os.path.join(args.out, "design", "results.csv"), spec["objective"]))
+    results = os.path.join(args.out, "design", "results.csv")
+    table = choose(spec, read_scores(results, spec["objective"]))
+    write_case_table(results, os.path.join(args.out, "design_cases.csv"), spec["objective"])
     with open(os.path.join(args.out, "design.md"), "w") as f:
         f.write(design_report(spec, table))
     chosen = {name: {"point": rows[best][0], "design": rows[best][1]} for name, (rows, best) in table.items()}
@@ -242,18 +290,29 @@ def test_study(spec, spec_path, chosen):
 
 def test_report(spec, scores, families):
     names = [fam["name"] for fam in spec["families"]]
+    metric = error_metric(spec["objective"])
     lines = [f"# Test stage: {spec['name']} (run once, the chosen candidate of each family)", "",
-             "Each cell: worst max|e| [um]; worst J_c; cases whose command is within every signal limit; cases "
-             "that pass (max|e| <= limit as well).", "", "| test family | " + " | ".join(names) + " |",
-             "|---|" + "---|" * len(names)]
+             f"Each cell: worst `{metric}` [um] (the objective's error); worst max|e| over the whole run [um]; "
+             "worst J_c; cases whose command is within every signal limit; cases that pass (error <= limit as "
+             "well).", "", "| test family | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+    summaries = {}
     for tf in families:
         cells = []
         for name in names:
             cases = [c for c in scores.get(name, []) if c[0] == tf]
-            s = summarise(cases) if cases else None
-            cells.append("–" if s is None else f"{fmt(s['worst_e_um'])}; J {fmt(s['J'])}; "
-                         f"signal ok {s['signal_ok']}/{s['cases']}; pass {s['pass']}/{s['cases']}")
+            s = summaries[tf, name] = summarise(cases) if cases else None
+            cells.append("–" if s is None else f"{fmt(s['worst_e_um'])}; full run {fmt(s['worst']['full_run_um'])}; "
+                         f"J {fmt(s['J'])}; signal ok {s['signal_ok']}/{s['cases']}; pass {s['pass']}/{s['cases']}")
         lines.append(f"| {tf} | " + " | ".join(cells) + " |")
+    limits = spec["objective"]["signal_limits"]
+    lines += ["", "The worst of each control-signal figure (limit in the header).", "",
+              "| test family | family | " + " | ".join(f"{k} ({fmt(v, 4)})" for k, v in limits.items()) + " |",
+              "|---|---|" + "---|" * len(limits)]
+    for tf in families:
+        for name in names:
+            s = summaries[tf, name]
+            if s is not None:
+                lines.append(f"| {tf} | {name} | " + " | ".join(fmt(s["worst"][k], 4) for k in limits) + " |")
     return "\n".join(lines) + "\n"
 
 
@@ -262,7 +321,9 @@ def stage_test(spec, spec_path, args, chosen):
     path = os.path.join(args.out, "test.yaml")
     write_yaml(path, study)
     run_study(args.bin, path, os.path.join(args.out, "test"), args.jobs)
-    scores = read_scores(os.path.join(args.out, "test", "results.csv"), spec["objective"])
+    results = os.path.join(args.out, "test", "results.csv")
+    scores = read_scores(results, spec["objective"])
+    write_case_table(results, os.path.join(args.out, "test_cases.csv"), spec["objective"])
     with open(os.path.join(args.out, "test.md"), "w") as f:
         f.write(test_report(spec, scores, [fam["name"] for fam in study["families"]]))
 

@@ -1,10 +1,11 @@
 // Regression bounds of the robustness study on every move (studies/robustness_moves.yaml, issue 24
 // item 7; docs/robustness.md, "Every move, wider mismatch"): robust_smc's worst case of each move
-// and its control-signal figures at those corners, and the recommended controller's
+// and its control-signal figures at those corners; and the recommended controller's
 // (cascade_recommended, docs/controllers.md "Which controller, and where it holds") worst passing
-// cases and the cases where it does not hold, run from the study file
-// itself (the same resolved scenario as the study's case: same plant, encoder seed, delay and
-// nominal model), so a change to a controller, the plant or the study shows here first.
+// cases and the cases where it does not hold on its blind test set (studies/tuning_test.yaml).
+// Each runs from the study file itself (the same resolved scenario as the study's case: same
+// plant, encoder seed, delay and nominal model), so a change to a controller, the plant or the
+// study shows here first.
 //
 // Tolerances. Every case is deterministic (seeded encoder noise, CVODE at fixed tolerances, a
 // fixed control period): on this machine a rerun gives the same bits. The bounds are the figure
@@ -54,7 +55,11 @@ Outcome run(const Study& s, const std::string& controller, const std::string& fa
     for (const Want& w : want) {
       bool found = false;
       for (const Variation& v : c.variations)
-        if (v.key == w.key) found = std::abs((v.scale ? v.factor : std::stod(v.value)) - w.factor_or_value) < 1e-12;
+        if (v.key == w.key) {
+          // A factor or a listed value; relative, since a value is a product (102.04 * 0.7)
+          const double x = v.scale ? v.factor : std::stod(v.value);
+          found = std::abs(x - w.factor_or_value) <= 1e-9 * std::max(1.0, std::abs(w.factor_or_value));
+        }
       match = match && found;
     }
     if (!match) continue;
@@ -172,30 +177,38 @@ namespace feeddrive::study {
 namespace {
 
 // The recommended controller (docs/controllers.md, "Which controller, and where it holds"): the
-// cascade on the observer with the Smith predictor, a 2 kHz velocity filter and the rule's
-// bandwidth x 0.6, chosen by the tuning procedure (docs/tuning.md) on a design set this study
-// does not contain. Its worst passing case of a few families (within 0.8 um and every signal
-// limit), and the cases where it does not hold, each run from studies/robustness_moves.yaml.
+// entry cascade_recommended of studies/robustness_moves.yaml (the one place that names it): the
+// cascade on the x,v,d observer (1,000 rad/s) with the Smith predictor, a 2 kHz velocity filter,
+// the rule's bandwidth x 0.6 and the friction level and inertia of its feedforward adapted online
+// (gamma = 50 1/s), the family cascade_adaptive's choice of the tuning procedure (docs/tuning.md).
+// Run on cases of its blind test set, studies/tuning_test.yaml (corner noise seed 31, Monte Carlo
+// seed 2431 with noise seeds 41-43): the same resolved scenarios as the tuning test run, whose
+// figures (docs/tuning/test_cases.csv) are the measured values below. The error is the tuning
+// objective's: max |e| after the analysis window, t >= 0.1 s (position_error_max_abs_settled_m).
+//
 // Tolerances: the measured figure + 10 % as a bound on the error (the header: room for another
-// libm or compiler moving CVODE's steps, a regression of a tenth fails); the verdicts exactly;
-// the 0.8 um goal itself where the measured figure is within 10 % of it (0.721 um: the bound is
-// then 0.793 um, so "passes" stays true); a failing case bounded from below (more than 0.8 um,
-// or saturated), so that a fix shows here and the docs change with it.
+// libm or compiler moving CVODE's steps, a regression of a tenth fails), and at least half of it
+// (the case stopped being the one the docs name); the verdicts exactly; the 0.8 um goal itself
+// where the measured figure is within 10 % of it (0.781 um: the bound is then 0.8 um, so "passes"
+// stays true); a failing case bounded from below by 0.8 um, so that a fix shows here and the
+// docs change with it.
 //
 // The four control-signal figures of each case (docs/scenario.md, "Control-signal quality"), as
-// measured by the tuning test run (docs/tuning.md, the same cases): step RMS of du, direction
-// changes per second, the force above 1 kHz and the saturated fraction. Each is bounded by the
-// measured figure + 10 % (the same reason as the error: another libm or compiler moves CVODE's
-// steps and the noise-driven samples by a fraction of the figure; a command that got noisier by
-// a tenth fails) and from below by half of it (the figure stopped measuring this case: a metric
-// that no longer counts, a filter or variation that stopped reaching the command). A saturated
-// fraction measured 0 must stay exactly 0 (a passing case never touches the +-10 V rails; one
-// saturated sample is a change in kind, not noise).
+// measured by the tuning test run: step RMS of du, direction changes per second, the force above
+// 1 kHz and the saturated fraction. Each is bounded by the measured figure + 10 % (the same
+// reason as the error: another libm or compiler moves CVODE's steps and the noise-driven samples
+// by a fraction of the figure; a command that got noisier by a tenth fails) and from below by
+// half of it (the figure stopped measuring this case: a metric that no longer counts, a filter or
+// variation that stopped reaching the command). A saturated fraction measured 0 must stay exactly
+// 0 (none of these cases touches the +-10 V rails; one saturated sample is a change in kind, not
+// noise).
+const std::string kTestStudy = std::string(FEEDDRIVE_SOURCE_DIR) + "/studies/tuning_test.yaml";
+const char* const kWindowed = "position_error_max_abs_settled_m";
+
 struct Signal {
   double step_rms_V;         // control_step_rms_V
   double direction_changes;  // control_direction_changes_per_s
   double force_hf_N;         // force_hf_rms_N
-  double saturated;          // control_saturated_fraction
 };
 
 void expect_signal(const Outcome& o, const Signal& m) {
@@ -206,75 +219,90 @@ void expect_signal(const Outcome& o, const Signal& m) {
   bounded("control_step_rms_V", m.step_rms_V);
   bounded("control_direction_changes_per_s", m.direction_changes);
   bounded("force_hf_rms_N", m.force_hf_N);
-  if (m.saturated == 0.0) EXPECT_EQ(metric(o, "control_saturated_fraction"), 0.0);
-  else bounded("control_saturated_fraction", m.saturated);
+  EXPECT_EQ(metric(o, "control_saturated_fraction"), 0.0);
+  EXPECT_EQ(metric(o, "control_signal_within_limits"), 1.0);  // every case here: within every limit
 }
 
 void expect_passes(const Outcome& o, double measured_um, const Signal& signal) {
-  const double e_um = metric(o, "position_error_max_abs_m") * 1e6;
+  const double e_um = metric(o, kWindowed) * 1e6;
   EXPECT_LE(e_um, std::min(1.1 * measured_um, 0.8));
   EXPECT_GE(e_um, 0.5 * measured_um);  // half of it: no longer the family's worst passing case
-  EXPECT_EQ(metric(o, "control_signal_within_limits"), 1.0);
   expect_signal(o, signal);
 }
 
-using RecommendedCascade = MovesStudy;
+// Where it does not hold: over 0.8 um (the docs say so, with this figure), within the signal limits.
+void expect_misses(const Outcome& o, double measured_um, const Signal& signal) {
+  const double e_um = metric(o, kWindowed) * 1e6;
+  EXPECT_GT(e_um, 0.8);
+  EXPECT_LE(e_um, 1.1 * measured_um);
+  expect_signal(o, signal);
+}
 
-// The worst passing corner of the jerk-limited move (mass -30 %, Fs/Fc +50 %, sigma +50 %,
-// 200 us: 0.561 um, 0.085 V, 1,274 /s, 15.4 N) and of the fast S-curve (mass -30 %, Fs/Fc and
-// sigma -50 %, 200 us: 0.721 um), a move the tuner never saw.
-// (0.077 V, 1,364 /s, 14.1 N).
+// A corner of the test set by its factors on the nominal drive (102.04 kg, Fs 120 N, sigma0
+// 2e6 N/m; Fc and sigma1 move with them) and its delay [s]: the values its grid lists.
+std::vector<Want> test_corner(double mass, double friction, double bristle, double delay) {
+  return {{"plant.mass", 102.04 * mass},
+          {"plant.friction.static_force", 120.0 * friction},
+          {"plant.friction.bristle_stiffness", 2.0e6 * bristle},
+          {"controller.computation_delay", delay}};
+}
+
+// The test set with the recommended controller as its one controller.
+class RecommendedCascade : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const Study moves = load_study(kStudy);
+    study_ = new Study(load_study(kTestStudy));
+    const auto it = std::find_if(moves.controllers.begin(), moves.controllers.end(),
+                                 [](const ControllerEntry& c) { return c.name == "cascade_recommended"; });
+    ASSERT_NE(it, moves.controllers.end()) << "studies/robustness_moves.yaml names no cascade_recommended";
+    study_->controllers = {*it};
+  }
+  static void TearDownTestSuite() {
+    delete study_;
+    study_ = nullptr;
+  }
+  static Outcome test_case(const std::string& family, const std::vector<Want>& want, long draw = -1) {
+    return run(*study_, "cascade_recommended", family, want, draw);
+  }
+  static Study* study_;
+};
+Study* RecommendedCascade::study_ = nullptr;
+
+// The worst passing corner of the jerk-limited move (a design move, at a corner of the other
+// fraction), and of the acceleration-limited move and the fast S-curve (moves the tuner never
+// saw): the plant 30 % lighter with 500 us of delay, where the previous recommendation
+// limit-cycled in saturation.
 TEST_F(RecommendedCascade, WorstPassingCorners) {
-  expect_passes(run(*study_, "cascade_recommended", "jerk_limited_corners", corner(0.7, 1.5, 1.5, 2e-4)), 0.561,
-                {0.0853, 1274, 15.40, 0.0});
-  expect_passes(run(*study_, "cascade_recommended", "scurve_fast_corners", corner(0.7, 0.5, 0.5, 2e-4)), 0.721,
-                {0.0768, 1364, 14.12, 0.0});
+  expect_passes(test_case("jerk_limited_corners", test_corner(0.7, 0.5, 0.5, 5e-4)), 0.6900, {0.02510, 877.3, 4.014});
+  expect_passes(test_case("accel_limited_corners", test_corner(0.7, 0.5, 0.5, 5e-4)), 0.7811, {0.03107, 862.7, 4.741});
+  expect_passes(test_case("scurve_fast_corners", test_corner(0.7, 1.5, 1.5, 5e-4)), 0.6907, {0.02320, 884.0, 3.836});
 }
 
-// The acceleration-limited move (a move the tuner never saw; the paper's 0.1 m at 0.4 m/s^2, a
-// triangle to 0.2 m/s): its worst passing corner (mass +50 %, Fs/Fc -50 %, sigma -50 %, 500 us: 0.573 um,
-// 0.047 V, 1,601 /s, 10.1 N), and its worst draw (draw 2: mass x0.77, Fs/Fc x0.58, 442 us, noise
-// seed 2), which misses 0.8 um (0.932 um) with a command within every limit (0.138 V, 1,405 /s,
-// 22.5 N): bounded from below by 0.8 um so that a fix shows here and the docs change with it.
-TEST_F(RecommendedCascade, AccelLimited) {
-  expect_passes(run(*study_, "cascade_recommended", "accel_limited_corners", corner(1.5, 0.5, 0.5, 5e-4)), 0.573,
-                {0.0470, 1601, 10.10, 0.0});
-  const Outcome draw = run(*study_, "cascade_recommended", "accel_limited_mc", {{"plant.sensor.seed", 2}}, 2);
-  const double e_um = metric(draw, "position_error_max_abs_m") * 1e6;
-  EXPECT_GT(e_um, 0.8);
-  EXPECT_LE(e_um, 1.1 * 0.932);
-  EXPECT_EQ(metric(draw, "control_signal_within_limits"), 1.0);
-  expect_signal(draw, {0.1380, 1405, 22.47, 0.0});
+// Both grinding moves pass at every corner; their worst (light plant, Fs/Fc and sigma x0.5,
+// 500 us): 0.770 and 0.763 um.
+TEST_F(RecommendedCascade, GrindingWorstCorners) {
+  expect_passes(test_case("grinding_ramp_corners", test_corner(0.7, 0.5, 0.5, 5e-4)), 0.7699, {0.05541, 733.3, 7.589});
+  expect_passes(test_case("grinding_infeed_corners", test_corner(0.7, 0.5, 0.5, 5e-4)), 0.7631,
+                {0.04928, 767.3, 6.881});
 }
 
-// Both grinding moves pass in every case; their worst draw (mass x0.77, Fs/Fc x0.58, 442 us)
-// with noise seeds 3 and 2: 0.667 and 0.648 um, step RMS 0.142 and 0.135 V (limit 0.2 V).
-TEST_F(RecommendedCascade, GrindingMonteCarloWorstDraw) {
-  expect_passes(run(*study_, "cascade_recommended", "grinding_ramp_mc", {{"plant.sensor.seed", 3}}, 2), 0.667,
-                {0.1424, 1297, 24.22, 0.0});
-  expect_passes(run(*study_, "cascade_recommended", "grinding_infeed_mc", {{"plant.sensor.seed", 2}}, 2), 0.648,
-                {0.1352, 1325, 23.06, 0.0});
+// Other encoder-noise sequences: the worst draw of the acceleration-limited Monte Carlo (draw 3:
+// mass x1.43, Fs/Fc x0.74, 252 us; noise seed 42) and of the jerk-limited one (the same draw, seed 43).
+TEST_F(RecommendedCascade, MonteCarloOtherNoiseSeeds) {
+  expect_passes(test_case("accel_limited_mc", {{"plant.sensor.seed", 42}}, 3), 0.7038, {0.01154, 902.0, 2.403});
+  expect_passes(test_case("jerk_limited_mc", {{"plant.sensor.seed", 43}}, 3), 0.1703, {0.01015, 930.0, 2.132});
 }
 
-// Where it does not hold. (1) The plant 30 % lighter than the model with 500 us of delay: the
-// Smith predictor runs on the model's mass and the loop limit-cycles in saturation (measured
-// 11.4 um, 19.5 % of the run saturated, 1.51 V step RMS, 789 /s, 235 N on the jerk-limited move;
-// its signal figures bounded like the others: a worse limit cycle fails, so does one that stops).
-// (2) The sine: its worst corner (mass +50 %, Fs/Fc -50 %, sigma +50 %, 500 us) 3.39 um within
-// every signal limit (0.050 V, 1,735 /s, 10.5 N): the start's acceleration step and the
-// reversals (docs/controllers.md).
+// Where it does not hold (within every signal limit in each): the jerk-limited move at the light
+// plant with Fs/Fc and sigma x1.5 and 500 us (1.003 um); the acceleration-limited move at the heavy
+// plant, Fs/Fc x0.5, sigma x1.5, 500 us (1.068 um); the sine's worst corner (heavy, Fs/Fc x1.5,
+// sigma x0.5, 500 us: 5.75 um, the reversals) and its worst draw (draw 1, noise seed 42: 1.81 um).
 TEST_F(RecommendedCascade, WhereItDoesNotHold) {
-  const Outcome light = run(*study_, "cascade_recommended", "jerk_limited_corners", corner(0.7, 1.5, 1.5, 5e-4));
-  EXPECT_GT(metric(light, "position_error_max_abs_m") * 1e6, 0.8);
-  EXPECT_GT(metric(light, "control_saturated_fraction"), 0.01);
-  EXPECT_EQ(metric(light, "control_signal_within_limits"), 0.0);
-  expect_signal(light, {1.514, 789.3, 235.2, 0.1951});
-  const Outcome sine = run(*study_, "cascade_recommended", "sine_corners", corner(1.5, 0.5, 1.5, 5e-4));
-  const double e_um = metric(sine, "position_error_max_abs_m") * 1e6;
-  EXPECT_GT(e_um, 0.8);
-  EXPECT_LE(e_um, 1.1 * 3.394);
-  EXPECT_EQ(metric(sine, "control_signal_within_limits"), 1.0);
-  expect_signal(sine, {0.04975, 1735, 10.48, 0.0});
+  expect_misses(test_case("jerk_limited_corners", test_corner(0.7, 1.5, 1.5, 5e-4)), 1.0027, {0.03666, 832.0, 5.135});
+  expect_misses(test_case("accel_limited_corners", test_corner(1.5, 0.5, 1.5, 5e-4)), 1.0683, {0.01390, 1012.7, 2.857});
+  expect_misses(test_case("sine_corners", test_corner(1.5, 1.5, 0.5, 5e-4)), 5.7498, {0.01521, 1053.3, 2.943});
+  expect_misses(test_case("sine_mc", {{"plant.sensor.seed", 42}}, 1), 1.8082, {0.01129, 903.3, 2.173});
 }
 
 }  // namespace

@@ -74,9 +74,25 @@ class Objective(unittest.TestCase):
             tune.case_score(row(0.4e-6), objective)
 
     def test_pass_means_j_at_most_one_and_no_penalty(self):
-        s = tune.summarise([("f", 0.9, 0.72, 0.0), ("f", 1.2, 0.4, 0.7), ("f", 1.1, 0.88, 0.0)])
+        s = tune.summarise([("f", 0.9, 0.72, 0.0, {"full_run_um": 1.5}), ("f", 1.2, 0.4, 0.7, {"full_run_um": 0.5}),
+                            ("f", 1.1, 0.88, 0.0, {"full_run_um": 0.9})])
         self.assertEqual((s["pass"], s["signal_ok"], s["cases"]), (1, 2, 3))
         self.assertAlmostEqual(s["J"], 1.2, places=12)
+        self.assertEqual(s["worst"], {"full_run_um": 1.5})
+        # An unknown figure is never hidden by the max of the others.
+        s = tune.summarise([("f", 0.9, 0.72, 0.0, {"full_run_um": math.nan}), ("f", 1.2, 0.4, 0.7, {"full_run_um": 0.5})])
+        self.assertTrue(math.isnan(s["worst"]["full_run_um"]))
+
+    def test_the_error_term_reads_the_objectives_error_metric(self):
+        # studies/tuning.yaml scores the max |e| after the analysis window: a start transient of
+        # 2 um over the whole run and 0.4 um after the window scores J_c = 0.5, not 2.5.
+        objective = {**OBJECTIVE, "error_metric": "position_error_max_abs_settled_m"}
+        r = {**row(2.0e-6), "position_error_max_abs_settled_m": repr(0.4e-6)}
+        self.assertAlmostEqual(tune.case_score(r, objective)[0], 0.5, places=12)
+        self.assertAlmostEqual(tune.case_score(r, OBJECTIVE)[0], 2.5, places=12)
+        # A window without a value (a run shorter than the window: an empty cell) never passes.
+        r["position_error_max_abs_settled_m"] = ""
+        self.assertTrue(math.isinf(tune.case_score(r, objective)[0]))
 
 
 class Grid(unittest.TestCase):
@@ -119,6 +135,18 @@ class Grid(unittest.TestCase):
         fam = "[{name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2]}}]"
         self.assertEqual(self.run_spec(fam, "{control_step_rms_V: -1}"),
                          (2, "error: SPEC: objective.signal_limits.control_step_rms_V = -1: must be a number > 0"))
+
+    def test_an_error_metric_that_is_no_column_is_an_error(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "results.csv")
+            with open(path, "w") as f:
+                f.write("controller,family,ok,position_error_max_abs_m\na,f,true,4e-7\n")
+            code = "import sys, tune; tune.read_scores(sys.argv[1], {'error_limit_um': 0.8, " \
+                   "'error_metric': 'position_error_max_abs_settled', 'signal_limits': {}})"
+            out = subprocess.run([sys.executable, "-c", code, path], capture_output=True, text=True,
+                                 env={**os.environ, "PYTHONPATH": os.path.join(SRC, "scripts")})
+        self.assertEqual((out.returncode, out.stderr.strip()),
+                         (2, f"error: objective.error_metric: no such column in {path}"))
 
     def test_the_projects_specs_have_equal_budgets(self):
         for name in ("tuning.yaml", "tuning_long.yaml"):
