@@ -174,6 +174,21 @@ TEST(PluginRunInfo, DerivedKeysAreNotKeysOfTheList) {
     for (const std::string& d : plant::table_derived_keys()) EXPECT_NE(v.key, d);
 }
 
+// The built-in boundary-layer law's scenario with the example plugin in its place: its model, its
+// gains as the plugin's parameters.
+sim::Scenario as_example_plugin(const sim::Scenario& builtin) {
+  const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
+  sim::Scenario plugin = builtin;
+  sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
+  plugin.controller.plugin.model = smc.model;
+  plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
+                                         {"k", validate::format_number(smc.k)},
+                                         {"lambda", validate::format_number(smc.lambda)},
+                                         {"switching", "sat"},
+                                         {"boundary_layer", validate::format_number(smc.boundary_layer)}};
+  return plugin;
+}
+
 // Every record of the two runs the same, bit for bit.
 void expect_same_records(const sim::Scenario& builtin, const sim::Scenario& plugin, const std::string& name) {
   const auto a = sim::run(builtin), b = sim::run(plugin);
@@ -194,17 +209,8 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
         sim::load_scenario(std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml");
     builtin.duration = 0.4;  // the move's start, its constant velocity and (ramp) the contact: 4,000 periods
     ASSERT_EQ(builtin.controller.type, sim::ControllerType::kSlidingMode);
-    const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
-    ASSERT_EQ(smc.switching, controller::Switching::kSaturation);
-    sim::Scenario plugin = builtin;
-    sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
-    plugin.controller.plugin.model = smc.model;
-    plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
-                                           {"k", validate::format_number(smc.k)},
-                                           {"lambda", validate::format_number(smc.lambda)},
-                                           {"switching", "sat"},
-                                           {"boundary_layer", validate::format_number(smc.boundary_layer)}};
-    expect_same_records(builtin, plugin, name);
+    ASSERT_EQ(builtin.controller.sliding_mode.switching, controller::Switching::kSaturation);
+    expect_same_records(builtin, as_example_plugin(builtin), name);
   }
 }
 
@@ -221,16 +227,7 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawWithStaticFrictionShape) {
     m->friction.static_smoothing_shape = 0.5;
     m->friction.stribeck_exponent = 1.5;
   }
-  const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
-  sim::Scenario plugin = builtin;
-  sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
-  plugin.controller.plugin.model = smc.model;
-  plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
-                                         {"k", validate::format_number(smc.k)},
-                                         {"lambda", validate::format_number(smc.lambda)},
-                                         {"switching", "sat"},
-                                         {"boundary_layer", validate::format_number(smc.boundary_layer)}};
-  expect_same_records(builtin, plugin, "static friction, shape 0.5");
+  expect_same_records(builtin, as_example_plugin(builtin), "static friction, shape 0.5");
 }
 
 }  // namespace
