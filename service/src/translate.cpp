@@ -4,6 +4,7 @@
 
 #include "feeddrive/plant/parameter_table.hpp"
 #include "feeddrive/service/contract.hpp"
+#include "feeddrive/sim/summary.hpp"
 #include "feeddrive/wire.hpp"
 
 namespace feeddrive::service {
@@ -52,24 +53,9 @@ run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std
   m.steps = s.steps();
   m.plant = to_parameters(plant::parameter_table(s.plant));
   m.plant_count = static_cast<std::int16_t>(m.plant.size());
-  switch (s.controller.type) {
-    case sim::ControllerType::kSlidingMode:
-      m.u_min = s.controller.sliding_mode.u_min;
-      m.u_max = s.controller.sliding_mode.u_max;
-      break;
-    case sim::ControllerType::kCascade:
-      m.u_min = s.controller.cascade.u_min;
-      m.u_max = s.controller.cascade.u_max;
-      break;
-    case sim::ControllerType::kOpenLoop:
-      m.u_min = s.controller.open_loop.u_min;
-      m.u_max = s.controller.open_loop.u_max;
-      break;
-    case sim::ControllerType::kPlugin:
-      m.u_min = s.controller.plugin.u_min;
-      m.u_max = s.controller.plugin.u_max;
-      break;
-  }
+  const sim::OutputLimits limits = sim::controller_output_limits(s);
+  m.u_min = limits.u_min;
+  m.u_max = limits.u_max;
   return m;
 }
 
