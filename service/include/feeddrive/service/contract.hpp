@@ -10,7 +10,7 @@
 //   3  (26 November 2026)  contract_version in process_status_t and run_info_t; run_info_t carries
 //                          the protocol's options, the initial state, the sensor model, the
 //                          scenario's hash and the current step
-//   4  (issue 22)          run_info_t.plant: the drive's parameters as (key, value) entries
+//   4  (27 November 2026)  run_info_t.plant: the drive's parameters as (key, value) entries
 //                          (parameter_t), the plant's one list walked, in place of a hand-written
 //                          set of fields (which missed stribeck_exponent)
 
