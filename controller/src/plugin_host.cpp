@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "check.hpp"
+#include "feeddrive/plant/parameter_table.hpp"
 
 namespace feeddrive::controller {
 namespace {
@@ -71,57 +72,23 @@ PluginLibrary::~PluginLibrary() {
   if (handle_) dlclose(handle_);
 }
 
-feeddrive_run_info plugin_run_info(const PluginParams& p) {
-  feeddrive_run_info r{};
-  r.abi_version = FEEDDRIVE_CONTROLLER_ABI_VERSION;
-  r.size = sizeof(feeddrive_run_info);
-  r.period = p.period;
-  r.u_min = p.u_min;
-  r.u_max = p.u_max;
-  r.computation_delay = p.computation_delay;
-  const plant::PlantParams& m = p.model;
-  feeddrive_model& o = r.model;
-  o.mass = m.mass;
-  o.thrust_gain = m.thrust_gain();
-  o.amplifier_gain = m.amplifier_gain;
-  o.force_constant = m.force_constant;
-  const plant::FrictionParams& f = m.friction;
-  o.friction_model = f.model == plant::FrictionModel::kLuGre    ? FEEDDRIVE_FRICTION_LUGRE
-                     : f.model == plant::FrictionModel::kStatic ? FEEDDRIVE_FRICTION_STATIC
-                                                                : FEEDDRIVE_FRICTION_NONE;
-  o.static_force = f.static_force;
-  o.coulomb_force = f.coulomb_force;
-  o.stribeck_velocity = f.stribeck_velocity;
-  o.stribeck_exponent = f.stribeck_exponent;
-  o.bristle_stiffness = f.bristle_stiffness;
-  o.bristle_damping = f.bristle_damping;
-  o.viscous = f.viscous;
-  o.damping_decay_velocity = f.damping_decay_velocity;
-  o.static_smoothing_velocity = f.static_smoothing_velocity;
-  const plant::RippleParams& rp = m.ripple;
-  o.ripple_enabled = rp.enabled;
-  o.pitch = rp.pitch;
-  o.cogging_amplitude = rp.cogging_amplitude;
-  o.cogging_phase = rp.cogging_phase;
-  o.cogging_third = rp.cogging_third;
-  o.cogging_third_phase = rp.cogging_third_phase;
-  o.reluctance_amplitude = rp.reluctance_amplitude;
-  o.reluctance_phase = rp.reluctance_phase;
-  o.reluctance_third = rp.reluctance_third;
-  o.reluctance_third_phase = rp.reluctance_third_phase;
-  o.grinding_enabled = m.grinding.enabled;
-  o.grinding_stiffness = m.grinding.stiffness;
-  o.grinding_damping = m.grinding.damping();
-  o.contact_position = m.grinding.contact_position;
-  o.contact_width = m.grinding.contact_width;
-  o.sensor_quantization = m.sensor.quantization;
-  return r;
+PluginRunInfo::PluginRunInfo(const PluginParams& p) : values_(plant::parameter_table(p.model)) {
+  table_.reserve(values_.size());
+  for (const fields::FlatValue& v : values_) table_.push_back({v.key.c_str(), v.number, v.name.c_str()});
+  info_.abi_version = FEEDDRIVE_CONTROLLER_ABI_VERSION;
+  info_.size = sizeof(feeddrive_run_info);
+  info_.period = p.period;
+  info_.u_min = p.u_min;
+  info_.u_max = p.u_max;
+  info_.computation_delay = p.computation_delay;
+  info_.model = table_.data();
+  info_.model_size = table_.size();
 }
 
 PluginController::PluginController(const PluginParams& p, std::shared_ptr<const PluginLibrary> library)
-    : lib_(library ? std::move(library) : PluginLibrary::open(p.library)) {
+    : lib_(library ? std::move(library) : PluginLibrary::open(p.library)), run_info_(p) {
   p.validate("controller");
-  const feeddrive_run_info info = plugin_run_info(p);
+  const feeddrive_run_info& info = run_info_.info();
   std::vector<feeddrive_parameter> params;
   params.reserve(p.parameters.size());
   for (const auto& [k, v] : p.parameters) params.push_back({k.c_str(), v.c_str()});

@@ -7,13 +7,14 @@
  *
  * The "hardware" is a drive model of its own, not feeddrive's (so a run checks the framework
  * against a plant it did not make):
- *     m x'' = Ka*Kf*u - b*v - Fc*tanh(v / v_c)          (viscous and smooth Coulomb friction)
- * integrated with classical RK4, 10 substeps a period, u held over the period; the encoder
- * quantises the position to q (x_m = q*round(x/q)) and the velocity is the encoder difference
- * (x_m[k] - x_m[k-1]) / T, as a drive computes it. m, Ka*Kf, b (run_info_t.viscous), Fc
- * (coulomb_force), x(0), v(0), q (sensor_quantization; 0.1 um when the run's sensor is ideal: this
- * "hardware" has an encoder), T, the step count, the limits and the protocol's timeouts all come
- * from run_info_t: nothing about the run is configured here by hand.
+ *     m x'' = Ka*Kf*u - b*v - g(v)*tanh(v / v_c),  g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta)
+ * (viscous friction and a smooth Stribeck curve, no bristles) integrated with classical RK4, 10
+ * substeps a period, u held over the period; the encoder quantises the position to q
+ * (x_m = q*round(x/q)) and the velocity is the encoder difference (x_m[k] - x_m[k-1]) / T, as a
+ * drive computes it. m, Ka*Kf, b, Fc, Fs, vs, delta, the input limit, x(0), v(0) and q (0.1 um
+ * when the run's sensor is ideal: this "hardware" has an encoder) come from run_info_t.plant by
+ * their scenario keys (read_drive); T, the step count, the limits and the protocol's timeouts
+ * from run_info_t's own fields: nothing about the run is configured here by hand.
  *
  * Usage: drive_adapter [--url URL] [--prefix P] [--key FILE] [--run-id N]
  *        test hooks (tests/service/hil_test.sh): [--skip-at K] publishes state K+1 in place of K;
@@ -38,7 +39,7 @@
 #include "feeddrive_resend_request_t.h"
 #include "feeddrive_run_info_t.h"
 
-#define CONTRACT_VERSION 3 /* docs/lcm-contract.md, Versions */
+#define CONTRACT_VERSION 4 /* docs/lcm-contract.md, Versions */
 #define KEEP 4096          /* states kept for resend requests */
 #define V_COULOMB 1e-4     /* m/s: the smoothing velocity of this drive's Coulomb friction */
 
@@ -58,6 +59,10 @@ static double cmd_arrival;              /* real time: when it came [s, monotonic
 static int have_cmd;
 static feeddrive_drive_state_t kept[KEEP];
 static double x, v, x_m_prev, q; /* the drive: position, velocity, last encoder reading, resolution */
+/* The drive's parameters, from run_info_t.plant (read_drive). */
+static struct {
+  double mass, thrust_gain, viscous, coulomb, stiction, stribeck_velocity, delta, input_limit, x0, v0, quantization;
+} drive;
 
 static double now(void) {
   struct timespec t;
@@ -205,9 +210,48 @@ static void handle(double timeout) {
   while (ppoll(&p, 1, &zero, NULL) > 0) lcm_handle(lc);
 }
 
-/* The drive: x'' = (Ka*Kf*u - b*v - Fc*tanh(v/v_c)) / m over one period, RK4 with 10 substeps. */
+/* The number of the drive's parameter `key` (run_info_t.plant, contract 4: every key of the
+ * plant's list by its scenario key, docs/lcm-contract.md): 1, or 0 when the run has none. */
+static int parameter(const char* key, double* out) {
+  for (int i = 0; i < info.plant_count; ++i) {
+    if (strcmp(info.plant[i].key, key) != 0 || info.plant[i].name[0] != '\0') continue;
+    *out = info.plant[i].value;
+    return 1;
+  }
+  return 0;
+}
+
+/* The drive's parameters from run_info_t.plant; 0 with `why` naming a missing key. */
+static int read_drive(char* why, size_t size) {
+  const struct {
+    const char* key;
+    double* to;
+  } keys[] = {{"mass", &drive.mass},
+              {"thrust_gain", &drive.thrust_gain},
+              {"friction.viscous", &drive.viscous},
+              {"friction.coulomb_force", &drive.coulomb},
+              {"friction.static_force", &drive.stiction},
+              {"friction.stribeck_velocity", &drive.stribeck_velocity},
+              {"friction.stribeck_exponent", &drive.delta},
+              {"input_limit", &drive.input_limit},
+              {"initial.position", &drive.x0},
+              {"initial.velocity", &drive.v0},
+              {"sensor.quantization", &drive.quantization}};
+  for (size_t i = 0; i < sizeof keys / sizeof keys[0]; ++i) {
+    if (!parameter(keys[i].key, keys[i].to)) {
+      snprintf(why, size, "run_info_t.plant has no number %s (docs/lcm-contract.md)", keys[i].key);
+      return 0;
+    }
+  }
+  return 1;
+}
+
+/* The drive: x'' = (Ka*Kf*u - b*v - g(v)*tanh(v/v_c)) / m over one period, RK4 with 10 substeps;
+ * g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta), the Stribeck curve (Xie & Liang eq. 7). */
 static double accel(double vel, double u) {
-  return (info.thrust_gain * u - info.viscous * vel - info.coulomb_force * tanh(vel / V_COULOMB)) / info.mass;
+  const double g =
+      drive.coulomb + (drive.stiction - drive.coulomb) * exp(-pow(fabs(vel / drive.stribeck_velocity), drive.delta));
+  return (drive.thrust_gain * u - drive.viscous * vel - g * tanh(vel / V_COULOMB)) / drive.mass;
 }
 static void integrate(double u, double T) {
   const double h = T / 10.0;
@@ -233,7 +277,7 @@ static void publish_state(int64_t k, double u_prev, int safe) {
   m->end_of_run = k >= info.steps;
   m->realtime = !strcmp(info.mode, "realtime");
   m->x_measured = xm;
-  m->v_measured = k == 0 ? info.initial_velocity : (xm - x_m_prev) / T;
+  m->v_measured = k == 0 ? drive.v0 : (xm - x_m_prev) / T;
   if (!m->end_of_run) x_m_prev = xm;
   m->truth.valid = 0; /* hardware: no true state */
   m->previous.seq = k - 1;
@@ -253,9 +297,9 @@ static double admit_u(double u, double fallback) {
     ++rejected;
     return fallback;
   }
-  if (fabs(u) > info.input_limit) {
+  if (fabs(u) > drive.input_limit) {
     ++rejected;
-    return u > 0 ? info.input_limit : -info.input_limit;
+    return u > 0 ? drive.input_limit : -drive.input_limit;
   }
   return u;
 }
@@ -345,16 +389,19 @@ int main(int argc, char** argv) {
              info.contract_version, CONTRACT_VERSION);
     return fail(m);
   }
+  char why[200];
+  if (!read_drive(why, sizeof why)) return fail(why);
   const double T = info.control_period, resend = info.resend_interval, step_timeout = info.step_timeout;
   const int realtime = !strcmp(info.mode, "realtime");
-  x = info.initial_position;
-  v = info.initial_velocity;
-  q = info.sensor_quantization > 0 ? info.sensor_quantization : 1e-7;
+  x = drive.x0;
+  v = drive.v0;
+  q = drive.quantization > 0 ? drive.quantization : 1e-7;
   fprintf(stderr,
           "drive_adapter: run %lld, %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V, b = %g N*s/m, "
-          "Fc = %g N, q = %g m, x0 = %g m, scenario sha256 %.12s...\n",
-          (long long)run_id, info.scenario, info.mode, T, (long long)info.steps, info.mass, info.thrust_gain,
-          info.viscous, info.coulomb_force, q, info.initial_position, info.scenario_hash);
+          "Fc = %g N, Fs = %g N, vs = %g m/s, delta = %g, q = %g m, x0 = %g m, scenario sha256 %.12s...\n",
+          (long long)run_id, info.scenario, info.mode, T, (long long)info.steps, drive.mass, drive.thrust_gain,
+          drive.viscous, drive.coulomb, drive.stiction, drive.stribeck_velocity, drive.delta, q, drive.x0,
+          info.scenario_hash);
 
   /* Step 3: the steps. */
   double u_prev = 0.0, last_good = 0.0, t0 = 0.0;

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/controller/sliding_mode.hpp"
 #include "feeddrive/drive_state_t.hpp"
@@ -34,10 +35,29 @@ namespace fd = feeddrive;
 
 namespace {
 
+constexpr std::int32_t kContractVersion = 4;  // the contract of lcmtypes/ this example is built from
+
 double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 std::int64_t wall_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+// The drive's parameters of run_info_t.plant (every key of the plant's list, contract 4) set in
+// the model through the model's own list (fields::unflatten): delta, the smoothed sign's shape and
+// the ripple's harmonics included, and any key a later feeddrive adds to both. Throws on a
+// parameter the model cannot take (an unknown friction law).
+fd::plant::PlantParams model_from(const fd::run_info_t& info) {
+  std::vector<fd::fields::FlatValue> table;
+  for (const fd::parameter_t& p : info.plant) table.push_back({p.key, p.value, p.name, !p.name.empty()});
+  fd::plant::PlantParams m;
+  const std::size_t set = fd::fields::unflatten(m, [&](const std::string& key) -> const fd::fields::FlatValue* {
+    for (const fd::fields::FlatValue& v : table)
+      if (v.key == key) return &v;
+    return nullptr;
+  });
+  if (set == 0) throw std::runtime_error("run_info_t.plant has no parameter of the model (contract 4?)");
+  return m;
 }
 
 // The controller of the run, from its self-description: the drive's nominal model and limits,
@@ -51,24 +71,7 @@ fd::controller::SlidingModeParams params_from(const fd::run_info_t& info) {
   p.u_min = info.u_min;
   p.u_max = info.u_max;
   p.period = info.control_period;
-  fd::plant::PlantParams& m = p.model;
-  m.mass = info.mass;
-  m.force_constant = 1.0;
-  m.amplifier_gain = info.thrust_gain;  // only Ka*Kf matters to the law
-  m.input_limit = info.input_limit;
-  m.friction.model = fd::plant::friction_model_from_string(info.friction_model);
-  m.friction.static_force = info.static_force;
-  m.friction.coulomb_force = info.coulomb_force;
-  m.friction.stribeck_velocity = info.stribeck_velocity;
-  m.friction.bristle_stiffness = info.bristle_stiffness;
-  m.friction.bristle_damping = info.bristle_damping;
-  m.friction.viscous = info.viscous;
-  // The message carries the ripple's first harmonics; the third ones are the paper's.
-  if (info.ripple) m.ripple = fd::plant::RippleParams::paper();
-  m.ripple.enabled = info.ripple;
-  m.ripple.pitch = info.ripple_pitch;
-  m.ripple.cogging_amplitude = info.cogging_amplitude;
-  m.ripple.reluctance_amplitude = info.reluctance_amplitude;
+  p.model = model_from(info);
   return p;
 }
 
@@ -133,11 +136,27 @@ class Node {
   void on_info(const lcm::ReceiveBuffer* rb) {
     fd::run_info_t info;
     if (controller_ || !decode(rb, info)) return;
-    controller_ = std::make_unique<fd::controller::SlidingModeController>(params_from(info));
+    if (info.contract_version != kContractVersion) {
+      failure_ = "run_info_t of contract version " + std::to_string(info.contract_version) +
+                 ", this controller speaks " + std::to_string(kContractVersion) + " (docs/lcm-contract.md, Versions)";
+      return;
+    }
+    fd::controller::SlidingModeParams p;
+    try {
+      p = params_from(info);
+    } catch (const std::exception& e) {
+      failure_ = std::string("run_info_t: ") + e.what();
+      return;
+    }
+    controller_ = std::make_unique<fd::controller::SlidingModeController>(p);
     run_id_ = info.run_id;  // stamped on everything published: messages of another run are ignored
-    std::fprintf(stderr, "sliding-mode-controller: run %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V\n",
+    const fd::plant::FrictionParams& f = p.model.friction;
+    std::fprintf(stderr,
+                 "sliding-mode-controller: run %s (%s): T = %g s, %lld steps, m = %g kg, Ka*Kf = %g N/V, friction %s "
+                 "(Fs %g N, Fc %g N, vs %g m/s, delta %g)\n",
                  info.scenario.c_str(), info.mode.c_str(), info.control_period, static_cast<long long>(info.steps),
-                 info.mass, info.thrust_gain);
+                 p.model.mass, p.model.thrust_gain(), fd::plant::to_string(f.model).c_str(), f.static_force,
+                 f.coulomb_force, f.stribeck_velocity, f.stribeck_exponent);
     try_answer();
   }
   void on_state(const lcm::ReceiveBuffer* rb) {
@@ -208,7 +227,7 @@ class Node {
     m.state = state;
     m.seq = next_seq_ - 1;
     m.acked_seq = -1;
-    m.contract_version = 3;  // docs/lcm-contract.md, Versions
+    m.contract_version = kContractVersion;  // docs/lcm-contract.md, Versions
     m.message = message;
     m.invalid = invalid_;
     lc_.publish(p_ + "_STATUS", &m);

@@ -199,6 +199,7 @@ local P = opt.prefix
 local ch = {state = P .. '_STATE', command = P .. '_CMD', reference = P .. '_REF',
             status = P .. '_STATUS', resend = P .. '_RESEND', info = P .. '_INFO'}
 local ROLE = 'controller'
+local CONTRACT_VERSION = 4       -- the contract of the lcmtypes/ this example's bindings are made from
 local RESEND_MS = math.max(1, math.floor(opt['resend-interval'] * 1000 + 0.5))
 local KEEP = 65536              -- commands remembered for repeats and resend requests
 
@@ -286,7 +287,7 @@ local function send_status(st, message)
   m.state = st
   m.seq = last_seq
   m.acked_seq = -1
-  m.contract_version = 3  -- docs/lcm-contract.md, Versions
+  m.contract_version = CONTRACT_VERSION  -- docs/lcm-contract.md, Versions
   m.message = message or ''
   m.resends = counters.resends
   m.duplicates = counters.duplicates
@@ -478,12 +479,30 @@ end)
 -- The run describes itself (run_info_t, re-published every second and on request): take the
 -- drive's nominal mass, thrust gain, Coulomb friction, the command limit and the period from it,
 -- unless given on the command line.
+-- The drive's parameters are run_info_t.plant (contract 4): every key of the plant's list by its
+-- scenario key, a number in value, an enum's name in name (docs/lcm-contract.md).
+local function parameters(m)
+  local by_key = {}
+  for i = 1, m.plant_count do by_key[m.plant[i].key] = m.plant[i] end
+  return function(key)
+    local p = by_key[key]
+    if p == nil then fail(string.format('run_info_t.plant has no %s (docs/lcm-contract.md)', key)) end
+    if p.name ~= '' then return p.name end
+    return p.value
+  end
+end
+
 subscribe(ch.info, feeddrive.run_info_t, function(m)
   if run_info then return end
+  if m.contract_version ~= CONTRACT_VERSION then
+    fail(string.format('run_info_t of contract version %d, this controller speaks %d (docs/lcm-contract.md, Versions)',
+                       m.contract_version, CONTRACT_VERSION))
+  end
   run_info = m
-  local from = {mass = m.mass, ['thrust-gain'] = m.thrust_gain,
-                coulomb = m.friction_model == 'none' and 0.0 or m.coulomb_force,
-                ['u-limit'] = math.min(-m.u_min, m.u_max, m.input_limit)}
+  local p = parameters(m)
+  local from = {mass = p('mass'), ['thrust-gain'] = p('thrust_gain'),
+                coulomb = p('friction.model') == 'none' and 0.0 or p('friction.coulomb_force'),
+                ['u-limit'] = math.min(-m.u_min, m.u_max, p('input_limit'))}
   for name, value in pairs(from) do
     if not given[name] and finite(value) and value >= 0 then opt[name] = value end
   end

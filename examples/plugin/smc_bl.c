@@ -7,8 +7,9 @@
  *                                                                                     (eq. 19)
  * sw(S) = sat(S/phi) (default), tanh(S/phi) or sgn(S); F^f from the plant's true bristle state
  * (the paper's "all states available"): sigma0*z + sigma1(v)*zdot^ + sigma2*v with
- * zdot^ = (z_k - z_{k-1})/T (the model rate v - sigma0|v|z/g(v) at the first sample); F^g =
- * s(x)*Fg from the true Fg; the ripple from the nominal model. u saturated to [u_min, u_max].
+ * zdot^ = (z_k - z_{k-1})/T (the model rate v - sigma0|v|z/g(v) at the first sample), or the
+ * static map g(v)*sgn_eps(v) + sigma2*v; F^g = s(x)*Fg from the true Fg; the ripple from the
+ * nominal model, read from the host's table by key (read_model). u saturated to [u_min, u_max].
  *
  * It computes every term in the same order as feeddrive's built-in sliding_mode controller
  * (controller/src/sliding_mode.cpp with friction_state/grinding_state: true, motion_state:
@@ -32,9 +33,23 @@
 #endif
 
 enum switching { SW_SAT, SW_TANH, SW_SGN };
+enum friction { FR_LUGRE, FR_STATIC, FR_NONE };
+
+/* The law's nominal model: what it reads of the host's model table (plugin.h, feeddrive_run_info.model). */
+typedef struct {
+  enum friction friction;
+  int ripple_enabled, grinding_enabled;
+  double mass, thrust_gain;
+  double static_force, coulomb_force, stribeck_velocity, stribeck_exponent, bristle_stiffness, bristle_damping, viscous;
+  double damping_decay_velocity, static_smoothing_velocity, static_smoothing_shape;
+  double pitch, cogging_amplitude, cogging_phase, cogging_third, cogging_third_phase;
+  double reluctance_amplitude, reluctance_phase, reluctance_third, reluctance_third_phase;
+  double contact_position, contact_width;
+} model;
 
 typedef struct {
-  feeddrive_run_info info;
+  model m;
+  double period, u_min, u_max;
   double eta, k, lambda, phi;
   enum switching sw;
   int has_last_z;
@@ -45,33 +60,98 @@ static void set_error(char* error, size_t size, const char* fmt, const char* a, 
   if (error && size) snprintf(error, size, fmt, a, b);
 }
 
+/* The model from the host's table, by the scenario's keys; a key the table lacks is an error
+ * naming it (a host of another feeddrive). */
+static int read_model(const feeddrive_run_info* info, model* m, char* error, size_t size) {
+  double ripple = 0.0, grinding = 0.0;
+  const struct {
+    const char* key;
+    double* to;
+  } numbers[] = {
+      {"mass", &m->mass},
+      {"thrust_gain", &m->thrust_gain},
+      {"friction.static_force", &m->static_force},
+      {"friction.coulomb_force", &m->coulomb_force},
+      {"friction.stribeck_velocity", &m->stribeck_velocity},
+      {"friction.stribeck_exponent", &m->stribeck_exponent},
+      {"friction.bristle_stiffness", &m->bristle_stiffness},
+      {"friction.bristle_damping", &m->bristle_damping},
+      {"friction.viscous", &m->viscous},
+      {"friction.damping_decay_velocity", &m->damping_decay_velocity},
+      {"friction.static_smoothing_velocity", &m->static_smoothing_velocity},
+      {"friction.static_smoothing_shape", &m->static_smoothing_shape},
+      {"ripple.enabled", &ripple},
+      {"ripple.pitch", &m->pitch},
+      {"ripple.cogging_amplitude", &m->cogging_amplitude},
+      {"ripple.cogging_phase", &m->cogging_phase},
+      {"ripple.cogging_third", &m->cogging_third},
+      {"ripple.cogging_third_phase", &m->cogging_third_phase},
+      {"ripple.reluctance_amplitude", &m->reluctance_amplitude},
+      {"ripple.reluctance_phase", &m->reluctance_phase},
+      {"ripple.reluctance_third", &m->reluctance_third},
+      {"ripple.reluctance_third_phase", &m->reluctance_third_phase},
+      {"grinding.enabled", &grinding},
+      {"grinding.contact_position", &m->contact_position},
+      {"grinding.contact_width", &m->contact_width},
+  };
+  for (size_t i = 0; i < sizeof numbers / sizeof numbers[0]; ++i) {
+    if (!feeddrive_model_number(info, numbers[i].key, numbers[i].to)) {
+      set_error(error, size, "the host's model has no number %s%s (plugin.h, feeddrive_run_info.model)", numbers[i].key,
+                "");
+      return 0;
+    }
+  }
+  m->ripple_enabled = ripple != 0.0;
+  m->grinding_enabled = grinding != 0.0;
+  const char* law = feeddrive_model_name(info, "friction.model");
+  if (law == NULL) {
+    set_error(error, size, "the host's model has no name friction.model%s%s", "", "");
+    return 0;
+  }
+  if (strcmp(law, "lugre") == 0) m->friction = FR_LUGRE;
+  else if (strcmp(law, "static") == 0) m->friction = FR_STATIC;
+  else if (strcmp(law, "none") == 0) m->friction = FR_NONE;
+  else {
+    set_error(error, size, "friction.model = '%s': expected lugre, static or none%s", law, "");
+    return 0;
+  }
+  return 1;
+}
+
 /* Xie & Liang eq. 7 (Canudas de Wit 1995 eq. 3): g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta). */
 static double power(double r, double d) { return d == 2.0 ? r * r : d == 1.0 ? r : pow(r, d); }
-static double stribeck(const feeddrive_model* m, double v) {
+static double stribeck(const model* m, double v) {
   const double r = fabs(v / m->stribeck_velocity);
   return m->coulomb_force + (m->static_force - m->coulomb_force) * exp(-power(r, m->stribeck_exponent));
 }
-static double micro_damping(const feeddrive_model* m, double v) {
+/* The smoothed sign of the static model (plant/forces.hpp, smoothed_sign): with b the shape,
+ * (1 - b)*tanh(v/eps) + b*v/sqrt(v^2 + eps^2). */
+static double smoothed_sign(const model* m, double v) {
+  const double eps = m->static_smoothing_velocity, b = m->static_smoothing_shape;
+  const double th = tanh(v / eps);
+  return b == 0.0 ? th : (1.0 - b) * th + b * v / sqrt(v * v + eps * eps);
+}
+static double micro_damping(const model* m, double v) {
   if (m->damping_decay_velocity <= 0.0) return m->bristle_damping;
   const double r = v / m->damping_decay_velocity;
   return m->bristle_damping * exp(-r * r);
 }
-static double lugre_zdot(const feeddrive_model* m, double v, double z) {
+static double lugre_zdot(const model* m, double v, double z) {
   return v - m->bristle_stiffness * fabs(v) * z / stribeck(m, v);
 }
 /* Ripple, Xie & Liang eqs. 14-15. */
 static const double kTwoPi = 2.0 * M_PI;
-static double cogging(const feeddrive_model* m, double x) {
+static double cogging(const model* m, double x) {
   const double th = kTwoPi * x / m->pitch;
   return m->cogging_amplitude * sin(th + m->cogging_phase) + m->cogging_third * sin(3.0 * th + m->cogging_third_phase);
 }
-static double reluctance(const feeddrive_model* m, double x) {
+static double reluctance(const model* m, double x) {
   const double th = kTwoPi * x / m->pitch;
   return m->reluctance_amplitude * sin(th + m->reluctance_phase) +
          m->reluctance_third * sin(3.0 * th + m->reluctance_third_phase);
 }
 /* Grinding contact fraction s(x). */
-static double contact_fraction(const feeddrive_model* m, double x) {
+static double contact_fraction(const model* m, double x) {
   if (!(x > m->contact_position)) return 0.0;
   if (m->contact_width <= 0.0) return 1.0;
   const double s = (x - m->contact_position) / m->contact_width;
@@ -98,7 +178,8 @@ FD_EXPORT void* feeddrive_controller_create(const feeddrive_run_info* info, cons
     return NULL;
   }
   smc c = {0};
-  c.info = *info;
+  if (!read_model(info, &c.m, error, size)) return NULL;
+  c.period = info->period, c.u_min = info->u_min, c.u_max = info->u_max;
   c.eta = 5.0, c.k = 10.0, c.lambda = 50.0, c.phi = 1e-3, c.sw = SW_SAT;
   for (size_t i = 0; i < n; ++i) {
     const feeddrive_parameter* p = &params[i];
@@ -149,8 +230,8 @@ static double switching_function(const smc* c, double s) {
 FD_EXPORT int feeddrive_controller_update(void* self, const feeddrive_input* in, feeddrive_output* out, char* error,
                                           size_t size) {
   smc* c = self;
-  const feeddrive_model* m = &c->info.model;
-  const int lugre = m->friction_model == FEEDDRIVE_FRICTION_LUGRE;
+  const model* m = &c->m;
+  const int lugre = m->friction == FR_LUGRE;
   if (!in->has_truth && (lugre || m->grinding_enabled)) {
     set_error(error, size, "this law uses the plant's true z and Fg%s%s, which this host does not send (hardware)", "",
               "");
@@ -160,12 +241,12 @@ FD_EXPORT int feeddrive_controller_update(void* self, const feeddrive_input* in,
   double f_friction = 0.0;
   if (lugre) {
     const double z = in->z;
-    const double zdot = c->has_last_z ? (z - c->last_z) / c->info.period : lugre_zdot(m, v, z);
+    const double zdot = c->has_last_z ? (z - c->last_z) / c->period : lugre_zdot(m, v, z);
     if (isfinite(z)) c->has_last_z = 1, c->last_z = z;
     f_friction = m->bristle_stiffness * z + micro_damping(m, v) * zdot + m->viscous * v;
     out->z_estimate = z;
-  } else if (m->friction_model == FEEDDRIVE_FRICTION_STATIC) {
-    f_friction = stribeck(m, v) * tanh(v / m->static_smoothing_velocity) + m->viscous * v;
+  } else if (m->friction == FR_STATIC) {
+    f_friction = stribeck(m, v) * smoothed_sign(m, v) + m->viscous * v;
     out->z_estimate = 0.0;
   }
   double f_grinding = 0.0;
@@ -186,7 +267,7 @@ FD_EXPORT int feeddrive_controller_update(void* self, const feeddrive_input* in,
   out->u_unsaturated =
       (m->mass * a_cmd + f_friction + f_grinding + cog + dc + e0) / (m->thrust_gain * (1.0 - rel - e1));
   const double u = out->u_unsaturated;
-  out->u = isnan(u) ? 0.0 : u < c->info.u_min ? c->info.u_min : (c->info.u_max < u ? c->info.u_max : u);
+  out->u = isnan(u) ? 0.0 : u < c->u_min ? c->u_min : (c->u_max < u ? c->u_max : u);
   return 0;
 }
 

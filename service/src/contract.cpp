@@ -7,7 +7,9 @@ namespace {
 
 // LCM fingerprints (the first 8 bytes of an encoded message, big-endian) of the types of earlier
 // contracts, computed with lcm-gen from lcmtypes/ at the commits of each version (git history:
-// 96fcf52 for 1; 3825bbe, b527dd6 and bf315dd for 2). Types that did not change are not listed.
+// 96fcf52 for 1; 3825bbe, b527dd6 and bf315dd for 2; fad0b3a for 3). Types that did not change are
+// not listed: a version 3 participant's heartbeat (process_status_t, unchanged in 4) decodes, and
+// its contract_version 3 names it (the monitor's check_peer_status).
 struct Known {
   std::uint64_t hash;
   int version;
@@ -24,6 +26,7 @@ constexpr Known kOlder[] = {
     {0x82c6d4827f2f3fedULL, 2, "process_status_t", "24 November 2026"},
     {0x10e6db5df442da54ULL, 2, "drive_state_t", "24 November 2026, before its overrun fields"},
     {0xa573df60dff0e8e1ULL, 2, "run_info_t", "24 November 2026"},
+    {0x2a2e53f13bd0f348ULL, 3, "run_info_t", "26 November 2026, with its drive's parameters as fields"},
 };
 
 std::uint64_t be64(const std::uint8_t* p) {
@@ -54,7 +57,7 @@ std::string publisher_of(const Channels& ch, std::string_view channel) {
 }
 
 std::string heartbeat_role(const std::uint8_t* data, std::size_t size) {
-  // process_status_t of contract 3: fingerprint, run_id, utime, run_nonce, role.
+  // process_status_t of contracts 3 and 4: fingerprint, run_id, utime, run_nonce, role.
   return lcm_string(data, size, 8 + 8 + 8 + 8);
 }
 

@@ -1,11 +1,36 @@
 #include "feeddrive/service/translate.hpp"
+
+#include <stdexcept>
+
+#include "feeddrive/plant/parameter_table.hpp"
+#include "feeddrive/service/contract.hpp"
+#include "feeddrive/sim/summary.hpp"
 #include "feeddrive/wire.hpp"
 
-#include <limits>
-
-#include "feeddrive/service/contract.hpp"
-
 namespace feeddrive::service {
+
+std::vector<parameter_t> to_parameters(const std::vector<fields::FlatValue>& table) {
+  using Bounds = wire::Check<parameter_t>;
+  if (table.size() > static_cast<std::size_t>(wire::Check<run_info_t>::kMax_plant_count))
+    throw std::logic_error("run_info_t.plant: " + std::to_string(table.size()) + " parameters, above the contract's " +
+                           std::to_string(wire::Check<run_info_t>::kMax_plant_count) +
+                           " (raise the bound in lcmtypes/run_info_t.lcm: a new contract version)");
+  std::vector<parameter_t> out;
+  out.reserve(table.size());
+  for (const fields::FlatValue& v : table) {
+    // A key or name cut to its bound would name another parameter: refused, never cut.
+    if (v.key.size() > Bounds::kMax_key || v.name.size() > Bounds::kMax_name)
+      throw std::logic_error(
+          "run_info_t.plant: " + v.key + " = '" + v.name +
+          "' is longer than parameter_t's bounds (lcmtypes/parameter_t.lcm: a new contract version)");
+    parameter_t p;
+    p.key = v.key;
+    p.value = v.number;
+    p.name = v.name;
+    out.push_back(std::move(p));
+  }
+  return out;
+}
 
 run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std::string& scenario_hash) {
   run_info_t m;
@@ -21,48 +46,16 @@ run_info_t to_run_info(const sim::Scenario& s, const NodeOptions& opt, const std
   m.monitor_window = opt.monitor_window;
   m.max_bad_commands = opt.max_bad_commands;
   m.max_rate = opt.max_rate;
-  m.initial_position = s.plant.initial.position;
-  m.initial_velocity = s.plant.initial.velocity;
-  m.sensor_quantization = s.plant.sensor.quantization;
-  m.sensor_noise_stddev = s.plant.sensor.noise_stddev;
   // "auto" resolved by the sensor's one rule: the true velocity only from an ideal sensor.
   m.sensor_velocity = s.plant.sensor.differenced_velocity() ? "difference" : "true";
   m.current_step = -1;
   m.control_period = s.control_period;
   m.steps = s.steps();
-  const plant::PlantParams& p = s.plant;
-  m.mass = p.mass;
-  m.thrust_gain = p.thrust_gain();
-  m.friction_model = plant::to_string(p.friction.model);
-  m.static_force = p.friction.static_force;
-  m.coulomb_force = p.friction.coulomb_force;
-  m.stribeck_velocity = p.friction.stribeck_velocity;
-  m.bristle_stiffness = p.friction.bristle_stiffness;
-  m.bristle_damping = p.friction.bristle_damping;
-  m.viscous = p.friction.viscous;
-  m.ripple = p.ripple.enabled;
-  m.ripple_pitch = p.ripple.pitch;
-  m.cogging_amplitude = p.ripple.cogging_amplitude;
-  m.reluctance_amplitude = p.ripple.reluctance_amplitude;
-  m.input_limit = p.input_limit;
-  switch (s.controller.type) {
-    case sim::ControllerType::kSlidingMode:
-      m.u_min = s.controller.sliding_mode.u_min;
-      m.u_max = s.controller.sliding_mode.u_max;
-      break;
-    case sim::ControllerType::kCascade:
-      m.u_min = s.controller.cascade.u_min;
-      m.u_max = s.controller.cascade.u_max;
-      break;
-    case sim::ControllerType::kOpenLoop:
-      m.u_min = s.controller.open_loop.u_min;
-      m.u_max = s.controller.open_loop.u_max;
-      break;
-    case sim::ControllerType::kPlugin:
-      m.u_min = s.controller.plugin.u_min;
-      m.u_max = s.controller.plugin.u_max;
-      break;
-  }
+  m.plant = to_parameters(plant::parameter_table(s.plant));
+  m.plant_count = static_cast<std::int16_t>(m.plant.size());
+  const sim::OutputLimits limits = sim::controller_output_limits(s);
+  m.u_min = limits.u_min;
+  m.u_max = limits.u_max;
   return m;
 }
 

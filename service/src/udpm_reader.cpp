@@ -19,9 +19,10 @@ constexpr std::size_t kShortHeader = 8;
 constexpr std::size_t kLongHeader = 20;
 constexpr std::size_t kMaxDatagram = 65536;
 constexpr std::size_t kBatch = 16;  // datagrams per recvmmsg call
-// Fragmented messages: feeddrive's own are all below 2 kB (wire_check.hpp's kMaxEncoded) and never
-// fragmented, so a fragmented one is another application's or forged. At most kMaxPartial of at
-// most kMaxPayload bytes are kept while their fragments come: 8 MB per process, whatever is sent.
+// Fragmented messages: feeddrive's own are all below 8.5 kB (wire_check.hpp's kMaxEncoded; LCM
+// fragments above 64 kB) and never fragmented, so a fragmented one is another application's or
+// forged. At most kMaxPartial of at most kMaxPayload bytes are kept while their fragments come:
+// 8 MB per process, whatever is sent.
 constexpr std::size_t kMaxPayload = 1024u * 1024u;
 constexpr std::size_t kMaxPartial = 8;
 

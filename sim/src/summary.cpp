@@ -9,14 +9,20 @@
 
 namespace feeddrive::sim {
 
-double controller_output_range(const Scenario& s) {
-  switch (s.controller.type) {
-    case ControllerType::kSlidingMode: return s.controller.sliding_mode.u_max - s.controller.sliding_mode.u_min;
-    case ControllerType::kCascade: return s.controller.cascade.u_max - s.controller.cascade.u_min;
-    case ControllerType::kOpenLoop: return s.controller.open_loop.u_max - s.controller.open_loop.u_min;
-    case ControllerType::kPlugin: return s.controller.plugin.u_max - s.controller.plugin.u_min;
+OutputLimits controller_output_limits(const Scenario& s) {
+  const ControllerConfig& c = s.controller;
+  switch (c.type) {
+    case ControllerType::kSlidingMode: return {c.sliding_mode.u_min, c.sliding_mode.u_max};
+    case ControllerType::kCascade: return {c.cascade.u_min, c.cascade.u_max};
+    case ControllerType::kOpenLoop: return {c.open_loop.u_min, c.open_loop.u_max};
+    case ControllerType::kPlugin: return {c.plugin.u_min, c.plugin.u_max};
   }
-  return 0.0;
+  return {};
+}
+
+double controller_output_range(const Scenario& s) {
+  const OutputLimits l = controller_output_limits(s);
+  return l.u_max - l.u_min;
 }
 
 std::string controller_model_source(const Scenario& s) {

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
@@ -167,53 +169,123 @@ std::string sha256_hex(const std::string& text) {
   return hex;
 }
 
-struct Resolver::Impl {
-  const Study& s;
-  // The base as read, once per controller, with the controller's block in place of its own.
-  std::vector<sim::Scenario> bases;
-  // The nominal case of a controller and family: the base with the layers' settings as read
-  // (each case copies it and sets its variations in it), and its keys (a scale's nominal value).
-  struct Nominal {
-    sim::Scenario read;
-    sim::ResolvedKeys keys;
-  };
-  std::map<std::pair<std::size_t, std::size_t>, Nominal> nominals;
-  // The controller's nominal model (the nominal model rule), by the case's settings that are not
-  // plant-only; at most kMaxModels (cases come in order, so a reset costs one model per layer).
-  std::map<std::string, plant::PlantParams> models;
-  static constexpr std::size_t kMaxModels = 256;
-  std::vector<std::string> varied;  // every key a grid or draw of the study varies
-  // SHA-256 of a plugin library's bytes, once per path per study.
-  std::map<std::string, std::string> digests;
+// --- settings and bases as bytes -----------------------------------------------------------
 
-  explicit Impl(const Study& st) : s(st) {
-    varied = varied_keys(s);
-    for (const ControllerEntry& c : s.controllers) {
-      try {
-        bases.push_back(sim::read_scenario(s.base_yaml, s.base_dir, "base", c.block));
-      } catch (const sim::ScenarioError& e) {
-        throw StudyError(s.path + (c.block.empty() ? "" : ": controller '" + c.name + "'") + ": " + e.what());
-      }
+namespace {
+
+// A list of strings as bytes: each as its length in decimal, ':', its bytes.
+void put(std::string& out, const std::string& s) { out += std::to_string(s.size()) + ":" + s; }
+
+[[noreturn]] void not_a_packing() {
+  throw StudyError("a case's settings or a study's bases from rank 0 that do not unpack (another build?)");
+}
+
+class Reader {
+ public:
+  explicit Reader(const std::string& b) : b_(b) {}
+  std::string next() {
+    const std::size_t colon = b_.find(':', at_);
+    if (colon == std::string::npos || colon == at_ || colon - at_ > 12) not_a_packing();
+    std::size_t n = 0;
+    for (std::size_t i = at_; i < colon; ++i) {
+      if (b_[i] < '0' || b_[i] > '9') not_a_packing();
+      n = n * 10 + static_cast<std::size_t>(b_[i] - '0');
     }
+    if (n > b_.size() - colon - 1) not_a_packing();
+    at_ = colon + 1 + n;
+    return b_.substr(colon + 1, n);
+  }
+  std::size_t count() {
+    const std::string s = next();
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) not_a_packing();
+    return static_cast<std::size_t>(std::stoul(s));
+  }
+  void finish() const {
+    if (at_ != b_.size()) not_a_packing();
   }
 
-  const std::string& library_digest(const std::string& path) {
-    auto it = digests.find(path);
-    if (it != digests.end()) return it->second;
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    if (!in) throw StudyError("plugin " + path + ": cannot be read to key the study's cases");
-    return digests.emplace(path, sha256_hex(bytes.str())).first->second;
-  }
-
-  using Values = std::vector<sim::KeySetting>;
-  static Values variation_values(const CaseSpec& c, const sim::ResolvedKeys& nominal, const std::string& origin);
-  const Nominal& nominal(const CaseSpec& c, const std::string& origin);
-  const plant::PlantParams& nominal_model(const CaseSpec& c, const Nominal& n, const Values& values,
-                                          const std::string& origin);
-  ResolvedCase result(std::shared_ptr<const sim::Scenario> sc, const Values& values);
+ private:
+  const std::string& b_;
+  std::size_t at_{0};
 };
+
+void put_settings(std::string& out, const std::vector<sim::KeySetting>& v) {
+  put(out, std::to_string(v.size()));
+  for (const sim::KeySetting& k : v) put(out, k.key), put(out, k.value);
+}
+std::vector<sim::KeySetting> get_settings(Reader& r) {
+  std::vector<sim::KeySetting> v(r.count());
+  for (sim::KeySetting& k : v) k.key = r.next(), k.value = r.next();
+  return v;
+}
+
+bool same_settings(const std::vector<sim::KeySetting>& a, const std::vector<sim::KeySetting>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const auto& x, const auto& y) { return x.key == y.key && x.value == y.value; });
+}
+
+}  // namespace
+
+bool CaseSettings::operator==(const CaseSettings& o) const {
+  return controller == o.controller && same_settings(layers, o.layers) && same_settings(values, o.values) &&
+         nominal_model == o.nominal_model;
+}
+
+std::string pack_settings(const CaseSettings& c) {
+  std::string out;
+  put(out, std::to_string(c.controller));
+  put(out, c.nominal_model ? "1" : "0");
+  put_settings(out, c.layers);
+  put_settings(out, c.values);
+  return out;
+}
+
+CaseSettings unpack_settings(const std::string& bytes) {
+  Reader r(bytes);
+  CaseSettings c;
+  c.controller = r.count();
+  const std::string rule = r.next();
+  if (rule != "0" && rule != "1") not_a_packing();
+  c.nominal_model = rule == "1";
+  c.layers = get_settings(r);
+  c.values = get_settings(r);
+  r.finish();
+  return c;
+}
+
+StudyBases StudyBases::of(const Study& s) {
+  StudyBases b{s.path, s.base_yaml, s.base_dir, {}, {}};
+  for (const ControllerEntry& c : s.controllers) b.names.push_back(c.name), b.blocks.push_back(c.block);
+  return b;
+}
+
+bool StudyBases::operator==(const StudyBases& o) const {
+  return path == o.path && base_yaml == o.base_yaml && base_dir == o.base_dir && names == o.names && blocks == o.blocks;
+}
+
+std::string pack_bases(const StudyBases& b) {
+  std::string out;
+  put(out, b.path);
+  put(out, b.base_yaml);
+  put(out, b.base_dir);
+  put(out, std::to_string(b.names.size()));
+  for (std::size_t i = 0; i < b.names.size(); ++i) put(out, b.names[i]), put(out, b.blocks[i]);
+  return out;
+}
+
+StudyBases unpack_bases(const std::string& bytes) {
+  Reader r(bytes);
+  StudyBases b;
+  b.path = r.next();
+  b.base_yaml = r.next();
+  b.base_dir = r.next();
+  const std::size_t n = r.count();
+  for (std::size_t i = 0; i < n; ++i) b.names.push_back(r.next()), b.blocks.push_back(r.next());
+  r.finish();
+  return b;
+}
+
+// --- building a case from its settings ---------------------------------------------------------
 
 namespace {
 
@@ -230,76 +302,196 @@ sim::Scenario with_settings(sim::Scenario sc, const std::vector<sim::KeySetting>
   return sc;
 }
 
+// A cache key of a controller and a list of settings.
+std::string key_of(std::size_t controller, const std::vector<sim::KeySetting>& v) {
+  std::string k = std::to_string(controller) + "\n";
+  put_settings(k, v);
+  return k;
+}
+
 }  // namespace
 
-// The layers without the variations: the nominal case of this controller and family. The
-// study's set comes after the controller block it would otherwise be replaced by: what it sets
-// holds for every controller (docs/study.md, "How a case is made").
-const Resolver::Impl::Nominal& Resolver::Impl::nominal(const CaseSpec& c, const std::string& origin) {
-  const auto id = std::make_pair(c.controller, c.family);
-  auto it = nominals.find(id);
-  if (it != nominals.end()) return it->second;
-  const ControllerEntry& ctl = s.controllers[c.controller];
-  std::vector<sim::KeySetting> layers;
-  for (const auto* set : {&ctl.block_set, &s.set, &ctl.set, &s.families[c.family].set})
-    for (const Setting& st : *set) layers.push_back({st.key, st.value});
-  Nominal n;
-  const std::string where = origin + " (without its variations)";
-  n.read = with_settings(bases[c.controller], layers, false, where);
-  n.keys = sim::resolved_keys(with_settings(n.read, {}, true, where));
-  return nominals.emplace(id, std::move(n)).first->second;
-}
+struct CaseBuilder::Impl {
+  // The base as read, once per controller, with the controller's block in place of its own.
+  std::vector<sim::Scenario> bases;
+  // The base with a case's layers set, as read (each case copies it and sets its values in it),
+  // and its keys (a scale's nominal value), by (controller, layers): in a study one per
+  // controller and family.
+  struct Layered {
+    sim::Scenario read;
+    sim::ResolvedKeys keys;
+  };
+  std::map<std::string, Layered> layered;
+  // The controller's nominal model (the nominal model rule), by the case's settings that are not
+  // plant-only; at most kMaxModels (cases come in order, so a reset costs one model per layer).
+  std::map<std::string, plant::PlantParams> models;
+  static constexpr std::size_t kMaxModels = 256;
 
-// The variations' values as YAML scalar text: a `scale` one is its factor times the key's
-// nominal value (its effective value in the case without variations, defaults included).
-Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const sim::ResolvedKeys& nominal,
-                                                        const std::string& origin) {
-  Values values;
-  for (const Variation& v : c.variations) {
-    if (!v.scale) {
-      values.push_back({v.key, v.value});
-      continue;
+  const Layered& with_layers(const CaseSettings& c, const std::string& origin) {
+    if (c.controller >= bases.size())
+      throw StudyError(origin + ": controller " + std::to_string(c.controller) + " of a study with " +
+                       std::to_string(bases.size()));
+    const std::string id = key_of(c.controller, c.layers);
+    auto it = layered.find(id);
+    if (it != layered.end()) return it->second;
+    Layered l;
+    const std::string where = origin + " (without its variations)";
+    l.read = with_settings(bases[c.controller], c.layers, false, where);
+    l.keys = sim::resolved_keys(with_settings(l.read, {}, true, where));
+    return layered.emplace(id, std::move(l)).first->second;
+  }
+
+  // The nominal model rule (cases.hpp): the controller's model of the case without its
+  // plant-only values.
+  const plant::PlantParams& nominal_model(const CaseSettings& c, const Layered& l, const std::string& origin) {
+    std::vector<sim::KeySetting> others;
+    for (const sim::KeySetting& k : c.values)
+      if (!plant_only(k.key)) others.push_back(k);
+    std::string id = key_of(c.controller, c.layers) + key_of(c.controller, others);
+    auto it = models.find(id);
+    if (it != models.end()) return it->second;
+    if (models.size() >= kMaxModels) models.clear();
+    const sim::Scenario m = with_settings(l.read, others, false, origin + " (the controller's nominal model)");
+    return models.emplace(std::move(id), m.controller.model).first->second;
+  }
+};
+
+CaseBuilder::CaseBuilder(const StudyBases& b) : impl_(std::make_unique<Impl>()) {
+  for (std::size_t i = 0; i < b.blocks.size(); ++i) {
+    try {
+      impl_->bases.push_back(sim::read_scenario(b.base_yaml, b.base_dir, "base", b.blocks[i]));
+    } catch (const sim::ScenarioError& e) {
+      throw StudyError(b.path + (b.blocks[i].empty() ? "" : ": controller '" + b.names[i] + "'") + ": " + e.what());
     }
-    const auto it = nominal.find(v.key);
-    if (it == nominal.end())
-      throw StudyError(origin + ": " + v.key +
-                       ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or "
-                       "reference type)");
-    if (it->second.is_string || it->second.text == "true" || it->second.text == "false")
-      throw StudyError(origin + ": " + v.key + " = '" + it->second.text +
-                       "': cannot scale a value that is not a number");
-    const double nominal_value = std::strtod(it->second.text.c_str(), nullptr);
-    // Every factor of 0 is 0: the cases would silently all be the nominal one.
-    if (nominal_value == 0.0)
-      throw StudyError(origin + ": " + v.key +
-                       " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a "
-                       "distribution without scale: true)");
-    values.push_back({v.key, validate::format_number(nominal_value * v.factor)});
   }
-  return values;
 }
 
-// The nominal model rule (cases.hpp): the controller's model of the case without its plant-only
-// variations.
-const plant::PlantParams& Resolver::Impl::nominal_model(const CaseSpec& c, const Nominal& n, const Values& values,
-                                                        const std::string& origin) {
-  std::string id = std::to_string(c.controller) + " " + std::to_string(c.family) + "\n";
-  Values others;
-  for (const sim::KeySetting& k : values) {
-    if (plant_only(k.key)) continue;
-    others.push_back(k);
-    id += k.key + "=" + k.value + "\n";
+CaseBuilder::~CaseBuilder() = default;
+
+const sim::ResolvedKeys& CaseBuilder::nominal_keys(const CaseSettings& c, const std::string& origin) {
+  return impl_->with_layers(c, origin).keys;
+}
+
+// The base as read with the layers set (once per layers), the values set in a copy, the nominal
+// model rule's model from the same without the plant-only values, derived and checked: a
+// struct, never YAML read again. A setting the struct cannot take is the case's one-line error
+// naming the key and value.
+std::shared_ptr<const sim::Scenario> CaseBuilder::build(const CaseSettings& c, const std::string& origin) {
+  const Impl::Layered& l = impl_->with_layers(c, origin);
+  sim::Scenario sc = with_settings(l.read, c.values, false, origin);
+  if (c.nominal_model) sc.controller.model = impl_->nominal_model(c, l, origin);
+  return std::make_shared<const sim::Scenario>(with_settings(std::move(sc), {}, true, origin));
+}
+
+namespace {
+
+bool same_lists(const sim::Scenario& a, const sim::Scenario& b) {
+  const sim::ControllerConfig &ca = a.controller, &cb = b.controller;
+  const sim::ReferenceConfig &ra = a.reference, &rb = b.reference;
+  return fields::same(a.plant, b.plant) && fields::same(ca.model, cb.model) &&
+         fields::same(ca.sliding_mode, cb.sliding_mode) && fields::same(ca.sliding_mode.model, cb.sliding_mode.model) &&
+         fields::same(ca.cascade, cb.cascade) && fields::same(ca.open_loop, cb.open_loop) &&
+         fields::same(ca.plugin.model, cb.plugin.model) && fields::same(ra.sine, rb.sine) &&
+         fields::same(ra.step, rb.step) && fields::same(ra.accel_limited, rb.accel_limited) &&
+         fields::same(ra.scurve, rb.scurve) && fields::same(ra.ramp, rb.ramp);
+}
+
+bool same_beside_lists(const sim::Scenario& a, const sim::Scenario& b) {
+  const sim::ControllerConfig &ca = a.controller, &cb = b.controller;
+  const sim::ReferenceConfig &ra = a.reference, &rb = b.reference;
+  const auto same_points = [](const std::vector<trajectory::Waypoint>& x, const std::vector<trajectory::Waypoint>& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(),
+                      [](const auto& p, const auto& q) { return std::memcmp(&p, &q, sizeof p) == 0; });
+  };
+  const bool controller =
+      ca.type == cb.type && ca.computation_delay == cb.computation_delay && ca.model_given == cb.model_given &&
+      ca.open_loop_file == cb.open_loop_file && ca.open_loop.table_t == cb.open_loop.table_t &&
+      ca.open_loop.table_value == cb.open_loop.table_value &&
+      ca.open_loop.table_is_force == cb.open_loop.table_is_force && ca.plugin.library == cb.plugin.library &&
+      ca.plugin.parameters == cb.plugin.parameters && ca.plugin.period == cb.plugin.period &&
+      ca.plugin.u_min == cb.plugin.u_min && ca.plugin.u_max == cb.plugin.u_max &&
+      ca.plugin.computation_delay == cb.plugin.computation_delay;
+  const bool reference =
+      ra.type == rb.type && ra.waypoints_file == rb.waypoints_file && same_points(ra.waypoints, rb.waypoints);
+  return controller && reference && a.name == b.name && a.duration == b.duration &&
+         a.control_period == b.control_period && a.analysis.settled_after == b.analysis.settled_after &&
+         a.analysis.settling_band == b.analysis.settling_band && a.output.every == b.output.every &&
+         a.output.columns == b.output.columns && a.grinding_process == b.grinding_process &&
+         a.given_keys == b.given_keys && a.listed_effects == b.listed_effects && a.base_dir == b.base_dir &&
+         a.warnings == b.warnings && std::memcmp(&a.move_end_s, &b.move_end_s, sizeof(double)) == 0;
+}
+
+}  // namespace
+
+bool same_case(const sim::Scenario& a, const sim::Scenario& b) {
+  return same_lists(a, b) && same_beside_lists(a, b) && sim::resolved_keys(a) == sim::resolved_keys(b);
+}
+
+// --- resolving a case ------------------------------------------------------------------------
+
+struct Resolver::Impl {
+  const Study& s;
+  CaseBuilder builder;
+  std::vector<std::string> varied;  // every key a grid or draw of the study varies
+  // SHA-256 of a plugin library's bytes, once per path per study.
+  std::map<std::string, std::string> digests;
+
+  explicit Impl(const Study& st) : s(st), builder(StudyBases::of(st)), varied(varied_keys(st)) {}
+
+  const std::string& library_digest(const std::string& path) {
+    auto it = digests.find(path);
+    if (it != digests.end()) return it->second;
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    if (!in) throw StudyError("plugin " + path + ": cannot be read to key the study's cases");
+    return digests.emplace(path, sha256_hex(bytes.str())).first->second;
   }
-  auto it = models.find(id);
-  if (it != models.end()) return it->second;
-  if (models.size() >= kMaxModels) models.clear();
-  const sim::Scenario m = with_settings(n.read, others, false, origin + " (the controller's nominal model)");
-  return models.emplace(std::move(id), m.controller.model).first->second;
+
+  CaseSettings settings(const CaseSpec& c, const std::string& origin);
+  std::string scaled(const Variation& v, const CaseSettings& c, const std::string& origin);
+  ResolvedCase result(std::shared_ptr<const sim::Scenario> sc, CaseSettings settings);
+};
+
+// A `scale` variation's value as YAML scalar text: its factor times the key's nominal value (its
+// effective value in the case without variations, defaults included).
+std::string Resolver::Impl::scaled(const Variation& v, const CaseSettings& c, const std::string& origin) {
+  const sim::ResolvedKeys& nominal = builder.nominal_keys(c, origin);
+  const auto it = nominal.find(v.key);
+  if (it == nominal.end())
+    throw StudyError(origin + ": " + v.key +
+                     ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or "
+                     "reference type)");
+  if (it->second.is_string || it->second.text == "true" || it->second.text == "false")
+    throw StudyError(origin + ": " + v.key + " = '" + it->second.text + "': cannot scale a value that is not a number");
+  const double nominal_value = std::strtod(it->second.text.c_str(), nullptr);
+  // Every factor of 0 is 0: the cases would silently all be the nominal one.
+  if (nominal_value == 0.0)
+    throw StudyError(origin + ": " + v.key +
+                     " = 0: scaling a zero value gives 0 for every factor (give absolute values: values:, or a "
+                     "distribution without scale: true)");
+  return validate::format_number(nominal_value * v.factor);
+}
+
+// The case's settings: the layers (the controller block's set; the study's set after the
+// controller block it would otherwise be replaced by, so what it sets holds for every
+// controller, docs/study.md "How a case is made"; the controller's; the family's), the
+// variations' values, and the nominal model rule.
+CaseSettings Resolver::Impl::settings(const CaseSpec& c, const std::string& origin) {
+  CaseSettings out;
+  out.controller = c.controller;
+  const ControllerEntry& ctl = s.controllers[c.controller];
+  for (const auto* set : {&ctl.block_set, &s.set, &ctl.set, &s.families[c.family].set})
+    for (const Setting& st : *set) out.layers.push_back({st.key, st.value});
+  for (const Variation& v : c.variations) out.values.push_back({v.key, v.scale ? scaled(v, out, origin) : v.value});
+  out.nominal_model = s.model == ModelRule::kNominal && std::any_of(out.values.begin(), out.values.end(),
+                                                                    [](const auto& k) { return plant_only(k.key); });
+  return out;
 }
 
 // The case's scenario (its keys written as one YAML document), its hash and the effective value
 // of every varied key of the study.
-ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, const Values& values) {
+ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, CaseSettings settings) {
   ResolvedCase r;
   const sim::ResolvedKeys keys = sim::resolved_keys(*sc);
   r.scenario = std::move(sc);
@@ -317,8 +509,9 @@ ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, con
     const auto it = keys.find(k);
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
-  for (const sim::KeySetting& v : values)
+  for (const sim::KeySetting& v : settings.values)
     if (!r.parameters.count(v.key)) r.parameters[v.key] = v.value;
+  r.settings = std::move(settings);
   return r;
 }
 
@@ -333,21 +526,14 @@ std::string Resolver::label(const CaseSpec& c) const {
   return l;
 }
 
-// The case's nominal layers are set in the base as read once per controller and family; a case
-// is that scenario with its variations set in it (sim::set_read_keys), with the nominal model
-// rule's model from the same struct without the plant-only variations, derived and checked
-// (sim::complete_read): a struct, never YAML read again. A setting the struct cannot take is the
-// case's one-line error naming the key and value.
+// A case is its settings (Impl::settings) built by the CaseBuilder: the struct another MPI rank
+// builds from the same settings by the same code.
 ResolvedCase Resolver::resolve(const CaseSpec& c) {
   Impl& m = *impl_;
   const std::string origin = (m.s.path.empty() ? std::string("study") : m.s.path) + ": " + label(c);
-  const Impl::Nominal& nominal = m.nominal(c, origin);
-  const Impl::Values values = Impl::variation_values(c, nominal.keys, origin);
-  sim::Scenario sc = with_settings(nominal.read, values, false, origin);
-  if (m.s.model == ModelRule::kNominal &&
-      std::any_of(values.begin(), values.end(), [](const sim::KeySetting& k) { return plant_only(k.key); }))
-    sc.controller.model = m.nominal_model(c, nominal, values, origin);
-  return m.result(std::make_shared<const sim::Scenario>(with_settings(std::move(sc), {}, true, origin)), values);
+  CaseSettings settings = m.settings(c, origin);
+  auto scenario = m.builder.build(settings, origin);
+  return m.result(std::move(scenario), std::move(settings));
 }
 
 }  // namespace feeddrive::study

@@ -13,15 +13,10 @@
 
 namespace feeddrive::study {
 
-namespace {
-
-// Runs the scenario `scenario()` gives (it may throw: a failed case).
-template <typename GetScenario>
-Outcome run_one(GetScenario scenario, const interrupt::StopToken& stop) {
+Outcome run_case(const sim::Scenario& s, const interrupt::StopToken& stop) {
   Outcome o;
   const auto start = std::chrono::steady_clock::now();
   try {
-    const sim::Scenario& s = scenario();
     // Streamed: the online summary keeps no records (memory independent of the run's length).
     sim::SummaryBuilder builder(s);
     const sim::RunStats st = sim::run(
@@ -46,22 +41,6 @@ Outcome run_one(GetScenario scenario, const interrupt::StopToken& stop) {
   }
   o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return o;
-}
-
-}  // namespace
-
-Outcome run_case(const sim::Scenario& s, const interrupt::StopToken& stop) {
-  return run_one([&s]() -> const sim::Scenario& { return s; }, stop);
-}
-
-Outcome run_case(const std::string& yaml, const interrupt::StopToken& stop) {
-  sim::Scenario parsed;
-  return run_one(
-      [&]() -> const sim::Scenario& {
-        parsed = sim::parse_scenario(yaml, ".", "case");
-        return parsed;
-      },
-      stop);
 }
 
 std::string outcome_json(const std::string& hash, const Outcome& o) {

@@ -15,7 +15,6 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-#include <variant>
 
 #include "feeddrive/common/errors.hpp"
 #include "feeddrive/common/interrupt.hpp"
@@ -38,7 +37,7 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-// "<index>\n<text>": the case index and its YAML or outcome JSON in one MPI message.
+// "<index>\n<bytes>": the case index and its settings (pack_settings) or outcome JSON in one MPI message.
 std::string pack(std::size_t index, const std::string& text) { return std::to_string(index) + "\n" + text; }
 std::pair<std::size_t, std::string> unpack(const std::string& m) {
   const std::size_t nl = m.find('\n');
@@ -86,14 +85,13 @@ int available_cores() {
 
 namespace {
 
-// Worker threads running cases: the main thread hands each its index and scenario (the struct
-// on rank 0, the resolved YAML a rank received).
+// Worker threads running cases: the main thread hands each its index and the case's scenario, a
+// struct (built from the case's settings on every rank: cases.hpp, CaseBuilder).
 class CasePool {
  public:
-  using Case = std::variant<std::shared_ptr<const sim::Scenario>, std::string>;
+  using Case = std::shared_ptr<const sim::Scenario>;
   CasePool(int jobs, const interrupt::StopToken& stop)
-      : stop_(stop),
-        pool_(jobs, [this](std::size_t i) { return std::visit([this](const auto& c) { return run(c); }, take(i)); }) {}
+      : stop_(stop), pool_(jobs, [this](std::size_t i) { return run_case(*take(i), stop_); }) {}
   void push(std::size_t i, Case c) {
     {
       std::lock_guard<std::mutex> g(mu_);
@@ -111,8 +109,6 @@ class CasePool {
     cases_.erase(i);
     return c;
   }
-  Outcome run(const std::shared_ptr<const sim::Scenario>& s) const { return run_case(*s, stop_); }
-  Outcome run(const std::string& yaml) const { return run_case(yaml, stop_); }
   std::mutex mu_;
   std::map<std::size_t, Case> cases_;  // handed over, not yet taken by a thread
   const interrupt::StopToken stop_;
@@ -303,7 +299,7 @@ class CaseStream {
       } else {
         const std::size_t i = ready_.front();
         ready_.pop_front();
-        t_->send(rank, kAssign, pack(i, slots_.at(i).record.resolved.yaml));
+        t_->send(rank, kAssign, pack(i, pack_settings(slots_.at(i).record.resolved.settings)));
       }
     }
   }
@@ -471,7 +467,13 @@ StudyResult run_study(const Options& o, Transport* t, Reporter& reporter) {
     return result;
   }
   const LockedFolder folder = open_folder(o.out, t);
-  if (t) t->broadcast(0);
+  if (t) {
+    t->broadcast(0);
+    // What the other ranks build every case from (its settings come with each case): the base's
+    // text and the controllers' blocks, once.
+    const std::string bases = pack_bases(StudyBases::of(checked.study));
+    for (int r = 1; r < t->size(); ++r) t->send(r, kBases, bases);
+  }
   for (const std::string& w : folder.warnings) reporter.warning(w);
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1, available_cores() / (t ? t->local_size() : 1));
   const int ranks = t ? t->size() : 1;
@@ -492,9 +494,50 @@ StudyResult run_study(const Options& o, Transport* t, Reporter& reporter) {
   return result;
 }
 
+namespace {
+
+// A rank's cases: built from the study's bases (sent once) and each case's settings, by the code
+// that builds them on rank 0 (CaseBuilder); a case that does not build here is a failed case
+// naming this rank (it built on rank 0), as are all of them if the bases do not.
+class RankCases {
+ public:
+  RankCases(int rank, const std::string& bases) : rank_(rank) {
+    try {
+      builder_ = std::make_unique<CaseBuilder>(unpack_bases(bases));
+    } catch (const std::exception& e) {
+      error_ = e.what();
+    }
+  }
+  // The case's scenario, or nullptr with `failed` its outcome.
+  std::shared_ptr<const sim::Scenario> build(std::size_t index, const std::string& settings, Outcome& failed) {
+    if (builder_) {
+      try {
+        return builder_->build(unpack_settings(settings), "case " + std::to_string(index));
+      } catch (const std::exception& e) {
+        failed.error = e.what();
+      }
+    } else {
+      failed.error = error_;
+    }
+    failed.ok = false;
+    failed.error = "rank " + std::to_string(rank_) + " could not build the case: " + failed.error;
+    for (char& c : failed.error)
+      if (c == '\n' || c == '\r') c = ' ';
+    return nullptr;
+  }
+
+ private:
+  int rank_;
+  std::unique_ptr<CaseBuilder> builder_;
+  std::string error_;
+};
+
+}  // namespace
+
 int serve(Transport& t, int jobs, const interrupt::StopToken& stop) {
   const int status = t.broadcast(0);
   if (status != 0) return status;
+  RankCases cases(t.rank(), t.receive(0).payload);  // kBases: the first message after the broadcast
   if (jobs <= 0) jobs = std::max(1, available_cores() / t.local_size());
   CasePool pool(jobs, stop);
   bool done = false;
@@ -505,8 +548,13 @@ int serve(Transport& t, int jobs, const interrupt::StopToken& stop) {
       if (m.payload.empty()) {
         done = true;
       } else {
-        auto [i, text] = unpack(m.payload);
-        pool.push(i, std::move(text));
+        auto [i, settings] = unpack(m.payload);
+        Outcome failed;
+        if (auto scenario = cases.build(i, settings, failed)) {
+          pool.push(i, std::move(scenario));
+        } else {
+          t.send(0, kResult, pack(i, outcome_json("", failed)));
+        }
       }
       continue;
     }

@@ -103,8 +103,13 @@ run_info_t valid(std::mt19937_64& rng) {
   m.run_id = 1;
   m.scenario = text(rng, 40);
   m.mode = "lockstep";
-  m.friction_model = "lugre";
-  m.mass = num(rng);
+  m.plant.resize(1 + rng() % 4);  // run_info_t.plant: the drive's parameters, 1..96 of them
+  for (parameter_t& p : m.plant) {
+    p.key = text(rng, wire::Check<parameter_t>::kMax_key);
+    p.value = num(rng);
+    p.name = text(rng, wire::Check<parameter_t>::kMax_name);
+  }
+  m.plant_count = static_cast<std::int16_t>(m.plant.size());
   mac(rng, m.mac_size, m.mac);
   return m;
 }
@@ -156,7 +161,11 @@ std::vector<std::size_t> string_length_offsets(const Bytes& b, const std::vector
 
 std::vector<std::string> strings_of(const process_status_t& m) { return {m.role, m.state, m.message}; }
 std::vector<std::string> strings_of(const resend_request_t& m) { return {m.requester, m.channel}; }
-std::vector<std::string> strings_of(const run_info_t& m) { return {m.scenario, m.mode, m.friction_model}; }
+std::vector<std::string> strings_of(const run_info_t& m) {
+  std::vector<std::string> s = {m.scenario, m.mode};
+  for (const parameter_t& p : m.plant) s.insert(s.end(), {p.key, p.name});
+  return s;
+}
 std::vector<std::string> strings_of(const run_summary_t& m) { return {m.scenario, m.failure}; }
 template <typename Msg>
 std::vector<std::string> strings_of(const Msg&) {
@@ -170,6 +179,10 @@ std::vector<std::pair<std::size_t, std::size_t>> count_offsets(const Msg& m, con
   std::vector<std::pair<std::size_t, std::size_t>> at;  // (offset, size)
   at.emplace_back(b.size() - m.mac.size() - 2, 2);
   if constexpr (std::is_same_v<Msg, reference_block_t>) at.emplace_back(8 + 8 + 8, 4);
+  // run_info_t.plant_count: after the fingerprint, run_id, utime, run_nonce, scenario, mode,
+  // control_period and steps.
+  if constexpr (std::is_same_v<Msg, run_info_t>)
+    at.emplace_back(8 + 3 * 8 + (4 + m.scenario.size() + 1) + (4 + m.mode.size() + 1) + 2 * 8, 2);
   return at;
 }
 
@@ -177,6 +190,8 @@ template <typename Msg>
 bool within_bounds(const Msg& m) {
   if constexpr (std::is_same_v<Msg, reference_block_t>)
     if (m.refs.size() > 16 || m.count < 1) return false;
+  if constexpr (std::is_same_v<Msg, run_info_t>)
+    if (m.plant.size() > 96 || m.plant_count < 0) return false;
   return m.mac.size() <= 32 && m.getEncodedSize() <= static_cast<int>(wire::Check<Msg>::kMaxEncoded);
 }
 

@@ -4,12 +4,14 @@
 // names the library and what failed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
 
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/controller/plugin_host.hpp"
+#include "feeddrive/plant/parameter_table.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
 
@@ -48,7 +50,10 @@ void expect_one_line(const std::string& e, const std::string& library, const std
 TEST(PluginHost, ErrorsAreOneLineNamingLibraryAndCause) {
   expect_one_line(error_of(params_of("no_such_plugin")), module("no_such_plugin"), "no such file");
   expect_one_line(error_of(params_of("fd_fault_version")), module("fd_fault_version"),
-                  "ABI version 999, this feeddrive hosts ABI version 1");
+                  "ABI version 999, this feeddrive hosts ABI version 2");
+  // A plugin built for ABI version 1 (the struct of model fields): refused, both versions named.
+  expect_one_line(error_of(params_of("fd_fault_old")), module("fd_fault_old"),
+                  "ABI version 1, this feeddrive hosts ABI version 2 only (rebuild the plugin");
   expect_one_line(error_of(params_of("fd_fault_no_reset")), module("fd_fault_no_reset"),
                   "missing symbol feeddrive_controller_reset");
   expect_one_line(error_of(params_of("fd_fault_refuse")), module("fd_fault_refuse"),
@@ -93,6 +98,108 @@ TEST(PluginHost, ManyInstancesOfOneLibraryAreIndependent) {
   EXPECT_EQ(b.update({}, {}, nullptr).sliding, 1.0);
 }
 
+// The model a plugin is given is the plant's one list walked (plugin.h, feeddrive_run_info.model):
+// every key of PlantParams' Serialize but the excluded sections, each with the model's value, read
+// through plugin.h's own accessors; a field added to the list is there without further code (the
+// struct of ABI version 1 was a hand copy that missed friction.static_smoothing_shape).
+TEST(PluginRunInfo, ModelTableIsThePlantListWalked) {
+  controller::PluginParams p;
+  p.library = "unused.so";
+  p.period = 2e-4;
+  p.u_min = -7.0;
+  p.u_max = 8.0;
+  p.model.mass = 91.5;
+  p.model.friction.model = plant::FrictionModel::kStatic;
+  p.model.friction.stribeck_exponent = 1.3;
+  p.model.friction.static_smoothing_shape = 0.25;
+  p.model.ripple.enabled = true;
+  p.model.sensor.velocity = plant::VelocityMeasurement::kDifference;
+  const controller::PluginRunInfo run(p);
+  const feeddrive_run_info& info = run.info();
+  EXPECT_EQ(info.abi_version, 2u);
+  EXPECT_EQ(info.size, sizeof(feeddrive_run_info));
+  EXPECT_EQ(info.period, 2e-4);
+  EXPECT_EQ(info.u_min, -7.0);
+  EXPECT_EQ(info.u_max, 8.0);
+
+  // Every value of the list, walked here independently of the host's table.
+  const std::vector<std::string> excluded = plant::table_excluded_keys();
+  std::size_t listed = 0;
+  for (const fields::FlatValue& v : fields::flatten(p.model)) {
+    const bool out = std::any_of(excluded.begin(), excluded.end(),
+                                 [&](const std::string& e) { return v.key.rfind(e + ".", 0) == 0; });
+    double number = -12345.0;
+    if (out) {
+      EXPECT_FALSE(feeddrive_model_number(&info, v.key.c_str(), &number)) << v.key << " should be left out";
+      EXPECT_EQ(feeddrive_model_name(&info, v.key.c_str()), nullptr) << v.key;
+      continue;
+    }
+    ++listed;
+    if (v.is_name) {
+      const char* name = feeddrive_model_name(&info, v.key.c_str());
+      ASSERT_NE(name, nullptr) << v.key;
+      EXPECT_EQ(std::string(name), v.name) << v.key;
+      EXPECT_FALSE(feeddrive_model_number(&info, v.key.c_str(), &number)) << v.key << " is a name";
+    } else {
+      ASSERT_TRUE(feeddrive_model_number(&info, v.key.c_str(), &number)) << v.key;
+      EXPECT_EQ(std::memcmp(&number, &v.number, sizeof number), 0) << v.key << " = " << number;  // bit for bit
+    }
+  }
+  EXPECT_GT(listed, 40u);  // mass, Ka, Kf, the limit and the friction, ripple, grinding, ... sections
+  EXPECT_EQ(info.model_size, listed + plant::table_derived_keys().size());
+
+  // The values this test set, by their scenario keys, and the derived ones.
+  double x = 0.0;
+  ASSERT_TRUE(feeddrive_model_number(&info, "friction.static_smoothing_shape", &x));
+  EXPECT_EQ(x, 0.25);
+  ASSERT_TRUE(feeddrive_model_number(&info, "friction.stribeck_exponent", &x));
+  EXPECT_EQ(x, 1.3);
+  ASSERT_TRUE(feeddrive_model_number(&info, "mass", &x));
+  EXPECT_EQ(x, 91.5);
+  ASSERT_TRUE(feeddrive_model_number(&info, "ripple.enabled", &x));
+  EXPECT_EQ(x, 1.0);  // a flag is 1 or 0
+  EXPECT_STREQ(feeddrive_model_name(&info, "friction.model"), "static");
+  EXPECT_STREQ(feeddrive_model_name(&info, "sensor.velocity"), "difference");
+  ASSERT_TRUE(feeddrive_model_number(&info, "thrust_gain", &x));
+  EXPECT_EQ(x, p.model.thrust_gain());
+  ASSERT_TRUE(feeddrive_model_number(&info, "grinding.damping", &x));
+  EXPECT_EQ(x, p.model.grinding.damping());
+  EXPECT_FALSE(feeddrive_model_number(&info, "friction.stribeck_exponant", &x));  // a misspelt key: not found
+  EXPECT_EQ(feeddrive_model_name(&info, "mass"), nullptr);                        // a number, not a name
+}
+
+// A derived value of the table is never a key of the list (it would shadow it).
+TEST(PluginRunInfo, DerivedKeysAreNotKeysOfTheList) {
+  for (const fields::FlatValue& v : fields::flatten(plant::PlantParams{}))
+    for (const std::string& d : plant::table_derived_keys()) EXPECT_NE(v.key, d);
+}
+
+// The built-in boundary-layer law's scenario with the example plugin in its place: its model, its
+// gains as the plugin's parameters.
+sim::Scenario as_example_plugin(const sim::Scenario& builtin) {
+  const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
+  sim::Scenario plugin = builtin;
+  sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
+  plugin.controller.plugin.model = smc.model;
+  plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
+                                         {"k", validate::format_number(smc.k)},
+                                         {"lambda", validate::format_number(smc.lambda)},
+                                         {"switching", "sat"},
+                                         {"boundary_layer", validate::format_number(smc.boundary_layer)}};
+  return plugin;
+}
+
+// Every record of the two runs the same, bit for bit.
+void expect_same_records(const sim::Scenario& builtin, const sim::Scenario& plugin, const std::string& name) {
+  const auto a = sim::run(builtin), b = sim::run(plugin);
+  ASSERT_EQ(a.records.size(), b.records.size());
+  for (std::size_t k = 0; k < a.records.size(); ++k) {
+    const auto va = sim::record_values(a.records[k]), vb = sim::record_values(b.records[k]);
+    ASSERT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)), 0)
+        << name << ": record " << k << " differs";
+  }
+}
+
 // The example plugin (the boundary-layer law in C) against the built-in sliding_mode law on the
 // paper's moves: every record identical, bit for bit (it computes the same terms in the same
 // order). The ramp with friction, ripple and grinding exercises every force term it compensates.
@@ -102,24 +209,25 @@ TEST(PluginHost, ExamplePluginEqualsBuiltInLawRecordForRecord) {
         sim::load_scenario(std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/paper/" + name + ".yaml");
     builtin.duration = 0.4;  // the move's start, its constant velocity and (ramp) the contact: 4,000 periods
     ASSERT_EQ(builtin.controller.type, sim::ControllerType::kSlidingMode);
-    const controller::SlidingModeParams& smc = builtin.controller.sliding_mode;
-    ASSERT_EQ(smc.switching, controller::Switching::kSaturation);
-    sim::Scenario plugin = builtin;
-    sim::use_plugin(plugin, std::string(FEEDDRIVE_EXAMPLE_PLUGIN));
-    plugin.controller.plugin.model = smc.model;
-    plugin.controller.plugin.parameters = {{"eta", validate::format_number(smc.eta)},
-                                           {"k", validate::format_number(smc.k)},
-                                           {"lambda", validate::format_number(smc.lambda)},
-                                           {"switching", "sat"},
-                                           {"boundary_layer", validate::format_number(smc.boundary_layer)}};
-    const auto a = sim::run(builtin), b = sim::run(plugin);
-    ASSERT_EQ(a.records.size(), b.records.size());
-    for (std::size_t k = 0; k < a.records.size(); ++k) {
-      const auto va = sim::record_values(a.records[k]), vb = sim::record_values(b.records[k]);
-      ASSERT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)), 0)
-          << name << ": record " << k << " differs";
-    }
+    ASSERT_EQ(builtin.controller.sliding_mode.switching, controller::Switching::kSaturation);
+    expect_same_records(builtin, as_example_plugin(builtin), name);
   }
+}
+
+// The same with the static friction law and a smoothed sign between tanh and the algebraic form
+// (friction.static_smoothing_shape = 0.5): the plugin reads the shape from the host's table. With
+// ABI version 1 it could not (the struct had no such field), and its tanh(v/eps) differed.
+TEST(PluginHost, ExamplePluginEqualsBuiltInLawWithStaticFrictionShape) {
+  sim::Scenario builtin =
+      sim::load_scenario(std::string(FEEDDRIVE_SOURCE_DIR) + "/scenarios/paper/smc_bl_ramp_all_forces.yaml");
+  builtin.duration = 0.2;
+  for (plant::PlantParams* m : {&builtin.plant, &builtin.controller.sliding_mode.model}) {
+    m->friction.model = plant::FrictionModel::kStatic;
+    m->friction.static_smoothing_velocity = 1e-3;  // wide enough that the shape shows in the force
+    m->friction.static_smoothing_shape = 0.5;
+    m->friction.stribeck_exponent = 1.5;
+  }
+  expect_same_records(builtin, as_example_plugin(builtin), "static friction, shape 0.5");
 }
 
 }  // namespace

@@ -207,6 +207,47 @@ TEST_F(MonitorProtocol, RecordsEveryStepAndAcknowledgesIt) {
   EXPECT_EQ(listener.infos.front().contract_version, service::kContractVersion);
 }
 
+// A participant of contract version 3: its heartbeat decodes (process_status_t did not change in
+// version 4) and says contract_version 3; the monitor names it in one line with both versions
+// and what to do, and the run fails at once instead of at a timeout.
+TEST_F(MonitorProtocol, AVersion3ParticipantIsNamedAndTheRunFails) {
+  MonitorNode& node = make_node("version3");
+  process_status_t hb{};
+  hb.role = "controller";
+  hb.state = "running";
+  hb.seq = -1;
+  hb.acked_seq = -1;
+  hb.contract_version = 3;
+  run->publish(kCh.status, hb);
+  EXPECT_FALSE(node.run());
+  listener.wait_for_the_end();
+  const std::string& why = node.summary().failure;
+  EXPECT_NE(why.find("the controller speaks contract version 3; this run speaks 4: rebuild it with this feeddrive's "
+                     "lcmtypes/ (docs/lcm-contract.md, Versions)"),
+            std::string::npos)
+      << why;
+  EXPECT_EQ(why.find('\n'), std::string::npos) << "one line";
+}
+
+// A run_info_t of contract version 3 (a monitor of an older feeddrive on the group) does not decode
+// as version 4's (its drive's parameters were fields); its fingerprint names it, with both versions.
+TEST(Contract, AVersion3RunInfoIsRecognisedByItsFingerprint) {
+  std::vector<std::uint8_t> v3(200, 0);
+  const std::uint64_t fp = 0x2a2e53f13bd0f348ULL;  // lcm-gen's run_info_t of lcmtypes/ at fad0b3a (contract 3)
+  for (int i = 0; i < 8; ++i) v3[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(fp >> (56 - 8 * i));
+  const auto older = service::older_contract(kCh, kCh.info, v3.data(), v3.size());
+  ASSERT_TRUE(older);
+  EXPECT_EQ(older->version, 3);
+  const std::string line = service::describe_older(*older, kCh.info);
+  EXPECT_EQ(line.rfind("a participant speaks contract version 3 (a run_info_t of 26 November 2026", 0), 0u) << line;
+  EXPECT_NE(line.find("this run speaks 4: rebuild it"), std::string::npos) << line;
+
+  run_info_t now{};
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(now.getEncodedSize()));
+  now.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  EXPECT_FALSE(service::older_contract(kCh, kCh.info, bytes.data(), bytes.size())) << "this contract's is not older";
+}
+
 // A lost command: the monitor asks for it on FD_RESEND (only for it: every other message of the
 // run is there), the controller re-sends it, the record is complete. A state that arrives twice
 // is a duplicate, recorded once.

@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <string>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/reference_block_t.hpp"
 #include "feeddrive/run_info_t.hpp"
@@ -167,8 +169,7 @@ TEST(Translate, RunInfoFromTheScenarioAndOptions) {
   EXPECT_EQ(i.scenario_hash, "abc123");
   EXPECT_EQ(i.contract_version, kContractVersion);
   EXPECT_EQ(i.current_step, -1);
-  EXPECT_EQ(i.mass, s.plant.mass);
-  EXPECT_EQ(i.friction_model, "lugre");
+  EXPECT_EQ(i.plant_count, static_cast<std::int16_t>(i.plant.size()));
   EXPECT_EQ(i.u_min, s.controller.sliding_mode.u_min);
   EXPECT_EQ(i.u_max, s.controller.sliding_mode.u_max);
   EXPECT_EQ(i.sensor_velocity, s.plant.sensor.ideal() ? "true" : "difference");
@@ -186,6 +187,66 @@ TEST(Translate, RunInfoFromTheScenarioAndOptions) {
   const auto got = over_memq(to_run_info(s, opt, ""));
   ASSERT_TRUE(got) << "a run_info_t with a 300-byte scenario name did not arrive";
   EXPECT_EQ(got->scenario, std::string(wire::Check<run_info_t>::kMax_scenario, 'n'));
+}
+
+// The value of run_info_t.plant's entry `key`, or nullptr.
+const parameter_t* entry(const run_info_t& i, const std::string& key) {
+  for (const parameter_t& p : i.plant)
+    if (p.key == key) return &p;
+  return nullptr;
+}
+
+// run_info_t.plant is the plant's one list walked (plant::parameter_table): every key of
+// PlantParams' Serialize, walked here independently, arrives over memq:// with the scenario's
+// value, bit for bit, except the effects (the hidden discrepancy) and the integrator; a key added
+// to the list reaches the participants without a change here. Contract 3 had a hand-written set
+// of fields that missed friction.stribeck_exponent (the C++ example assumed delta = 2).
+TEST(Translate, RunInfoCarriesEveryParameterOfThePlantList) {
+  sim::Scenario s = scenario(20);
+  s.plant.friction.stribeck_exponent = 1.7;
+  s.plant.friction.static_smoothing_shape = 0.5;
+  s.plant.ripple.cogging_third = 0.75;
+  s.plant.effects.constant_force.enabled = true;
+  s.plant.effects.constant_force.force_N = 3.0;
+  const auto got = over_memq(to_run_info(s, node_options(), ""));
+  ASSERT_TRUE(got) << "run_info_t did not arrive";
+  std::size_t listed = 0;
+  for (const fields::FlatValue& v : fields::flatten(s.plant)) {
+    const parameter_t* p = entry(*got, v.key);
+    if (v.key.rfind("effects.", 0) == 0 || v.key.rfind("integrator.", 0) == 0) {
+      EXPECT_EQ(p, nullptr) << v.key << " is not told to the participants";
+      continue;
+    }
+    ++listed;
+    ASSERT_NE(p, nullptr) << v.key << " is missing from run_info_t.plant";
+    EXPECT_EQ(p->name, v.name) << v.key;
+    if (v.is_name) {
+      EXPECT_TRUE(std::isnan(p->value)) << v.key;
+    } else {
+      EXPECT_EQ(std::memcmp(&p->value, &v.number, sizeof(double)), 0) << v.key << " = " << p->value;
+    }
+  }
+  EXPECT_EQ(got->plant.size(), listed + 2) << "the list and the two derived values";
+  ASSERT_NE(entry(*got, "friction.stribeck_exponent"), nullptr);
+  EXPECT_EQ(entry(*got, "friction.stribeck_exponent")->value, 1.7);
+  EXPECT_EQ(entry(*got, "friction.static_smoothing_shape")->value, 0.5);
+  EXPECT_EQ(entry(*got, "friction.model")->name, "lugre");
+  EXPECT_EQ(entry(*got, "thrust_gain")->value, s.plant.thrust_gain());
+  EXPECT_EQ(entry(*got, "grinding.damping")->value, s.plant.grinding.damping());
+  EXPECT_EQ(entry(*got, "input_limit")->value, s.plant.input_limit);
+  EXPECT_EQ(got->plant_count, static_cast<std::int16_t>(got->plant.size()));
+}
+
+// A table that does not fit the contract's bounds is refused, never cut: a key cut to 47 bytes
+// would name another parameter.
+TEST(Translate, AParameterBeyondTheContractsBoundsIsRefused) {
+  std::vector<fields::FlatValue> t = {{"mass", 1.0, "", false}};
+  EXPECT_EQ(to_parameters(t).size(), 1u);
+  t.push_back({std::string(wire::Check<parameter_t>::kMax_key + 1, 'k'), 2.0, "", false});
+  EXPECT_THROW(to_parameters(t), std::logic_error);
+  std::vector<fields::FlatValue> many(static_cast<std::size_t>(wire::Check<run_info_t>::kMax_plant_count) + 1,
+                                      {"mass", 1.0, "", false});
+  EXPECT_THROW(to_parameters(many), std::logic_error);
 }
 
 // A block of no references (the contract: 1..16) leaves the sender but no receiver takes it:

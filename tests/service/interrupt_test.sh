@@ -11,8 +11,10 @@ cd "$TMP"
 scen=$SRC/scenarios/paper/smc_sine.yaml
 
 # interrupt NAME PID WHEN: sends SIGINT to PID once WHEN (a shell test) holds, within 30 s, then
-# checks exit code, time to exit, stderr ($TMP/NAME.err) and that no staging folder remains. A
-# WHEN that is only a sleep is a point in time of the phase under test, not a wait for something.
+# checks exit code, time to exit, stderr ($TMP/NAME.err) and that no staging folder remains. WHEN
+# is the phase under test reached (CPU time spent computing, a child started, a step of the run
+# on the bus), never a fixed sleep: a sleep long enough on a loaded machine is past the phase on
+# a fast one.
 interrupt() {
   local name=$1 pid=$2 when=$3 t0 t1 rc
   wait_until 30 "$name: the phase to interrupt" eval "$when"
@@ -35,7 +37,7 @@ gnuplot_running() { pgrep -P "$1" gnuplot > /dev/null; }
 
 feeddrive-sim "$scen" --out sim_run -q 2> sim_run.err &
 p=$!
-interrupt sim_run $p "sleep 0.3; true"  # under test: 0.3 s into the simulation (a point in time)
+interrupt sim_run $p "cpu_ms_at_least $p 100"  # under test: simulating (loading takes a few ms of CPU)
 [ ! -e sim_run ] || fail "sim_run: an output folder was created"
 
 feeddrive-sim "$scen" --out sim_plot -q 2> sim_plot.err &
@@ -52,7 +54,7 @@ timeout 120 feeddrive-sim truth.yaml --out fitdata --no-plots -q
 cut -d, -f1,7,13 fitdata/timeseries.csv | sed '1s/.*/t,x,u/' > fitdata.csv
 feeddrive-fit -s "$SRC/scenarios/fit/model.yaml" -d fitdata.csv --out fit_run -q > /dev/null 2> fit_run.err &
 p=$!
-interrupt fit_run $p "sleep 0.5; true"  # under test: 0.5 s into the fit (a point in time)
+interrupt fit_run $p "cpu_ms_at_least $p 300"  # under test: fitting (seconds of CPU; loading takes ms)
 [ ! -e fit_run ] || fail "fit_run: an output folder was created"
 feeddrive-fit -s "$SRC/scenarios/fit/model.yaml" -d fitdata.csv --out fit_plot -q > /dev/null 2> fit_plot.err &
 p=$!
@@ -62,8 +64,8 @@ interrupt fit_plot $p "gnuplot_running $p"
 # feeddrive-launch: four processes in lockstep; SIGINT to the launcher is forwarded to each.
 feeddrive-launch "$scen" --out launch_run --lcm-url "$URL" --no-plots -q 2> launch_run.err &
 p=$!
-# Under test: 1 s after the monitor started, mid-run (a point in time, once the monitor is there).
-interrupt launch_run $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"
+# Under test: mid-run, once step 3000 (of 15,000) is on the bus: the monitor has recorded steps.
+interrupt launch_run $p "wait_bus_step 3000"
 [ -z "$(pgrep -P $p)" ] || fail "launch_run: a child process still runs"
 [ "$(json launch_run/summary.json .lockstep.completed)" = false ] || fail "launch_run: summary does not say completed: false"
 json launch_run/summary.json .lockstep.failure | grep -q "interrupted by SIGINT" || fail "launch_run: the failure is not the interrupt"
@@ -76,18 +78,19 @@ timeout 120 feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plo
 before=$(md5sum < launch_run2/timeseries.csv)
 feeddrive-launch "$scen" --out launch_run2 --lcm-url "$URL" --no-plots -q 2> launch_run2.err &
 p=$!
-interrupt launch_run2 $p "[ -n \"\$(pgrep -P $p feeddrive-monit)\" ] && sleep 1"  # as launch_run: a point in time
+interrupt launch_run2 $p "wait_bus_step 3000"  # as launch_run: mid-run
 [ "$(md5sum < launch_run2/timeseries.csv)" = "$before" ] || fail "launch_run2: the earlier output was changed"
 [ "$(json launch_run2/summary.json .lockstep.completed)" = true ] || fail "launch_run2: the earlier summary was replaced"
 [ "$(json launch_run2.incomplete-1/summary.json .lockstep.completed)" = false ] ||
   fail "launch_run2: the interrupted record is not in launch_run2.incomplete-1"
 pass "launch_run2: the earlier output kept, the interrupted record ($(json launch_run2.incomplete-1/summary.json .steps) steps) beside it"
 
-# Ctrl-C while the launcher starts its processes (50 ms in): a signal that reached a child
-# between fork and exec was lost, and the child ran on to its 10 s start timeout.
+# Ctrl-C while the launcher starts its processes (its first child forked, the others to come): a
+# signal that reached a child between fork and exec was lost, and the child ran on to its 10 s
+# start timeout.
 feeddrive-launch "$scen" --out launch_early --lcm-url "$URL" --no-plots -q 2> launch_early.err &
 p=$!
-interrupt launch_early $p "sleep 0.05; true"  # under test: 50 ms in (a point in time)
+interrupt launch_early $p "pgrep -P $p > /dev/null"  # under test: the launcher starting its processes
 [ -z "$(pgrep -P $p)" ] || fail "launch_early: a child process still runs"
 
 # Ctrl-C while the monitor draws the plots of a complete run: what it recorded cannot be made

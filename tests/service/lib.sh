@@ -53,6 +53,21 @@ monitor_step_at_least() { [ "$(monitor_step "$1")" -ge "$2" ]; }
 wait_step() {
   wait_until 30 "the monitor's progress in $1 reached step $2" monitor_step_at_least "$1" "$2"
 }
+# wait_bus_step STEP [PREFIX]: waits until a state of step STEP or later is on the bus (the run
+# is that far; fd-test-peer watch listens, never publishes), within 30 s; fails naming STEP. For
+# a run started with -q, whose stderr has no progress line for wait_step to read.
+wait_bus_step() {
+  "$BUILD/tests/fd-test-peer" watch --steps "$1" --prefix "${2:-FD}" --lcm-url "$URL" --seconds 30 > /dev/null ||
+    fail "no state of step $1 or later on the bus within 30 s"
+}
+# cpu_ms_at_least PID MS: process PID (all its threads) has used at least MS ms of CPU time
+# (user + system, /proc/PID/stat): how far a computation has come, whatever the machine's load.
+cpu_ms_at_least() {
+  local stat ticks
+  stat=$(cat "/proc/$1/stat" 2> /dev/null) || return 1
+  ticks=$(echo "${stat##*) }" | awk '{ print $12 + $13 }')  # utime, stime: fields 14, 15 of the line
+  [ $((ticks * 1000 / $(getconf CLK_TCK))) -ge "$2" ]
+}
 # descendants PID: the processes below PID (its children, theirs, ...).
 descendants() {
   local c

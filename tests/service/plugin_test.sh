@@ -111,10 +111,12 @@ expect_error() {  # LIBRARY EXPECTED-TEXT [TOOL...]
 }
 expect_error "$TMP/nowhere.so" "no such file"
 expect_error "$PD/libfd_fault_no_reset.so" "missing symbol feeddrive_controller_reset"
-expect_error "$PD/libfd_fault_version.so" "ABI version 999, this feeddrive hosts ABI version 1"
+expect_error "$PD/libfd_fault_version.so" "ABI version 999, this feeddrive hosts ABI version 2"
+# A plugin built for ABI version 1 (the model as a struct of fields, before issue 22's table).
+expect_error "$PD/libfd_fault_old.so" "ABI version 1, this feeddrive hosts ABI version 2 only (rebuild the plugin"
 expect_error "$PD/libfd_fault_nan.so" "returned u = nan"
 expect_error "$PD/libfd_fault_throw.so" "an exception left the plugin"
 rc=0
 timeout 60 feeddrive-controller "$BUILTIN" --plugin "$PD/libfd_fault_version.so" --lcm-url "$URL" 2> "$TMP/err" || rc=$?
 [ "$rc" = 2 ] && grep -q "ABI version 999" "$TMP/err" || { cat "$TMP/err" >&2; fail "feeddrive-controller --plugin (ABI 999): exit $rc"; }
-pass "errors: missing library, missing symbol, ABI mismatch, NaN, exception: one line and exit 2 each"
+pass "errors: missing library, missing symbol, ABI mismatch (999, and an ABI 1 plugin), NaN, exception: one line and exit 2 each"

@@ -24,7 +24,8 @@ sdk_check() {
   timeout 120 "$exe" "$URL" FD 2> "$TMP/c.err" & c=$!
   timeout 120 feeddrive-launch "$scen" --out "$TMP/run" --no-plots -q --external controller --lcm-url "$URL"
   wait $c || { cat "$TMP/c.err" >&2; fail "the example controller failed"; }
-  grep -q "run smc_bl_jerk_limited (lockstep): T = 0.0001 s, 15000 steps, m = 102.04 kg, Ka\*Kf = 260 N/V" "$TMP/c.err" ||
+  # Its whole model from run_info_t.plant (contract 4), delta included.
+  grep -q "run smc_bl_jerk_limited (lockstep): T = 0.0001 s, 15000 steps, m = 102.04 kg, Ka\*Kf = 260 N/V, friction lugre (Fs 120 N, Fc 80 N, vs 0.1 m/s, delta 2)" "$TMP/c.err" ||
     { cat "$TMP/c.err" >&2; fail "the example did not configure itself from run_info_t"; }
   [ "$(json "$TMP/run/summary.json" .lockstep.completed)" = true ] || fail "run not completed"
   e=$(json "$TMP/run/summary.json" .position_error_max_abs_m)

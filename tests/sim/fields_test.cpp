@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 #include <string>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/sim/key_tables.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "scenario_error.hpp"
@@ -116,6 +118,62 @@ TEST(Fields, RippleIsZeroUnlessThePaperIsNamed) {
   EXPECT_DOUBLE_EQ(back.plant.ripple.cogging_third, 1.0);
   EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: sine}", "{ripple: papers}")),
             "s.yaml: plant.ripple = 'papers': expected a map of keys, or one of none, paper");
+}
+
+// flatten walks a list to (dotted key, value), nested structs, flags, integers and enums
+// included, leaving out the keys it is told; unflatten sets a struct from such a table through
+// the same list: the round trip is the same struct (fields::same), every field set once.
+TEST(Fields, FlattenAndUnflattenRoundTripThroughTheList) {
+  plant::PlantParams p;
+  p.mass = 91.25;
+  p.friction.model = plant::FrictionModel::kStatic;
+  p.friction.stribeck_exponent = 1.3;
+  p.friction.static_smoothing_shape = 0.75;
+  p.ripple.enabled = true;
+  p.sensor.seed = 123456789;
+  p.sensor.velocity = plant::VelocityMeasurement::kDifference;
+  p.integrator.max_steps = 777;
+  p.grinding.contact_position = -std::numeric_limits<double>::infinity();
+  const std::vector<fields::FlatValue> t = fields::flatten(p);
+  const auto find = [&](const std::string& key) -> const fields::FlatValue* {
+    for (const fields::FlatValue& v : t)
+      if (v.key == key) return &v;
+    return nullptr;
+  };
+  ASSERT_NE(find("friction.stribeck_exponent"), nullptr);
+  EXPECT_EQ(find("friction.stribeck_exponent")->number, 1.3);
+  EXPECT_EQ(find("friction.model")->name, "static");
+  EXPECT_TRUE(find("friction.model")->is_name);
+  EXPECT_EQ(find("ripple.enabled")->number, 1.0);
+  EXPECT_EQ(find("integrator.max_steps")->number, 777.0);
+  EXPECT_EQ(find("effects.constant_force.force_N")->number, 0.0);
+  plant::PlantParams q;
+  EXPECT_FALSE(fields::same(p, q));
+  EXPECT_EQ(fields::unflatten(q, find), t.size());
+  EXPECT_TRUE(fields::same(p, q));
+  // Left out: a key and a whole section; the fields a table lacks keep their values.
+  const std::vector<fields::FlatValue> part = fields::flatten(p, {"mass", "effects"});
+  EXPECT_EQ(
+      std::count_if(part.begin(), part.end(),
+                    [](const fields::FlatValue& v) { return v.key == "mass" || v.key.rfind("effects.", 0) == 0; }),
+      0);
+  plant::PlantParams r;
+  r.mass = 50.0;
+  fields::unflatten(r, [&](const std::string& key) -> const fields::FlatValue* {
+    for (const fields::FlatValue& v : part)
+      if (v.key == key) return &v;
+    return nullptr;
+  });
+  EXPECT_EQ(r.mass, 50.0);
+  EXPECT_EQ(r.friction.stribeck_exponent, 1.3);
+  // An enum's name it does not know: one line naming the key.
+  fields::FlatValue bad{"friction.model", 0.0, "lugr", true};
+  try {
+    fields::unflatten(r, [&](const std::string& key) { return key == "friction.model" ? &bad : nullptr; });
+    ADD_FAILURE() << "an unknown friction law was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "friction.model = 'lugr': expected one of lugre, static, none");
+  }
 }
 
 TEST(Fields, KeyTablesListEverySection) {

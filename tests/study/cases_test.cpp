@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/study/cases.hpp"
@@ -292,8 +293,12 @@ TEST(StudyCases, EveryKindOfSettingBuildsTheCaseAsAStruct) {
   EXPECT_DOUBLE_EQ(sc.plant.friction.coulomb_force, 70);
   EXPECT_DOUBLE_EQ(sc.plant.friction.static_force, 120);  // the default: the map replaced the part
   EXPECT_EQ(sc.controller.model.friction.model, plant::FrictionModel::kLuGre);  // the nominal model rule
-  // The struct runs as its record would: the same metrics, bit for bit.
-  const Outcome a = run_case(sc), b = run_case(last.yaml);
+  // Built on another MPI rank from the case's settings (cases.hpp): the same struct, which runs
+  // to the same metrics, bit for bit.
+  CaseBuilder rank(unpack_bases(pack_bases(StudyBases::of(s))));
+  const auto there = rank.build(unpack_settings(pack_settings(last.settings)), "case");
+  ASSERT_TRUE(same_case(sc, *there));
+  const Outcome a = run_case(sc), b = run_case(*there);
   ASSERT_TRUE(a.ok) << a.error;
   ASSERT_TRUE(b.ok) << b.error;
   ASSERT_EQ(a.metrics.size(), b.metrics.size());
@@ -304,6 +309,62 @@ TEST(StudyCases, EveryKindOfSettingBuildsTheCaseAsAStruct) {
         << a.metrics[i].first;
   }
   EXPECT_EQ(a.warnings, b.warnings);
+}
+
+// An MPI rank builds each case from the study's bases (sent once) and the case's settings (sent
+// with it), never from a YAML document of the case: every case of a study with two controllers, a
+// grid of absolute and scaled values, Monte Carlo draws, a family set and the nominal model rule
+// is the same struct on the rank as on rank 0 (same_case: every section's list by fields::same,
+// the resolved keys, the reader's records beside the lists). The resolved YAML read back, what
+// ranks parsed before, is not the same struct: every key counts as given there.
+TEST(StudyCases, ACaseBuiltOnAnotherRankIsTheSameStruct) {
+  const Study s = families();
+  Resolver local(s);
+  const std::string bases = pack_bases(StudyBases::of(s));  // what rank 0 sends each rank once
+  CaseBuilder rank(unpack_bases(bases));
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < case_count(s); i += 3) {  // every third case: 38 of 114, each family and controller
+    const CaseSpec c = case_at(s, i);
+    const ResolvedCase here = local.resolve(c);
+    const std::string sent = pack_settings(here.settings);  // what rank 0 sends with the case
+    const CaseSettings received = unpack_settings(sent);
+    EXPECT_TRUE(received == here.settings) << local.label(c);
+    const auto there = rank.build(received, "case " + std::to_string(i));
+    EXPECT_TRUE(same_case(*here.scenario, *there)) << local.label(c);
+    EXPECT_TRUE(fields::same(here.scenario->plant, there->plant)) << local.label(c);
+    EXPECT_TRUE(fields::same(here.scenario->controller.sliding_mode.model, there->controller.sliding_mode.model))
+        << local.label(c);
+    ++n;
+  }
+  EXPECT_EQ(n, 38u);
+  // The check can fail: the resolved YAML read back (the old wire format) gives another struct.
+  const ResolvedCase first = local.resolve(case_at(s, 0));
+  EXPECT_FALSE(same_case(*first.scenario, sim::parse_scenario(first.yaml, ".", "case")));
+  // And the nominal model rule is in the settings: a plant-only variation with it.
+  const ResolvedCase grid = local.resolve(case_at(s, 1 + 4));
+  EXPECT_TRUE(grid.settings.nominal_model);
+  EXPECT_DOUBLE_EQ(rank.build(grid.settings, "case")->controller.sliding_mode.model.mass, 102.04);
+}
+
+// The packings: what one packs the other unpacks; bytes that are not a packing are one line.
+TEST(StudyCases, SettingsAndBasesPackAndUnpack) {
+  CaseSettings c;
+  c.controller = 3;
+  c.nominal_model = true;
+  c.layers = {{"duration", "0.5"}, {"plant.friction", "{model: static, coulomb_force: 70}"}};
+  c.values = {{"plant.mass", "97.5"}, {"name", "with:colons\nand a newline"}, {"x", ""}};
+  EXPECT_TRUE(unpack_settings(pack_settings(c)) == c);
+  const StudyBases b{"s.yaml", "duration: 1\n", "/tmp", {"a", "b:c"}, {"", "{type: cascade}"}};
+  EXPECT_TRUE(unpack_bases(pack_bases(b)) == b);
+  for (const std::string bad : {std::string(""), std::string("1:3"), std::string("x:"), pack_settings(c) + "1:a",
+                                pack_settings(c).substr(0, 20), std::string("99999999999999:")}) {
+    try {
+      unpack_settings(bad);
+      ADD_FAILURE() << "unpacked: " << bad;
+    } catch (const StudyError& e) {
+      EXPECT_NE(std::string(e.what()).find("do not unpack"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(StudyCases, TheStudysSetHoldsForEveryControllerAndAControllersOwnSetIsMoreSpecific) {

@@ -63,7 +63,7 @@ Outcome run(const Study& s, const std::string& controller, const std::string& fa
       match = match && found;
     }
     if (!match) continue;
-    const Outcome o = run_case(resolver.resolve(c).yaml);
+    const Outcome o = run_case(*resolver.resolve(c).scenario);
     EXPECT_TRUE(o.ok) << o.error;
     return o;
   }

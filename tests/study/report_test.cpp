@@ -71,7 +71,7 @@ TEST(StudyOutcome, ACaseCarriesItsLoaderWarningsAndWhetherItsMoveFinished) {
   Study st = s;
   st.set.push_back({"duration", "0.01"});
   Resolver r(st);
-  const Outcome o = run_case(r.resolve(case_at(st, 1)).yaml);
+  const Outcome o = run_case(*r.resolve(case_at(st, 1)).scenario);
   ASSERT_TRUE(o.ok) << o.error;
   ASSERT_TRUE(o.move_finished.has_value());
   EXPECT_FALSE(*o.move_finished);

@@ -4,6 +4,8 @@
 //   FAULT_NAN       returns u = NaN at the third update
 //   FAULT_THROW     throws a C++ exception out of update (what a plugin must not do)
 //   FAULT_VERSION   reports ABI version 999
+//   FAULT_OLD       reports ABI version 1 (a plugin built against the struct of model fields, before
+//                   the key/value table of version 2)
 //   FAULT_NO_RESET  does not export feeddrive_controller_reset
 //   FAULT_REFUSE    create refuses, with a message
 //   FAULT_FAIL      update fails at t >= 1e-3 s, with a message
@@ -26,8 +28,10 @@ struct Law {
 extern "C" {
 
 uint32_t feeddrive_controller_abi_version(void) {
-#ifdef FAULT_VERSION
+#if defined(FAULT_VERSION)
   return 999;
+#elif defined(FAULT_OLD)
+  return 1;
 #else
   return FEEDDRIVE_CONTROLLER_ABI_VERSION;
 #endif

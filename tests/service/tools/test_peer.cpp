@@ -31,6 +31,9 @@
 //                   (docs/lcm-contract.md) and no LCM type: feeddrive-log2csv and feeddrive-fit
 //                   count it among the foreign events. lcm-logger flushes its file only when an
 //                   event comes (--flush-interval), so the markers bring its buffered tail out.
+//   watch           not a misbehaving peer: only listens, and exits 0 once a state of step --steps
+//                   or later is on <prefix>_STATE (the run is that far), 1 if none came within
+//                   --seconds (lib.sh, wait_bus_step: a wait on the run's progress, not a sleep).
 // Every peer joins the run of the first message it hears (or --run-id).
 #include <CLI/CLI.hpp>
 
@@ -62,9 +65,9 @@ int main(int argc, char** argv) {
   std::int64_t run_id = 0;
   app.add_option("mode", mode)
       ->required()
-      ->check(
-          CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
-                         "forge-reference", "malformed", "fake-monitor", "fake-heartbeats", "replay-status", "mark"}));
+      ->check(CLI::IsMember({"nan-controller", "stall-controller", "junk", "stale-controller", "forge-controller",
+                             "forge-reference", "malformed", "fake-monitor", "fake-heartbeats", "replay-status", "mark",
+                             "watch"}));
   app.add_option("--u", forged_u, "forge-controller: the forged command [V]; forge-reference: the forged position [m]");
   app.add_option("--run-id", run_id, "the run to join (default: the first one heard)");
   app.add_option("--lcm-url", url);
@@ -93,6 +96,15 @@ int main(int argc, char** argv) {
     bus.join_first_seen();
   }
   const Channels ch(prefix);
+  if (mode == "watch") {
+    std::int64_t highest = -1;
+    bus.subscribe<drive_state_t>(
+        ch.state, [&](const drive_state_t& m, std::int64_t) { highest = std::max<std::int64_t>(highest, m.seq); });
+    const auto end = mono_us() + static_cast<std::int64_t>(seconds * 1e6);
+    while (highest < steps && mono_us() < end) bus.poll(std::chrono::milliseconds(10));
+    std::printf("watch: highest state heard %lld (waited for %ld)\n", static_cast<long long>(highest), steps);
+    return highest >= steps ? 0 : 1;
+  }
   if (mode == "replay-status") {
     // The raw datagrams, as the run's processes signed them: a replay needs no key.
     lcm::LCM raw(url);

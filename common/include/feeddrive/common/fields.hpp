@@ -14,13 +14,16 @@
 //     validate.hpp ("plant.mass = -1: must be > 0");
 //   * the plausibility warnings for a linear feed drive (plausibility() below);
 //   * the key tables of docs/scenario.md (feeddrive-keys, checked for drift by a test);
-//   * the study's key access and --set, through the scenario reader.
+//   * the study's key access and --set, through the scenario reader;
+//   * the readers that are not C++ (flatten() below, plant/parameter_table.hpp): the controller
+//     plugin ABI's model table (controller/plugin.h) and run_info_t.plant on LCM.
 // Adding a key is one Visit line (docs/contributing.md, "How to add a scenario key").
 //
 // Header-only; no dependency beyond the standard library.
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -258,6 +261,115 @@ std::vector<std::string> plausibility(const S& obj, const std::string& prefix) {
   PlausibilityArchive a(prefix, &out);
   const_cast<S&>(obj).Serialize(&a);
   return out;
+}
+
+// --- flatten: the list as (key, value) pairs ---------------------------------------------------
+
+/// One value of a list, nested structs flattened to dotted keys ("friction.stribeck_exponent").
+struct FlatValue {
+  std::string key;
+  /// A number (an integer converted), a flag 1 or 0; NaN for a name.
+  double number{std::numeric_limits<double>::quiet_NaN()};
+  /// An enum's name or a string's text; "" for a number or a flag.
+  std::string name;
+  bool is_name{false};
+};
+
+/// Collects every value of a list in list order, nested structs under their key; a key in
+/// `skip` (a dotted key, a whole nested struct by its key) is left out with what is below it.
+class FlattenArchive {
+ public:
+  FlattenArchive(std::string prefix, const std::vector<std::string>* skip, std::vector<FlatValue>* out)
+      : prefix_(std::move(prefix)), skip_(skip), out_(out) {}
+  template <typename T>
+  void Visit(const Field<T>& f) {
+    const std::string key = prefix_.empty() ? std::string(f.meta.name) : prefix_ + "." + f.meta.name;
+    for (const std::string& s : *skip_)
+      if (s == key) return;
+    const T& v = *f.value;
+    if constexpr (std::is_same_v<T, bool>) {
+      out_->push_back({key, v ? 1.0 : 0.0, "", false});
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      out_->push_back({key, static_cast<double>(v), "", false});
+    } else if constexpr (is_named_enum<T>::value) {
+      out_->push_back({key, std::numeric_limits<double>::quiet_NaN(), enum_name(v), true});
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      out_->push_back({key, std::numeric_limits<double>::quiet_NaN(), v, true});
+    } else {
+      static_assert(is_serializable<T>::value, "fields::flatten: a field type it does not know");
+      FlattenArchive child(key, skip_, out_);
+      const_cast<T&>(v).Serialize(&child);  // the archive only reads
+    }
+  }
+
+ private:
+  std::string prefix_;
+  const std::vector<std::string>* skip_;
+  std::vector<FlatValue>* out_;
+};
+
+/// Every value of `obj`'s list as (dotted key, value), in list order, without the keys in `skip`
+/// (and what is below them): the list handed to a reader that is not C++ (the controller plugin
+/// ABI, run_info_t), so a field added to the list reaches it without further code.
+template <typename S>
+std::vector<FlatValue> flatten(const S& obj, const std::vector<std::string>& skip = {}) {
+  std::vector<FlatValue> out;
+  FlattenArchive a("", &skip, &out);
+  const_cast<S&>(obj).Serialize(&a);  // the archive only reads
+  return out;
+}
+
+/// The inverse of flatten: sets every field of `obj`'s list whose dotted key `find(key)` knows
+/// (a const FlatValue*, nullptr for a key it does not have; those fields keep their values), a
+/// flag from number != 0, an integer from the number, an enum from its name (std::invalid_argument
+/// "KEY = 'NAME': expected one of ..." for another). Returns how many fields it set. A reader of
+/// a table (run_info_t.plant) fills its params struct by the struct's own list.
+class UnflattenArchive {
+ public:
+  using Find = std::function<const FlatValue*(const std::string&)>;
+  UnflattenArchive(std::string prefix, const Find* find, std::size_t* set)
+      : prefix_(std::move(prefix)), find_(find), set_(set) {}
+  template <typename T>
+  void Visit(const Field<T>& f) {
+    const std::string key = prefix_.empty() ? std::string(f.meta.name) : prefix_ + "." + f.meta.name;
+    if constexpr (is_serializable<T>::value) {
+      UnflattenArchive child(key, find_, set_);
+      f.value->Serialize(&child);
+      return;
+    } else {
+      const FlatValue* v = (*find_)(key);
+      if (v == nullptr) return;
+      T& out = *f.value;
+      if constexpr (std::is_same_v<T, bool>) {
+        out = v->number != 0.0;
+      } else if constexpr (std::is_arithmetic_v<T>) {
+        out = static_cast<T>(v->number);
+      } else if constexpr (is_named_enum<T>::value) {
+        try {
+          out = enum_from_name<T>(v->name);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(key + " = '" + v->name + "': " + e.what());
+        }
+      } else {
+        static_assert(std::is_same_v<T, std::string>, "fields::unflatten: a field type it does not know");
+        out = v->name;
+      }
+      ++*set_;
+    }
+  }
+
+ private:
+  std::string prefix_;
+  const Find* find_;
+  std::size_t* set_;
+};
+
+template <typename S>
+std::size_t unflatten(S& obj, const UnflattenArchive::Find& find) {
+  std::size_t set = 0;
+  UnflattenArchive a("", &find, &set);
+  obj.Serialize(&a);
+  return set;
 }
 
 // --- same: equality through the list --------------------------------------------------------

@@ -1,4 +1,4 @@
-/* feeddrive controller plugin ABI, version 1 (docs/plugins.md).
+/* feeddrive controller plugin ABI, version 2 (docs/plugins.md).
  *
  * A controller plugin is a shared library (a .so) that exports the five functions below with C
  * linkage, so it can be written in C, C++, Rust, Fortran (bind(C)) or any language with a C FFI.
@@ -25,7 +25,9 @@
  * (a field added, removed, reordered or retyped) or to a function's signature or meaning
  * increments it; the host loads only a plugin whose feeddrive_controller_abi_version() returns
  * exactly the host's version, and names both otherwise. `size` fields let a plugin check that it
- * was compiled against the same layout the host fills.
+ * was compiled against the same layout the host fills. Version 2 (issue 22) replaced version 1's
+ * struct of model fields (a copy of the plant's list that missed friction.static_smoothing_shape)
+ * by the key/value table of feeddrive_run_info.model.
  *
  * Units are SI: m, m/s, m/s^2, N, kg, s, V.
  */
@@ -34,51 +36,20 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define FEEDDRIVE_CONTROLLER_ABI_VERSION 1u
+#define FEEDDRIVE_CONTROLLER_ABI_VERSION 2u
 
-/* The friction law of the nominal model (plant/params.hpp FrictionModel). */
-enum feeddrive_friction_model {
-  FEEDDRIVE_FRICTION_LUGRE = 0,
-  FEEDDRIVE_FRICTION_STATIC = 1,
-  FEEDDRIVE_FRICTION_NONE = 2
-};
-
-/* The controller's nominal model of the drive (the scenario's controller.model, which defaults
- * to the plant without its effects): the fields of plant/params.hpp, same names and units. */
-typedef struct feeddrive_model {
-  double mass;           /* m [kg] */
-  double thrust_gain;    /* Ka*Kf [N/V] (amplifier_gain * force_constant) */
-  double amplifier_gain; /* Ka */
-  double force_constant; /* Kf [N/A] */
-  /* friction: F = sigma0*z + sigma1(v)*z' + sigma2*v (LuGre) or g(v)*tanh(v/eps) + sigma2*v (static) */
-  int32_t friction_model;           /* enum feeddrive_friction_model */
-  double static_force;              /* Fs [N] */
-  double coulomb_force;             /* Fc [N] */
-  double stribeck_velocity;         /* vs [m/s] */
-  double stribeck_exponent;         /* delta */
-  double bristle_stiffness;         /* sigma0 [N/m] */
-  double bristle_damping;           /* sigma1 [N s/m] */
-  double viscous;                   /* sigma2 [N s/m] */
-  double damping_decay_velocity;    /* vd [m/s], 0 = constant sigma1 */
-  double static_smoothing_velocity; /* eps [m/s] */
-  /* ripple (Xie & Liang eqs. 14-15) */
-  int32_t ripple_enabled;
-  double pitch, cogging_amplitude, cogging_phase, cogging_third, cogging_third_phase;
-  double reluctance_amplitude, reluctance_phase, reluctance_third, reluctance_third_phase;
-  /* grinding (Hahn-Lindsay, eq. 13): force s(x)*Fg, s(x) = clamp((x - contact_position)/contact_width, 0, 1) */
-  int32_t grinding_enabled;
-  double grinding_stiffness; /* ke [N/m] */
-  double grinding_damping;   /* C = c*pi*dw*bs [N s/m] */
-  double contact_position;   /* [m], -inf = always in contact */
-  double contact_width;      /* [m] */
-  /* encoder */
-  double sensor_quantization; /* q [m], 0 = ideal */
-} feeddrive_model;
+/* One value of the controller's nominal model (feeddrive_run_info.model). */
+typedef struct feeddrive_value {
+  const char* key;  /* the scenario's key below controller.model: "mass", "friction.stribeck_exponent" */
+  double number;    /* a number [SI unit of the key, docs/scenario.md]; a flag 1 or 0; NaN for a name */
+  const char* name; /* an enum's name ("lugre", "static", "none" for friction.model); "" for a number */
+} feeddrive_value;
 
 /* What a run tells the plugin when it creates it. */
 typedef struct feeddrive_run_info {
@@ -87,8 +58,38 @@ typedef struct feeddrive_run_info {
   double period;            /* control period T [s] */
   double u_min, u_max;      /* command limits [V] (scenario controller.u_min, u_max) */
   double computation_delay; /* [s]: the command computed at t_k acts from t_k + delay */
-  feeddrive_model model;    /* the nominal model */
+  /* The nominal model (the scenario's controller.model, which defaults to the plant without its
+   * effects): every key of the plant's parameter list (plant/params.hpp; the tables of
+   * docs/scenario.md, "plant") by its key below plant:, in the list's order, except the sections
+   * effects (off in a plugin's model) and integrator (the simulator's tolerances); then two
+   * derived values: "thrust_gain" Ka*Kf [N/V] and "grinding.damping" C = c*pi*dw*bs [N s/m].
+   * Read it with feeddrive_model_number / feeddrive_model_name below. A key added to the list
+   * appears here without an ABI change. The table and its strings stay valid until destroy. */
+  const feeddrive_value* model;
+  size_t model_size;
 } feeddrive_run_info;
+
+/* The number of the model's key `key` into *out: 1, or 0 (and *out unchanged) when the model has
+ * no such key or it is a name. */
+static inline int feeddrive_model_number(const feeddrive_run_info* info, const char* key, double* out) {
+  size_t i;
+  for (i = 0; i < info->model_size; ++i) {
+    if (strcmp(info->model[i].key, key) != 0) continue;
+    if (info->model[i].name[0] != '\0') return 0;
+    *out = info->model[i].number;
+    return 1;
+  }
+  return 0;
+}
+
+/* The name of the model's key `key` (friction.model: "lugre", "static" or "none"), or NULL when
+ * the model has no such key or it is a number. */
+static inline const char* feeddrive_model_name(const feeddrive_run_info* info, const char* key) {
+  size_t i;
+  for (i = 0; i < info->model_size; ++i)
+    if (strcmp(info->model[i].key, key) == 0) return info->model[i].name[0] != '\0' ? info->model[i].name : NULL;
+  return NULL;
+}
 
 /* One user parameter: the scenario's controller.parameters entry as text ("5e-4", "sat"). */
 typedef struct feeddrive_parameter {

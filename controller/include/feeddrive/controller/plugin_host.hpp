@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/plugin.h"
 #include "feeddrive/plant/params.hpp"
@@ -61,8 +62,22 @@ class PluginLibrary {
   void* handle_{nullptr};
 };
 
-/// The run information the host passes to create() (plugin.h feeddrive_run_info).
-feeddrive_run_info plugin_run_info(const PluginParams& p);
+/// The run information the host passes to create() (plugin.h feeddrive_run_info), with the
+/// storage its model table points into: the nominal model's plant::parameter_table (the plant's
+/// one list, walked). Valid while this object lives (a PluginController keeps it until destroy);
+/// not copyable, as the table points into it.
+class PluginRunInfo {
+ public:
+  explicit PluginRunInfo(const PluginParams& p);
+  PluginRunInfo(const PluginRunInfo&) = delete;
+  PluginRunInfo& operator=(const PluginRunInfo&) = delete;
+  const feeddrive_run_info& info() const { return info_; }
+
+ private:
+  std::vector<fields::FlatValue> values_;
+  std::vector<feeddrive_value> table_;
+  feeddrive_run_info info_{};
+};
 
 class PluginController final : public Controller {
  public:
@@ -82,6 +97,7 @@ class PluginController final : public Controller {
  private:
   [[noreturn]] void fail(const std::string& what) const;
   std::shared_ptr<const PluginLibrary> lib_;
+  PluginRunInfo run_info_;  // what create() was given: the plugin may keep pointers into it until destroy
   void* self_{nullptr};
 };
 

@@ -10,6 +10,9 @@
 //   3  (26 November 2026)  contract_version in process_status_t and run_info_t; run_info_t carries
 //                          the protocol's options, the initial state, the sensor model, the
 //                          scenario's hash and the current step
+//   4  (27 November 2026)  run_info_t.plant: the drive's parameters as (key, value) entries
+//                          (parameter_t), the plant's one list walked, in place of a hand-written
+//                          set of fields (which missed stribeck_exponent)
 
 #include <cstddef>
 #include <cstdint>
@@ -21,7 +24,7 @@
 
 namespace feeddrive::service {
 
-inline constexpr std::int32_t kContractVersion = 3;
+inline constexpr std::int32_t kContractVersion = 4;
 
 /// The role that publishes on `channel` of a run: <prefix>_STATE the plant, _CMD the controller,
 /// _REF the trajectory; "" for the others (every role, or a tool).
@@ -39,7 +42,7 @@ std::optional<OlderSender> older_contract(const Channels& ch, std::string_view c
                                           std::size_t size);
 
 /// One line: "the controller speaks contract version 2 (a control_command_t of 24 November 2026)
-/// on FD_CMD; this run speaks 3: update it to the lcmtypes/ of this feeddrive (docs/lcm-contract.md, Versions)".
+/// on FD_CMD; this run speaks 4: update it to the lcmtypes/ of this feeddrive (docs/lcm-contract.md, Versions)".
 std::string describe_older(const OlderSender& s, std::string_view channel);
 
 /// The role field of a heartbeat that would not be admitted (another run, no valid mac), read

@@ -133,6 +133,11 @@ struct SignalLimits {
 };
 inline constexpr SignalLimits kSignalLimits{};
 
+/// The scenario controller's output limits [V], of whichever type it is (its u_min, u_max).
+struct OutputLimits {
+  double u_min{0.0}, u_max{0.0};
+};
+OutputLimits controller_output_limits(const Scenario& s);
 /// The controller's output range u_max - u_min [V] of a scenario (chatter threshold).
 double controller_output_range(const Scenario& s);
 /// summary.json's controller_model: "plant" (the controller's model is the plant's own

@@ -18,6 +18,11 @@
 // plant.sensor.*: the mismatch is in the plant, while the controller is set up for the encoder it actually has. The
 // case's scenario is then the loader's resolved keys written as one YAML document (sim::resolved_yaml): every key with
 // its effective value, loadable by feeddrive-sim. Its SHA-256 keys the case in the output folder.
+//
+// What a case is built from, besides its controller's base, is its CaseSettings (the layers and the
+// variations' values as key=value settings); CaseBuilder builds it, on rank 0 and on every other
+// MPI rank alike: a rank receives the study's bases once (StudyBases) and each case's settings,
+// never a YAML document of the case, so both build the same struct by the same code.
 
 #include <cstdint>
 #include <map>
@@ -78,11 +83,72 @@ double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::u
 /// appearance (the parameter columns of results.csv).
 std::vector<std::string> varied_keys(const Study& s);
 
+/// What a case is built from, besides its controller's base (StudyBases): the settings set in
+/// it as the file would say them (sim::set_read_keys), in this order, and the nominal model rule.
+struct CaseSettings {
+  std::size_t controller{0};
+  /// The layers: the controller block's set, the study's, the controller's, the family's.
+  std::vector<sim::KeySetting> layers;
+  /// The variations' values (a scale's factor applied to the key's nominal value).
+  std::vector<sim::KeySetting> values;
+  /// The nominal model rule (spec.hpp, ModelRule::kNominal): the controller's model is that of
+  /// the case without its plant-only values.
+  bool nominal_model{false};
+  bool operator==(const CaseSettings& o) const;
+};
+
+/// The settings as bytes for another rank (strings, each as its length and its bytes), and back.
+/// unpack_settings throws StudyError on bytes that are not such a packing.
+std::string pack_settings(const CaseSettings& c);
+CaseSettings unpack_settings(const std::string& bytes);
+
+/// The study's bases: the base scenario's text, read once per controller with that controller's
+/// block (YAML text of a controller map, "" for the base's own) in place of its controller. What
+/// a rank needs of the study to build its cases (packed once per rank, not per case).
+struct StudyBases {
+  std::string path;  ///< the study file, for messages
+  std::string base_yaml;
+  std::string base_dir;
+  std::vector<std::string> names;   ///< the controllers' names
+  std::vector<std::string> blocks;  ///< their blocks
+  static StudyBases of(const Study& s);
+  bool operator==(const StudyBases& o) const;
+};
+std::string pack_bases(const StudyBases& b);
+StudyBases unpack_bases(const std::string& bytes);
+
+/// Builds cases from their settings: the controller's base as read (once), the layers set in it
+/// (kept for the next case of the same layers), the values set in that, with the nominal model
+/// rule the model from the same without the plant-only values, then derived and checked
+/// (sim::complete_read). Not thread-safe; the scenarios it returns are.
+class CaseBuilder {
+ public:
+  /// Reads the bases; throws StudyError naming the study (and controller) and the loader's error.
+  explicit CaseBuilder(const StudyBases& bases);
+  ~CaseBuilder();
+  /// Throws StudyError "<origin>: <the loader's key and value>".
+  std::shared_ptr<const sim::Scenario> build(const CaseSettings& c, const std::string& origin);
+  /// The resolved keys of the case without its values (the layers only, derived): a scale's
+  /// nominal value.
+  const sim::ResolvedKeys& nominal_keys(const CaseSettings& c, const std::string& origin);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// True when two cases' scenarios are the same: every section's field list (fields::same: the
+/// plant, every controller's and reference's parameters, the controller's model, ...), the
+/// resolved keys, and what the reader records beside the lists (given keys, listed effects, the
+/// grinding process, the warnings, the move's end).
+bool same_case(const sim::Scenario& a, const sim::Scenario& b);
+
 struct ResolvedCase {
   /// The case's scenario as it runs: built as a struct, derived and checked (Resolver::resolve).
   std::shared_ptr<const sim::Scenario> scenario;
-  std::string yaml;  ///< the complete scenario's keys (resolved_yaml; loads in feeddrive-sim)
-  std::string hash;  ///< SHA-256 (hex) of the format tag and yaml
+  CaseSettings settings;  ///< what the scenario is built from (another MPI rank builds it from these)
+  std::string yaml;       ///< the complete scenario's keys (resolved_yaml; loads in feeddrive-sim)
+  std::string hash;       ///< SHA-256 (hex) of the format tag and yaml
   /// Effective value of every key of varied_keys() that this case's scenario has, by key.
   std::map<std::string, std::string> parameters;
 };

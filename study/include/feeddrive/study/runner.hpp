@@ -40,9 +40,6 @@ struct Outcome {
 /// kept) and returns the summary.json metrics. Never throws: a failure is an Outcome with its
 /// one-line error; a run stopped by Ctrl-C/SIGTERM is marked `interrupted`.
 Outcome run_case(const sim::Scenario& s, const interrupt::StopToken& stop = {});
-/// The same for a case that came as its resolved YAML (another MPI rank's: the text is the wire
-/// format between processes; the ranks share no memory).
-Outcome run_case(const std::string& yaml, const interrupt::StopToken& stop = {});
 
 /// The format of a case file (its "format" key). 2 (issue 23) added warnings and move_finished;
 /// a file of another format is not reused: its case runs again.

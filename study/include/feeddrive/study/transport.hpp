@@ -2,8 +2,11 @@
 // How the cases of one study are spread over the processes of an MPI job (Open MPI: mpirun,
 // or srun under Slurm). Rank 0 owns the study: it loads and resolves it, keeps the queue of
 // pending cases and the output folder; every other rank asks rank 0 for one case at a time, runs
-// it and sends the outcome back (session.cpp). The messages carry the resolved scenario YAML and
-// the outcome JSON, so the other ranks need no file of the study.
+// it and sends the outcome back (session.cpp). Rank 0 sends each rank the study's bases once
+// (the base scenario's text and the controllers' blocks: StudyBases) and then each case's
+// settings (CaseSettings, cases.hpp), from which the rank builds the case as a struct by the code
+// rank 0 builds it with; the outcomes come back as JSON. The other ranks need no file of the
+// study (the files its scenarios name, a plugin library, a waypoint table, they do need).
 //
 // MPI support is compiled in when CMake finds MPI (FEEDDRIVE_STUDY_MPI); MPI is initialised only
 // when an MPI launcher started the process (its environment variables), so feeddrive-study
@@ -15,7 +18,7 @@
 
 namespace feeddrive::study {
 
-enum Tag : int { kRequest = 1, kAssign = 2, kResult = 3 };
+enum Tag : int { kRequest = 1, kAssign = 2, kResult = 3, kBases = 4 };
 
 struct Message {
   int from{0};
