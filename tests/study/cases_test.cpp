@@ -356,8 +356,8 @@ TEST(StudyCases, SettingsAndBasesPackAndUnpack) {
   EXPECT_TRUE(unpack_settings(pack_settings(c)) == c);
   const StudyBases b{"s.yaml", "duration: 1\n", "/tmp", {"a", "b:c"}, {"", "{type: cascade}"}};
   EXPECT_TRUE(unpack_bases(pack_bases(b)) == b);
-  for (const std::string bad : {std::string(""), std::string("1:3"), std::string("x:"), pack_settings(c) + "1:a",
-                                pack_settings(c).substr(0, 20), std::string("99999999999999:")}) {
+  for (const std::string& bad : {std::string(""), std::string("1:3"), std::string("x:"), pack_settings(c) + "1:a",
+                                 pack_settings(c).substr(0, 20), std::string("99999999999999:")}) {
     try {
       unpack_settings(bad);
       ADD_FAILURE() << "unpacked: " << bad;
