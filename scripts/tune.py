@@ -217,8 +217,8 @@ def probe_columns(spec, spec_path, args):
         columns = next(csv.reader(f), [])
     for key in [error_metric(spec["objective"]), *spec["objective"]["signal_limits"]]:
         if key not in columns:
-            what = "error_metric" if key == error_metric(spec["objective"]) else f"signal_limits.{key}"
-            fail(f"{spec_path}: objective.{what} = {key!r}: no such results column (probe: {path})")
+            what = f"error_metric = {key!r}" if key == error_metric(spec["objective"]) else f"signal_limits.{key}"
+            fail(f"{spec_path}: objective.{what}: no such results column (probe: {path})")
 
 
 def run_study(binary, study_path, out, jobs):

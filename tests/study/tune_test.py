@@ -12,8 +12,8 @@ import sys
 import tempfile
 import unittest
 
-SRC = sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..")
-BIN = sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(SRC, "build", "bin")
+SRC = os.path.abspath(sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.path.abspath(sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(SRC, "build", "bin"))
 sys.path.insert(0, os.path.join(SRC, "scripts"))
 import tune  # noqa: E402
 
@@ -241,7 +241,7 @@ class SpecUpFront(unittest.TestCase):
                 "families: [{name: f}]}\ntest: {study: x.yaml}\n")
         rc, err = self.run_spec(f"[{{name: smc, scenario: {scenario}, grid: {{controller.k: [10.0, 11.0]}}}}]", head=head)
         self.assertEqual(rc, 2)
-        self.assertEqual(err.splitlines()[-1], "error: SPEC: objective.signal_limits = 'control_step_rms': no such "
+        self.assertEqual(err.splitlines()[-1], "error: SPEC: objective.signal_limits.control_step_rms: no such "
                                                "results column (probe: DIR/out/probe.yaml)")
         self.assertNotIn("t_design", err)
 
@@ -267,6 +267,35 @@ class HardConstraint(unittest.TestCase):
         table = {"a": ([({}, self.summary(3.0, 0.5))], 0), "b": ([({}, self.summary(5.0, 0.0))], 0),
                  "c": ([({}, self.summary(4.0, 0.0))], 0)}
         self.assertEqual(tune.recommend(table), "c")
+
+
+class RecommendedOneSource(unittest.TestCase):
+    """The recommended controller's settings live in scenarios/robustness/recommended.yaml; the
+    tuning record (docs/tuning/chosen.yaml: the family and its point) and the family's definition
+    (studies/tuning.yaml: its scenario and fixed keys) must say the same, and the studies that
+    run it must take that file, not a copy of its keys."""
+
+    def load(self, *parts):
+        import yaml
+        with open(os.path.join(SRC, *parts)) as f:
+            return yaml.safe_load(f)
+
+    def test_the_file_is_the_tuning_choice(self):
+        chosen = self.load("docs", "tuning", "chosen.yaml")
+        spec = self.load("studies", "tuning.yaml")
+        fam = next(f for f in spec["families"] if f["name"] == chosen["recommended"])
+        expected = self.load("studies", fam["scenario"])["controller"]
+        for key, value in {**fam.get("set", {}), **chosen["families"][fam["name"]]["point"]}.items():
+            self.assertTrue(key.startswith("controller."), key)
+            expected[key[len("controller."):]] = value
+        self.assertEqual(self.load("scenarios", "robustness", "recommended.yaml")["controller"], expected)
+
+    def test_the_studies_take_the_file(self):
+        for study in ("robustness_moves.yaml",):
+            entries = [c for c in self.load("studies", study)["controllers"] if c["name"] == "recommended"]
+            self.assertEqual(len(entries), 1, study)
+            self.assertEqual(entries[0]["scenario"], "../scenarios/robustness/recommended.yaml", study)
+            self.assertNotIn("set", entries[0], study)
 
 
 if __name__ == "__main__":
