@@ -291,7 +291,7 @@ class RecommendedOneSource(unittest.TestCase):
         self.assertEqual(self.load("scenarios", "robustness", "recommended.yaml")["controller"], expected)
 
     def test_the_studies_take_the_file(self):
-        for study in ("robustness_moves.yaml",):
+        for study in ("robustness_moves.yaml", "reversal_fix.yaml"):
             entries = [c for c in self.load("studies", study)["controllers"] if c["name"] == "recommended"]
             self.assertEqual(len(entries), 1, study)
             self.assertEqual(entries[0]["scenario"], "../scenarios/robustness/recommended.yaml", study)
