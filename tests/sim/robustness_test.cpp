@@ -170,7 +170,9 @@ TEST(RobustConfiguration, WorstCornerKeepsTheErrorButBreaksTheSignalLimits) {
     const Summary m = summarize(r, s);
     EXPECT_FALSE(m.control_signal_within_limits) << "the robust SMC's command breaks the limits: not a pass";
     EXPECT_GT(m.control_direction_changes_per_s, 2000.0);
-    if (!std::isnan(k.changes)) EXPECT_NEAR(m.control_direction_changes_per_s, k.changes, 0.1 * k.changes);
+    if (!std::isnan(k.changes)) {
+      EXPECT_NEAR(m.control_direction_changes_per_s, k.changes, 0.1 * k.changes);
+    }
   }
 }
 
