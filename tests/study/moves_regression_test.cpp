@@ -1,8 +1,9 @@
 // Regression bounds of the robustness study on every move (studies/robustness_moves.yaml, issue 24
 // item 7; docs/robustness.md, "Every move, wider mismatch"): robust_smc's worst case of each move
 // and its control-signal figures at those corners; and the recommended controller's
-// (cascade_recommended, docs/controllers.md "Which controller, and where it holds") worst passing
-// cases and the cases where it does not hold on its blind test set (studies/tuning_test.yaml).
+// (`recommended`, scenarios/robustness/recommended.yaml; docs/controllers.md "Which controller,
+// and where it holds") worst cases per move family on its blind test set (studies/tuning_test.yaml),
+// passing or documented misses.
 // Each runs from the study file itself (the same resolved scenario as the study's case: same
 // plant, encoder seed, delay and nominal model), so a change to a controller, the plant or the
 // study shows here first.
