@@ -234,11 +234,37 @@ bool case_passes(const Study& s, const Outcome& o, double shown) {
   return verdicts_hold(s, o);
 }
 
+namespace {
+
+// One case's control-signal figures into its controller's Signal (ReportData::Signal).
+void add_signal(ReportData::Signal& sig, const Outcome& o) {
+  bool verdict_found = false;
+  for (std::size_t k = 0; k < ReportData::kSignalFigures.size(); ++k) {
+    double x = NAN;
+    for (const auto& [key, value] : o.metrics)
+      if (key == ReportData::kSignalFigures[k]) x = value;
+    if (!o.ok || std::isnan(x)) {
+      ++sig.no_value[k];
+    } else if (std::isnan(sig.worst[k]) || x > sig.worst[k]) {
+      sig.worst[k] = x;
+    }
+  }
+  for (const auto& [key, value] : o.metrics)
+    if (o.ok && key == "control_signal_within_limits") {
+      verdict_found = true;
+      (value == 1.0 ? sig.within : sig.outside) += 1;
+    }
+  if (!verdict_found) ++sig.unknown;
+}
+
+}  // namespace
+
 ReportData::ReportData(const Study& st)
     : s(st),
       params(varied_keys(st)),
       table(st.families.size(), std::vector<Cell>(st.controllers.size())),
       worst(st.controllers.size()),
+      signal(st.controllers.size()),
       categories(params.size()) {
   const auto n = static_cast<std::size_t>(st.total_cases());  // exact: no doubling of the largest vectors
   controller.reserve(n);
@@ -267,6 +293,7 @@ void ReportData::add(std::size_t index, const CaseRecord& c) {
     Worst& w = worst[c.spec.controller];
     if (!w.any || v > w.value) w = {true, index, c.spec.family, v, c.resolved.parameters};
   }
+  add_signal(signal[c.spec.controller], c.outcome);
   controller.push_back(static_cast<std::uint32_t>(c.spec.controller));
   shown.push_back(v);
   for (std::size_t p = 0; p < params.size(); ++p) {
@@ -576,6 +603,35 @@ void md_worst_per_controller(std::ostringstream& md, const ReportData& d) {
   if (criterion) md << "\n" << criterion_text(s) << "\n";
 }
 
+// "## Control signal per controller": always, whatever the report's metric: the worst of each
+// control-signal figure (docs/scenario.md, "Control-signal quality") and the cases within the
+// signal limits (control_signal_within_limits true). A case without the verdict (failed, or an
+// outcome of an older version) is counted apart: unknown is never within the limits.
+void md_signal_per_controller(std::ostringstream& md, const ReportData& d) {
+  const Study& s = d.s;
+  md << "\n## Control signal per controller\n\nThe worst (largest) of each control-signal figure over the "
+        "controller's cases (docs/scenario.md, \"Control-signal quality\"), and the cases whose command is within "
+        "every signal limit (`control_signal_within_limits`). Bold: not every case is within the limits.\n\n"
+        "| controller | within the signal limits |";
+  for (const char* k : ReportData::kSignalFigures) md << " worst `" << k << "` |";
+  md << "\n|---|---|---|---|---|---|\n";
+  for (std::size_t c = 0; c < s.controllers.size(); ++c) {
+    const ReportData::Signal& g = d.signal[c];
+    const long total = g.within + g.outside + g.unknown;
+    const bool all = g.within == total;
+    md << "| " << cell(s.controllers[c].name) << " | " << (all ? "" : "**") << g.within << " of " << total
+       << (all ? "" : "**");
+    if (g.unknown) md << " (" << g.unknown << " without the verdict)";
+    md << " |";
+    for (std::size_t k = 0; k < ReportData::kSignalFigures.size(); ++k) {
+      md << " " << num(g.worst[k]);
+      if (g.no_value[k]) md << " (" << g.no_value[k] << " without a value)";
+      md << " |";
+    }
+    md << "\n";
+  }
+}
+
 // The head of a table with one row per family and one column per controller.
 void md_family_table_head(std::ostringstream& md, const Study& s) {
   md << "| family |";
@@ -661,6 +717,7 @@ std::string report_md(const ReportData& d, const std::string& command, const std
   std::ostringstream md;
   md_head(md, d, command);
   md_worst_per_controller(md, d);
+  md_signal_per_controller(md, d);
   md_family_table(md, d, "Worst case per family [" + unit + "]", true);
   if (!std::isnan(s.report.limit)) md << "\nBold: over " << num(s.report.limit) << " " << unit << " (or failed).\n";
   if (s.report.has_criterion()) md_passes_per_family(md, d);

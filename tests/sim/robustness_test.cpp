@@ -9,6 +9,7 @@
 
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
+#include "feeddrive/sim/summary.hpp"
 #include "scenario_error.hpp"
 
 namespace feeddrive::sim {
@@ -104,8 +105,8 @@ controller: {type: cascade, tuning: rule, computation_delay: 1e-3, motion_state:
             "s.yaml: controller.tuning = 'fast': expected one of manual, rule");
 }
 
-double max_error_um(const Scenario& s) {
-  const RunResult r = run(s);
+// max |xd - x| over the run [um].
+double max_error_um(const RunResult& r) {
   double e = 0.0;
   for (const Record& rec : r.records) e = std::max(e, std::abs(rec.xd - rec.x));
   return e * 1e6;
@@ -129,17 +130,18 @@ Scenario corner(const std::string& file, double mass, double friction, double br
   return s;
 }
 
-// The robust configuration keeps the paper's 0.8 um on the jerk-limited move in the hardest
-// corners of the robustness study (docs/controllers.md, "The robust configuration"): 1 ms of
-// computation delay with the 50 nm encoder and 20 nm noise, mass -20 %, and Fs/Fc, sigma0/sigma1
-// 30 % off in opposite directions, and it beats the tuned cascade's worst corner of the study
-// (mass -20 %, Fs/Fc +30 %, sigma0/sigma1 -30 %: 0.312 um, docs/robustness.md). Measured: the
-// robust SMC 0.211 um (Fs/Fc -30 %) and 0.226 um (Fs/Fc +30 %, the same corner as the cascade's
-// worst). The bound is the cascade's own error in its worst corner, run here (the noise is seeded:
-// both runs are deterministic, and the cascade's 0.312 is checked to 0.001 um, the rounding of the
-// study's figure, so the test reproduces the study's case), so the test fails if either
-// controller moves the other way.
-TEST(RobustConfiguration, KeepsTheClaimAndBeatsTheTunedCascadesWorstCorner) {
+// The issue-10 study's worst corner (docs/robustness.md, "Verdict"): 1 ms of computation delay
+// with the 50 nm encoder and 20 nm noise, mass -20 %, Fs/Fc +30 %, sigma0/sigma1 -30 %. The ERROR
+// claim holds: the robust SMC keeps 0.8 um (0.226 um) and is below the tuned cascade's 0.312 um,
+// and so does its other opposite corner (Fs/Fc -30 %, sigma +30 %: 0.211 um). But NEITHER command
+// is within the signal limits (docs/scenario.md, "Control-signal quality": 2,000 direction
+// changes/s): the robust SMC changes direction 4,022 times a second, the cascade 5,836 (its
+// differenced encoder velocity through kv). So neither passes: the test asserts both halves, so a
+// report of "0.8 um in every case" as a pass fails here. The cascade's 0.312 is checked to
+// 0.001 um (the study's rounding: the same, seeded scenario). The direction-change counts are
+// bounded 10 % either side of the measured figures (deterministic runs; room for another libm
+// moving CVODE's steps, not for a change that would move the verdict: both stay far over 2,000).
+TEST(RobustConfiguration, WorstCornerKeepsTheErrorButBreaksTheSignalLimits) {
   Scenario c = corner("cascade_tuned.yaml", 0.8, 1.3, 0.7);
   c.controller.cascade.computation_delay = 1e-3;
   // The rule's gains for this delay and sensor (read_cascade sets them at load time, delay 0).
@@ -148,15 +150,29 @@ TEST(RobustConfiguration, KeepsTheClaimAndBeatsTheTunedCascadesWorstCorner) {
   c.controller.cascade.kv = g.kv;
   c.controller.cascade.ki = g.ki;
   c.controller.cascade.quantization = 5e-8;
-  const double cascade = max_error_um(c);
+  const RunResult rc = run(c);
+  const double cascade = max_error_um(rc);
   EXPECT_NEAR(cascade, 0.312, 0.001) << "the study's number for this corner (the same scenario)";
-  for (const double friction : {0.7, 1.3}) {
-    const Scenario s = corner("robust_smc.yaml", 0.8, friction, 2.0 - friction);
+  const Summary mc = summarize(rc, c);
+  EXPECT_FALSE(mc.control_signal_within_limits) << "the tuned cascade's command breaks the limits here";
+  EXPECT_NEAR(mc.control_direction_changes_per_s, 5836.0, 584.0);
+  struct Corner {
+    double friction, changes;  // Fs/Fc factor (sigma the opposite), measured direction changes/s
+  };
+  for (const Corner k : {Corner{0.7, NAN}, Corner{1.3, 4022.0}}) {
+    const Scenario s = corner("robust_smc.yaml", 0.8, k.friction, 2.0 - k.friction);
     EXPECT_EQ(s.controller.sliding_mode.model.mass, 102.04) << "the model stays nominal";
-    const double e = max_error_um(s);
-    SCOPED_TRACE("Fs,Fc x" + std::to_string(friction));
+    const RunResult r = run(s);
+    const double e = max_error_um(r);
+    SCOPED_TRACE("Fs,Fc x" + std::to_string(k.friction));
     EXPECT_LE(e, 0.8);
     EXPECT_LT(e, cascade) << "the tuned cascade's worst corner: " << cascade << " um";
+    const Summary m = summarize(r, s);
+    EXPECT_FALSE(m.control_signal_within_limits) << "the robust SMC's command breaks the limits: not a pass";
+    EXPECT_GT(m.control_direction_changes_per_s, 2000.0);
+    if (!std::isnan(k.changes)) {
+      EXPECT_NEAR(m.control_direction_changes_per_s, k.changes, 0.1 * k.changes);
+    }
   }
 }
 

@@ -100,5 +100,39 @@ TEST(StudyReportCriterion, ReportCountsPassingCasesPerFamily) {
   EXPECT_EQ(report_md(p, "cmd", "").find("pass per family"), std::string::npos);
 }
 
+// report.md always tabulates, per controller, the worst of each of the four control-signal
+// figures and the cases within the signal limits, whatever the report's metric and criterion (a
+// study without `require` must not read as an all-clear on the command). A case without the
+// verdict (an outcome of an older version) is counted apart, never as within the limits.
+TEST(StudyReportCriterion, ReportAlwaysTabulatesTheSignalFiguresPerController) {
+  const Study s = parse_study(study_text("report: {limit: 0.8}\n"), ".", "s.yaml");
+  ReportData d(s);
+  const auto add = [&](std::size_t index, double step, double changes, double hf, double sat, double within) {
+    CaseRecord c;
+    c.spec.controller = 0;
+    c.spec.family = 0;
+    c.outcome = outcome(0.5e-6, within);
+    c.outcome.metrics.push_back({"control_step_rms_V", step});
+    c.outcome.metrics.push_back({"control_direction_changes_per_s", changes});
+    c.outcome.metrics.push_back({"force_hf_rms_N", hf});
+    c.outcome.metrics.push_back({"control_saturated_fraction", sat});
+    d.add(index, c);
+  };
+  add(0, 0.1, 1500.0, 20.0, 0.0, 1.0);
+  add(1, 0.15, 4022.0, 25.0, 0.002, 0.0);  // within 0.8 um, but the command breaks the limits
+  add(2, 0.05, 900.0, 5.0, 0.0, 1.0);
+  const std::string md = report_md(d, "cmd", "");
+  EXPECT_NE(md.find("## Control signal per controller"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **2 of 3** | 0.15 | 4022 | 25 | 0.002 |"), std::string::npos) << md;
+  // The same cases without the verdict on one: unknown, not within.
+  ReportData e(s);
+  CaseRecord c;
+  c.outcome.ok = true;
+  c.outcome.metrics = {{"position_error_max_abs_m", 0.5e-6}, {"control_step_rms_V", 0.1}};
+  e.add(0, c);
+  const std::string me = report_md(e, "cmd", "");
+  EXPECT_NE(me.find("| **0 of 1** (1 without the verdict) | 0.1 | – (1 without a value) |"), std::string::npos) << me;
+}
+
 }  // namespace
 }  // namespace feeddrive::study

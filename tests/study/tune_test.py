@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Unit tests of scripts/tune.py's pure logic (docs/tuning.md): the objective of one case, the
-grid's order, the choice, and the spec checks' one-line errors (exit 2): the budget, a grid
-written as a list, families not a list, a bad or misspelt signal limit; nan/empty figures.
-Usage: python3 tests/study/tune_test.py SOURCE_DIR"""
+grid's order, the choice (the signal limits a hard constraint; the recommendation across
+families), and the spec checks' one-line errors (exit 2) before any case runs: the budget, a grid
+written as a list, families not a list, a bad or misspelt signal limit (the probe, with the
+binaries), name, set, design, test, chosen.yaml, a second test run; nan/empty figures.
+Usage: python3 tests/study/tune_test.py SOURCE_DIR [BIN_DIR]"""
 import math
 import os
 import subprocess
@@ -10,7 +12,8 @@ import sys
 import tempfile
 import unittest
 
-SRC = sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "..")
+SRC = os.path.abspath(sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", ".."))
+BIN = os.path.abspath(sys.argv.pop(1) if len(sys.argv) > 1 else os.path.join(SRC, "build", "bin"))
 sys.path.insert(0, os.path.join(SRC, "scripts"))
 import tune  # noqa: E402
 
@@ -108,16 +111,24 @@ class Grid(unittest.TestCase):
         self.assertEqual(code, 2)
         self.assertEqual(err, "error: SPEC: families.smc.grid: 3 points, the budget is 4")
 
-    def run_spec(self, families, limits="{}", budget=2):
-        spec = (f"name: t\nobjective: {{error_limit_um: 0.8, signal_limits: {limits}}}\nbudget: {budget}\n"
-                f"design: {{base: {{}}, families: []}}\ntest: {{study: x.yaml}}\nfamilies: {families}\n")
+    def run_spec(self, families, limits="{}", budget=2, head=None, args=(), files=None):
+        """Runs tune.py on a spec (its families, limits and budget, or the whole `head` before
+        `families:`) in a fresh folder holding s.yaml and x.yaml (and `files`: {name: text});
+        returns (exit status, stderr with the spec's path as SPEC and the folder as DIR)."""
+        if head is None:
+            head = (f"name: t\nobjective: {{error_limit_um: 0.8, signal_limits: {limits}}}\nbudget: {budget}\n"
+                    f"design: {{base: {{}}, families: []}}\ntest: {{study: x.yaml}}\n")
         with tempfile.TemporaryDirectory() as d:
+            for name, text in {"s.yaml": "name: s\n", "x.yaml": "name: x\n", **(files or {})}.items():
+                os.makedirs(os.path.dirname(os.path.join(d, name)), exist_ok=True)
+                with open(os.path.join(d, name), "w") as f:
+                    f.write(text)
             path = os.path.join(d, "spec.yaml")
             with open(path, "w") as f:
-                f.write(spec)
+                f.write(head + f"families: {families}\n")
             out = subprocess.run([sys.executable, os.path.join(SRC, "scripts", "tune.py"), path, "--out",
-                                  os.path.join(d, "out")], capture_output=True, text=True)
-        return out.returncode, out.stderr.strip().replace(path, "SPEC")
+                                  os.path.join(d, "out"), "--bin", BIN, *args], capture_output=True, text=True)
+        return out.returncode, out.stderr.strip().replace(path, "SPEC").replace(d, "DIR")
 
     def test_a_grid_written_as_a_list_is_a_one_line_error(self):
         # Study files write grids as lists of points; tune.py's grid is a map {key: [values]}.
@@ -152,6 +163,139 @@ class Grid(unittest.TestCase):
         for name in ("tuning.yaml", "tuning_long.yaml"):
             spec = tune.load_spec(os.path.join(SRC, "studies", name))
             self.assertTrue(all(len(tune.grid_points(f["grid"])) == spec["budget"] for f in spec["families"]))
+
+
+FAM = "[{name: smc, scenario: s.yaml, grid: {controller.lambda: [1, 2]}}]"
+HEAD = "objective: {error_limit_um: 0.8, signal_limits: {}}\nbudget: 2\n"
+
+
+class SpecUpFront(unittest.TestCase):
+    """Every malformed spec is one line naming the key and the value, exit 2, before any case runs
+    (no Python traceback, no feeddrive-study)."""
+    run_spec = Grid.run_spec
+
+    def check(self, head, want, families=FAM, **kw):
+        rc, err = self.run_spec(families, head=head, **kw)
+        self.assertEqual((rc, err), (2, want))
+        self.assertNotIn("Traceback", err)
+
+    def test_no_name(self):
+        self.check(HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n", "error: SPEC: name: missing")
+
+    def test_budget_as_a_string_names_the_type(self):
+        # "12" is not 12: the old message said "12 points, the budget is 12".
+        self.check("name: t\nobjective: {error_limit_um: 0.8, signal_limits: {}}\nbudget: '2'\n"
+                   "design: {base: {}, families: []}\ntest: {study: x.yaml}\n",
+                   "error: SPEC: budget = '2': must be an integer >= 1 (grid points per family)")
+
+    def test_design_not_a_map_or_without_base(self):
+        self.check("name: t\n" + HEAD + "design: [a]\ntest: {study: x.yaml}\n",
+                   "error: SPEC: design = ['a']: must be a map with base and families")
+        self.check("name: t\n" + HEAD + "design: {families: []}\ntest: {study: x.yaml}\n",
+                   "error: SPEC: design.base: missing")
+
+    def test_test_not_a_map_without_study_or_naming_a_missing_file(self):
+        design = "design: {base: {}, families: []}\n"
+        self.check("name: t\n" + HEAD + design + "test: x.yaml\n",
+                   "error: SPEC: test = 'x.yaml': must be a map with study")
+        self.check("name: t\n" + HEAD + design + "test: {}\n", "error: SPEC: test.study = None: must be a study file name")
+        self.check("name: t\n" + HEAD + design + "test: {study: nope.yaml}\n",
+                   "error: SPEC: test.study = 'nope.yaml': no such file")
+
+    def test_set_given_as_a_list(self):
+        self.check("name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n",
+                   "error: SPEC: families.smc.set = ['controller.k', 1]: must be a map {key: value}",
+                   families="[{name: smc, scenario: s.yaml, set: [controller.k, 1], grid: {controller.lambda: [1, 2]}}]")
+
+    def test_a_family_scenario_that_is_no_file(self):
+        self.check("name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n",
+                   "error: SPEC: families.smc.scenario = 'gone.yaml': no such file",
+                   families="[{name: smc, scenario: gone.yaml, grid: {controller.lambda: [1, 2]}}]")
+
+    def test_stage_test_with_a_chosen_yaml_lacking_a_family_or_malformed(self):
+        head = "name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
+        self.check(head, "error: DIR/out/chosen.yaml: families.smc.point: missing", args=("--stage", "test"),
+                   files={"out/chosen.yaml": "recommended: smc\nfamilies: {other: {point: {controller.lambda: 1}}}\n"})
+        self.check(head, "error: DIR/out/chosen.yaml: families = None: must be a map {family: {point: ...}}",
+                   args=("--stage", "test"), files={"out/chosen.yaml": "smc: {point: {controller.lambda: 1}}\n"})
+        self.check(head, "error: DIR/out/chosen.yaml: families.smc.point = {'controller.lambda': 3}: "
+                         "not a point of the spec's grid", args=("--stage", "test"),
+                   files={"out/chosen.yaml": "recommended: smc\nfamilies: {smc: {point: {controller.lambda: 3}}}\n"})
+        self.check(head, "error: DIR/out/chosen.yaml: recommended = 'cascade': must name one of the families ['smc']",
+                   args=("--stage", "test"),
+                   files={"out/chosen.yaml": "recommended: cascade\nfamilies: {smc: {point: {controller.lambda: 1}}}\n"})
+
+    def test_a_second_test_run_is_refused_without_force(self):
+        head = "name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
+        self.check(head, "error: --stage test: DIR/out/test exists: the test set is run once (--force to run it again)",
+                   args=("--stage", "test"),
+                   files={"out/chosen.yaml": "recommended: smc\nfamilies: {smc: {point: {controller.lambda: 1}}}\n",
+                          "out/test/results.csv": "case\n"})
+
+    @unittest.skipUnless(os.path.exists(os.path.join(BIN, "feeddrive-study")), "needs feeddrive-study (BIN_DIR)")
+    def test_a_misspelt_signal_limit_is_caught_before_the_design_stage(self):
+        # The probe (one 0.15 s case) reads the real results header; the design study never runs.
+        scenario = os.path.join(SRC, "scenarios", "robustness", "robust_smc.yaml")
+        head = ("name: t\nobjective: {error_limit_um: 0.8, signal_limits: {control_step_rms: 0.2}}\nbudget: 2\n"
+                "design: {base: {duration: 1.0, control_period: 1.0e-4, reference: {type: scurve}}, "
+                "families: [{name: f}]}\ntest: {study: x.yaml}\n")
+        rc, err = self.run_spec(f"[{{name: smc, scenario: {scenario}, grid: {{controller.k: [10.0, 11.0]}}}}]", head=head)
+        self.assertEqual(rc, 2)
+        self.assertEqual(err.splitlines()[-1], "error: SPEC: objective.signal_limits.control_step_rms: no such "
+                                               "results column (probe: DIR/out/probe.yaml)")
+        self.assertNotIn("t_design", err)
+
+
+class HardConstraint(unittest.TestCase):
+    """The signal limits are a hard constraint and the recommendation is chosen across families."""
+
+    def summary(self, j, penalty):
+        return tune.summarise([("f", j, 0.8 * j, penalty, {"full_run_um": 0.8 * j})])
+
+    def test_a_feasible_candidate_ranks_before_any_infeasible_one(self):
+        # J 4.87 within every limit beats J 3.36 with a signal penalty (the first round's SMC choice).
+        feasible, infeasible = self.summary(4.87, 0.0), self.summary(3.36, 0.4)
+        self.assertTrue(feasible["feasible"] and not infeasible["feasible"])
+        self.assertLess(tune.rank(feasible), tune.rank(infeasible))
+        # Among feasible ones the lower J; among infeasible ones too.
+        self.assertLess(tune.rank(self.summary(2.0, 0.0)), tune.rank(feasible))
+        self.assertLess(tune.rank(self.summary(3.0, 0.1)), tune.rank(self.summary(5.0, 0.1)))
+        # A failed case (J infinite) is never feasible.
+        self.assertFalse(tune.summarise([("f", math.inf, math.inf, math.inf, {"full_run_um": math.nan})])["feasible"])
+
+    def test_the_recommendation_is_the_best_family_choice_by_the_same_rule(self):
+        table = {"a": ([({}, self.summary(3.0, 0.5))], 0), "b": ([({}, self.summary(5.0, 0.0))], 0),
+                 "c": ([({}, self.summary(4.0, 0.0))], 0)}
+        self.assertEqual(tune.recommend(table), "c")
+
+
+class RecommendedOneSource(unittest.TestCase):
+    """The recommended controller's settings live in scenarios/robustness/recommended.yaml; the
+    tuning record (docs/tuning/chosen.yaml: the family and its point) and the family's definition
+    (studies/tuning.yaml: its scenario and fixed keys) must say the same, and the studies that
+    run it must take that file, not a copy of its keys."""
+
+    def load(self, *parts):
+        import yaml
+        with open(os.path.join(SRC, *parts)) as f:
+            return yaml.safe_load(f)
+
+    def test_the_file_is_the_tuning_choice(self):
+        chosen = self.load("docs", "tuning", "chosen.yaml")
+        spec = self.load("studies", "tuning.yaml")
+        fam = next(f for f in spec["families"] if f["name"] == chosen["recommended"])
+        expected = self.load("studies", fam["scenario"])["controller"]
+        for key, value in {**fam.get("set", {}), **chosen["families"][fam["name"]]["point"]}.items():
+            self.assertTrue(key.startswith("controller."), key)
+            expected[key[len("controller."):]] = value
+        self.assertEqual(self.load("scenarios", "robustness", "recommended.yaml")["controller"], expected)
+
+    def test_the_studies_take_the_file(self):
+        for study in ("robustness_moves.yaml", "reversal_fix.yaml"):
+            entries = [c for c in self.load("studies", study)["controllers"] if c["name"] == "recommended"]
+            self.assertEqual(len(entries), 1, study)
+            self.assertEqual(entries[0]["scenario"], "../scenarios/robustness/recommended.yaml", study)
+            self.assertNotIn("set", entries[0], study)
 
 
 if __name__ == "__main__":

@@ -7,6 +7,8 @@
 // shortest round-trip form, nothing measured on the clock, so the same study gives the same bytes
 // for any -j, any number of MPI ranks and a rerun that reuses finished cases.
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -85,6 +87,17 @@ struct ReportData {
     std::size_t index, controller, family;
     std::string error;
   };
+  /// The four control-signal figures of docs/scenario.md ("Control-signal quality").
+  static constexpr std::array<const char*, 4> kSignalFigures{"control_step_rms_V", "control_direction_changes_per_s",
+                                                             "force_hf_rms_N", "control_saturated_fraction"};
+  /// Per controller: the worst (largest) of each signal figure over its cases, the cases without
+  /// a value of it (failed, or not measurable), and the cases whose control_signal_within_limits
+  /// is true, false or absent (a failed case: absent).
+  struct Signal {
+    std::array<double, 4> worst{NAN, NAN, NAN, NAN};
+    std::array<long, 4> no_value{0, 0, 0, 0};
+    long within{0}, outside{0}, unknown{0};
+  };
 
   explicit ReportData(const Study& s);
   void add(std::size_t index, const CaseRecord& c);
@@ -96,6 +109,7 @@ struct ReportData {
   std::vector<double> shown;              ///< per case: the report metric x scale, NaN without one
   std::vector<float> x;           ///< per case, params.size() each: the varied keys' values (NaN if not a number)
   std::vector<Worst> worst;       ///< per controller
+  std::vector<Signal> signal;     ///< per controller
   std::vector<Failure> failures;  ///< the first kListedFailures
   std::size_t cases{0}, failed{0}, cached{0};
   /// Per varied key: its values in order of first appearance (at most kMaxCategories; `more`
