@@ -52,13 +52,24 @@ def fail(msg):
     sys.exit(2)
 
 
-def load_spec(path):
-    """The spec, checked whole before anything runs (one-line error naming the key, exit 2)."""
+def load_yaml(path, what=""):
+    """The YAML document at path, or a one-line error (exit 2): the file, the line and PyYAML's
+    problem (its message spans several lines, which the one-line rule does not allow)."""
     try:
         with open(path) as f:
-            spec = yaml.safe_load(f)
-    except (OSError, yaml.YAMLError) as e:
-        fail(f"{path}: {e}")
+            return yaml.safe_load(f)
+    except OSError as e:
+        fail(f"{path}: {e.strerror}{what}")
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
+        fail(f"{path}:{where}: not YAML: {problem}")
+
+
+def load_spec(path):
+    """The spec, checked whole before anything runs (one-line error naming the key, exit 2)."""
+    spec = load_yaml(path)
     if not isinstance(spec, dict):
         fail(f"{path}: not a map")
     for key in ("name", "objective", "budget", "design", "test", "families"):
@@ -100,6 +111,9 @@ def check_test(path, test):
         fail(f"{path}: test.study = {study!r}: must be a study file name")
     if not os.path.isfile(relative_to(path, study)):
         fail(f"{path}: test.study = {study!r}: no such file")
+    body = load_yaml(relative_to(path, study))  # parsed now: a broken test study must not wait for the design stage
+    if not isinstance(body, dict):
+        fail(f"{relative_to(path, study)}: not a map (test.study of {path})")
 
 
 def check_families(path, spec):
@@ -386,13 +400,7 @@ RULE = ("signal limits a hard constraint (feasible: within every signal limit in
 def load_chosen(spec, path):
     """DIR/chosen.yaml for --stage test: {recommended, rule, families: {name: {point: {key: value}}}}
     with every family of the spec, each point a point of its grid (one-line error, exit 2)."""
-    try:
-        with open(path) as f:
-            chosen = yaml.safe_load(f)
-    except OSError as e:
-        fail(f"--stage test: {e} (run the design stage first)")
-    except yaml.YAMLError as e:
-        fail(f"{path}: {e}")
+    chosen = load_yaml(path, " (run the design stage first)")
     if not isinstance(chosen, dict) or not isinstance(chosen.get("families"), dict):
         fail(f"{path}: families = {chosen.get('families') if isinstance(chosen, dict) else chosen!r}: "
              "must be a map {family: {point: ...}}")
@@ -411,8 +419,7 @@ def load_chosen(spec, path):
 
 def test_study(spec, spec_path, chosen):
     path = relative_to(spec_path, spec["test"]["study"])
-    with open(path) as f:
-        study = yaml.safe_load(f)
+    study = load_yaml(path)  # checked by check_test before any case ran
     if isinstance(study.get("base"), str):
         study["base"] = relative_to(path, study["base"])
     study["name"] = spec["name"] + "_test"

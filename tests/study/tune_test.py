@@ -225,6 +225,22 @@ class SpecUpFront(unittest.TestCase):
                    args=("--stage", "test"),
                    files={"out/chosen.yaml": "recommended: cascade\nfamilies: {smc: {point: {controller.lambda: 1}}}\n"})
 
+    def test_a_malformed_test_study_is_refused_before_the_design_stage(self):
+        # Found in review: a test study that is not YAML passed the up-front check, the whole
+        # design stage ran, and --stage test then died with a traceback (exit 1).
+        head = "name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
+        rc, err = self.run_spec(FAM, head=head, files={"x.yaml": "name: x\nbase: [1,\n"})
+        self.assertEqual(rc, 2)
+        self.assertEqual(len(err.splitlines()), 1, err)
+        self.assertRegex(err, r"^error: DIR/x\.yaml: line \d+, column \d+: not YAML: ")
+        self.check(head, "error: DIR/x.yaml: not a map (test.study of SPEC)", files={"x.yaml": "- a\n"})
+
+    def test_a_spec_that_is_not_yaml_is_one_line(self):
+        rc, err = self.run_spec(FAM, head="name: t\nobjective: {error_limit_um: [0.8\n")
+        self.assertEqual(rc, 2)
+        self.assertEqual(len(err.splitlines()), 1, err)
+        self.assertRegex(err, r"^error: SPEC: line \d+, column \d+: not YAML: ")
+
     def test_a_second_test_run_is_refused_without_force(self):
         head = "name: t\n" + HEAD + "design: {base: {}, families: []}\ntest: {study: x.yaml}\n"
         self.check(head, "error: --stage test: DIR/out/test exists: the test set is run once (--force to run it again)",
