@@ -302,6 +302,16 @@ TEST_F(RecommendedController, SineWithReversals) {
   expect_measured(test_case("sine_mc", {{"plant.sensor.seed", 6115}}, 3), {0.7834, 3.038, 0.03003, 1543, 5.846, true});
 }
 
+// The case nearest a signal limit (review, 27 November): the sine at mass x0.7, Fs/Fc x1.5,
+// sigma0 x1.5 / sigma1 x1.5, 500 us (case 393), 1,945 direction changes/s against the limit of
+// 2,000 (2.7 % below). The same case with encoder-noise seed 17 gives 2,008 /s (over the limit:
+// docs/tuning.md), so this bound's upper side (x1.1 as for every figure) is looser than the limit;
+// the exact verdict (within the limits, as measured) is what keeps the margin from being lost.
+TEST_F(RecommendedController, NearestTheSignalLimit) {
+  expect_measured(test_case("sine_corners", test_corner(71.428, 180.0, 3000000.0, 0.0005)),
+                  {2.519, 2.519, 0.0765, 1945, 12.62, true});
+}
+
 // The fast S-curve: the worst corner after the window (a documented miss), the worst corner over the whole run (a
 // documented miss: its acceleration phase, which the window mostly leaves out), the worst draw after the window and
 // over the whole run. Measured (after 0.1 s, whole run; step RMS, direction changes/s, force above 1 kHz; within the
