@@ -260,7 +260,7 @@ Resolver::Impl::Values Resolver::Impl::variation_values(const CaseSpec& c, const
       values.push_back({v.key, v.value});
       continue;
     }
-    const auto it = nominal.find(v.key);
+    const auto it = nominal.find(sim::canonical_key(v.key));  // an old spelling scales its key
     if (it == nominal.end())
       throw StudyError(origin + ": " + v.key +
                        ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or "
@@ -314,7 +314,7 @@ ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, con
   // Every varied key of the study, with its effective value in this case (its nominal value
   // where this case does not vary it), so each row of results.csv places the case on every axis.
   for (const std::string& k : varied) {
-    const auto it = keys.find(k);
+    const auto it = keys.find(sim::canonical_key(k));
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
   for (const sim::KeySetting& v : values)

@@ -33,7 +33,7 @@ families:
       parameters:
         - {key: plant.mass, distribution: uniform, low: 0.8, high: 1.2, scale: true}
         - {keys: [plant.friction.bristle_stiffness, plant.friction.bristle_damping], distribution: lognormal, mu: 0, sigma: 0.1, scale: true}
-        - {key: plant.effects.input_delay.delay_s, distribution: normal, mean: 5.0e-4, stddev: 3.0e-4, low: 0, high: 1.0e-3}
+        - {key: plant.effects.input_delay.delay, distribution: normal, mean: 5.0e-4, stddev: 3.0e-4, low: 0, high: 1.0e-3}
 )";
 
 Study families() {
