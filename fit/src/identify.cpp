@@ -676,9 +676,7 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
     for (const Effect& e : plant::enabled_effects(fitted.effects))
       if (e.name == name) {
         named.push_back(e);
-        // the columns in the list's order (params.hpp), not the names' alphabetical one: renaming a
-        // parameter leaves the numbers alone
-        for (const std::string& k : plant::effect_parameter_names(name)) keys.emplace_back(name, k);
+        for (const auto& [k, v] : e.parameters) keys.emplace_back(name, k);
       }
   if (keys.empty()) return out;
   const Eigen::VectorXd r0 = force_residual(rec, fitted);

@@ -298,12 +298,17 @@ struct ElectricalParams {
 /// quantity the plant's own sections have is named, and declared, as there (`quantity` above:
 /// cogging_ripple.cogging_amplitude is ripple.cogging_amplitude). Units are in the list, not in
 /// the names; each key's old spelling (amplitude_N, ...) is its alias, still read with a warning.
+/// Every effect's `enabled`: listing the effect turns it on (`enabled: false` switches it off again).
+inline fields::Field<bool> listed_enabled(bool& v) {
+  return fields::field("enabled", v).doc("on (listing the effect turns it on)");
+}
+
 struct ConstantForceEffect {  ///< F = force (gravity on an incline, cable weight, offset)
   bool enabled{false};
   double force{0.0};  ///< [N]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(FD_FIELD(force).unit("N").plausible(-1e4, 1e4).doc("the constant force").alias("force_N"));
   }
 };
@@ -313,7 +318,7 @@ struct CoulombFrictionEffect {  ///< F = coulomb_force*sgn(v), sgn smoothed as t
   double coulomb_force{0.0};  ///< Fc [N]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::coulomb_force(coulomb_force).alias("coulomb_N"));
   }
 };
@@ -322,7 +327,7 @@ struct ViscousFrictionEffect {  ///< F = viscous*v
   double viscous{0.0};  ///< sigma2 [N*s/m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::viscous(viscous).alias("viscous_Ns_per_m"));
   }
 };
@@ -335,7 +340,7 @@ struct StribeckFrictionEffect {
   double stribeck_velocity{0.01};  ///< vs [m/s]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::static_force(static_force).alias("static_N"));
     a->Visit(quantity::coulomb_force(coulomb_force).alias("coulomb_N"));
     a->Visit(quantity::stribeck_velocity(stribeck_velocity).alias("stribeck_velocity_mps"));
@@ -350,7 +355,7 @@ struct PreslidingEffect {
   double bristle_damping{0.0};    ///< sigma1 [N*s/m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::bristle_stiffness(bristle_stiffness).alias("bristle_stiffness_N_per_m"));
     a->Visit(quantity::bristle_damping(bristle_damping).alias("bristle_damping_Ns_per_m"));
   }
@@ -366,7 +371,7 @@ struct CoggingRippleEffect {
   double cogging_third_phase{0.0};  ///< phi_c3 [rad]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::pitch(pitch).alias("pitch_m"));
     a->Visit(quantity::cogging_amplitude(cogging_amplitude).alias("amplitude_N"));
     a->Visit(quantity::cogging_phase(cogging_phase).alias("phase_rad"));
@@ -383,7 +388,7 @@ struct ReluctanceRippleEffect {
   double reluctance_phase{0.0};      ///< phi_11 [rad]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::pitch(pitch).alias("pitch_m"));
     a->Visit(quantity::reluctance_amplitude(reluctance_amplitude).alias("relative_amplitude"));
     a->Visit(quantity::reluctance_phase(reluctance_phase).alias("phase_rad"));
@@ -398,7 +403,7 @@ struct GrindingForceEffect {
   double contact_position{0.0};  ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(FD_FIELD(damping)
                  .unit("N*s/m")
                  .positive()
@@ -416,7 +421,7 @@ struct SpringForceEffect {
   double rest_position{0.0};  ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(FD_FIELD(stiffness)
                  .unit("N/m")
                  .non_negative()
@@ -436,7 +441,7 @@ struct MassErrorEffect {
   double mass{102.04};  ///< [kg]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(quantity::mass(mass).alias("mass_kg"));
   }
 };
@@ -446,7 +451,7 @@ struct InputDelayEffect {
   double delay{0.0};  ///< [s]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
+    a->Visit(listed_enabled(enabled));
     a->Visit(FD_FIELD(delay)
                  .unit("s")
                  .non_negative()
