@@ -290,63 +290,63 @@ void draw_hidden(const CaseSpec& spec, Rng& r, double m_nom, double travel, Trut
   const double v_typ = 0.05;  // m/s, a typical move speed of the reference
   if (hidden("constant_force")) {
     T.F0 = r.sign() * r.u(3, 20);
-    truth.push_back({"constant_force", {{"force_N", T.F0}}});
+    truth.push_back({"constant_force", {{"force", T.F0}}});
   }
   if (hidden("coulomb_friction")) {
     T.hc = r.u(5, 30);
-    truth.push_back({"coulomb_friction", {{"coulomb_N", T.hc}}});
+    truth.push_back({"coulomb_friction", {{"coulomb_force", T.hc}}});
   }
   if (hidden("viscous_friction")) {
     T.hv = r.u(50, 300);
-    truth.push_back({"viscous_friction", {{"viscous_Ns_per_m", T.hv}}});
+    truth.push_back({"viscous_friction", {{"viscous", T.hv}}});
   }
   if (hidden("stribeck_friction")) {
     T.strib = true;
     T.sFc = r.u(5, 20), T.sFs = T.sFc + r.u(5, 20), T.svs = r.u(1e-3, 10e-3);
     truth.push_back(
-        {"stribeck_friction", {{"static_N", T.sFs}, {"coulomb_N", T.sFc}, {"stribeck_velocity_mps", T.svs}}});
+        {"stribeck_friction", {{"static_force", T.sFs}, {"coulomb_force", T.sFc}, {"stribeck_velocity", T.svs}}});
   }
   if (hidden("presliding")) {
     T.pres = true;
     T.sig0 = std::exp(r.u(std::log(1e5), std::log(1e7)));
     T.sig1 = 2 * r.u(0.05, 0.5) * std::sqrt(T.sig0 * T.m);
-    truth.push_back({"presliding", {{"bristle_stiffness_N_per_m", T.sig0}, {"bristle_damping_Ns_per_m", T.sig1}}});
+    truth.push_back({"presliding", {{"bristle_stiffness", T.sig0}, {"bristle_damping", T.sig1}}});
   }
   if (hidden("cogging_ripple")) {
     T.cp = r.u(0.01, std::min(0.04, travel / 3)), T.ca = r.u(2, 10), T.cphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.cp = travel / spec.ripple_periods;
     T.cb = T.ca * r.u(0, 0.4), T.cphi3 = r.u(-kPi, kPi);
     truth.push_back({"cogging_ripple",
-                     {{"pitch_m", T.cp},
-                      {"amplitude_N", T.ca},
-                      {"phase_rad", T.cphi},
-                      {"third_harmonic_N", T.cb},
-                      {"third_phase_rad", T.cphi3}}});
+                     {{"pitch", T.cp},
+                      {"cogging_amplitude", T.ca},
+                      {"cogging_phase", T.cphi},
+                      {"cogging_third", T.cb},
+                      {"cogging_third_phase", T.cphi3}}});
   }
   if (hidden("reluctance_ripple")) {
     T.rp = r.u(0.01, std::min(0.04, travel / 3)), T.rA = r.u(0.03, 0.08), T.rphi = r.u(-kPi, kPi);
     if (spec.ripple_periods > 0) T.rp = travel / spec.ripple_periods;
-    truth.push_back({"reluctance_ripple", {{"pitch_m", T.rp}, {"relative_amplitude", T.rA}, {"phase_rad", T.rphi}}});
+    truth.push_back(
+        {"reluctance_ripple", {{"pitch", T.rp}, {"reluctance_amplitude", T.rA}, {"reluctance_phase", T.rphi}}});
   }
   if (hidden("grinding_force")) {
     T.grind = true;
     T.xc = r.u(0.2, 0.8) * travel;
     T.C = r.u(20, 100) / v_typ;
     T.ke = T.C / r.u(2e-3, 50e-3);
-    truth.push_back(
-        {"grinding_force", {{"gain_Ns_per_m", T.C}, {"stiffness_N_per_m", T.ke}, {"contact_position_m", T.xc}}});
+    truth.push_back({"grinding_force", {{"damping", T.C}, {"stiffness", T.ke}, {"contact_position", T.xc}}});
   }
   if (hidden("spring_force")) {
     T.k = r.u(200, 2000), T.xr = r.u(0.0, 1.0) * travel;
-    truth.push_back({"spring_force", {{"stiffness_N_per_m", T.k}, {"rest_position_m", T.xr}}});
+    truth.push_back({"spring_force", {{"stiffness", T.k}, {"rest_position", T.xr}}});
   }
   if (hidden("mass_error")) {
     T.m = m_nom * (1.0 + r.sign() * r.u(0.1, 0.3));
-    truth.push_back({"mass_error", {{"mass_kg", T.m}}});
+    truth.push_back({"mass_error", {{"mass", T.m}}});
   }
   if (hidden("input_delay")) {
     T.delay = r.u(0.5e-3, 3e-3);
-    truth.push_back({"input_delay", {{"delay_s", T.delay}}});
+    truth.push_back({"input_delay", {{"delay", T.delay}}});
   }
 }
 

@@ -63,17 +63,17 @@ struct Outcome {
 /// Main parameters and their relative tolerances, per effect.
 inline const std::map<std::string, std::vector<std::pair<std::string, double>>>& tolerances() {
   static const std::map<std::string, std::vector<std::pair<std::string, double>>> t{
-      {"constant_force", {{"force_N", 0.2}}},
-      {"coulomb_friction", {{"coulomb_N", 0.2}}},
-      {"viscous_friction", {{"viscous_Ns_per_m", 0.2}}},
-      {"stribeck_friction", {{"static_N", 0.2}}},
-      {"presliding", {{"bristle_stiffness_N_per_m", 0.5}}},
-      {"cogging_ripple", {{"pitch_m", 0.02}, {"amplitude_N", 0.2}}},
-      {"reluctance_ripple", {{"pitch_m", 0.02}, {"relative_amplitude", 0.2}}},
-      {"grinding_force", {{"gain_Ns_per_m", 0.2}}},
-      {"spring_force", {{"stiffness_N_per_m", 0.2}}},
-      {"mass_error", {{"mass_kg", 0.05}}},
-      {"input_delay", {{"delay_s", 0.2}}},
+      {"constant_force", {{"force", 0.2}}},
+      {"coulomb_friction", {{"coulomb_force", 0.2}}},
+      {"viscous_friction", {{"viscous", 0.2}}},
+      {"stribeck_friction", {{"static_force", 0.2}}},
+      {"presliding", {{"bristle_stiffness", 0.5}}},
+      {"cogging_ripple", {{"pitch", 0.02}, {"cogging_amplitude", 0.2}}},
+      {"reluctance_ripple", {{"pitch", 0.02}, {"reluctance_amplitude", 0.2}}},
+      {"grinding_force", {{"damping", 0.2}}},
+      {"spring_force", {{"stiffness", 0.2}}},
+      {"mass_error", {{"mass", 0.05}}},
+      {"input_delay", {{"delay", 0.2}}},
   };
   return t;
 }
@@ -101,7 +101,7 @@ inline EffectParameters true_parameters(const fdgen::Generated& g) {
   for (const auto& e : g.truth) truth[e.name] = e.parameters;
   if (truth.count("constant_force") && truth.count("spring_force")) {
     auto& s = truth["spring_force"];
-    s["rest_position_m"] -= truth["constant_force"]["force_N"] / s["stiffness_N_per_m"];
+    s["rest_position"] -= truth["constant_force"]["force"] / s["stiffness"];
     truth.erase("constant_force");
   }
   return truth;
@@ -219,7 +219,7 @@ inline Outcome run_case(const fdgen::CaseSpec& spec, FitOptions opt = {}, const 
   take_result(r, o, found);
   const double range = *std::max_element(g.x.begin(), g.x.end()) - *std::min_element(g.x.begin(), g.x.end());
   for (const char* rip : {"cogging_ripple", "reluctance_ripple"})
-    if (truth.count(rip)) o.periods = range / truth.at(rip).at("pitch_m");
+    if (truth.count(rip)) o.periods = range / truth.at(rip).at("pitch");
   judge(r, truth, std::move(found), o);
   return o;
 }

@@ -123,11 +123,11 @@ const std::vector<Spec>& specs() {
       sp.starts = [start](const Ctx&) { return std::vector<Theta>{{start}}; };
       return sp;
     };
-    s.push_back(one("constant_force", "force_N", 0.0));
+    s.push_back(one("constant_force", "force", 0.0));
     // Friction and spring effects have the physical sign the plant requires (>= 0).
-    s.push_back(one("coulomb_friction", "coulomb_N", 0.0));
+    s.push_back(one("coulomb_friction", "coulomb_force", 0.0));
     s.back().lower = {{0, 0.0}};
-    s.push_back(one("viscous_friction", "viscous_Ns_per_m", 0.0));
+    s.push_back(one("viscous_friction", "viscous", 0.0));
     s.back().lower = {{0, 0.0}};
     {
       Spec sp;
@@ -135,11 +135,12 @@ const std::vector<Spec>& specs() {
       sp.dim = 3;  // Fc, Fs - Fc, ln vs  (Fs >= Fc >= 0, as the plant requires)
       sp.to_effect = [](const Theta& t, const Ctx&) {
         return Effect{"stribeck_friction",
-                      {{"static_N", t[0] + t[1]}, {"coulomb_N", t[0]}, {"stribeck_velocity_mps", std::exp(t[2])}}};
+                      {{"static_force", t[0] + t[1]}, {"coulomb_force", t[0]}, {"stribeck_velocity", std::exp(t[2])}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
-        return Theta{e.parameters.at("coulomb_N"), e.parameters.at("static_N") - e.parameters.at("coulomb_N"),
-                     std::log(e.parameters.at("stribeck_velocity_mps"))};
+        return Theta{e.parameters.at("coulomb_force"),
+                     e.parameters.at("static_force") - e.parameters.at("coulomb_force"),
+                     std::log(e.parameters.at("stribeck_velocity"))};
       };
       sp.starts = [](const Ctx& c) {
         std::vector<Theta> out;
@@ -155,12 +156,10 @@ const std::vector<Spec>& specs() {
       sp.name = "presliding";
       sp.dim = 2;  // ln sigma0, sigma1
       sp.to_effect = [](const Theta& t, const Ctx&) {
-        return Effect{"presliding",
-                      {{"bristle_stiffness_N_per_m", std::exp(t[0])}, {"bristle_damping_Ns_per_m", t[1]}}};
+        return Effect{"presliding", {{"bristle_stiffness", std::exp(t[0])}, {"bristle_damping", t[1]}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
-        return Theta{std::log(e.parameters.at("bristle_stiffness_N_per_m")),
-                     e.parameters.at("bristle_damping_Ns_per_m")};
+        return Theta{std::log(e.parameters.at("bristle_stiffness")), e.parameters.at("bristle_damping")};
       };
       sp.starts = [](const Ctx& c) {
         const double s1 =
@@ -178,18 +177,18 @@ const std::vector<Spec>& specs() {
       sp.dim = 5;  // ln p, a cos(phi), a sin(phi), b cos(phi3), b sin(phi3)
       sp.to_effect = [](const Theta& t, const Ctx&) {
         return Effect{"cogging_ripple",
-                      {{"pitch_m", std::exp(t[0])},
-                       {"amplitude_N", std::hypot(t[1], t[2])},
-                       {"phase_rad", std::atan2(t[2], t[1])},
-                       {"third_harmonic_N", std::hypot(t[3], t[4])},
-                       {"third_phase_rad", std::atan2(t[4], t[3])}}};
+                      {{"pitch", std::exp(t[0])},
+                       {"cogging_amplitude", std::hypot(t[1], t[2])},
+                       {"cogging_phase", std::atan2(t[2], t[1])},
+                       {"cogging_third", std::hypot(t[3], t[4])},
+                       {"cogging_third_phase", std::atan2(t[4], t[3])}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
         const auto& p = e.parameters;
-        return Theta{std::log(p.at("pitch_m")), p.at("amplitude_N") * std::cos(p.at("phase_rad")),
-                     p.at("amplitude_N") * std::sin(p.at("phase_rad")),
-                     p.at("third_harmonic_N") * std::cos(p.at("third_phase_rad")),
-                     p.at("third_harmonic_N") * std::sin(p.at("third_phase_rad"))};
+        return Theta{std::log(p.at("pitch")), p.at("cogging_amplitude") * std::cos(p.at("cogging_phase")),
+                     p.at("cogging_amplitude") * std::sin(p.at("cogging_phase")),
+                     p.at("cogging_third") * std::cos(p.at("cogging_third_phase")),
+                     p.at("cogging_third") * std::sin(p.at("cogging_third_phase"))};
       };
       sp.starts = [](const Ctx& c) {
         std::vector<Theta> out;
@@ -207,14 +206,14 @@ const std::vector<Spec>& specs() {
       sp.dim = 3;  // ln p, A cos(phi), A sin(phi)
       sp.to_effect = [](const Theta& t, const Ctx&) {
         return Effect{"reluctance_ripple",
-                      {{"pitch_m", std::exp(t[0])},
-                       {"relative_amplitude", std::hypot(t[1], t[2])},
-                       {"phase_rad", std::atan2(t[2], t[1])}}};
+                      {{"pitch", std::exp(t[0])},
+                       {"reluctance_amplitude", std::hypot(t[1], t[2])},
+                       {"reluctance_phase", std::atan2(t[2], t[1])}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
         const auto& p = e.parameters;
-        return Theta{std::log(p.at("pitch_m")), p.at("relative_amplitude") * std::cos(p.at("phase_rad")),
-                     p.at("relative_amplitude") * std::sin(p.at("phase_rad"))};
+        return Theta{std::log(p.at("pitch")), p.at("reluctance_amplitude") * std::cos(p.at("reluctance_phase")),
+                     p.at("reluctance_amplitude") * std::sin(p.at("reluctance_phase"))};
       };
       sp.starts = [](const Ctx& c) {
         std::vector<Theta> out;
@@ -229,13 +228,12 @@ const std::vector<Spec>& specs() {
       sp.dim = 3;  // ln C, ln ke, contact position (scanned, held by Ceres)
       sp.fixed = {2};
       sp.to_effect = [](const Theta& t, const Ctx&) {
-        return Effect{
-            "grinding_force",
-            {{"gain_Ns_per_m", std::exp(t[0])}, {"stiffness_N_per_m", std::exp(t[1])}, {"contact_position_m", t[2]}}};
+        return Effect{"grinding_force",
+                      {{"damping", std::exp(t[0])}, {"stiffness", std::exp(t[1])}, {"contact_position", t[2]}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx&) {
         const auto& p = e.parameters;
-        return Theta{std::log(p.at("gain_Ns_per_m")), std::log(p.at("stiffness_N_per_m")), p.at("contact_position_m")};
+        return Theta{std::log(p.at("damping")), std::log(p.at("stiffness")), p.at("contact_position")};
       };
       sp.starts = [](const Ctx& c) {
         std::vector<double> qs;
@@ -254,24 +252,24 @@ const std::vector<Spec>& specs() {
       sp.dim = 2;  // k, F0 = k*(x_mean - rest)
       sp.to_effect = [](const Theta& t, const Ctx& c) {
         const double rest = std::abs(t[0]) > 1e-12 ? c.x_mean - t[1] / t[0] : c.x_mean;
-        return Effect{"spring_force", {{"stiffness_N_per_m", t[0]}, {"rest_position_m", rest}}};
+        return Effect{"spring_force", {{"stiffness", t[0]}, {"rest_position", rest}}};
       };
       sp.from_effect = [](const Effect& e, const Ctx& c) {
-        const double k = e.parameters.at("stiffness_N_per_m");
-        return Theta{k, k * (c.x_mean - e.parameters.at("rest_position_m"))};
+        const double k = e.parameters.at("stiffness");
+        return Theta{k, k * (c.x_mean - e.parameters.at("rest_position"))};
       };
       sp.starts = [](const Ctx&) { return std::vector<Theta>{{0.0, 0.0}}; };
       sp.lower = {{0, 0.0}};
       s.push_back(sp);
     }
     {
-      Spec sp = one("mass_error", "mass_kg", 0.0);
+      Spec sp = one("mass_error", "mass", 0.0);
       sp.starts = [](const Ctx& c) { return std::vector<Theta>{{plant::effective_params(c.model).mass}}; };
       sp.lower = {{0, 1e-6}};
       s.push_back(sp);
     }
     {
-      Spec sp = one("input_delay", "delay_s", 0.0);
+      Spec sp = one("input_delay", "delay", 0.0);
       sp.starts = [](const Ctx& c) {
         const double T = c.rec.period;
         return std::vector<Theta>{{0.5 * T}, {2.0 * T}, {8.0 * T}};
@@ -347,7 +345,7 @@ plant::PlantParams with_theta(const plant::PlantParams& base, const std::vector<
     } else if (b.spec->name == kExponent) {
       p.friction.stribeck_exponent = t[0];
     } else if (b.spec->name == kOffset) {
-      plant::set_effect(p.effects, Effect{"constant_force", {{"force_N", c.offset_bound * std::tanh(t[0])}}});
+      plant::set_effect(p.effects, Effect{"constant_force", {{"force", c.offset_bound * std::tanh(t[0])}}});
     } else {
       plant::set_effect(p.effects, b.spec->to_effect(t, c));
     }
@@ -570,7 +568,7 @@ std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& mode
   }
   if (free.offset_bound > 0.0) {
     blocks.push_back({&spec(kOffset), static_cast<int>(theta.size())});
-    const double f = model.effects.constant_force.enabled ? model.effects.constant_force.force_N : 0.0;
+    const double f = model.effects.constant_force.enabled ? model.effects.constant_force.force : 0.0;
     theta.push_back(std::atanh(std::clamp(f / free.offset_bound, -0.999, 0.999)));
   }
   return {blocks, theta};
@@ -727,23 +725,23 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
 Effect canonical(const Effect& e) {
   if (e.name != "cogging_ripple") return e;
   const auto& p = e.parameters;
-  const double a1 = std::abs(p.at("amplitude_N")), a3 = std::abs(p.at("third_harmonic_N"));
+  const double a1 = std::abs(p.at("cogging_amplitude")), a3 = std::abs(p.at("cogging_third"));
   if (!(a3 > 0.0) || a1 >= 0.1 * a3) return e;
   return Effect{e.name,
-                {{"pitch_m", p.at("pitch_m") / 3.0},
-                 {"amplitude_N", a3},
-                 {"phase_rad", p.at("third_phase_rad")},
-                 {"third_harmonic_N", 0.0},
-                 {"third_phase_rad", 0.0}}};
+                {{"pitch", p.at("pitch") / 3.0},
+                 {"cogging_amplitude", a3},
+                 {"cogging_phase", p.at("cogging_third_phase")},
+                 {"cogging_third", 0.0},
+                 {"cogging_third_phase", 0.0}}};
 }
 
 double mean_position(const Record& rec) { return x_mean_of(rec); }
 
 std::optional<Effect> simpler_form(const Effect& e, double x_mean) {
   const auto& q = e.parameters;
-  if (e.name == "stribeck_friction") return Effect{"coulomb_friction", {{"coulomb_N", q.at("coulomb_N")}}};
+  if (e.name == "stribeck_friction") return Effect{"coulomb_friction", {{"coulomb_force", q.at("coulomb_force")}}};
   if (e.name == "spring_force")
-    return Effect{"constant_force", {{"force_N", q.at("stiffness_N_per_m") * (x_mean - q.at("rest_position_m"))}}};
+    return Effect{"constant_force", {{"force", q.at("stiffness") * (x_mean - q.at("rest_position"))}}};
   if (e.name == "cogging_ripple") {
     const Effect c = canonical(e);
     if (c.parameters != e.parameters) return c;
@@ -762,7 +760,7 @@ std::pair<std::string, std::vector<double>> effect_regressor(const Record& rec, 
     return {"velocity [mm/s]", out};
   }
   if (is_ripple(n)) {
-    const double p = e.parameters.at("pitch_m");
+    const double p = e.parameters.at("pitch");
     for (std::size_t i = 0; i < out.size(); ++i) {
       const double q = std::fmod(m.x[at(i)], p);
       out[i] = (q < 0 ? q + p : q) * 1e3;

@@ -170,7 +170,7 @@ Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Int
   const MeasuredData& d = *r.data;
   const long n = static_cast<long>(d.size());
   const double gain = thrust_per_input(r, pe);
-  const double delay = p.effects.input_delay.enabled ? p.effects.input_delay.delay_s : 0.0;
+  const double delay = p.effects.input_delay.enabled ? p.effects.input_delay.delay : 0.0;
   const Motion& m = r.motion;
 
   // Friction along the motion is the costly part and the same for every candidate that does

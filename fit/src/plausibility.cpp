@@ -26,8 +26,8 @@ std::string ripple_pitch(const Envelope& env, double p) {
 double friction_level(const plant::PlantParams& m) {
   double c = 0.0;
   if (m.friction.model != plant::FrictionModel::kNone) c += std::max(m.friction.static_force, m.friction.coulomb_force);
-  if (m.effects.coulomb_friction.enabled) c += m.effects.coulomb_friction.coulomb_N;
-  if (m.effects.stribeck_friction.enabled) c += m.effects.stribeck_friction.static_N;
+  if (m.effects.coulomb_friction.enabled) c += m.effects.coulomb_friction.coulomb_force;
+  if (m.effects.stribeck_friction.enabled) c += m.effects.stribeck_friction.static_force;
   return c;
 }
 
@@ -106,77 +106,77 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     std::snprintf(buf, sizeof buf, "%s %.4g N exceeds the peak thrust of the record (%.4g N)", what, value, F);
     return std::string(buf);
   };
-  if (n == "constant_force" && std::abs(par(e, "force_N")) > F) return above("force", std::abs(par(e, "force_N")));
+  if (n == "constant_force" && std::abs(par(e, "force")) > F) return above("force", std::abs(par(e, "force")));
   if (n == "constant_force") {
     // While the drive moves, a constant force F and a Coulomb friction whose level differs by 2F
     // between the directions are the same force (they differ only in stick phases, which the fit
     // leaves out). Real friction is asymmetric by a few per cent; a smaller force is not told
     // from that.
     const double level = friction_level(model);
-    if (level > 0 && std::abs(par(e, "force_N")) < kAsymmetry * level)
+    if (level > 0 && std::abs(par(e, "force")) < kAsymmetry * level)
       return fmt(
           "force %.3g N is within a %.0f %% direction asymmetry of the %.4g N Coulomb friction, from which "
           "moving data cannot tell it",
-          std::abs(par(e, "force_N")), 100 * kAsymmetry, level);
+          std::abs(par(e, "force")), 100 * kAsymmetry, level);
   }
-  if (n == "coulomb_friction" && par(e, "coulomb_N") > F) return above("Coulomb level", par(e, "coulomb_N"));
-  if (n == "viscous_friction" && par(e, "viscous_Ns_per_m") * env.v_max > F)
-    return above("viscous force at the peak speed", par(e, "viscous_Ns_per_m") * env.v_max);
+  if (n == "coulomb_friction" && par(e, "coulomb_force") > F) return above("Coulomb level", par(e, "coulomb_force"));
+  if (n == "viscous_friction" && par(e, "viscous") * env.v_max > F)
+    return above("viscous force at the peak speed", par(e, "viscous") * env.v_max);
   if (n == "stribeck_friction") {
-    if (par(e, "static_N") > F) return above("static level", par(e, "static_N"));
-    if (par(e, "static_N") - par(e, "coulomb_N") < 0.05 * par(e, "coulomb_N"))
+    if (par(e, "static_force") > F) return above("static level", par(e, "static_force"));
+    if (par(e, "static_force") - par(e, "coulomb_force") < 0.05 * par(e, "coulomb_force"))
       return fmt(
           "no Stribeck hump: the static level %.4g N is within 5 %% of the Coulomb level %.4g N (that is Coulomb "
           "friction)",
-          par(e, "static_N"), par(e, "coulomb_N"));
-    const double vs = par(e, "stribeck_velocity_mps");
+          par(e, "static_force"), par(e, "coulomb_force"));
+    const double vs = par(e, "stribeck_velocity");
     if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
       return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
                  0.5 * env.stick_velocity * 1e3, 0.5 * env.v_max * 1e3);
   }
   if (n == "presliding") {
-    const double d = model.friction.coulomb_force / std::max(par(e, "bristle_stiffness_N_per_m"), 1e-300);
+    const double d = model.friction.coulomb_force / std::max(par(e, "bristle_stiffness"), 1e-300);
     if (d < 1e-8 || d > 1e-3)
       return fmt("presliding displacement Fc/sigma0 = %.3g um is outside 0.01 um .. 1 mm", d * 1e6);
   }
   if (n == "cogging_ripple") {
-    const std::string p = ripple_pitch(env, par(e, "pitch_m"));
+    const std::string p = ripple_pitch(env, par(e, "pitch"));
     if (!p.empty()) return p;
-    const double a = std::abs(par(e, "amplitude_N")) + std::abs(par(e, "third_harmonic_N"));
+    const double a = std::abs(par(e, "cogging_amplitude")) + std::abs(par(e, "cogging_third"));
     if (a > 0.2 * F) return fmt("ripple amplitude %.3g N exceeds a fifth of the peak thrust (%.3g N)", a, F);
   }
   if (n == "reluctance_ripple") {
-    const std::string p = ripple_pitch(env, par(e, "pitch_m"));
+    const std::string p = ripple_pitch(env, par(e, "pitch"));
     if (!p.empty()) return p;
-    if (std::abs(par(e, "relative_amplitude")) > 0.2)
-      return fmt("relative ripple amplitude %.3g exceeds 0.2", std::abs(par(e, "relative_amplitude")));
+    if (std::abs(par(e, "reluctance_amplitude")) > 0.2)
+      return fmt("relative ripple amplitude %.3g exceeds 0.2", std::abs(par(e, "reluctance_amplitude")));
   }
   if (n == "grinding_force") {
-    const double xc = par(e, "contact_position_m");
+    const double xc = par(e, "contact_position");
     if (xc > env.x_max) return fmt("contact position %.4g mm lies beyond the travel", xc * 1e3);
-    const double tau = par(e, "gain_Ns_per_m") / std::max(par(e, "stiffness_N_per_m"), 1e-300);
+    const double tau = par(e, "damping") / std::max(par(e, "stiffness"), 1e-300);
     if (tau < env.period || tau > 0.25 * env.duration)
       return fmt("time constant C/ke = %.3g ms is not resolved by the record (%.3g ms .. %.3g s)", tau * 1e3,
                  env.period * 1e3, 0.25 * env.duration);
-    if (par(e, "gain_Ns_per_m") * env.v_max > 2.0 * F)
-      return above("grinding force at the peak speed", par(e, "gain_Ns_per_m") * env.v_max);
+    if (par(e, "damping") * env.v_max > 2.0 * F)
+      return above("grinding force at the peak speed", par(e, "damping") * env.v_max);
   }
   if (n == "spring_force") {
-    const double rest = par(e, "rest_position_m");
+    const double rest = par(e, "rest_position");
     if (rest < env.x_min - env.travel || rest > env.x_max + env.travel)
       return fmt("rest position %.4g mm lies more than one travel (%.3g mm) outside the travelled range", rest * 1e3,
                  env.travel * 1e3);
-    if (par(e, "stiffness_N_per_m") * env.travel > F)
-      return above("spring force over the travel", par(e, "stiffness_N_per_m") * env.travel);
+    if (par(e, "stiffness") * env.travel > F)
+      return above("spring force over the travel", par(e, "stiffness") * env.travel);
     const double level = friction_level(model);
-    if (level > 0 && par(e, "stiffness_N_per_m") * env.travel < kAsymmetry * level)
+    if (level > 0 && par(e, "stiffness") * env.travel < kAsymmetry * level)
       return fmt(
           "its force changes by only %.3g N over the travel, within a %.0f %% direction asymmetry of the "
           "%.4g N Coulomb friction: a constant force in disguise",
-          par(e, "stiffness_N_per_m") * env.travel, 100 * kAsymmetry, level);
+          par(e, "stiffness") * env.travel, 100 * kAsymmetry, level);
   }
   if (n == "mass_error") {
-    const double m = par(e, "mass_kg");
+    const double m = par(e, "mass");
     if (m < 0.5 * env.nominal_mass || m > 2.0 * env.nominal_mass)
       return fmt("mass %.4g kg is not within a factor of two of the nominal %.4g kg", m, env.nominal_mass);
     // A drive's moving mass is known to a few per cent (payload, cables, bearings); a smaller
@@ -185,7 +185,7 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
       return fmt("mass %.4g kg is within 2 %% of the nominal %.4g kg: no mass error worth naming", m, env.nominal_mass);
   }
   if (n == "input_delay") {
-    const double d = par(e, "delay_s");
+    const double d = par(e, "delay");
     if (d >= 0.999 * env.filter_half_width)
       return fmt("delay %.3g ms reaches the filter half-width (%.3g ms): longer delays are not resolved", d * 1e3,
                  env.filter_half_width * 1e3);

@@ -43,7 +43,7 @@ Replay replay(const Record& rec, const plant::PlantParams& model, double window,
     // With an input delay the commands held before the window still act in it.
     std::vector<std::pair<double, double>> history;
     if (p.effects.input_delay.enabled) {
-      for (long k = s; k > 0 && d.t[s] - d.t[k] <= p.effects.input_delay.delay_s + rec.period; --k)
+      for (long k = s; k > 0 && d.t[s] - d.t[k] <= p.effects.input_delay.delay + rec.period; --k)
         history.insert(history.begin(), {d.t[k - 1], per_input * d.input[k - 1]});
     }
     plant::Plant drive(p, rec.period, d.t[s]);

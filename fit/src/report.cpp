@@ -14,6 +14,7 @@
 #include "feeddrive/output/csv.hpp"
 #include "feeddrive/output/folder.hpp"
 #include "feeddrive/output/gnuplot.hpp"
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
 
@@ -64,6 +65,19 @@ nlohmann::json params_json(const Effect& e) {
   return p;
 }
 
+// The parameters' units (the names carry none: plant::effect_parameter_unit, the effect's list).
+nlohmann::json units_json(const Effect& e) {
+  nlohmann::json u = nlohmann::json::object();
+  for (const auto& [k, v] : e.parameters) u[k] = plant::effect_parameter_unit(e.name, k);
+  return u;
+}
+
+// " N" after a value of parameter k of e; "" for a number without unit.
+std::string unit_suffix(const Effect& e, const std::string& k) {
+  const std::string& u = plant::effect_parameter_unit(e.name, k);
+  return u == "-" ? std::string() : " " + u;
+}
+
 nlohmann::json bins_json(const std::vector<Bin>& bins) {
   nlohmann::json a = nlohmann::json::array();
   for (const Bin& b : bins)
@@ -92,6 +106,7 @@ nlohmann::json effect_json(const FitResult& r, const Effect& final) {
   const auto tent = r.tentative.find(final.name);
   nlohmann::json e = {{"name", final.name},
                       {"parameters", params_json(final)},
+                      {"units", units_json(final)},
                       {"ci95", ci},
                       {"tentative", tent != r.tentative.end()},
                       {"caveat", tent != r.tentative.end() ? tent->second : std::string()}};
@@ -217,7 +232,7 @@ std::string params_text(const Effect& e) {
   std::string s;
   char buf[96];
   for (const auto& [k, v] : e.parameters) {
-    std::snprintf(buf, sizeof buf, "%s%s = %.6g", s.empty() ? "" : ", ", k.c_str(), v);
+    std::snprintf(buf, sizeof buf, "%s%s = %.6g%s", s.empty() ? "" : ", ", k.c_str(), v, unit_suffix(e, k).c_str());
     s += buf;
   }
   return s;
@@ -322,8 +337,11 @@ void md_effects(std::ostringstream& md, const FitResult& r) {
     for (const auto& [k, v] : e.parameters) {
       double w = std::nan("");
       if (const auto it = r.ci95.find(e.name); it != r.ci95.end() && it->second.count(k)) w = it->second.at(k);
-      std::snprintf(buf, sizeof buf, std::isfinite(w) ? "%s%s = %.6g +- %.2g" : "%s%s = %.6g (interval undetermined)",
-                    sep.c_str(), k.c_str(), v, w);
+      const std::string u = unit_suffix(e, k);
+      if (std::isfinite(w))
+        std::snprintf(buf, sizeof buf, "%s%s = %.6g +- %.2g%s", sep.c_str(), k.c_str(), v, w, u.c_str());
+      else
+        std::snprintf(buf, sizeof buf, "%s%s = %.6g%s (interval undetermined)", sep.c_str(), k.c_str(), v, u.c_str());
       md << buf;
       sep = ", ";
     }

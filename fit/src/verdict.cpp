@@ -195,7 +195,7 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
   const std::string& n = c.effect.name;
   const double longer = std::max(2.0 * env.duration, env.duration + 10.0);
   if (is_ripple(n)) {
-    const double p = par(c.effect, "pitch_m");
+    const double p = par(c.effect, "pitch");
     if (p > 0 && p > env.max_pitch())
       return fmt(
           "a force periodic in position, pitch about %.3g mm, seen over %.2g periods: record a travel of at least 3 "

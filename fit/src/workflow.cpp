@@ -175,11 +175,11 @@ std::string borderline(const Context& cx, const plant::PlantParams& p, const std
   constexpr double kPitchMargin = 0.05;
   if (!is_ripple(e.name)) return "";
   const Envelope& env = cx.env;
-  const double pitch = e.parameters.at("pitch_m");
+  const double pitch = e.parameters.at("pitch");
   if (pitch <= env.max_pitch() && pitch >= env.min_pitch()) return "";  // another limit failed
   const double limit = pitch > env.max_pitch() ? env.max_pitch() : env.min_pitch();
   const auto ci = confidence_intervals(cx.rec, p, effects);
-  const double w = ci.count(e.name) && ci.at(e.name).count("pitch_m") ? ci.at(e.name).at("pitch_m") : 0.0;
+  const double w = ci.count(e.name) && ci.at(e.name).count("pitch") ? ci.at(e.name).at("pitch") : 0.0;
   // Within the 95 % interval, or within kPitchMargin of the limit: the limits (two periods in
   // the travel, four filter half-widths per period) are rules of thumb of resolvability, not
   // physical bounds; a pitch seen over 1.9 periods is resolved nearly as well as over 2.
@@ -410,7 +410,7 @@ const CandidateFit* short_ripple(const Context& cx, const std::vector<CandidateF
   const CandidateFit* best = nullptr;
   for (const CandidateFit& c : ranking) {
     if (!is_ripple(c.effect.name) || c.reason != Reason::kImplausible || !std::isfinite(c.score)) continue;
-    const auto it = c.effect.parameters.find("pitch_m");
+    const auto it = c.effect.parameters.find("pitch");
     if (it == c.effect.parameters.end() || !(it->second > cx.env.max_pitch() && it->second <= cx.env.travel)) continue;
     if (!best || c.score > best->score) best = &c;
   }
@@ -439,7 +439,7 @@ Choice choose(const Context& cx, const Search& s, StepResult& st) {
     }
     if (const CandidateFit* rip = short_ripple(cx, st.ranking);
         rip && c.effect.name == "spring_force" && rip->score >= c.score + cx.opt.score_threshold) {
-      const double pitch = rip->effect.parameters.at("pitch_m");
+      const double pitch = rip->effect.parameters.at("pitch");
       pass_over(c, Reason::kImplausible,
                 "stands in for a force periodic in position: " + rip->effect.name +
                     fmt(", pitch %.4g mm, scores %.4g against %.4g", pitch * 1e3, rip->score, c.score) +
@@ -641,7 +641,7 @@ void collect(const Context& cx, const plant::PlantParams& model, Search& s, FitR
     s.current.friction.static_smoothing_shape = model.friction.static_smoothing_shape;
   }
   if (s.current.effects.constant_force.enabled && !contains(s.added, "constant_force"))
-    out.asymmetry_offset = s.current.effects.constant_force.force_N;
+    out.asymmetry_offset = s.current.effects.constant_force.force;
   out.fitted = s.current;
   out.smoothing_final = s.current.friction.static_smoothing_velocity;
   out.shape_final = s.current.friction.static_smoothing_shape;
@@ -677,7 +677,7 @@ std::string resemblance(const Context& cx, const CandidateFit& c, bool resembles
   std::string line = "resembles " + c.effect.name;
   if (resembles) line += fmt(" (score %.4g)", c.score);
   if (is_ripple(c.effect.name)) {
-    const auto it = c.effect.parameters.find("pitch_m");
+    const auto it = c.effect.parameters.find("pitch");
     if (it != c.effect.parameters.end()) line += fmt(", pitch %.4g mm", it->second * 1e3);
   }
   line += "; not named: " + why;

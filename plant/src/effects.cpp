@@ -14,13 +14,13 @@ constexpr double kTwoPi = 2.0 * M_PI;
 
 // The Stribeck curve of the stribeck_friction effect as a FrictionParams, so that it shares
 // forces.hpp's g(v) and dg/dv (and their delta = 1, 2 fast paths):
-//   g(v) = coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta).
+//   g(v) = coulomb_force + (static_force - coulomb_force)*exp(-|v/stribeck_velocity|^delta).
 FrictionParams stribeck_curve(const PlantParams& p) {
   const StribeckFrictionEffect& e = p.effects.stribeck_friction;
   FrictionParams f;
-  f.static_force = e.static_N;
-  f.coulomb_force = e.coulomb_N;
-  f.stribeck_velocity = e.stribeck_velocity_mps;
+  f.static_force = e.static_force;
+  f.coulomb_force = e.coulomb_force;
+  f.stribeck_velocity = e.stribeck_velocity;
   f.stribeck_exponent = p.friction.stribeck_exponent;
   return f;
 }
@@ -42,46 +42,46 @@ PlantParams effective_params(const PlantParams& p) {
   const EffectsParams& fx = p.effects;
   if (fx.presliding.enabled) {
     e.friction.model = FrictionModel::kLuGre;
-    e.friction.bristle_stiffness = fx.presliding.bristle_stiffness_N_per_m;
-    e.friction.bristle_damping = fx.presliding.bristle_damping_Ns_per_m;
+    e.friction.bristle_stiffness = fx.presliding.bristle_stiffness;
+    e.friction.bristle_damping = fx.presliding.bristle_damping;
   }
   if (fx.grinding_force.enabled) {
     e.grinding.enabled = true;
     // C = c*pi*dw*bs (GrindingParams::damping), solved for the dullness c.
-    e.grinding.dullness =
-        fx.grinding_force.gain_Ns_per_m / (M_PI * p.grinding.workpiece_diameter * p.grinding.wheel_width);
-    e.grinding.stiffness = fx.grinding_force.stiffness_N_per_m;
-    e.grinding.contact_position = fx.grinding_force.contact_position_m;
+    e.grinding.dullness = fx.grinding_force.damping / (M_PI * p.grinding.workpiece_diameter * p.grinding.wheel_width);
+    e.grinding.stiffness = fx.grinding_force.stiffness;
+    e.grinding.contact_position = fx.grinding_force.contact_position;
   }
-  if (fx.mass_error.enabled) e.mass = fx.mass_error.mass_kg;
+  if (fx.mass_error.enabled) e.mass = fx.mass_error.mass;
   return e;
 }
 
 double extra_force(const PlantParams& p, double x, double v, double thrust) {
   const EffectsParams& fx = p.effects;
   double F = 0.0;
-  if (fx.constant_force.enabled) F += fx.constant_force.force_N;
-  if (fx.coulomb_friction.enabled) F += fx.coulomb_friction.coulomb_N * smoothed_sign(p.friction, v);
-  if (fx.viscous_friction.enabled) F += fx.viscous_friction.viscous_Ns_per_m * v;
+  if (fx.constant_force.enabled) F += fx.constant_force.force;
+  if (fx.coulomb_friction.enabled) F += fx.coulomb_friction.coulomb_force * smoothed_sign(p.friction, v);
+  if (fx.viscous_friction.enabled) F += fx.viscous_friction.viscous * v;
   if (fx.stribeck_friction.enabled) F += smoothed_sign(p.friction, v) * stribeck(stribeck_curve(p), v);
   if (fx.cogging_ripple.enabled) {
     const CoggingRippleEffect& c = fx.cogging_ripple;
-    const double th = kTwoPi * x / c.pitch_m;
-    F += c.amplitude_N * std::sin(th + c.phase_rad) + c.third_harmonic_N * std::sin(3.0 * th + c.third_phase_rad);
+    const double th = kTwoPi * x / c.pitch;
+    F += c.cogging_amplitude * std::sin(th + c.cogging_phase) +
+         c.cogging_third * std::sin(3.0 * th + c.cogging_third_phase);
   }
   if (fx.reluctance_ripple.enabled) {
     const ReluctanceRippleEffect& r = fx.reluctance_ripple;
-    F += thrust * r.relative_amplitude * std::sin(kTwoPi * x / r.pitch_m + r.phase_rad);
+    F += thrust * r.reluctance_amplitude * std::sin(kTwoPi * x / r.pitch + r.reluctance_phase);
   }
-  if (fx.spring_force.enabled) F += fx.spring_force.stiffness_N_per_m * (x - fx.spring_force.rest_position_m);
+  if (fx.spring_force.enabled) F += fx.spring_force.stiffness * (x - fx.spring_force.rest_position);
   return F;
 }
 
 ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v, double thrust) {
   const EffectsParams& fx = p.effects;
   ExtraForceGradient g;
-  if (fx.coulomb_friction.enabled) g.dv += fx.coulomb_friction.coulomb_N * smoothed_sign_derivative(p.friction, v);
-  if (fx.viscous_friction.enabled) g.dv += fx.viscous_friction.viscous_Ns_per_m;
+  if (fx.coulomb_friction.enabled) g.dv += fx.coulomb_friction.coulomb_force * smoothed_sign_derivative(p.friction, v);
+  if (fx.viscous_friction.enabled) g.dv += fx.viscous_friction.viscous;
   if (fx.stribeck_friction.enabled) {
     // d/dv [sgn_eps(v)*g(v)] = sgn_eps'(v)*g(v) + sgn_eps(v)*g'(v)
     const FrictionParams curve = stribeck_curve(p);
@@ -90,19 +90,19 @@ ExtraForceGradient extra_force_gradient(const PlantParams& p, double x, double v
   }
   if (fx.cogging_ripple.enabled) {
     const CoggingRippleEffect& c = fx.cogging_ripple;
-    const double w = kTwoPi / c.pitch_m;
+    const double w = kTwoPi / c.pitch;
     const double th = w * x;
-    g.dx += w * (c.amplitude_N * std::cos(th + c.phase_rad) +
-                 3.0 * c.third_harmonic_N * std::cos(3.0 * th + c.third_phase_rad));
+    g.dx += w * (c.cogging_amplitude * std::cos(th + c.cogging_phase) +
+                 3.0 * c.cogging_third * std::cos(3.0 * th + c.cogging_third_phase));
   }
   if (fx.reluctance_ripple.enabled) {
     const ReluctanceRippleEffect& r = fx.reluctance_ripple;
-    const double w = kTwoPi / r.pitch_m;
-    const double phase = w * x + r.phase_rad;
-    g.dx += thrust * r.relative_amplitude * w * std::cos(phase);
-    g.dthrust += r.relative_amplitude * std::sin(phase);
+    const double w = kTwoPi / r.pitch;
+    const double phase = w * x + r.reluctance_phase;
+    g.dx += thrust * r.reluctance_amplitude * w * std::cos(phase);
+    g.dthrust += r.reluctance_amplitude * std::sin(phase);
   }
-  if (fx.spring_force.enabled) g.dx += fx.spring_force.stiffness_N_per_m;
+  if (fx.spring_force.enabled) g.dx += fx.spring_force.stiffness;
   return g;
 }
 
@@ -119,10 +119,12 @@ class EffectFields {
   void Visit(const fields::Field<T>& f) {
     if constexpr (std::is_same_v<T, double>) {
       names.push_back(f.meta.name);
+      units[f.meta.name] = f.meta.unit;
       if (param_ && *param_ == f.meta.name) found = f.value;
     }
   }
   std::vector<std::string> names;
+  std::map<std::string, std::string> units;
   double* found{nullptr};
 
  private:
@@ -140,6 +142,7 @@ class EffectList {
     f.value->Serialize(&inner);
     names.push_back(f.meta.name);
     parameters[f.meta.name] = inner.names;
+    units[f.meta.name] = inner.units;
     if (name_ && *name_ == f.meta.name) {
       enabled = &f.value->enabled;
       param = inner.found;
@@ -147,6 +150,7 @@ class EffectList {
   }
   std::vector<std::string> names;
   std::map<std::string, std::vector<std::string>> parameters;
+  std::map<std::string, std::map<std::string, std::string>> units;
   bool* enabled{nullptr};
   double* param{nullptr};
 
@@ -180,6 +184,14 @@ const std::vector<std::string>& effect_parameter_names(const std::string& name) 
   const auto& p = vocabulary().parameters;
   const auto it = p.find(name);
   if (it == p.end()) throw std::invalid_argument("unknown effect '" + name + "'");
+  return it->second;
+}
+
+const std::string& effect_parameter_unit(const std::string& name, const std::string& param) {
+  effect_parameter_names(name);  // an unknown effect throws
+  const auto& u = vocabulary().units.at(name);
+  const auto it = u.find(param);
+  if (it == u.end()) throw std::invalid_argument("effect " + name + ": unknown parameter '" + param + "'");
   return it->second;
 }
 

@@ -80,12 +80,12 @@ class EnabledEffectsCheck {
 void EffectsParams::validate(const std::string& prefix) const {
   EnabledEffectsCheck check(prefix);
   const_cast<EffectsParams&>(*this).Serialize(&check);
-  if (stribeck_friction.enabled && stribeck_friction.static_N < stribeck_friction.coulomb_N)
-    fail(prefix + ".stribeck_friction.static_N", stribeck_friction.static_N, "must be >= coulomb_N");
+  if (stribeck_friction.enabled && stribeck_friction.static_force < stribeck_friction.coulomb_force)
+    fail(prefix + ".stribeck_friction.static_force", stribeck_friction.static_force, "must be >= coulomb_force");
   // As for ripple.reluctance_amplitude: |amplitude| < 1 keeps the thrust's sign.
-  if (reluctance_ripple.enabled && std::abs(reluctance_ripple.relative_amplitude) >= 1.0)
-    fail(prefix + ".reluctance_ripple.relative_amplitude", reluctance_ripple.relative_amplitude,
-         "|relative_amplitude| must be < 1");
+  if (reluctance_ripple.enabled && std::abs(reluctance_ripple.reluctance_amplitude) >= 1.0)
+    fail(prefix + ".reluctance_ripple.reluctance_amplitude", reluctance_ripple.reluctance_amplitude,
+         "|reluctance_amplitude| must be < 1");
 }
 
 void SensorParams::validate(const std::string& prefix) const {
@@ -118,8 +118,8 @@ void PlantParams::validate(const std::string& prefix) const {
   if (effects.presliding.enabled) {  // the friction becomes LuGre with Fs, Fc, vs, delta, sigma2
     FrictionParams lugre = friction;
     lugre.model = FrictionModel::kLuGre;
-    lugre.bristle_stiffness = effects.presliding.bristle_stiffness_N_per_m;
-    lugre.bristle_damping = effects.presliding.bristle_damping_Ns_per_m;
+    lugre.bristle_stiffness = effects.presliding.bristle_stiffness;
+    lugre.bristle_damping = effects.presliding.bristle_damping;
     lugre.validate(prefix + ".friction");
   }
   if (effects.coulomb_friction.enabled || effects.stribeck_friction.enabled) {  // sgn_eps(v)
@@ -166,20 +166,20 @@ std::string PlantParams::fastest_time_scales(std::size_t n) const {
                      ", inductance = " + format_number(electrical.inductance),
                  "current loop"});
   if (effects.presliding.enabled)
-    s.push_back({std::sqrt(effects.presliding.bristle_stiffness_N_per_m / mass),
-                 "plant.effects.presliding.bristle_stiffness_N_per_m = " +
-                     format_number(effects.presliding.bristle_stiffness_N_per_m) + " with " + m,
+    s.push_back({std::sqrt(effects.presliding.bristle_stiffness / mass),
+                 "plant.effects.presliding.bristle_stiffness = " + format_number(effects.presliding.bristle_stiffness) +
+                     " with " + m,
                  "presliding oscillation"});
   if (effects.spring_force.enabled)
-    s.push_back({std::sqrt(effects.spring_force.stiffness_N_per_m / mass),
-                 "plant.effects.spring_force.stiffness_N_per_m = " +
-                     format_number(effects.spring_force.stiffness_N_per_m) + " with " + m,
-                 "spring oscillation"});
+    s.push_back(
+        {std::sqrt(effects.spring_force.stiffness / mass),
+         "plant.effects.spring_force.stiffness = " + format_number(effects.spring_force.stiffness) + " with " + m,
+         "spring oscillation"});
   if (effects.viscous_friction.enabled)
-    s.push_back({effects.viscous_friction.viscous_Ns_per_m / mass,
-                 "plant.effects.viscous_friction.viscous_Ns_per_m = " +
-                     format_number(effects.viscous_friction.viscous_Ns_per_m) + " with " + m,
-                 "viscous damping"});
+    s.push_back(
+        {effects.viscous_friction.viscous / mass,
+         "plant.effects.viscous_friction.viscous = " + format_number(effects.viscous_friction.viscous) + " with " + m,
+         "viscous damping"});
   std::sort(s.begin(), s.end(), [](const Scale& a, const Scale& b) { return a.rate > b.rate; });
   std::string out;
   for (std::size_t i = 0; i < s.size() && i < n; ++i) {

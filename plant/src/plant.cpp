@@ -14,7 +14,7 @@ Plant::Plant(const PlantParams& params, double period, double t0)
       integrator_(params_, t0, initial_vector(params_)),
       sensor_(params_.sensor, period),
       delayed_(params_.effects.input_delay.enabled),
-      delay_(params_.effects.input_delay.delay_s),
+      delay_(params_.effects.input_delay.delay),
       // A switch t_j + d computed in floating point may miss the period boundary it equals
       // (e.g. d = 2T) by a few ulps; 1e-9 T is far above that and far below any step CVODE takes,
       // and it avoids restarting CVODE for an interval of a few ulps.

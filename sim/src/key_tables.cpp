@@ -45,6 +45,12 @@ std::string plausible_text(const Meta& m) {
   return number(m.plausible_lo) + " … " + number(m.plausible_hi);
 }
 
+// The Meaning cell: the field's doc, and its old spelling (fields::Meta::alias) if it has one.
+std::string meaning(const Meta& m) {
+  if (!*m.alias) return m.doc;
+  return std::string(m.doc) + (*m.doc ? "; " : "") + "formerly `" + m.alias + "` (still read, with a warning)";
+}
+
 // One row per field; a nested struct is a row of its own (its meaning) followed by its fields.
 class DocArchive {
  public:
@@ -55,15 +61,15 @@ class DocArchive {
     const std::string key = prefix_.empty() ? m.name : prefix_ + "." + m.name;
     const T& v = *f.value;
     if constexpr (std::is_same_v<T, double>) {
-      rows_->push_back({key, m.unit, number(v), valid_text(m), plausible_text(m), m.doc});
+      rows_->push_back({key, m.unit, number(v), valid_text(m), plausible_text(m), meaning(m)});
     } else if constexpr (std::is_same_v<T, long> || std::is_same_v<T, std::uint64_t>) {
       const std::string valid = std::is_same_v<T, long> ? "integer, " + valid_text(m) : "integer ≥ 0";
-      rows_->push_back({key, m.unit, std::to_string(v), valid, plausible_text(m), m.doc});
+      rows_->push_back({key, m.unit, std::to_string(v), valid, plausible_text(m), meaning(m)});
     } else if constexpr (std::is_same_v<T, bool>) {
-      rows_->push_back({key, "–", v ? "true" : "false", "true, false", "–", m.doc});
+      rows_->push_back({key, "–", v ? "true" : "false", "true, false", "–", meaning(m)});
     } else if constexpr (fields::is_named_enum<T>::value) {
       rows_->push_back(
-          {key, "–", std::string("`") + fields::enum_name(v) + "`", fields::enum_choices<T>(), "–", m.doc});
+          {key, "–", std::string("`") + fields::enum_name(v) + "`", fields::enum_choices<T>(), "–", meaning(m)});
     } else if constexpr (fields::is_serializable<T>::value) {
       if (*m.doc) rows_->push_back({key, "map", "", "", "", m.doc});
       DocArchive child(key, rows_);

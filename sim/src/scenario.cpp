@@ -340,8 +340,9 @@ std::vector<std::string> off_sections(const Scenario& s) {
 // linear feed drive (common/fields.hpp), and a move that the run cuts off.
 void find_warnings(Scenario& s) {
   std::vector<std::string>& w = s.warnings;
-  w = off_sections(s);
+  w = s.renamed_keys;  // a key's deprecated spelling, one line each
   const auto add = [&w](const std::vector<std::string>& more) { w.insert(w.end(), more.begin(), more.end()); };
+  add(off_sections(s));
   {
     fields::PlausibilityArchive top("", &w);
     top.Visit(fields::field("control_period", s.control_period)
@@ -467,7 +468,7 @@ Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
     throw ScenarioError(
         "the scenario must be a YAML map with keys plant, controller, reference, duration, control_period");
   Scenario s;
-  MapReader top(root, "", &s.given_keys);
+  MapReader top(root, "", &s.given_keys, &s.renamed_keys);
   s.base_dir = base_dir;
   read_timing(top, root, s);
   read_plant_section(top, s);
@@ -585,9 +586,9 @@ PlantParams Scenario::drive() const {
   const double d = controller.computation_delay;
   if (d > 0.0) {
     plant::InputDelayEffect& delay = p.effects.input_delay;
-    if (!delay.enabled) delay.delay_s = 0.0;
+    if (!delay.enabled) delay.delay = 0.0;
     delay.enabled = true;
-    delay.delay_s += d;
+    delay.delay += d;
   }
   return p;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 
 #include "feeddrive/common/text_file.hpp"
 #include "feeddrive/common/validate.hpp"
@@ -51,8 +52,9 @@ std::string shown(const YAML::Node& v) {
   throw ScenarioError(key + " = " + shown(v) + ": " + why);
 }
 
-[[noreturn]] void unknown(const std::string& parent, const std::string& name, const std::vector<std::string>& names) {
-  throw ScenarioError(parent + "." + name + ": unknown key" + did_you_mean(name, names));
+[[noreturn]] void unknown(const std::string& parent, const std::string& name, const std::vector<std::string>& names,
+                          const std::map<std::string, std::string>& aliases = {}) {
+  throw ScenarioError(parent + "." + name + ": unknown key" + did_you_mean(name, names, aliases));
 }
 
 // A map of the one key `key` = v, for the reader's accessors.
@@ -103,7 +105,7 @@ class FieldSetArchive {
     if (found_ == Found::kBelowValue)
       throw ScenarioError(parent_ + "." + rest_ + ": " + below_ +
                           " is a single value in the scenario, not a map of keys");
-    unknown(parent_, rest_.substr(0, rest_.find('.')), names_);
+    unknown(parent_, rest_.substr(0, rest_.find('.')), names_, aliases_);
   }
 
   template <typename T>
@@ -111,6 +113,7 @@ class FieldSetArchive {
     const std::size_t dot = rest_.find('.');
     const std::string head = rest_.substr(0, dot);
     names_.push_back(f.meta.name);
+    if (*f.meta.alias) aliases_[f.meta.alias] = f.meta.name;  // for the hint only: set_node respelled the key
     if (found_ != Found::kNone || head != f.meta.name) return;
     if constexpr (fields::is_serializable<T>::value) {
       if (dot == std::string::npos) {
@@ -142,6 +145,7 @@ class FieldSetArchive {
   std::string parent_, rest_, below_, error_;
   const YAML::Node& value_;
   std::vector<std::string> names_;
+  std::map<std::string, std::string> aliases_;
   Found found_{Found::kNone};
 };
 
@@ -191,8 +195,14 @@ void set_map(Scenario& s, const std::string& key, const YAML::Node& v, Reset res
   erase_below(s.given_keys, key);
   reset();
   std::vector<std::pair<std::string, YAML::Node>> entries;
+  std::map<std::string, std::string> spelled;  // key -> as written: one key in both spellings is refused
   if (v.IsMap())
-    for (const auto& kv : v) entries.emplace_back(key + "." + kv.first.Scalar(), kv.second);
+    for (const auto& kv : v) {
+      entries.emplace_back(key + "." + kv.first.Scalar(), kv.second);
+      const std::string& written = entries.back().first;
+      const auto [it, fresh] = spelled.emplace(canonical_key(written), written);
+      if (!fresh) throw ScenarioError(both_spellings_error(it->first == written ? it->second : written, it->first));
+    }
   std::stable_sort(entries.begin(), entries.end(),
                    [](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
   for (const auto& [k, ev] : entries) set_node(s, k, ev);
@@ -546,7 +556,11 @@ void top_key(Scenario& s, const std::string& key, const YAML::Node& v) {
   }
 }
 
-void set_node(Scenario& s, const std::string& key, const YAML::Node& v) {
+void set_node(Scenario& s, const std::string& written, const YAML::Node& v) {
+  std::string note;
+  const std::string key = canonical_key(written, &note);  // an old spelling is set as its key
+  auto& renamed = s.renamed_keys;
+  if (!note.empty() && std::find(renamed.begin(), renamed.end(), note) == renamed.end()) renamed.push_back(note);
   const std::size_t dot = key.find('.');
   const std::string section = key.substr(0, dot);
   const std::string rest = dot == std::string::npos ? "" : key.substr(dot + 1);
@@ -581,7 +595,62 @@ void check_required(const Scenario& s) {
     throw ScenarioError("controller.file = '': kind = csv needs a file");
 }
 
+// Walks the dotted path `rest` through a struct's list, each old spelling (fields::Meta::alias)
+// replaced by its key; a path the list does not have is left as it is (its setter refuses it).
+class SpellingArchive {
+ public:
+  explicit SpellingArchive(std::string rest) : rest_(std::move(rest)), path_(rest_) {}
+  const std::string& path() const { return path_; }
+  bool renamed() const { return renamed_; }
+
+  template <typename T>
+  void Visit(const fields::Field<T>& f) {
+    const std::size_t dot = rest_.find('.');
+    const std::string head = rest_.substr(0, dot);
+    const bool old = *f.meta.alias && head == f.meta.alias;
+    if (found_ || (head != f.meta.name && !old)) return;
+    found_ = true;
+    renamed_ = old;
+    path_ = f.meta.name;
+    if (dot == std::string::npos) return;
+    SpellingArchive below(rest_.substr(dot + 1));
+    if constexpr (fields::is_serializable<T>::value) f.value->Serialize(&below);
+    renamed_ = renamed_ || below.renamed_;
+    path_ += "." + below.path_;
+  }
+
+ private:
+  std::string rest_, path_;
+  bool found_{false}, renamed_{false};
+};
+
+// `key` below `prefix` respelled through the list of a default S (SpellingArchive), if it renames.
+template <typename S>
+bool respell(const std::string& prefix, const std::string& key, std::string& out) {
+  if (key.rfind(prefix + ".", 0) != 0) return false;
+  SpellingArchive a(key.substr(prefix.size() + 1));
+  S obj{};
+  obj.Serialize(&a);
+  if (a.renamed()) out = prefix + "." + a.path();
+  return a.renamed();
+}
+
 }  // namespace
+
+std::string canonical_key(const std::string& key, std::string* note) {
+  using namespace controller;
+  using namespace trajectory;
+  std::string out;
+  const bool renamed =
+      respell<plant::PlantParams>("plant", key, out) || respell<plant::PlantParams>("controller.model", key, out) ||
+      respell<SlidingModeParams>("controller", key, out) || respell<CascadeParams>("controller", key, out) ||
+      respell<OpenLoopParams>("controller", key, out) || respell<SineParams>("reference", key, out) ||
+      respell<StepParams>("reference", key, out) || respell<AccelLimitedParams>("reference", key, out) ||
+      respell<SCurveParams>("reference", key, out) || respell<RampParams>("reference", key, out);
+  if (!renamed) return key;
+  if (note != nullptr) *note = renamed_key_note(key, out);
+  return out;
+}
 
 void set_read_key(Scenario& s, const std::string& key, const std::string& value) {
   set_node(s, key, value_node(key, value));

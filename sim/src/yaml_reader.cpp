@@ -281,8 +281,9 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-MapReader::MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given)
-    : node_(node), path_(std::move(path)), given_(given) {
+MapReader::MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given,
+                     std::vector<std::string>* renamed)
+    : node_(node), path_(std::move(path)), given_(given), renamed_(renamed) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap())
     throw ScenarioError(path_ + " = " + describe(node_) + ": expected a map of keys");
 }
@@ -294,6 +295,15 @@ void MapReader::fail(const std::string& key, const std::string& what) const {
 }
 
 bool MapReader::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
+
+std::string MapReader::spelling(const std::string& key, const std::string& alias) {
+  if (alias.empty()) return key;
+  aliases_[alias] = key;
+  if (!has(alias)) return key;
+  if (has(key)) throw ScenarioError(both_spellings_error(key_path(alias), key));
+  if (renamed_ != nullptr) renamed_->push_back(renamed_key_note(key_path(alias), key_path(key)));
+  return alias;
+}
 
 YAML::Node MapReader::scalar(const std::string& key) {
   read_.insert(key);
@@ -421,7 +431,7 @@ MapReader MapReader::child(const std::string& key) {
   read_.insert(key);
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node(YAML::NodeType::Undefined);
   if (n.IsDefined()) mark_given(key);
-  return MapReader(n, key_path(key), given_);
+  return MapReader(n, key_path(key), given_, renamed_);
 }
 
 bool MapReader::scalar_text(const std::string& key, std::string& out) const {
@@ -435,7 +445,7 @@ bool MapReader::scalar_text(const std::string& key, std::string& out) const {
 MapReader MapReader::child_absent(const std::string& key) {
   read_.insert(key);
   if (has(key)) mark_given(key);
-  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key), given_);
+  return MapReader(YAML::Node(YAML::NodeType::Undefined), key_path(key), given_, renamed_);
 }
 
 void MapReader::finish() const {
@@ -443,7 +453,7 @@ void MapReader::finish() const {
   for (const auto& kv : node_) {
     const std::string key = kv.first.Scalar();
     if (read_.count(key)) continue;
-    throw ScenarioError(key_path(key) + ": unknown key" + did_you_mean(key, read_));
+    throw ScenarioError(key_path(key) + ": unknown key" + did_you_mean(key, read_, aliases_));
   }
 }
 

@@ -457,7 +457,7 @@ struct Resolver::Impl {
 // effective value in the case without variations, defaults included).
 std::string Resolver::Impl::scaled(const Variation& v, const CaseSettings& c, const std::string& origin) {
   const sim::ResolvedKeys& nominal = builder.nominal_keys(c, origin);
-  const auto it = nominal.find(v.key);
+  const auto it = nominal.find(sim::canonical_key(v.key));  // an old spelling scales its key
   if (it == nominal.end())
     throw StudyError(origin + ": " + v.key +
                      ": cannot scale a key the scenario does not have (misspelt, or not read for this controller or "
@@ -506,7 +506,7 @@ ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, Cas
   // Every varied key of the study, with its effective value in this case (its nominal value
   // where this case does not vary it), so each row of results.csv places the case on every axis.
   for (const std::string& k : varied) {
-    const auto it = keys.find(k);
+    const auto it = keys.find(sim::canonical_key(k));
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
   for (const sim::KeySetting& v : settings.values)

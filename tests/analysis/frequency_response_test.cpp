@@ -35,7 +35,7 @@ struct Analytic {
 };
 
 Analytic analytic(const sim::Scenario& s, double f) {
-  const double T = s.control_period, m = s.plant.mass, c = s.plant.effects.viscous_friction.viscous_Ns_per_m;
+  const double T = s.control_period, m = s.plant.mass, c = s.plant.effects.viscous_friction.viscous;
   const auto& k = s.controller.cascade;
   const double a = c / m, alpha = std::exp(-a * T);
   const cd z = std::polar(1.0, 2.0 * kPi * f * T);
@@ -49,7 +49,7 @@ Analytic analytic(const sim::Scenario& s, double f) {
 sim::Scenario linear_drive() {
   return sim::parse_scenario(
       "name: linear\nduration: 1.0\ncontrol_period: 1.0e-4\n"
-      "plant:\n  friction: {model: none}\n  effects: {viscous_friction: {viscous_Ns_per_m: 400.0}}\n"
+      "plant:\n  friction: {model: none}\n  effects: {viscous_friction: {viscous: 400.0}}\n"
       "controller: {type: cascade, tuning: rule, velocity_feedforward: 0.0, acceleration_feedforward: 0.0}\n",
       ".", "linear");
 }
@@ -269,7 +269,7 @@ TEST(FrequencyResponse, ScenarioAndOptionWarningsAreKeptAndWritten) {
   // 50 m/s gets reference.max_velocity's warning (mm/s?), beyond its 1000 m/s bound exit 2.
   sim::Scenario s = sim::parse_scenario(
       "name: heavy\nduration: 1.0\ncontrol_period: 1.0e-4\nplant:\n  mass: 5.0e4\n  friction: {model: none}\n"
-      "  effects: {viscous_friction: {viscous_Ns_per_m: 400.0}}\ncontroller: {type: cascade, tuning: rule}\n",
+      "  effects: {viscous_friction: {viscous: 400.0}}\ncontroller: {type: cascade, tuning: rule}\n",
       ".", "heavy");
   ASSERT_FALSE(s.warnings.empty());
   FrequencyResponseOptions o;

@@ -292,7 +292,7 @@ TEST(CascadeClosedLoop, DelayPredictionRestoresTheDelayFreeLoop) {
 
   plant::PlantParams delayed = plant_params;
   delayed.effects.input_delay.enabled = true;
-  delayed.effects.input_delay.delay_s = d;
+  delayed.effects.input_delay.delay = d;
   p.computation_delay = d;
   CascadeController predicted(p);
   const double e_pred = test::max_abs_error(test::run_loop(delayed, predicted, *ref, T, n), 0.0, 0.3);

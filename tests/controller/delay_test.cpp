@@ -111,7 +111,7 @@ TEST(SlidingModeDelay, CompensationKeepsTheDelayFreeAccuracy) {
   const double T = 1e-4, d = 1e-3;
   plant::PlantParams drive;  // nominal LuGre drive
   drive.effects.input_delay.enabled = true;
-  drive.effects.input_delay.delay_s = d;
+  drive.effects.input_delay.delay = d;
   const auto reference = trajectory::make_scurve(trajectory::SCurveParams{});
   const auto error_with = [&](bool compensate) {
     SlidingModeParams c;

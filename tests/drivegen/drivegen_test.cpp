@@ -66,7 +66,7 @@ TEST(DriveGen, AtADwellTheThrustBalancesAHiddenConstantForce) {
     s.hidden = {"constant_force"};
     const fdgen::Generated g = fdgen::generate(s);
     if (g.knobs.at("base_static_friction") != 0.0) continue;
-    const double F = g.truth.front().parameters.at("force_N");
+    const double F = g.truth.front().parameters.at("force");
     // the longest run of a constant reference: a dwell
     std::size_t best_end = 0, best_len = 0, len = 0;
     for (std::size_t k = 1; k < g.xd.size(); ++k) {

@@ -286,8 +286,7 @@ std::string short_scenario(const std::string& effects) {
 // 4 s of data of the model plus a 15 N constant force (feeddrive-sim, measured position).
 fs::path simulated_data() {
   static const fs::path data = [] {
-    const fs::path truth =
-        write_file("truth4.yaml", short_scenario("  effects:\n    constant_force: {force_N: 15.0}\n"));
+    const fs::path truth = write_file("truth4.yaml", short_scenario("  effects:\n    constant_force: {force: 15.0}\n"));
     const fs::path out = scratch() / "sim_truth";
     const ProcResult r = run(kSim, truth.string() + " --out " + out.string() + " --no-plots --quiet");
     if (r.code != 0) throw std::runtime_error("feeddrive-sim failed: " + r.err);
@@ -315,7 +314,7 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   // 20 %: with 4 s of closed-loop data (20 nm noise, 50 nm quantization) the force estimate is
   // good to well under 1 N; 20 % (3 N) still tells a found 15 N force from a partial one absorbed
   // by another effect, without being flaky.
-  const double f = first["parameters"]["force_N"].get<double>();
+  const double f = first["parameters"]["force"].get<double>();
   EXPECT_NEAR(f, 15.0, 0.2 * 15.0) << j.dump(2);
   // The constant force is the whole discrepancy, so adding it must remove most of the replay gap;
   // a factor 5 leaves room for noise and the short record, and still fails if it only half-fits.
@@ -329,8 +328,8 @@ TEST(FitCli, FindsAConstantForceEndToEnd) {
   ASSERT_NO_THROW(fitted = feeddrive::sim::load_scenario((out / "model.fitted.yaml").string()));
   EXPECT_TRUE(fitted.plant.effects.constant_force.enabled);
   // Same 20 % as above: the YAML carries the fitted value.
-  EXPECT_NEAR(fitted.plant.effects.constant_force.force_N, 15.0, 0.2 * 15.0);
-  EXPECT_NEAR(fitted.plant.effects.constant_force.force_N, f, 1e-3 * std::abs(f)) << "the YAML holds the JSON value";
+  EXPECT_NEAR(fitted.plant.effects.constant_force.force, 15.0, 0.2 * 15.0);
+  EXPECT_NEAR(fitted.plant.effects.constant_force.force, f, 1e-3 * std::abs(f)) << "the YAML holds the JSON value";
 
   // --out on an existing unrelated folder: refused, non-zero exit, one line, the folder untouched.
   const fs::path precious = scratch() / "precious";
@@ -515,7 +514,7 @@ TEST(FitVerdict, ExplainedNoDiscrepancyAndTheirExitCodes) {
   EXPECT_GT(j["noise_floor"]["gap_m"].get<double>(), 0.0);
   EXPECT_LE(j["gap_final"].get<double>(), 3.0 * j["noise_floor"]["gap_m"].get<double>());
   // the force's 95 % interval: finite and below 1 N on 4 s of 1 kHz data (the fit gives ~15 +- 0.1 N)
-  const double ci = j["effects"][0]["ci95"]["force_N"].get<double>();
+  const double ci = j["effects"][0]["ci95"]["force"].get<double>();
   EXPECT_GT(ci, 0.0);
   EXPECT_LT(ci, 1.0);
   EXPECT_NE(r.out.find("explained: found 1 effect(s): constant_force"), std::string::npos) << r.out;
@@ -639,8 +638,8 @@ TEST(FitVerdict, BorderlinePitchIsTentativeAndASpringWithoutSlopeIsSwapped) {
   EXPECT_NE(named["cogging_ripple"]["caveat"].get<std::string>().find("record a travel of at least 3 periods"),
             std::string::npos);
   // the truth (fd-drivegen's truth.txt): pitch 40.19 mm, 10.70 N; 2 % and 20 % as the sweep
-  EXPECT_NEAR(named["cogging_ripple"]["parameters"]["pitch_m"].get<double>(), 0.0401917, 0.02 * 0.0401917);
-  EXPECT_NEAR(named["constant_force"]["parameters"]["force_N"].get<double>(), 10.6976, 0.2 * 10.6976);
+  EXPECT_NEAR(named["cogging_ripple"]["parameters"]["pitch"].get<double>(), 0.0401917, 0.02 * 0.0401917);
+  EXPECT_NEAR(named["constant_force"]["parameters"]["force"].get<double>(), 10.6976, 0.2 * 10.6976);
   for (const auto& [n, e] : named)
     for (const auto& [k, v] : e["parameters"].items()) EXPECT_TRUE(e["ci95"].contains(k)) << n << "." << k;
   bool swapped = false;
@@ -723,7 +722,7 @@ TEST(FitData, LoggerFilesWithTheirOwnSeparatorDecimalCommaUnitsAndColumns) {
     ASSERT_FALSE(j["effects"].empty()) << j["conclusion"];
     EXPECT_EQ(j["effects"][0]["name"], "constant_force");
     // 20 % as FindsAConstantForceEndToEnd: the same record in other units
-    EXPECT_NEAR(j["effects"][0]["parameters"]["force_N"].get<double>(), 15.0, 3.0);
+    EXPECT_NEAR(j["effects"][0]["parameters"]["force"].get<double>(), 15.0, 3.0);
   };
   fit_ok("logger_out", logger,
          "--separator ';' --decimal-comma --units t=ms,x=mm --time-column time_ms --position-column pos_mm "

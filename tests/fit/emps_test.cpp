@@ -38,10 +38,10 @@ TEST(Emps, NamesThePublishedModelAndNothingForeign) {
   ASSERT_TRUE(found.count("viscous_friction")) << r.conclusion;
   ASSERT_TRUE(found.count("coulomb_friction")) << r.conclusion;
   ASSERT_TRUE(found.count("constant_force")) << r.conclusion;
-  EXPECT_NEAR(found["viscous_friction"]["viscous_Ns_per_m"], 203.5, 0.10 * 203.5);
-  EXPECT_NEAR(found["coulomb_friction"]["coulomb_N"], 20.39, 0.10 * 20.39);
+  EXPECT_NEAR(found["viscous_friction"]["viscous"], 203.5, 0.10 * 203.5);
+  EXPECT_NEAR(found["coulomb_friction"]["coulomb_force"], 20.39, 0.10 * 20.39);
   // The model's constant force opposes the thrust: the published offset on the force side is +F.
-  EXPECT_NEAR(found["constant_force"]["force_N"], -3.16, 0.10 * 3.16);
+  EXPECT_NEAR(found["constant_force"]["force"], -3.16, 0.10 * 3.16);
   // Foreign to this drive: it does no grinding, has no spring, and its mass is the published one.
   for (const char* foreign : {"grinding_force", "spring_force", "mass_error"})
     EXPECT_FALSE(found.count(foreign)) << foreign;

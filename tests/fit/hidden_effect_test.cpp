@@ -34,40 +34,37 @@ plant::PlantParams static_friction_model() {
 std::vector<Case> cases() {
   const auto model = test::base_model();
   return {
-      {"constant_force", {"constant_force", {{"force_N", 15.0}}}, model, {{"force_N", 0.2}}},
-      {"coulomb_friction", {"coulomb_friction", {{"coulomb_N", 12.0}}}, model, {{"coulomb_N", 0.2}}},
-      {"viscous_friction", {"viscous_friction", {{"viscous_Ns_per_m", 150.0}}}, model, {{"viscous_Ns_per_m", 0.2}}},
+      {"constant_force", {"constant_force", {{"force", 15.0}}}, model, {{"force", 0.2}}},
+      {"coulomb_friction", {"coulomb_friction", {{"coulomb_force", 12.0}}}, model, {{"coulomb_force", 0.2}}},
+      {"viscous_friction", {"viscous_friction", {{"viscous", 150.0}}}, model, {{"viscous", 0.2}}},
       {"stribeck_friction",
-       {"stribeck_friction", {{"static_N", 40.0}, {"coulomb_N", 10.0}, {"stribeck_velocity_mps", 0.005}}},
+       {"stribeck_friction", {{"static_force", 40.0}, {"coulomb_force", 10.0}, {"stribeck_velocity", 0.005}}},
        model,
-       {{"static_N", 0.2}, {"coulomb_N", 0.2}}},
+       {{"static_force", 0.2}, {"coulomb_force", 0.2}}},
       {"presliding",
-       {"presliding", {{"bristle_stiffness_N_per_m", 5e5}, {"bristle_damping_Ns_per_m", 2e3}}},
+       {"presliding", {{"bristle_stiffness", 5e5}, {"bristle_damping", 2e3}}},
        static_friction_model(),
-       {{"bristle_stiffness_N_per_m", 0.2}}},
+       {{"bristle_stiffness", 0.2}}},
       {"cogging_ripple",
        {"cogging_ripple",
-        {{"pitch_m", 0.024},
-         {"amplitude_N", 4.0},
-         {"phase_rad", 0.7},
-         {"third_harmonic_N", 1.5},
-         {"third_phase_rad", -0.4}}},
+        {{"pitch", 0.024},
+         {"cogging_amplitude", 4.0},
+         {"cogging_phase", 0.7},
+         {"cogging_third", 1.5},
+         {"cogging_third_phase", -0.4}}},
        model,
-       {{"pitch_m", 0.02}, {"amplitude_N", 0.2}}},
+       {{"pitch", 0.02}, {"cogging_amplitude", 0.2}}},
       {"reluctance_ripple",
-       {"reluctance_ripple", {{"pitch_m", 0.032}, {"relative_amplitude", 0.04}, {"phase_rad", 1.1}}},
+       {"reluctance_ripple", {{"pitch", 0.032}, {"reluctance_amplitude", 0.04}, {"reluctance_phase", 1.1}}},
        model,
-       {{"pitch_m", 0.02}, {"relative_amplitude", 0.2}}},
+       {{"pitch", 0.02}, {"reluctance_amplitude", 0.2}}},
       {"grinding_force",
-       {"grinding_force", {{"gain_Ns_per_m", 300.0}, {"stiffness_N_per_m", 3e4}, {"contact_position_m", 0.06}}},
+       {"grinding_force", {{"damping", 300.0}, {"stiffness", 3e4}, {"contact_position", 0.06}}},
        model,
-       {{"gain_Ns_per_m", 0.2}}},
-      {"spring_force",
-       {"spring_force", {{"stiffness_N_per_m", 400.0}, {"rest_position_m", 0.02}}},
-       model,
-       {{"stiffness_N_per_m", 0.2}}},
-      {"mass_error", {"mass_error", {{"mass_kg", 118.0}}}, model, {{"mass_kg", 0.05}}},
-      {"input_delay", {"input_delay", {{"delay_s", 1.5e-3}}}, model, {{"delay_s", 0.2}}},
+       {{"damping", 0.2}}},
+      {"spring_force", {"spring_force", {{"stiffness", 400.0}, {"rest_position", 0.02}}}, model, {{"stiffness", 0.2}}},
+      {"mass_error", {"mass_error", {{"mass", 118.0}}}, model, {{"mass", 0.05}}},
+      {"input_delay", {"input_delay", {{"delay", 1.5e-3}}}, model, {{"delay", 0.2}}},
   };
 }
 
@@ -121,8 +118,8 @@ namespace {
 // regressor) and input delay (time regressor, the one most sensitive to the sample period).
 TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
   const std::vector<Effect> effects = {
-      {"reluctance_ripple", {{"pitch_m", 0.032}, {"relative_amplitude", 0.04}, {"phase_rad", 1.1}}},
-      {"input_delay", {{"delay_s", 1.1e-3}}}};
+      {"reluctance_ripple", {{"pitch", 0.032}, {"reluctance_amplitude", 0.04}, {"reluctance_phase", 1.1}}},
+      {"input_delay", {{"delay", 1.1e-3}}}};
   for (const Effect& e : effects) {
     const plant::PlantParams model = test::base_model();
     plant::PlantParams truth = model;
@@ -140,8 +137,8 @@ TEST(HiddenEffectAt5kHz, RippleAndDelayAreNamedAndRecovered) {
     EXPECT_EQ(r.effects.front().name, e.name);
     if (r.effects.front().name != e.name) continue;
     // pitch within 2 %, delay within 20 % (the tolerances of the 1 kHz tests)
-    if (e.name == "reluctance_ripple") EXPECT_NEAR(r.effects.front().parameters.at("pitch_m"), 0.032, 0.02 * 0.032);
-    else EXPECT_NEAR(r.effects.front().parameters.at("delay_s"), 1.1e-3, 0.2 * 1.1e-3);
+    if (e.name == "reluctance_ripple") EXPECT_NEAR(r.effects.front().parameters.at("pitch"), 0.032, 0.02 * 0.032);
+    else EXPECT_NEAR(r.effects.front().parameters.at("delay"), 1.1e-3, 0.2 * 1.1e-3);
     EXPECT_LT(r.steps.front().gap_after, r.steps.front().gap_before / 5.0) << e.name;
   }
 }

@@ -32,9 +32,12 @@ TEST(Plausibility, RipplePitchMustBeResolvedByTheData) {
   EXPECT_DOUBLE_EQ(e.min_pitch(), 0.004);
   const plant::PlantParams m;
   const auto cog = [](double p, double a) {
-    return plant::NamedEffect{
-        "cogging_ripple",
-        {{"pitch_m", p}, {"amplitude_N", a}, {"phase_rad", 0.0}, {"third_harmonic_N", 0.0}, {"third_phase_rad", 0.0}}};
+    return plant::NamedEffect{"cogging_ripple",
+                              {{"pitch", p},
+                               {"cogging_amplitude", a},
+                               {"cogging_phase", 0.0},
+                               {"cogging_third", 0.0},
+                               {"cogging_third_phase", 0.0}}};
   };
   EXPECT_EQ(implausible(e, m, cog(0.024, 5.0)), "");
   EXPECT_NE(implausible(e, m, cog(2.7, 5.0)).find("fewer than two periods"), std::string::npos);
@@ -47,7 +50,7 @@ TEST(Plausibility, SpringRestWithinReachAndGrindingOnlyWhereDescribed) {
   const Envelope e = drive();
   const plant::PlantParams m;
   const auto spring = [](double rest) {
-    return plant::NamedEffect{"spring_force", {{"stiffness_N_per_m", 100.0}, {"rest_position_m", rest}}};
+    return plant::NamedEffect{"spring_force", {{"stiffness", 100.0}, {"rest_position", rest}}};
   };
   EXPECT_EQ(implausible(e, m, spring(0.05)), "");
   EXPECT_EQ(implausible(e, m, spring(-0.09)), "");  // within one travel of the range
@@ -77,8 +80,8 @@ TEST(Plausibility, PreslidingNeedsFrictionAndStickPhasesOrReversals) {
 TEST(Plausibility, MassWithinAFactorOfTwo) {
   const Envelope e = drive();
   const plant::PlantParams m;
-  EXPECT_EQ(implausible(e, m, {"mass_error", {{"mass_kg", 120.0}}}), "");
-  EXPECT_NE(implausible(e, m, {"mass_error", {{"mass_kg", 400.0}}}), "");
+  EXPECT_EQ(implausible(e, m, {"mass_error", {{"mass", 120.0}}}), "");
+  EXPECT_NE(implausible(e, m, {"mass_error", {{"mass", 400.0}}}), "");
 }
 
 // The case the issue reports: a pure 28.3 N ripple of pitch 42.4 mm fitted as the "third harmonic"
@@ -86,23 +89,23 @@ TEST(Plausibility, MassWithinAFactorOfTwo) {
 // sin(2 pi x/(p/3) + phi3), is reported at its physical pitch.
 TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
   const Effect raw{"cogging_ripple",
-                   {{"pitch_m", 0.1272},
-                    {"amplitude_N", 0.02},
-                    {"phase_rad", 0.5},
-                    {"third_harmonic_N", 28.3},
-                    {"third_phase_rad", -0.7}}};
+                   {{"pitch", 0.1272},
+                    {"cogging_amplitude", 0.02},
+                    {"cogging_phase", 0.5},
+                    {"cogging_third", 28.3},
+                    {"cogging_third_phase", -0.7}}};
   const Effect c = canonical(raw);
-  EXPECT_NEAR(c.parameters.at("pitch_m"), 0.0424, 1e-12);
-  EXPECT_DOUBLE_EQ(c.parameters.at("amplitude_N"), 28.3);
-  EXPECT_DOUBLE_EQ(c.parameters.at("phase_rad"), -0.7);
-  EXPECT_DOUBLE_EQ(c.parameters.at("third_harmonic_N"), 0.0);
+  EXPECT_NEAR(c.parameters.at("pitch"), 0.0424, 1e-12);
+  EXPECT_DOUBLE_EQ(c.parameters.at("cogging_amplitude"), 28.3);
+  EXPECT_DOUBLE_EQ(c.parameters.at("cogging_phase"), -0.7);
+  EXPECT_DOUBLE_EQ(c.parameters.at("cogging_third"), 0.0);
   // a real fundamental with a third harmonic is left alone
   const Effect both{"cogging_ripple",
-                    {{"pitch_m", 0.024},
-                     {"amplitude_N", 4.0},
-                     {"phase_rad", 0.7},
-                     {"third_harmonic_N", 1.0},
-                     {"third_phase_rad", -0.4}}};
+                    {{"pitch", 0.024},
+                     {"cogging_amplitude", 4.0},
+                     {"cogging_phase", 0.7},
+                     {"cogging_third", 1.0},
+                     {"cogging_third_phase", -0.4}}};
   EXPECT_EQ(canonical(both).parameters, both.parameters);
 }
 
@@ -112,32 +115,32 @@ TEST(CanonicalRipple, ANegligibleFundamentalMeansAThirdOfThePitch) {
 // cogging ripple with a vanishing fundamental is its harmonic; nothing else has a simpler form.
 TEST(SwapMove, ACollapsedEffectBecomesItsSimplerForm) {
   const auto s = simpler_form(
-      {"stribeck_friction", {{"static_N", 20.4}, {"coulomb_N", 20.4}, {"stribeck_velocity_mps", 1e-3}}}, 0.0);
+      {"stribeck_friction", {{"static_force", 20.4}, {"coulomb_force", 20.4}, {"stribeck_velocity", 1e-3}}}, 0.0);
   ASSERT_TRUE(s.has_value());
   EXPECT_EQ(s->name, "coulomb_friction");
-  EXPECT_DOUBLE_EQ(s->parameters.at("coulomb_N"), 20.4);
-  const auto k = simpler_form({"spring_force", {{"stiffness_N_per_m", 50.0}, {"rest_position_m", -0.15}}}, 0.05);
+  EXPECT_DOUBLE_EQ(s->parameters.at("coulomb_force"), 20.4);
+  const auto k = simpler_form({"spring_force", {{"stiffness", 50.0}, {"rest_position", -0.15}}}, 0.05);
   ASSERT_TRUE(k.has_value());
   EXPECT_EQ(k->name, "constant_force");
-  EXPECT_NEAR(k->parameters.at("force_N"), 10.0, 1e-12);  // 50 N/m * (0.05 - (-0.15)) m
+  EXPECT_NEAR(k->parameters.at("force"), 10.0, 1e-12);  // 50 N/m * (0.05 - (-0.15)) m
   const auto c = simpler_form({"cogging_ripple",
-                               {{"pitch_m", 0.1272},
-                                {"amplitude_N", 0.02},
-                                {"phase_rad", 0.5},
-                                {"third_harmonic_N", 28.3},
-                                {"third_phase_rad", -0.7}}},
+                               {{"pitch", 0.1272},
+                                {"cogging_amplitude", 0.02},
+                                {"cogging_phase", 0.5},
+                                {"cogging_third", 28.3},
+                                {"cogging_third_phase", -0.7}}},
                               0.0);
   ASSERT_TRUE(c.has_value());
-  EXPECT_NEAR(c->parameters.at("pitch_m"), 0.0424, 1e-12);
+  EXPECT_NEAR(c->parameters.at("pitch"), 0.0424, 1e-12);
   EXPECT_FALSE(simpler_form({"cogging_ripple",
-                             {{"pitch_m", 0.024},
-                              {"amplitude_N", 4.0},
-                              {"phase_rad", 0.7},
-                              {"third_harmonic_N", 1.0},
-                              {"third_phase_rad", -0.4}}},
+                             {{"pitch", 0.024},
+                              {"cogging_amplitude", 4.0},
+                              {"cogging_phase", 0.7},
+                              {"cogging_third", 1.0},
+                              {"cogging_third_phase", -0.4}}},
                             0.0)
                    .has_value());
-  EXPECT_FALSE(simpler_form({"viscous_friction", {{"viscous_Ns_per_m", 200.0}}}, 0.0).has_value());
+  EXPECT_FALSE(simpler_form({"viscous_friction", {{"viscous", 200.0}}}, 0.0).has_value());
 }
 
 }  // namespace

@@ -14,13 +14,13 @@ namespace {
 TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   const plant::PlantParams model = test::base_model();
   plant::PlantParams truth = model;
-  plant::set_effect(truth.effects, {"constant_force", {{"force_N", 15.0}}});
+  plant::set_effect(truth.effects, {"constant_force", {{"force", 15.0}}});
   plant::set_effect(truth.effects, {"cogging_ripple",
-                                    {{"pitch_m", 0.024},
-                                     {"amplitude_N", 4.0},
-                                     {"phase_rad", 0.7},
-                                     {"third_harmonic_N", 0.0},
-                                     {"third_phase_rad", 0.0}}});
+                                    {{"pitch", 0.024},
+                                     {"cogging_amplitude", 4.0},
+                                     {"cogging_phase", 0.7},
+                                     {"cogging_third", 0.0},
+                                     {"cogging_third_phase", 0.0}}});
   test::Recording ro;
   ro.seed = 5;
   const MeasuredData data = test::record(truth, ro, test::temp_dir());
@@ -30,9 +30,9 @@ TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
   EXPECT_EQ(r.effects[0].name, "constant_force");
   EXPECT_EQ(r.effects[1].name, "cogging_ripple");
   // 20 % on the force and the amplitude, 2 % on the pitch (as in hidden_effect_test.cpp).
-  EXPECT_NEAR(r.effects[0].parameters.at("force_N"), 15.0, 3.0);
-  EXPECT_NEAR(r.effects[1].parameters.at("pitch_m"), 0.024, 0.02 * 0.024);
-  EXPECT_NEAR(r.effects[1].parameters.at("amplitude_N"), 4.0, 0.8);
+  EXPECT_NEAR(r.effects[0].parameters.at("force"), 15.0, 3.0);
+  EXPECT_NEAR(r.effects[1].parameters.at("pitch"), 0.024, 0.02 * 0.024);
+  EXPECT_NEAR(r.effects[1].parameters.at("cogging_amplitude"), 4.0, 0.8);
   EXPECT_LT(r.replay_final.gap, r.replay_initial.gap / 5.0);
 }
 
@@ -41,7 +41,7 @@ TEST(FitSignificance, TwoHiddenEffectsAreFoundInOrderOfSize) {
 TEST(FitSignificance, ForceInputFindsTheSameEffect) {
   const plant::PlantParams model = test::base_model();
   plant::PlantParams truth = model;
-  plant::set_effect(truth.effects, {"constant_force", {{"force_N", -12.0}}});
+  plant::set_effect(truth.effects, {"constant_force", {{"force", -12.0}}});
   test::Recording ro;
   ro.seed = 8;
   ro.duration = 5.0;
@@ -56,7 +56,7 @@ TEST(FitSignificance, ForceInputFindsTheSameEffect) {
   ASSERT_EQ(a.effects.size(), 1u);
   ASSERT_EQ(b.effects.size(), 1u);
   EXPECT_EQ(b.effects[0].name, "constant_force");
-  EXPECT_NEAR(b.effects[0].parameters.at("force_N"), a.effects[0].parameters.at("force_N"), 0.12);
+  EXPECT_NEAR(b.effects[0].parameters.at("force"), a.effects[0].parameters.at("force"), 0.12);
   EXPECT_NEAR(b.replay_final.gap, a.replay_final.gap, 0.01 * a.replay_final.gap);
 }
 

@@ -162,11 +162,11 @@ def mutate_scenario(rng, text, case_dir):
     elif op == "name":
         doc["name"] = rng.choice(NAMES)
     elif op == "effect":
-        from_effects = {"constant_force": {"force_N": 1.0}, "coulomb_friction": {"coulomb_N": 5.0},
-                        "viscous_friction": {"viscous_Ns_per_m": 10.0}, "presliding": {"bristle_stiffness_N_per_m": 1e6},
-                        "cogging_ripple": {"pitch_m": 0.024, "amplitude_N": 2.0}, "spring_force": {"stiffness_N_per_m": 100.0},
-                        "mass_error": {"mass_kg": 90.0}, "input_delay": {"delay_s": 2e-4},
-                        "grinding_force": {"gain_Ns_per_m": 100.0, "stiffness_N_per_m": 1e5}}
+        from_effects = {"constant_force": {"force": 1.0}, "coulomb_friction": {"coulomb_force": 5.0},
+                        "viscous_friction": {"viscous": 10.0}, "presliding": {"bristle_stiffness": 1e6},
+                        "cogging_ripple": {"pitch": 0.024, "cogging_amplitude": 2.0}, "spring_force": {"stiffness": 100.0},
+                        "mass_error": {"mass": 90.0}, "input_delay": {"delay": 2e-4},
+                        "grinding_force": {"damping": 100.0, "stiffness": 1e5}}
         name = rng.choice(sorted(from_effects))
         params = dict(from_effects[name])
         key = rng.choice(sorted(params))

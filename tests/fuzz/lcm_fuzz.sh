@@ -8,7 +8,7 @@ seed=$3
 cases=$4
 ref=$SRC/scenarios/fit/rich_reference.csv
 sed -e 's/^duration: 10\.0/duration: 1.5/' -e "s#file: rich_reference.csv#file: $ref#" \
-  -e 's/^controller:/  effects:\n    constant_force: {force_N: 15.0}\ncontroller:/' \
+  -e 's/^controller:/  effects:\n    constant_force: {force: 15.0}\ncontroller:/' \
   "$SRC/scenarios/fit/model.yaml" > "$TMP/truth.yaml"
 grep -q 'constant_force' "$TMP/truth.yaml" || fail "truth.yaml: effect not added"
 prio=(chrt -f 20)

@@ -239,7 +239,7 @@ TEST(EffectsPlant, ViscousFrictionDecaysExponentiallyWithTimeConstantMOverC) {
   }
 }
 
-// mass_error: the same thrust accelerates the true mass: a = F/mass_kg, v(t) = F t/mass_kg.
+// mass_error: the same thrust accelerates the true mass: a = F/mass, v(t) = F t/mass.
 TEST(EffectsPlant, MassErrorUsesTheTrueMass) {
   PlantParams p = free_mass();
   const double F = 60.0, m_true = 120.0;
@@ -418,37 +418,38 @@ std::string error_of(const PlantParams& p) {
 
 TEST(EffectsParams, ValidateNamesKeyAndValue) {
   PlantParams p;
-  p.effects.cogging_ripple.pitch_m = -1.0;
+  p.effects.cogging_ripple.pitch = -1.0;
   EXPECT_EQ(error_of(p), "(no error)");  // only enabled effects are checked
   p.effects.cogging_ripple.enabled = true;
-  EXPECT_EQ(error_of(p), "plant.effects.cogging_ripple.pitch_m = -1: must be > 0");
+  EXPECT_EQ(error_of(p), "plant.effects.cogging_ripple.pitch = -1: must be > 0");
 
   p = PlantParams{};
   p.effects.stribeck_friction = {true, 10.0, 20.0, 0.01};
-  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.static_N = 10: must be >= coulomb_N");
+  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.static_force = 10: must be >= coulomb_force");
   p.effects.stribeck_friction = {true, 30.0, 20.0, 0.0};
-  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.stribeck_velocity_mps = 0: must be > 0");
+  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.stribeck_velocity = 0: must be > 0");
   p.effects.stribeck_friction = {true, 30.0, -1.0, 0.01};
-  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.coulomb_N = -1: must be >= 0");
+  EXPECT_EQ(error_of(p), "plant.effects.stribeck_friction.coulomb_force = -1: must be >= 0");
 
   p = PlantParams{};
   p.effects.mass_error = {true, 0.0};
-  EXPECT_EQ(error_of(p), "plant.effects.mass_error.mass_kg = 0: must be > 0");
+  EXPECT_EQ(error_of(p), "plant.effects.mass_error.mass = 0: must be > 0");
   p = PlantParams{};
   p.effects.input_delay = {true, -0.001};
-  EXPECT_EQ(error_of(p), "plant.effects.input_delay.delay_s = -0.001: must be >= 0");
+  EXPECT_EQ(error_of(p), "plant.effects.input_delay.delay = -0.001: must be >= 0");
   p = PlantParams{};
   p.effects.presliding = {true, 2e6, -5.0};
-  EXPECT_EQ(error_of(p), "plant.effects.presliding.bristle_damping_Ns_per_m = -5: must be >= 0");
+  EXPECT_EQ(error_of(p), "plant.effects.presliding.bristle_damping = -5: must be >= 0");
   p = PlantParams{};
   p.effects.grinding_force = {true, 7.85e6, 0.0, 0.0};
-  EXPECT_EQ(error_of(p), "plant.effects.grinding_force.stiffness_N_per_m = 0: must be > 0");
+  EXPECT_EQ(error_of(p), "plant.effects.grinding_force.stiffness = 0: must be > 0");
   p = PlantParams{};
   p.effects.constant_force = {true, std::nan("")};
-  EXPECT_EQ(error_of(p), "plant.effects.constant_force.force_N = nan: must be a finite number");
+  EXPECT_EQ(error_of(p), "plant.effects.constant_force.force = nan: must be a finite number");
   p = PlantParams{};
   p.effects.reluctance_ripple = {true, 0.03, 1.5, 0.0};
-  EXPECT_EQ(error_of(p), "plant.effects.reluctance_ripple.relative_amplitude = 1.5: |relative_amplitude| must be < 1");
+  EXPECT_EQ(error_of(p),
+            "plant.effects.reluctance_ripple.reluctance_amplitude = 1.5: |reluctance_amplitude| must be < 1");
 
   // The sections the effects use are checked even where they are off themselves.
   p = PlantParams{};

@@ -273,7 +273,7 @@ TEST(PluginScenario, KeysAreReadAndBadOnesRefused) {
   EXPECT_NE(load_error(plugin_scenario("  parameters: {eta: [1, 2]}\n")).find("controller.parameters.eta"),
             std::string::npos);
   EXPECT_NE(load_error(plugin_scenario("  libary: x.so\n")).find("libary"), std::string::npos);
-  EXPECT_NE(load_error(plugin_scenario("  model: {effects: {constant_force: {force_N: 1}}}\n"))
+  EXPECT_NE(load_error(plugin_scenario("  model: {effects: {constant_force: {force: 1}}}\n"))
                 .find("controller.model.effects"),
             std::string::npos);
   const std::string missing = load_error("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: plugin}\n");

@@ -207,7 +207,7 @@ TEST(Translate, RunInfoCarriesEveryParameterOfThePlantList) {
   s.plant.friction.static_smoothing_shape = 0.5;
   s.plant.ripple.cogging_third = 0.75;
   s.plant.effects.constant_force.enabled = true;
-  s.plant.effects.constant_force.force_N = 3.0;
+  s.plant.effects.constant_force.force = 3.0;
   const auto got = over_memq(to_run_info(s, node_options(), ""));
   ASSERT_TRUE(got) << "run_info_t did not arrive";
   std::size_t listed = 0;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # feeddrive-fit on a stock lcm-logger log: record a four-process run of the fit model plus a
 # hidden 15 N constant force (4 s), then fit the model without it to the log. The tool must name
-# constant_force first, with force_N within 20 % of 15, and shrink the replay gap five-fold. A log
+# constant_force first, with force within 20 % of 15, and shrink the replay gap five-fold. A log
 # cut short in the middle of an event is a shorter record, fitted, the cut noted.
 # lcm-logger runs with real-time priority where available, as in logger_test.sh: it must not drop
 # messages of the run.
@@ -11,10 +11,10 @@ ref=$SRC/scenarios/fit/rich_reference.csv
 # model: the same without it.
 sed -e 's/^duration: 10\.0/duration: 4.0/' -e "s#file: rich_reference.csv#file: $ref#" \
   "$SRC/scenarios/fit/model.yaml" > "$TMP/model.yaml"
-sed -e 's/^controller:/  effects:\n    constant_force: {force_N: 15.0}\ncontroller:/' "$TMP/model.yaml" > "$TMP/truth.yaml"
+sed -e 's/^controller:/  effects:\n    constant_force: {force: 15.0}\ncontroller:/' "$TMP/model.yaml" > "$TMP/truth.yaml"
 grep -q '^duration: 4.0' "$TMP/model.yaml" || fail "model.yaml: duration not set to 4 s"
 grep -q "file: $ref" "$TMP/model.yaml" || fail "model.yaml: reference file not made absolute"
-grep -q 'constant_force: {force_N: 15.0}' "$TMP/truth.yaml" || fail "truth.yaml: effect not added"
+grep -q 'constant_force: {force: 15.0}' "$TMP/truth.yaml" || fail "truth.yaml: effect not added"
 
 prio=(chrt -f 20)
 "${prio[@]}" true 2>/dev/null || { echo "note: no real-time priority available; logging without it"; prio=(); }
@@ -34,10 +34,10 @@ set -e
 [ $rc = 0 ] || [ $rc = 3 ] || { cat "$TMP/fit.out" "$TMP/fit.err" >&2; fail "feeddrive-fit on the log: exit $rc"; }
 f=$TMP/fit/findings.json
 [ "$(json "$f" '.effects[0].name')" = constant_force ] || { jq . "$f" >&2; fail "first effect is not constant_force"; }
-force=$(json "$f" '.effects[0].parameters.force_N')
+force=$(json "$f" '.effects[0].parameters.force')
 # 20 %: 4 s of closed-loop data pin a constant force to well under 1 N; 3 N of slack still
 # fails a force partly absorbed by another effect.
-jq -e '(.effects[0].parameters.force_N - 15.0 | fabs) <= 0.2 * 15.0' "$f" > /dev/null || fail "force_N = $force, not 15 N +- 20 %"
+jq -e '(.effects[0].parameters.force - 15.0 | fabs) <= 0.2 * 15.0' "$f" > /dev/null || fail "force = $force, not 15 N +- 20 %"
 # The force is the whole discrepancy: adding it must remove most of the replay gap (factor 5:
 # room for noise and the short record, fails a half fit).
 jq -e '.gap_initial > 0 and .gap_final < .gap_initial / 5' "$f" > /dev/null \

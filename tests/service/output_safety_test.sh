@@ -52,7 +52,7 @@ pass "feeddrive-launch (monitor): scenario names and file names ran nothing"
 # feeddrive-fit: model, data and output named to run a command, the position column too; with plots.
 sed -e 's/^duration: 10.0/duration: 3.0/' -e "s|file: rich_reference.csv|file: $SRC/scenarios/fit/rich_reference.csv|" \
   "$SRC/scenarios/fit/model.yaml" > "$work/m'; system 'touch MARK'; print '.yaml"
-sed '/^  sensor:/a\  effects:\n    constant_force: {force_N: 15.0}' "$work/m'; system 'touch MARK'; print '.yaml" > "$work/truth.yaml"
+sed '/^  sensor:/a\  effects:\n    constant_force: {force: 15.0}' "$work/m'; system 'touch MARK'; print '.yaml" > "$work/truth.yaml"
 grep -q constant_force "$work/truth.yaml" || fail "test setup: no effect in truth.yaml"
 sim_run "$work/truth.yaml" "$work/truth"
 col="pos'; system 'touch MARK'; print '"

@@ -30,7 +30,7 @@ duration: 0.01
 control_period: 1e-4
 controller: {type: sliding_mode, switching: sat}
 reference: {type: sine, amplitude: 0.1, frequency: 1.0}
-plant: {effects: {input_delay: {delay_s: 2.0e-4}}}
+plant: {effects: {input_delay: {delay: 2.0e-4}}}
 )",
                  ".", "s.yaml", &keys);
   // Given values, in shortest round-trip form.
@@ -44,7 +44,7 @@ plant: {effects: {input_delay: {delay_s: 2.0e-4}}}
   EXPECT_EQ(keys.at("plant.grinding.contact_position").text, "-.inf");
   // A listed effect: switched on, with its parameter; an unlisted one leaves no key.
   EXPECT_EQ(keys.at("plant.effects.input_delay.enabled").text, "true");
-  EXPECT_EQ(keys.at("plant.effects.input_delay.delay_s").text, "2e-04");
+  EXPECT_EQ(keys.at("plant.effects.input_delay.delay").text, "2e-04");
   for (const auto& [k, v] : keys) EXPECT_EQ(k.find("effects.spring"), std::string::npos) << k;
   // Only the keys of the chosen reference type.
   EXPECT_EQ(keys.count("reference.frequency"), 1u);
@@ -226,7 +226,7 @@ TEST(ResolvedKeys, ASetStructKeyFollowsTheReadersRules) {
   const std::string base = R"(
 duration: 0.01
 control_period: 1e-4
-plant: {ripple: paper, effects: {constant_force: {force_N: 2}}}
+plant: {ripple: paper, effects: {constant_force: {force: 2}}}
 controller: {type: sliding_mode, model: {friction: {static_force: 150}}}
 reference: {type: step, amplitude: 1.0e-3}
 )";
@@ -234,15 +234,15 @@ reference: {type: step, amplitude: 1.0e-3}
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.mass", "90"));
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.friction.static_force", "130"));
   EXPECT_TRUE(struct_as_yaml(base, ".", "controller.model.mass", "80"));
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.constant_force.force_N", "3"));
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.constant_force.force", "3"));
   EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.cogging_amplitude", "4"));
   EXPECT_TRUE(struct_as_yaml(base, ".", "controller.computation_delay", "2e-4"));
   // What the YAML reader decided alone before: now set in the struct, the same keys.
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.preset", "none"));  // a preset: the whole section
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple", "none"));         // its short form replaces it
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force.stiffness_N_per_m", "1"));  // listed: on
-  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force", "{}"));  // listed with its defaults
-  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.type", "cascade"));        // another type's keys
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple.preset", "none"));                // a preset: the whole section
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.ripple", "none"));                       // its short form replaces it
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force.stiffness", "1"));  // listed: on
+  EXPECT_TRUE(struct_as_yaml(base, ".", "plant.effects.spring_force", "{}"));           // listed with its defaults
+  EXPECT_TRUE(struct_as_yaml(base, ".", "controller.type", "cascade"));                 // another type's keys
   EXPECT_TRUE(struct_as_yaml(base, ".", {{"controller.kp", "50"}, {"controller.type", "cascade"}}));  // any order
   EXPECT_TRUE(struct_as_yaml(base, ".", {{"reference.type", "sine"}, {"reference.frequency", "2"}}));
   EXPECT_TRUE(struct_as_yaml(base, ".", "duration", "0.02"));                 // read_timing's rules

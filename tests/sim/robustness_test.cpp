@@ -22,20 +22,20 @@ TEST(ComputationDelay, TheDriveAppliesItAsAnInputDelay) {
   const Scenario s = parse_scenario(R"(
 duration: 0.01
 control_period: 1e-4
-plant: {effects: {input_delay: {delay_s: 2.0e-4}}}
+plant: {effects: {input_delay: {delay: 2.0e-4}}}
 controller: {type: cascade, computation_delay: 1.5e-4}
 )");
   EXPECT_EQ(s.controller.computation_delay, 1.5e-4);
   EXPECT_EQ(s.controller.cascade.computation_delay, 1.5e-4);
   const plant::PlantParams d = s.drive();
   EXPECT_TRUE(d.effects.input_delay.enabled);
-  EXPECT_DOUBLE_EQ(d.effects.input_delay.delay_s, 3.5e-4);
-  EXPECT_EQ(s.plant.effects.input_delay.delay_s, 2.0e-4) << "the plant as given is unchanged";
+  EXPECT_DOUBLE_EQ(d.effects.input_delay.delay, 3.5e-4);
+  EXPECT_EQ(s.plant.effects.input_delay.delay, 2.0e-4) << "the plant as given is unchanged";
   // Without a plant delay the drive gets the computation delay alone; without either, none.
   const Scenario t =
       parse_scenario("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: 1e-3}\n");
   EXPECT_TRUE(t.drive().effects.input_delay.enabled);
-  EXPECT_EQ(t.drive().effects.input_delay.delay_s, 1e-3);
+  EXPECT_EQ(t.drive().effects.input_delay.delay, 1e-3);
   EXPECT_FALSE(parse_scenario("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade}\n")
                    .drive()
                    .effects.input_delay.enabled);

@@ -1,6 +1,7 @@
 // Case expansion and resolution: pure functions of the study.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -34,7 +35,7 @@ families:
       parameters:
         - {key: plant.mass, distribution: uniform, low: 0.8, high: 1.2, scale: true}
         - {keys: [plant.friction.bristle_stiffness, plant.friction.bristle_damping], distribution: lognormal, mu: 0, sigma: 0.1, scale: true}
-        - {key: plant.effects.input_delay.delay_s, distribution: normal, mean: 5.0e-4, stddev: 3.0e-4, low: 0, high: 1.0e-3}
+        - {key: plant.effects.input_delay.delay, distribution: normal, mean: 5.0e-4, stddev: 3.0e-4, low: 0, high: 1.0e-3}
 )";
 
 Study families() {
@@ -184,6 +185,30 @@ TEST(StudyCases, ControllerKeepsTheNominalModelWhileThePlantVaries) {
   EXPECT_DOUBLE_EQ(mc.controller.sliding_mode.model.friction.bristle_stiffness, 2e6);
   // The rows of cases without a variation carry the nominal value.
   EXPECT_EQ(r.resolve(cases[0]).parameters.at("plant.mass"), "102.04");
+}
+
+// A key in its old spelling (a renamed key's alias, docs/contributing.md) is the key: it scales
+// its nominal value, its column carries the value, and the case's scenario warns of the spelling.
+TEST(StudyCases, AnOldSpellingOfAKeyIsTheKey) {
+  const Study s = parse_study(study_text(R"(
+families:
+  - name: grid
+    set: {plant.effects.input_delay.delay_s: 1.0e-3}
+    grid:
+      - {key: plant.effects.input_delay.delay_s, scale: [0.5, 2]}
+)"),
+                              ".", "s.yaml");
+  const auto cases = expand(s);
+  ASSERT_EQ(cases.size(), 2u);
+  Resolver r(s);
+  const ResolvedCase c = r.resolve(cases[1]);
+  EXPECT_DOUBLE_EQ(c.scenario->plant.effects.input_delay.delay, 2e-3);
+  EXPECT_EQ(c.parameters.at("plant.effects.input_delay.delay_s"), "0.002");
+  EXPECT_NE(c.yaml.find("delay: 0.002"), std::string::npos) << c.yaml;  // the case is written in the new key
+  EXPECT_EQ(std::count(c.scenario->warnings.begin(), c.scenario->warnings.end(),
+                       "plant.effects.input_delay.delay_s: old spelling of plant.effects.input_delay.delay "
+                       "(deprecated: rename the key)"),
+            1);
 }
 
 TEST(StudyCases, FollowsPlantRuleLetsTheModelFollow) {

@@ -36,7 +36,7 @@ families:
       seed: 3
       parameters:
         - {keys: [plant.friction.static_force, plant.friction.coulomb_force], distribution: uniform, low: 0.7, high: 1.3, scale: true}
-        - {key: plant.effects.input_delay.delay_s, distribution: lognormal, mu: -9.2, sigma: 0.5}
+        - {key: plant.effects.input_delay.delay, distribution: lognormal, mu: -9.2, sigma: 0.5}
   - name: broken
     set: {plant.integrator.max_steps: 1}
 YAML

@@ -17,7 +17,8 @@
 //   * the study's key access and --set, through the scenario reader;
 //   * the readers that are not C++ (flatten() below, plant/parameter_table.hpp): the controller
 //     plugin ABI's model table (controller/plugin.h) and run_info_t.plant on LCM.
-// Adding a key is one Visit line (docs/contributing.md, "How to add a scenario key").
+// Adding a key is one Visit line (docs/contributing.md, "How to add a scenario key"); renaming
+// one keeps the old spelling as .alias("old") on that line.
 //
 // Header-only; no dependency beyond the standard library.
 
@@ -60,6 +61,10 @@ struct Meta {
   const char* hint_high{""};
   const char* hint_low{""};
   const char* plausible_why{""};  ///< e.g. "any linear drive"
+  /// The key's old spelling, still read with a deprecation warning (a key renamed into the one
+  /// vocabulary: docs/contributing.md, "How to rename a key"); "" when it has none. Giving both
+  /// spellings is an error; did-you-mean and the docs' key tables know it.
+  const char* alias{""};
   bool allow_inf() const { return check == Check::kNotPlusInf; }
 };
 
@@ -82,6 +87,10 @@ struct Field {
   }
   Field minus_inf_allowed() const {
     return with([](Meta& m) { m.check = Check::kNotPlusInf; });
+  }
+  /// An old spelling of the key (Meta::alias).
+  Field alias(const char* old) const {
+    return with([&](Meta& m) { m.alias = old; });
   }
   Field unchecked() const {
     return with([](Meta& m) { m.check = Check::kNone; });

@@ -5,23 +5,25 @@
 //   m_eff*x'' = F_thrust_eff - F_friction_eff - F_ripple - F_grinding_eff - F_extra
 // where
 //   * effective_params() folds the effects that *modify* a sub-model into the base sections:
-//       presliding     -> friction.model = lugre, sigma0 = bristle_stiffness_N_per_m,
-//                         sigma1 = bristle_damping_Ns_per_m (Fs, Fc, vs, delta, sigma2 kept);
-//       grinding_force -> grinding.enabled, C = gain_Ns_per_m (dullness = C/(pi*dw*bs)),
-//                         ke = stiffness_N_per_m, contact_position = contact_position_m;
-//       mass_error     -> mass = mass_kg;
-//     (input_delay is applied by Plant::advance: the thrust uses u(t - delay_s));
+//       presliding     -> friction.model = lugre, friction.bristle_stiffness = bristle_stiffness,
+//                         friction.bristle_damping = bristle_damping (Fs, Fc, vs, delta, sigma2 kept);
+//       grinding_force -> grinding.enabled, C = damping (dullness = C/(pi*dw*bs)),
+//                         grinding.stiffness = stiffness, grinding.contact_position = contact_position;
+//       mass_error     -> mass = mass;
+//     (input_delay is applied by Plant::advance: the thrust uses u(t - delay));
 //   * extra_force() is the sum of the additive effects:
-//       constant_force     F = force_N
-//       coulomb_friction   F = coulomb_N*sgn_eps(v)
-//       viscous_friction   F = viscous_Ns_per_m*v
-//       stribeck_friction  F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))
-//       cogging_ripple     F = amplitude_N*sin(2 pi x/pitch_m + phase_rad)
-//                            + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
-//       reluctance_ripple  F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)
-//       spring_force       F = stiffness_N_per_m*(x - rest_position_m)
+//       constant_force     F = force
+//       coulomb_friction   F = coulomb_force*sgn_eps(v)
+//       viscous_friction   F = viscous*v
+//       stribeck_friction  F = sgn_eps(v)*(coulomb_force + (static_force - coulomb_force)
+//                                          *exp(-|v/stribeck_velocity|^delta))
+//       cogging_ripple     F = cogging_amplitude*sin(2 pi x/pitch + cogging_phase)
+//                            + cogging_third*sin(6 pi x/pitch + cogging_third_phase)
+//       reluctance_ripple  F = F_thrust*reluctance_amplitude*sin(2 pi x/pitch + reluctance_phase)
+//       spring_force       F = stiffness*(x - rest_position)
 //     with sgn_eps(v) the smoothed sign of forces.hpp (tanh(v/eps) by default), eps =
-//     friction.static_smoothing_velocity, and delta = friction.stribeck_exponent.
+//     friction.static_smoothing_velocity, and delta = friction.stribeck_exponent. Each effect's
+//     parameters have the names of the plant's sections (params.hpp, `quantity`).
 
 #include <map>
 #include <string>
@@ -39,7 +41,7 @@ PlantParams effective_params(const PlantParams& p);
 double extra_force(const PlantParams& p, double x, double v, double thrust);
 
 /// Partial derivatives of extra_force() with respect to x and v (for the analytic Jacobian), and
-/// with respect to the thrust (reluctance_ripple: relative_amplitude*sin(2 pi x/pitch_m + phase_rad);
+/// with respect to the thrust (reluctance_ripple: reluctance_amplitude*sin(2 pi x/pitch + reluctance_phase);
 /// the Jacobian's d/di is Kf times it with the electrical option).
 struct ExtraForceGradient {
   double dx{0.0};
@@ -64,6 +66,9 @@ struct NamedEffect {
 const std::vector<std::string>& effect_names();
 /// The parameter names of effect `name`. Throws std::invalid_argument for an unknown name.
 const std::vector<std::string>& effect_parameter_names(const std::string& name);
+/// The unit of parameter `param` of effect `name`, as its list gives it ("m", "N", "N*s/m", "-"):
+/// the names carry no unit. Throws std::invalid_argument for an unknown effect or parameter.
+const std::string& effect_parameter_unit(const std::string& name, const std::string& param);
 /// The field of parameter `param` of effect `name` and the effect's enabled flag, in e.
 double& effect_parameter(EffectsParams& e, const std::string& name, const std::string& param);
 bool& effect_enabled(EffectsParams& e, const std::string& name);

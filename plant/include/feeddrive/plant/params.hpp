@@ -37,6 +37,91 @@ FrictionModel friction_model_from_string(const std::string& s);
 // rule, plausible range for a linear feed drive, one line of meaning. The scenario reader,
 // validate()'s ranges, the plausibility warnings and docs/scenario.md's tables come from it.
 
+// The quantities a plant section and an effect of the model-discrepancy vocabulary (EffectsParams)
+// share, one vocabulary per physical effect: each is declared once here (name, unit, rule,
+// plausible range, meaning) and listed by both (RippleParams and CoggingRippleEffect, ...). A rule
+// that depends on the role is chained where the field is listed (the friction law's Fs, Fc > 0
+// against an additive effect's >= 0).
+namespace quantity {
+using fields::field;
+using fields::Field;
+
+// --- friction (FrictionParams; coulomb_friction, viscous_friction, stribeck_friction, presliding)
+// A force level of the Stribeck curve g(v) = Fc + (Fs - Fc)*exp(-|v/vs|^delta): Fs and Fc.
+inline Field<double> friction_level(const char* name, double& v, const char* doc) {
+  return field(name, v).unit("N").non_negative().plausible(0.1, 2e4, "", "", "a linear guide").doc(doc);
+}
+inline Field<double> static_force(double& v) {
+  return friction_level("static_force", v, "Fs, stiction level of g(v); >= coulomb_force");
+}
+inline Field<double> coulomb_force(double& v) {
+  return friction_level("coulomb_force", v, "Fc, Coulomb level of g(v)");
+}
+inline Field<double> stribeck_velocity(double& v) {
+  return field("stribeck_velocity", v).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s").doc("vs, Stribeck velocity");
+}
+inline Field<double> bristle_stiffness(double& v) {
+  return field("bristle_stiffness", v)
+      .unit("N/m")
+      .positive()
+      .plausible(1e3, 1e10, "", "N/um")
+      .doc("sigma0, LuGre bristle stiffness");
+}
+inline Field<double> bristle_damping(double& v) {
+  return field("bristle_damping", v)
+      .unit("N*s/m")
+      .non_negative()
+      .plausible(0, 1e7)
+      .doc("sigma1, LuGre bristle damping");
+}
+inline Field<double> viscous(double& v) {
+  return field("viscous", v).unit("N*s/m").non_negative().plausible(0, 1e5).doc("sigma2, viscous coefficient");
+}
+
+// --- force ripple (RippleParams; cogging_ripple, reluctance_ripple) --------------------------
+inline Field<double> pitch(double& v) {
+  return field("pitch", v).unit("m").positive().at_most(10).plausible(1e-3, 0.2, "mm").doc("p, magnet pitch");
+}
+inline Field<double> cogging_amplitude(double& v) {
+  return field("cogging_amplitude", v).unit("N").plausible(-2000, 2000).doc("ac, cogging amplitude");
+}
+inline Field<double> cogging_phase(double& v) {
+  return field("cogging_phase", v).unit("rad").plausible(-7, 7, "deg").doc("phi_c1");
+}
+inline Field<double> cogging_third(double& v) {
+  return field("cogging_third", v).unit("N").plausible(-2000, 2000).doc("bc, cogging third harmonic (6*pi*x/p)");
+}
+inline Field<double> cogging_third_phase(double& v) {
+  return field("cogging_third_phase", v).unit("rad").plausible(-7, 7, "deg").doc("phi_c3");
+}
+inline Field<double> reluctance_amplitude(double& v) {
+  return field("reluctance_amplitude", v)
+      .unit("-")
+      .plausible(-0.5, 0.5, "%")
+      .doc("af, fraction of the thrust; |af| + |bf| < 1");
+}
+inline Field<double> reluctance_phase(double& v) {
+  return field("reluctance_phase", v).unit("rad").plausible(-7, 7, "deg").doc("phi_11");
+}
+
+// --- grinding (GrindingParams; grinding_force) -----------------------------------------------
+inline Field<double> grinding_stiffness(double& v) {
+  return field("stiffness", v)
+      .unit("N/m")
+      .positive()
+      .plausible(1e5, 1e10, "", "N/um")
+      .doc("ke, wheel-work-machine stiffness");
+}
+inline Field<double> contact_position(double& v) {
+  return field("contact_position", v).unit("m").plausible(-5, 5, "mm").doc("contact for x > contact_position");
+}
+
+// --- the moving mass (PlantParams; mass_error) ------------------------------------------------
+inline Field<double> mass(double& v) {
+  return field("mass", v).unit("kg").positive().plausible(0.5, 5000, "g").doc("m, moving mass");
+}
+}  // namespace quantity
+
 /// LuGre / static friction parameters. Defaults: Xie & Liang Table 1, delta = 2.
 struct FrictionParams {
   FrictionModel model{FrictionModel::kLuGre};
@@ -60,23 +145,15 @@ struct FrictionParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(model).doc("friction law: lugre, static (Coulomb + Stribeck + viscous map) or none"));
-    a->Visit(FD_FIELD(static_force)
-                 .unit("N")
-                 .positive()
-                 .plausible(0.1, 2e4, "", "", "a linear guide")
-                 .doc("Fs, stiction level of g(v)"));
-    a->Visit(FD_FIELD(coulomb_force)
-                 .unit("N")
-                 .positive()
-                 .plausible(0.1, 2e4, "", "", "a linear guide")
-                 .doc("Fc, Coulomb level of g(v); <= static_force"));
-    a->Visit(
-        FD_FIELD(stribeck_velocity).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s").doc("vs, Stribeck velocity"));
+    // The friction law divides by g(v) = Fc + (Fs - Fc)*exp(...): its levels are > 0.
+    a->Visit(quantity::static_force(static_force).positive());
+    a->Visit(quantity::coulomb_force(coulomb_force).positive());
+    a->Visit(quantity::stribeck_velocity(stribeck_velocity));
     a->Visit(
         FD_FIELD(stribeck_exponent).unit("-").positive().plausible(0.3, 5.0).doc("delta, shape of exp(-|v/vs|^delta)"));
-    a->Visit(FD_FIELD(bristle_stiffness).unit("N/m").positive().plausible(1e3, 1e10, "", "N/um").doc("sigma0 (lugre)"));
-    a->Visit(FD_FIELD(bristle_damping).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1 (lugre)"));
-    a->Visit(FD_FIELD(viscous).unit("N*s/m").non_negative().plausible(0, 1e5).doc("sigma2, viscous coefficient"));
+    a->Visit(quantity::bristle_stiffness(bristle_stiffness));
+    a->Visit(quantity::bristle_damping(bristle_damping));
+    a->Visit(quantity::viscous(viscous));
     a->Visit(FD_FIELD(damping_decay_velocity)
                  .unit("m/s")
                  .non_negative()
@@ -145,16 +222,13 @@ struct RippleParams {
         FD_FIELD(preset).doc("paper: start from the paper's values (ac 3 N, bc 1 N, af 0.03, bf 0.01, on); `ripple: "
                              "paper` alone says the same; none: every part 0"));
     a->Visit(FD_FIELD(enabled).doc("the ripple force of eqs. 14-15 acts"));
-    a->Visit(FD_FIELD(pitch).unit("m").positive().at_most(10).plausible(1e-3, 0.2, "mm").doc("p, magnet pitch"));
-    a->Visit(FD_FIELD(cogging_amplitude).unit("N").plausible(-2000, 2000).doc("ac, cogging amplitude"));
-    a->Visit(FD_FIELD(cogging_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c1"));
-    a->Visit(FD_FIELD(cogging_third).unit("N").plausible(-2000, 2000).doc("bc, cogging third harmonic (6*pi*x/p)"));
-    a->Visit(FD_FIELD(cogging_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_c3"));
-    a->Visit(FD_FIELD(reluctance_amplitude)
-                 .unit("-")
-                 .plausible(-0.5, 0.5, "%")
-                 .doc("af, fraction of the desired force; |af| + |bf| < 1"));
-    a->Visit(FD_FIELD(reluctance_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_11"));
+    a->Visit(quantity::pitch(pitch));
+    a->Visit(quantity::cogging_amplitude(cogging_amplitude));
+    a->Visit(quantity::cogging_phase(cogging_phase));
+    a->Visit(quantity::cogging_third(cogging_third));
+    a->Visit(quantity::cogging_third_phase(cogging_third_phase));
+    a->Visit(quantity::reluctance_amplitude(reluctance_amplitude));
+    a->Visit(quantity::reluctance_phase(reluctance_phase));
     a->Visit(FD_FIELD(reluctance_third).unit("-").plausible(-0.5, 0.5, "%").doc("bf, third harmonic fraction"));
     a->Visit(FD_FIELD(reluctance_third_phase).unit("rad").plausible(-7, 7, "deg").doc("phi_12"));
   }
@@ -178,19 +252,13 @@ struct GrindingParams {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(FD_FIELD(enabled).doc("the Hahn-Lindsay grinding force of eq. 13 acts"));
-    a->Visit(FD_FIELD(stiffness)
-                 .unit("N/m")
-                 .positive()
-                 .plausible(1e5, 1e10, "", "N/um")
-                 .doc("ke, wheel-work-machine stiffness"));
+    a->Visit(quantity::grinding_stiffness(stiffness));
     a->Visit(
         FD_FIELD(dullness).unit("N*s/m^3").positive().plausible(1e6, 1e13).doc("c, force per material removal rate"));
     a->Visit(FD_FIELD(workpiece_diameter).unit("m").positive().plausible(1e-3, 2.0, "mm").doc("dw"));
     a->Visit(FD_FIELD(wheel_width).unit("m").positive().plausible(1e-3, 0.5, "mm").doc("bs"));
-    a->Visit(FD_FIELD(contact_position)
-                 .unit("m")
+    a->Visit(quantity::contact_position(contact_position)
                  .minus_inf_allowed()
-                 .plausible(-5, 5, "mm")
                  .doc("contact for x > contact_position; -.inf: always in contact"));
     a->Visit(FD_FIELD(contact_width)
                  .unit("m")
@@ -226,146 +294,170 @@ struct ElectricalParams {
 /// Extra forces of the model-discrepancy vocabulary (issue: feeddrive-fit, docs/fit.md). Each
 /// adds one more force F_extra to  m*x'' = Ka*Kf*u - F_friction - F_ripple - F_grinding - F_extra,
 /// or modifies the model as named. Every effect is off (enabled = false) by default. The field
-/// names are the vocabulary's parameter names; the YAML keys under plant.effects.<name> are the
-/// same strings.
-struct ConstantForceEffect {  ///< F = force_N (gravity on an incline, cable weight, offset)
+/// names are the vocabulary's parameter names and the YAML keys under plant.effects.<name>; a
+/// quantity the plant's own sections have is named, and declared, as there (`quantity` above:
+/// cogging_ripple.cogging_amplitude is ripple.cogging_amplitude). Units are in the list, not in
+/// the names; each key's old spelling (amplitude_N, ...) is its alias, still read with a warning.
+/// Every effect's `enabled`: listing the effect turns it on (`enabled: false` switches it off again).
+inline fields::Field<bool> listed_enabled(bool& v) {
+  return fields::field("enabled", v).doc("on (listing the effect turns it on)");
+}
+
+struct ConstantForceEffect {  ///< F = force (gravity on an incline, cable weight, offset)
   bool enabled{false};
-  double force_N{0.0};
+  double force{0.0};  ///< [N]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(force_N).unit("N").plausible(-1e4, 1e4).doc("the constant force"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(FD_FIELD(force).unit("N").plausible(-1e4, 1e4).doc("the constant force").alias("force_N"));
   }
 };
-struct CoulombFrictionEffect {  ///< F = coulomb_N*sgn(v), sgn smoothed as tanh(v/eps) (eps:
+struct CoulombFrictionEffect {  ///< F = coulomb_force*sgn(v), sgn smoothed as tanh(v/eps) (eps:
                                 ///< friction.static_smoothing_velocity)
   bool enabled{false};
-  double coulomb_N{0.0};
+  double coulomb_force{0.0};  ///< Fc [N]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(coulomb_N).unit("N").non_negative().plausible(0, 2e4));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::coulomb_force(coulomb_force).alias("coulomb_N"));
   }
 };
-struct ViscousFrictionEffect {  ///< F = viscous_Ns_per_m*v
+struct ViscousFrictionEffect {  ///< F = viscous*v
   bool enabled{false};
-  double viscous_Ns_per_m{0.0};
+  double viscous{0.0};  ///< sigma2 [N*s/m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(viscous_Ns_per_m).unit("N*s/m").non_negative().plausible(0, 1e5));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::viscous(viscous).alias("viscous_Ns_per_m"));
   }
 };
-/// F = sgn(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta)), delta =
-/// friction.stribeck_exponent, sgn smoothed as for coulomb_friction.
+/// F = sgn(v)*(coulomb_force + (static_force - coulomb_force)*exp(-|v/stribeck_velocity|^delta)),
+/// delta = friction.stribeck_exponent, sgn smoothed as for coulomb_friction.
 struct StribeckFrictionEffect {
   bool enabled{false};
-  double static_N{0.0};
-  double coulomb_N{0.0};
-  double stribeck_velocity_mps{0.01};
+  double static_force{0.0};        ///< Fs [N]
+  double coulomb_force{0.0};       ///< Fc [N]
+  double stribeck_velocity{0.01};  ///< vs [m/s]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(static_N).unit("N").plausible(0, 2e4).doc("static_N >= coulomb_N"));
-    a->Visit(FD_FIELD(coulomb_N).unit("N").non_negative().plausible(0, 2e4));
-    a->Visit(FD_FIELD(stribeck_velocity_mps).unit("m/s").positive().plausible(1e-6, 1.0, "mm/s"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::static_force(static_force).alias("static_N"));
+    a->Visit(quantity::coulomb_force(coulomb_force).alias("coulomb_N"));
+    a->Visit(quantity::stribeck_velocity(stribeck_velocity).alias("stribeck_velocity_mps"));
   }
 };
 /// The LuGre bristle dynamics (Canudas de Wit 1995): the friction becomes LuGre with
-/// sigma0 = bristle_stiffness_N_per_m and sigma1 = bristle_damping_Ns_per_m, keeping Fs, Fc, vs,
-/// delta and sigma2 of the friction section. F_extra = F_LuGre - F_friction(model).
+/// sigma0 = bristle_stiffness and sigma1 = bristle_damping, keeping Fs, Fc, vs, delta and sigma2
+/// of the friction section. F_extra = F_LuGre - F_friction(model).
 struct PreslidingEffect {
   bool enabled{false};
-  double bristle_stiffness_N_per_m{2e6};
-  double bristle_damping_Ns_per_m{0.0};
+  double bristle_stiffness{2e6};  ///< sigma0 [N/m]
+  double bristle_damping{0.0};    ///< sigma1 [N*s/m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(bristle_stiffness_N_per_m)
-                 .unit("N/m")
-                 .positive()
-                 .plausible(1e3, 1e10, "", "N/um")
-                 .doc("sigma0 of the LuGre friction it makes"));
-    a->Visit(FD_FIELD(bristle_damping_Ns_per_m).unit("N*s/m").non_negative().plausible(0, 1e7).doc("sigma1"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::bristle_stiffness(bristle_stiffness).alias("bristle_stiffness_N_per_m"));
+    a->Visit(quantity::bristle_damping(bristle_damping).alias("bristle_damping_Ns_per_m"));
   }
 };
-/// F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + third_phase_rad)
+/// F = cogging_amplitude*sin(2 pi x/pitch + cogging_phase)
+///   + cogging_third*sin(6 pi x/pitch + cogging_third_phase)   (ripple's cogging part, eq. 14)
 struct CoggingRippleEffect {
   bool enabled{false};
-  double pitch_m{0.03};
-  double amplitude_N{0.0};
-  double phase_rad{0.0};
-  double third_harmonic_N{0.0};
-  double third_phase_rad{0.0};
+  double pitch{0.03};               ///< p [m]
+  double cogging_amplitude{0.0};    ///< ac [N]
+  double cogging_phase{0.0};        ///< phi_c1 [rad]
+  double cogging_third{0.0};        ///< bc [N]
+  double cogging_third_phase{0.0};  ///< phi_c3 [rad]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(pitch_m).unit("m").positive().plausible(1e-3, 0.2, "mm"));
-    a->Visit(FD_FIELD(amplitude_N).unit("N").plausible(-2000, 2000));
-    a->Visit(FD_FIELD(phase_rad).unit("rad").plausible(-7, 7, "deg"));
-    a->Visit(FD_FIELD(third_harmonic_N).unit("N").plausible(-2000, 2000));
-    a->Visit(FD_FIELD(third_phase_rad).unit("rad").plausible(-7, 7, "deg"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::pitch(pitch).alias("pitch_m"));
+    a->Visit(quantity::cogging_amplitude(cogging_amplitude).alias("amplitude_N"));
+    a->Visit(quantity::cogging_phase(cogging_phase).alias("phase_rad"));
+    a->Visit(quantity::cogging_third(cogging_third).alias("third_harmonic_N"));
+    a->Visit(quantity::cogging_third_phase(cogging_third_phase).alias("third_phase_rad"));
   }
 };
-/// F = Ka*Kf*u*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)  (the thrust actually produced)
+/// F = F_thrust*reluctance_amplitude*sin(2 pi x/pitch + reluctance_phase)  (the thrust actually
+/// produced; ripple's reluctance fundamental, eq. 15)
 struct ReluctanceRippleEffect {
   bool enabled{false};
-  double pitch_m{0.03};
-  double relative_amplitude{0.0};
-  double phase_rad{0.0};
+  double pitch{0.03};                ///< p [m]
+  double reluctance_amplitude{0.0};  ///< af [-]
+  double reluctance_phase{0.0};      ///< phi_11 [rad]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(pitch_m).unit("m").positive().plausible(1e-3, 0.2, "mm"));
-    a->Visit(FD_FIELD(relative_amplitude).unit("-").plausible(-0.5, 0.5, "%").doc("|relative_amplitude| < 1"));
-    a->Visit(FD_FIELD(phase_rad).unit("rad").plausible(-7, 7, "deg"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::pitch(pitch).alias("pitch_m"));
+    a->Visit(quantity::reluctance_amplitude(reluctance_amplitude).alias("relative_amplitude"));
+    a->Visit(quantity::reluctance_phase(reluctance_phase).alias("phase_rad"));
   }
 };
-/// Hahn-Lindsay grinding force (the grinding section's model) with C = gain_Ns_per_m,
-/// ke = stiffness_N_per_m and contact past contact_position_m. Uses the Fg state.
+/// Hahn-Lindsay grinding force (the grinding section's model) with C = damping (GrindingParams::
+/// damping(), c*pi*dw*bs), ke = stiffness and contact past contact_position. Uses the Fg state.
 struct GrindingForceEffect {
   bool enabled{false};
-  double gain_Ns_per_m{7.85e6};
-  double stiffness_N_per_m{2e7};
-  double contact_position_m{0.0};
+  double damping{7.85e6};        ///< C [N*s/m]
+  double stiffness{2e7};         ///< ke [N/m]
+  double contact_position{0.0};  ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(gain_Ns_per_m).unit("N*s/m").positive().plausible(1e3, 1e10).doc("C"));
-    a->Visit(FD_FIELD(stiffness_N_per_m).unit("N/m").positive().plausible(1e5, 1e10, "", "N/um").doc("ke"));
-    a->Visit(FD_FIELD(contact_position_m).unit("m").plausible(-5, 5, "mm"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(FD_FIELD(damping)
+                 .unit("N*s/m")
+                 .positive()
+                 .plausible(1e3, 1e10)
+                 .doc("C = c*pi*dw*bs, the steady-state force per infeed velocity (grinding: damping())")
+                 .alias("gain_Ns_per_m"));
+    a->Visit(quantity::grinding_stiffness(stiffness).alias("stiffness_N_per_m"));
+    a->Visit(quantity::contact_position(contact_position).alias("contact_position_m"));
   }
 };
-/// F = stiffness_N_per_m*(x - rest_position_m)  (a cable carrier)
+/// F = stiffness*(x - rest_position)  (a cable carrier)
 struct SpringForceEffect {
   bool enabled{false};
-  double stiffness_N_per_m{0.0};
-  double rest_position_m{0.0};
+  double stiffness{0.0};      ///< [N/m]
+  double rest_position{0.0};  ///< [m]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(stiffness_N_per_m).unit("N/m").non_negative().plausible(0, 1e7));
-    a->Visit(FD_FIELD(rest_position_m).unit("m").plausible(-5, 5, "mm"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(FD_FIELD(stiffness)
+                 .unit("N/m")
+                 .non_negative()
+                 .plausible(0, 1e7)
+                 .doc("spring rate (a cable carrier's)")
+                 .alias("stiffness_N_per_m"));
+    a->Visit(FD_FIELD(rest_position)
+                 .unit("m")
+                 .plausible(-5, 5, "mm")
+                 .doc("where the spring force is 0")
+                 .alias("rest_position_m"));
   }
 };
 /// The true moving mass replaces PlantParams::mass.
 struct MassErrorEffect {
   bool enabled{false};
-  double mass_kg{102.04};
+  double mass{102.04};  ///< [kg]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(mass_kg).unit("kg").positive().plausible(0.5, 5000, "g").doc("the true moving mass"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(quantity::mass(mass).alias("mass_kg"));
   }
 };
-/// The thrust acts delay_s after the command: F_thrust(t) = Ka*Kf*u(t - delay_s) (u = 0 before t0).
+/// The thrust acts `delay` after the command: F_thrust(t) = Ka*Kf*u(t - delay) (u = 0 before t0).
 struct InputDelayEffect {
   bool enabled{false};
-  double delay_s{0.0};
+  double delay{0.0};  ///< [s]
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(enabled).doc("on (listing the effect turns it on)"));
-    a->Visit(FD_FIELD(delay_s).unit("s").non_negative().plausible(0, 0.1, "ms"));
+    a->Visit(listed_enabled(enabled));
+    a->Visit(FD_FIELD(delay)
+                 .unit("s")
+                 .non_negative()
+                 .plausible(0, 0.1, "ms")
+                 .doc("the command's delay to the thrust")
+                 .alias("delay_s"));
   }
 };
 
@@ -384,25 +476,26 @@ struct EffectsParams {
 
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(constant_force).doc("F = force_N (gravity on an incline, cable weight, an offset)"));
-    a->Visit(FD_FIELD(coulomb_friction).doc("F = coulomb_N*sgn_eps(v)"));
-    a->Visit(FD_FIELD(viscous_friction).doc("F = viscous_Ns_per_m*v"));
-    a->Visit(FD_FIELD(stribeck_friction)
-                 .doc("F = sgn_eps(v)*(coulomb_N + (static_N - coulomb_N)*exp(-|v/stribeck_velocity_mps|^delta))"));
+    a->Visit(FD_FIELD(constant_force).doc("F = force (gravity on an incline, cable weight, an offset)"));
+    a->Visit(FD_FIELD(coulomb_friction).doc("F = coulomb_force*sgn_eps(v)"));
+    a->Visit(FD_FIELD(viscous_friction).doc("F = viscous*v"));
+    a->Visit(
+        FD_FIELD(stribeck_friction)
+            .doc("F = sgn_eps(v)*(coulomb_force + (static_force - coulomb_force)*exp(-|v/stribeck_velocity|^delta))"));
     a->Visit(
         FD_FIELD(presliding)
             .doc(
                 "the friction becomes LuGre with sigma0, sigma1 below, keeping Fs, Fc, vs, delta, sigma2 of friction"));
     a->Visit(FD_FIELD(cogging_ripple)
-                 .doc("F = amplitude_N*sin(2 pi x/pitch_m + phase_rad) + third_harmonic_N*sin(6 pi x/pitch_m + "
-                      "third_phase_rad)"));
-    a->Visit(FD_FIELD(reluctance_ripple).doc("F = F_thrust*relative_amplitude*sin(2 pi x/pitch_m + phase_rad)"));
+                 .doc("F = cogging_amplitude*sin(2 pi x/pitch + cogging_phase) + cogging_third*sin(6 pi x/pitch + "
+                      "cogging_third_phase)"));
+    a->Visit(FD_FIELD(reluctance_ripple).doc("F = F_thrust*reluctance_amplitude*sin(2 pi x/pitch + reluctance_phase)"));
     a->Visit(FD_FIELD(grinding_force)
-                 .doc("the grinding section's force on, with C = gain_Ns_per_m, ke = stiffness_N_per_m, contact past "
-                      "contact_position_m"));
-    a->Visit(FD_FIELD(spring_force).doc("F = stiffness_N_per_m*(x - rest_position_m) (a cable carrier)"));
-    a->Visit(FD_FIELD(mass_error).doc("the true moving mass mass_kg replaces plant.mass"));
-    a->Visit(FD_FIELD(input_delay).doc("F_thrust(t) = Ka*Kf*u(t - delay_s)"));
+                 .doc("the grinding section's force on, with C = damping, ke = stiffness, contact past "
+                      "contact_position"));
+    a->Visit(FD_FIELD(spring_force).doc("F = stiffness*(x - rest_position) (a cable carrier)"));
+    a->Visit(FD_FIELD(mass_error).doc("the true moving mass `mass` replaces plant.mass"));
+    a->Visit(FD_FIELD(input_delay).doc("F_thrust(t) = Ka*Kf*u(t - delay)"));
   }
   bool any() const;
   void validate(const std::string& prefix = "effects") const;
@@ -522,7 +615,7 @@ struct PlantParams {
 
   template <class Archive>
   void Serialize(Archive* a) {
-    a->Visit(FD_FIELD(mass).unit("kg").positive().plausible(0.5, 5000, "g").doc("m, moving mass"));
+    a->Visit(quantity::mass(mass));
     a->Visit(FD_FIELD(amplifier_gain)
                  .unit("A/V")
                  .positive()

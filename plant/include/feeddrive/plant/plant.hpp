@@ -4,7 +4,7 @@
 //   Measurement m = plant.measure();   // what the controller sees at t_k
 //   plant.advance(u, t_{k+1});         // apply the held command over [t_k, t_{k+1})
 //
-// With the input_delay effect (params.hpp) the ODE sees u_d(t) = u(t - d), d = delay_s: the
+// With the input_delay effect (params.hpp) the ODE sees u_d(t) = u(t - d), d = delay: the
 // command held from t_j acts from t_j + d until the next command's t_{j+1} + d, and u_d = 0
 // before the first command's t_0 + d. advance() keeps the commands (t_j, u_j) that still act or
 // will, and integrates [t, t_next] piecewise, restarting CVODE at every switch time t_j + d
@@ -35,7 +35,7 @@ class Plant {
   /// Samples the encoder at the current time. Call exactly once per control period.
   Measurement measure();
   /// Force breakdown at the current state when u is commanded now; with input_delay the thrust
-  /// is that of the delayed input u_d(t) acting now (u itself if delay_s = 0).
+  /// is that of the delayed input u_d(t) acting now (u itself if delay = 0).
   Forces forces(double u) const;
   /// Integrates to t_next with input u held (zero-order hold), delayed by input_delay if enabled.
   void advance(double u, double t_next);
@@ -51,7 +51,7 @@ class Plant {
 
  private:
   struct HeldCommand {
-    double t;  ///< time the command was issued [s]; it acts from t + delay_s
+    double t;  ///< time the command was issued [s]; it acts from t + delay
     double u;  ///< [V]
   };
   void advance_delayed(double u, double t_next);

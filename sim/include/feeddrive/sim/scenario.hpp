@@ -134,6 +134,10 @@ struct Scenario {
   /// "controller.model.effects.spring_force"). Listing one enables it; a listed one is part of
   /// the run's description (resolved_keys) even when it says `enabled: false`.
   std::set<std::string> listed_effects;
+  /// The old spellings of keys the scenario uses (fields::Meta::alias: a key renamed into the
+  /// plant's vocabulary, e.g. plant.effects.cogging_ripple.amplitude_N), one line each naming the
+  /// old and the new key; read as the new key, and warnings (a deprecation).
+  std::vector<std::string> renamed_keys;
   /// Values that load but are implausible for a linear feed drive (each naming the key, the
   /// value, the bound and the likely unit: "reference.max_velocity: 500 m/s is above any linear
   /// drive (10 m/s); mm/s?"), and a move that does not finish within `duration`. The loader
@@ -188,6 +192,12 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& base_di
 /// controller section (a study's controller entry). Throws ScenarioError "<origin>: ...".
 Scenario read_scenario(const std::string& yaml_text, const std::string& base_dir = ".",
                        const std::string& origin = "scenario", const std::string& controller = "");
+
+/// `key` with each old spelling in it (fields::Meta::alias, in the lists of the plant, the
+/// controller's model, the controllers and the references) replaced by its key:
+/// "plant.effects.cogging_ripple.amplitude_N" -> "plant.effects.cogging_ripple.cogging_amplitude";
+/// any other key as it is. `note` (optional) receives the deprecation line of a replaced one.
+std::string canonical_key(const std::string& key, std::string* note = nullptr);
 
 /// Sets one dotted key of a scenario as read to `value` (YAML scalar text, or a flow list or map
 /// `[t, x]`, `{model: none}`), as if the file said so, through the sections' lists: the value

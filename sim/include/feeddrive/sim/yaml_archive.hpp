@@ -10,6 +10,9 @@
 //   std::string           -> string
 //   a named enum          -> its name (fields::enum_names), "expected one of ..." otherwise
 //   a nested params struct-> a child map, read the same way and finished (unknown keys refused)
+//
+// A field's old spelling (fields::Meta::alias) is read as the field, with a deprecation line
+// (MapReader::spelling); both spellings given is a one-line error.
 
 #include <cmath>
 #include <cstdint>
@@ -30,8 +33,8 @@ class YamlReadArchive {
 
   template <typename T>
   void Visit(const fields::Field<T>& f) {
-    const std::string key = f.meta.name;
-    if (skip_.count(key)) return;
+    if (skip_.count(f.meta.name)) return;
+    const std::string key = r_.spelling(f.meta.name, f.meta.alias);  // the name, or its old spelling
     T& v = *f.value;
     if constexpr (std::is_same_v<T, double>) {
       if (f.meta.allow_inf()) {

@@ -41,7 +41,9 @@ class MapReader {
   /// node must be a map (or null/absent, treated as empty); path is its dotted key ("plant").
   /// `given` (optional, handed on to child readers): receives the dotted key of every map and
   /// value present in the node that is read (the presence facts, Scenario::given_keys).
-  MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given = nullptr);
+  /// `renamed` (optional, handed on too): one line for each old spelling read (spelling()).
+  MapReader(const YAML::Node& node, std::string path, std::set<std::string>* given = nullptr,
+            std::vector<std::string>* renamed = nullptr);
 
   bool has(const std::string& key) const;
   /// Reads a finite number into out if the key is present; throws if present but invalid.
@@ -68,12 +70,18 @@ class MapReader {
   /// An empty nested map at `key` (marked as read), whatever the node holds: a section given in
   /// another form (`ripple: paper`) is read as its defaults.
   MapReader child_absent(const std::string& key);
+  /// The spelling of `key` the map gives, to read it by: `key`, or its old spelling `alias`
+  /// (fields::Meta::alias; "" for none). An old spelling is recorded in `renamed`
+  /// (renamed_key_note) and given as `key`. Both spellings given: a one-line error
+  /// (both_spellings_error). finish() hints a word near the old spelling at `key`.
+  std::string spelling(const std::string& key, const std::string& alias);
   /// Marks `key` as known (read by the caller some other way, e.g. a list), for finish().
   void known(const std::string& key) { read_.insert(key); }
   /// Records `key` (below this map) as given, for a form the accessors do not see (a preset's
   /// short form `ripple: paper` gives ripple.preset).
   void mark_given(const std::string& key) const {
-    if (given_ != nullptr) given_->insert(key_path(key));
+    const auto old = aliases_.find(key);  // an old spelling is given as its key
+    if (given_ != nullptr) given_->insert(key_path(old == aliases_.end() ? key : old->second));
   }
   /// Throws for every key present in the node but never read.
   void finish() const;
@@ -86,16 +94,32 @@ class MapReader {
   YAML::Node node_;
   std::string path_;
   std::set<std::string> read_;
+  std::map<std::string, std::string> aliases_;  // old spelling -> key (spelling())
   std::set<std::string>* given_{nullptr};
+  std::vector<std::string>* renamed_{nullptr};
 };
+
+/// The deprecation line of a key read by its old spelling (fields::Meta::alias), both dotted:
+/// "plant.effects.constant_force.force_N: old spelling of plant.effects.constant_force.force
+/// (deprecated: rename the key)". The one wording of the reader and the setter (canonical_key).
+inline std::string renamed_key_note(const std::string& old_key, const std::string& key) {
+  return old_key + ": old spelling of " + key + " (deprecated: rename the key)";
+}
+/// The one-line error of a map that gives a key in both spellings (`old_key` dotted).
+inline std::string both_spellings_error(const std::string& old_key, const std::string& key) {
+  return old_key + ": old spelling of " + key + ", which is given too: give " + key + " only";
+}
 
 /// Levenshtein distance, for "did you mean" hints.
 std::size_t edit_distance(const std::string& a, const std::string& b);
 
 /// " (did you mean 'X'?)" for the candidate X closest to `word` within two edits (the first of
-/// equally close ones), "" if none is that close.
+/// equally close ones), "" if none is that close. `aliases` (old spelling -> key,
+/// fields::Meta::alias) are candidates too: a word nearest an old spelling is hinted at its key,
+/// " (did you mean 'cogging_amplitude', formerly 'amplitude_N'?)".
 template <typename Names>
-std::string did_you_mean(const std::string& word, const Names& candidates) {
+std::string did_you_mean(const std::string& word, const Names& candidates,
+                         const std::map<std::string, std::string>& aliases = {}) {
   std::string hint;
   std::size_t best = 3;
   for (const std::string& known : candidates) {
@@ -103,6 +127,13 @@ std::string did_you_mean(const std::string& word, const Names& candidates) {
     if (d < best) {
       best = d;
       hint = " (did you mean '" + known + "'?)";
+    }
+  }
+  for (const auto& [old, key] : aliases) {
+    const std::size_t d = edit_distance(word, old);
+    if (d < best) {
+      best = d;
+      hint = " (did you mean '" + key + "', formerly '" + old + "'?)";
     }
   }
   return hint;

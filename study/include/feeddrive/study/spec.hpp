@@ -22,7 +22,7 @@
 //           - {key: plant.mass, distribution: uniform, low: 0.8, high: 1.2, scale: true}
 //           - {keys: [plant.friction.bristle_stiffness, plant.friction.bristle_damping],
 //              distribution: lognormal, mu: 0.0, sigma: 0.1, scale: true}
-//           - {key: plant.effects.input_delay.delay_s, distribution: normal, mean: 5e-4, stddev: 2e-4,
+//           - {key: plant.effects.input_delay.delay, distribution: normal, mean: 5e-4, stddev: 2e-4,
 //              low: 0, high: 1e-3}
 //   report: {metric: position_error_max_abs_m, scale: 1.0e6, unit: um, limit: 0.8,   # optional
 //            require: [control_signal_within_limits]}
