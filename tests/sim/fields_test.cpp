@@ -146,7 +146,7 @@ TEST(Fields, FlattenAndUnflattenRoundTripThroughTheList) {
   EXPECT_TRUE(find("friction.model")->is_name);
   EXPECT_EQ(find("ripple.enabled")->number, 1.0);
   EXPECT_EQ(find("integrator.max_steps")->number, 777.0);
-  EXPECT_EQ(find("effects.constant_force.force_N")->number, 0.0);
+  EXPECT_EQ(find("effects.constant_force.force")->number, 0.0);
   plant::PlantParams q;
   EXPECT_FALSE(fields::same(p, q));
   EXPECT_EQ(fields::unflatten(q, find), t.size());
