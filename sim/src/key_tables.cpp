@@ -27,13 +27,13 @@ std::string number(double v) {
 }
 
 std::string valid_text(const Meta& m) {
-  std::string s;
+  std::string s = m.required ? "required; " : "";
   switch (m.check) {
-    case Check::kFinite: s = "finite"; break;
-    case Check::kPositive: s = "> 0"; break;
-    case Check::kNonNegative: s = "≥ 0"; break;
-    case Check::kNotPlusInf: s = "finite or -.inf"; break;
-    case Check::kNone: s = "its own rule (Meaning)"; break;
+    case Check::kFinite: s += "finite"; break;
+    case Check::kPositive: s += "> 0"; break;
+    case Check::kNonNegative: s += "≥ 0"; break;
+    case Check::kNotPlusInf: s += "finite or -.inf"; break;
+    case Check::kNone: s += "its own rule (Meaning)"; break;
   }
   if (m.min > -fields::kInf) s += ", ≥ " + number(m.min);
   if (m.max < fields::kInf) s += ", ≤ " + number(m.max);
@@ -51,6 +51,9 @@ std::string meaning(const Meta& m) {
   return std::string(m.doc) + (*m.doc ? "; " : "") + "formerly `" + m.alias + "` (still read, with a warning)";
 }
 
+// The Default cell: "required" for a key without one, else the value's text.
+std::string default_text(const Meta& m, const std::string& value) { return m.required ? "required" : value; }
+
 // One row per field; a nested struct is a row of its own (its meaning) followed by its fields.
 class DocArchive {
  public:
@@ -61,15 +64,20 @@ class DocArchive {
     const std::string key = prefix_.empty() ? m.name : prefix_ + "." + m.name;
     const T& v = *f.value;
     if constexpr (std::is_same_v<T, double>) {
-      rows_->push_back({key, m.unit, number(v), valid_text(m), plausible_text(m), meaning(m)});
+      rows_->push_back({key, m.unit, default_text(m, number(v)), valid_text(m), plausible_text(m), meaning(m)});
     } else if constexpr (std::is_same_v<T, long> || std::is_same_v<T, std::uint64_t>) {
       const std::string valid = std::is_same_v<T, long> ? "integer, " + valid_text(m) : "integer ≥ 0";
-      rows_->push_back({key, m.unit, std::to_string(v), valid, plausible_text(m), meaning(m)});
+      rows_->push_back({key, m.unit, default_text(m, std::to_string(v)), valid, plausible_text(m), meaning(m)});
     } else if constexpr (std::is_same_v<T, bool>) {
       rows_->push_back({key, "–", v ? "true" : "false", "true, false", "–", meaning(m)});
     } else if constexpr (fields::is_named_enum<T>::value) {
-      rows_->push_back(
-          {key, "–", std::string("`") + fields::enum_name(v) + "`", fields::enum_choices<T>(), "–", meaning(m)});
+      rows_->push_back({key, "–", default_text(m, std::string("`") + fields::enum_name(v) + "`"),
+                        std::string(m.required ? "required; " : "") + fields::enum_choices<T>(), "–", meaning(m)});
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      rows_->push_back({key, "–", default_text(m, v.empty() ? "–" : "`" + v + "`"),
+                        std::string(m.required ? "required; " : "") + "text", "–", meaning(m)});
+    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      rows_->push_back({key, "list", v.empty() ? "[]" : "…", "a list of names", "–", meaning(m)});
     } else if constexpr (fields::is_serializable<T>::value) {
       if (*m.doc) rows_->push_back({key, "map", "", "", "", m.doc});
       DocArchive child(key, rows_);
@@ -135,15 +143,32 @@ void collect_keys(const std::string& text, F&& add) {
   }
 }
 
+// The key prefix of a table's rows: "" for the top level (scenario), the section for a
+// controller's or a reference's type (controller.cascade -> controller), else the table's name.
+std::string key_prefix(const std::string& table_name) {
+  if (table_name == "scenario") return "";
+  if (table_name.rfind("controller", 0) == 0) return "controller";
+  if (table_name.rfind("reference.", 0) == 0) return "reference";
+  return table_name;
+}
+
+std::string dotted(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> key_tables() {
   return {
+      {"scenario", table(Scenario{})},
       {"plant", table(PlantSections{})},
       {"plant.effects", table(plant::EffectsParams{})},
+      {"controller", table(ControllerConfig{})},
       {"controller.sliding_mode", table(controller::SlidingModeParams{})},
       {"controller.cascade", table(controller::CascadeParams{})},
       {"controller.open_loop", table(controller::OpenLoopParams{})},
+      {"controller.plugin", table(controller::PluginParams{})},
+      {"reference", table(ReferenceConfig{})},
       {"reference.sine", table(trajectory::SineParams{})},
       {"reference.step", table(trajectory::StepParams{})},
       {"reference.accel_limited", table(trajectory::AccelLimitedParams{})},
@@ -156,23 +181,13 @@ namespace {
 // key -> unit, from the tables' rows (| `key` | unit | ...).
 const std::map<std::string, std::string>& unit_map() {
   static const std::map<std::string, std::string> units = [] {
-    // The keys the loader reads outside the params lists (scenario.cpp, parse_node; docs/scenario.md,
-    // "The scenario file"): the run's times, the controller's delay and the analysis windows.
-    std::map<std::string, std::string> m = {{"duration", "s"},
-                                            {"control_period", "s"},
-                                            {"controller.computation_delay", "s"},
-                                            {"analysis.settled_after", "s"},
-                                            {"analysis.settling_band", "m"},
-                                            {"output.every", "-"}};
+    std::map<std::string, std::string> m;
     for (const auto& [name, text] : key_tables()) {
-      const std::string prefix = name.rfind("controller.", 0) == 0  ? "controller"
-                                 : name.rfind("reference.", 0) == 0 ? "reference"
-                                                                    : name;
       std::size_t i = 0;
       while ((i = text.find("\n| `", i)) != std::string::npos) {
         const std::size_t b = i + 4, e = text.find('`', b);
         const std::size_t u = text.find("| ", e) + 2, ue = text.find(" |", u);
-        m[prefix + "." + text.substr(b, e - b)] = text.substr(u, ue - u);
+        m[dotted(key_prefix(name), text.substr(b, e - b))] = text.substr(u, ue - u);
         i = e;
       }
     }
@@ -191,12 +206,8 @@ std::string key_unit(const std::string& key) {
 
 std::vector<std::string> listed_keys() {
   std::vector<std::string> out;
-  for (const auto& [name, text] : key_tables()) {
-    const std::string prefix = name.rfind("controller.", 0) == 0  ? "controller"
-                               : name.rfind("reference.", 0) == 0 ? "reference"
-                                                                  : name;
-    collect_keys(text, [&](const std::string& k) { out.push_back(prefix + "." + k); });
-  }
+  for (const auto& [name, text] : key_tables())
+    collect_keys(text, [&](const std::string& k) { out.push_back(dotted(key_prefix(name), k)); });
   return out;
 }
 

@@ -66,7 +66,6 @@ void check_timing(const Scenario& s, const std::string& duration, const std::str
 }
 
 void check_output(const OutputConfig& out, bool columns_given) {
-  if (out.every < 1) throw ScenarioError("output.every = " + std::to_string(out.every) + ": must be an integer >= 1");
   const auto& all = record_columns();
   for (const std::string& c : out.columns) {
     if (std::find(all.begin(), all.end(), c) == all.end()) {
@@ -90,6 +89,10 @@ plant::PlantParams model_of_plant(const plant::PlantParams& plant) {
 std::string resolved_file(const std::string& base_dir, const std::string& file) {
   namespace fs = std::filesystem;
   return fs::path(file).is_relative() ? (fs::path(base_dir) / file).string() : file;
+}
+
+std::string plugin_library(const std::string& base_dir, const std::string& file) {
+  return std::filesystem::path(resolved_file(base_dir, file)).lexically_normal().string();
 }
 
 bool parameter_name(const std::string& key) {
@@ -181,7 +184,8 @@ void read_plant(MapReader r, PlantParams& p, std::set<std::string>* listed_effec
 // (a map of numbers and words, handed to the plugin as text), the nominal model and the limits.
 // The library is opened here (file, symbols, ABI version), so a bad one fails at load.
 void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, const std::string& base_dir) {
-  p.library = fs::path(detail::resolved_file(base_dir, r.required_string("library"))).lexically_normal().string();
+  read_fields(r, p);  // library, u_min, u_max
+  p.library = detail::plugin_library(base_dir, p.library);
   MapReader params = r.child("parameters");
   for (const std::string& key : params.keys()) {
     if (!detail::parameter_name(key)) params.fail(key, ": a parameter name is letters, digits and _ only");
@@ -190,8 +194,6 @@ void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, 
     p.parameters.emplace_back(key, value);
   }
   params.finish();
-  r.number("u_min", p.u_min);
-  r.number("u_max", p.u_max);
   read_plant(r.child("model"), model, nullptr);
 }
 
@@ -226,13 +228,7 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& fi
 // --- reference -----------------------------------------------------------------------------
 
 void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir) {
-  std::string type = fields::enum_name(c.type);
-  r.string("type", type);
-  try {
-    c.type = fields::enum_from_name<ReferenceType>(type);
-  } catch (const std::invalid_argument& e) {
-    r.fail("type", " = '" + type + "': " + e.what());
-  }
+  read_fields(r, c);  // type
   switch (c.type) {
     case ReferenceType::kNone: break;
     case ReferenceType::kSine: read_fields(r, c.sine); break;
@@ -343,15 +339,8 @@ void find_warnings(Scenario& s) {
   w = s.renamed_keys;  // a key's deprecated spelling, one line each
   const auto add = [&w](const std::vector<std::string>& more) { w.insert(w.end(), more.begin(), more.end()); };
   add(off_sections(s));
-  {
-    fields::PlausibilityArchive top("", &w);
-    top.Visit(fields::field("control_period", s.control_period)
-                  .unit("s")
-                  .plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period"));
-    top.Visit(fields::field("controller.computation_delay", s.controller.computation_delay)
-                  .unit("s")
-                  .plausible(0, 0.01, "ms", "", "a servo drive's delay"));
-  }
+  add(fields::plausibility(s, ""));
+  add(fields::plausibility(s.controller, "controller"));
   add(fields::plausibility(s.plant, "plant"));  // sections that are off too: their keys were written
   const auto warned = [&w](const std::string& key, std::size_t from) {
     for (std::size_t i = from; i < w.size(); ++i)
@@ -404,17 +393,19 @@ void find_warnings(Scenario& s) {
 // values as written); derive() then computes what one section takes from another, and
 // check_scenario() validates the whole (parse_node: read -> derive -> check).
 
-// name, duration and control_period, each error quoting the value as written.
-void read_timing(MapReader& top, const YAML::Node& root, Scenario& s) {
-  top.string("name", s.name);
+// The top-level list (Scenario::Serialize: name, duration, control_period, analysis, output), with
+// its one-line errors; then the rules of their own: the name's bytes, the run's length (quoting
+// the values as written) and the output's column names.
+void read_top(MapReader& top, const YAML::Node& root, Scenario& s) {
+  read_fields(top, s);
   check_name(s.name, "name");
-  if (!top.has("duration")) top.fail("duration", ": missing (required)");
-  if (!top.has("control_period")) top.fail("control_period", ": missing (required)");
-  top.number("duration", s.duration);
-  top.number("control_period", s.control_period);
-  if (!(s.duration > 0.0)) top.fail("duration", " = " + root["duration"].Scalar() + ": must be > 0");
-  if (!(s.control_period > 0.0)) top.fail("control_period", " = " + root["control_period"].Scalar() + ": must be > 0");
+  try {
+    s.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
   detail::check_timing(s, root["duration"].Scalar(), root["control_period"].Scalar());
+  detail::check_output(s.output, detail::gives(s, "output.columns"));
 }
 
 // plant: its keys; a grinding process if it gives a grinding section or lists the grinding force.
@@ -425,42 +416,31 @@ void read_plant_section(MapReader& top, Scenario& s) {
 
 // controller: its type's keys; the nominal model (controller.model) into s.controller.model, on
 // top of the plant's own parameters (a model never carries the plant's effects).
-void read_controller(MapReader& top, const YAML::Node& root, Scenario& s, const std::string& base_dir) {
+void read_controller(MapReader& top, Scenario& s, const std::string& base_dir) {
   ControllerConfig& cc = s.controller;
   MapReader c = top.child("controller");
-  std::string type = c.required_string("type");
-  c.number("computation_delay", cc.computation_delay);
-  if (cc.computation_delay < 0.0)
-    c.fail("computation_delay", " = " + root["controller"]["computation_delay"].Scalar() + ": must be >= 0");
+  read_fields(c, cc);  // type, computation_delay
+  try {
+    cc.validate("controller");
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
   cc.model = model_of_plant(s.plant);
-  if (type == "sliding_mode") {
-    cc.type = ControllerType::kSlidingMode;
-    read_fields(c, cc.sliding_mode);
-    read_plant(c.child("model"), cc.model, &s.listed_effects);
-  } else if (type == "cascade") {
-    cc.type = ControllerType::kCascade;
-    read_cascade(c, cc.cascade, cc.model);
-    if (!(cc.cascade.bandwidth_scale > 0.0))  // derive()'s tuning rule divides by it
-      c.fail("bandwidth_scale", " = " + validate::format_number(cc.cascade.bandwidth_scale) + ": must be > 0");
-  } else if (type == "open_loop") {
-    cc.type = ControllerType::kOpenLoop;
-    read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir);
-  } else if (type == "plugin") {
-    cc.type = ControllerType::kPlugin;
-    read_plugin(c, cc.plugin, cc.model, base_dir);
-  } else {
-    c.fail("type", " = '" + type + "': expected one of " + fields::enum_choices<ControllerType>());
+  switch (cc.type) {
+    case ControllerType::kSlidingMode:
+      read_fields(c, cc.sliding_mode);
+      read_plant(c.child("model"), cc.model, &s.listed_effects);
+      break;
+    case ControllerType::kCascade:
+      read_cascade(c, cc.cascade, cc.model);
+      if (!(cc.cascade.bandwidth_scale > 0.0))  // derive()'s tuning rule divides by it
+        c.fail("bandwidth_scale", " = " + validate::format_number(cc.cascade.bandwidth_scale) + ": must be > 0");
+      break;
+    case ControllerType::kOpenLoop: read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir); break;
+    case ControllerType::kPlugin: read_plugin(c, cc.plugin, cc.model, base_dir); break;
   }
   cc.model_given = c.has("model");
   c.finish();
-}
-
-void read_output(MapReader& top, const YAML::Node& root, OutputConfig& out) {
-  MapReader o = top.child("output");
-  o.integer("every", out.every);
-  o.string_list("columns", out.columns);
-  o.finish();
-  detail::check_output(out, top.has("output") && root["output"]["columns"].IsDefined());
 }
 
 Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
@@ -470,20 +450,11 @@ Scenario read_node(const YAML::Node& root, const std::string& base_dir) {
   Scenario s;
   MapReader top(root, "", &s.given_keys, &s.renamed_keys);
   s.base_dir = base_dir;
-  read_timing(top, root, s);
+  read_top(top, root, s);
   read_plant_section(top, s);
-  read_controller(top, root, s, base_dir);
+  read_controller(top, s, base_dir);
   read_reference(top.child("reference"), s.reference, base_dir);
-  read_output(top, root, s.output);
-  MapReader a = top.child("analysis");
-  a.number("settled_after", s.analysis.settled_after);
-  a.number("settling_band", s.analysis.settling_band);
-  a.finish();
   top.finish();
-  if (s.analysis.settled_after < 0.0) a.fail("settled_after", " must be >= 0");
-  if (s.analysis.settling_band < 0.0)
-    a.fail("settling_band", " = " + validate::format_number(s.analysis.settling_band) +
-                                ": must be >= 0 (0: 2 % of the move's distance)");
   return s;
 }
 
@@ -623,10 +594,6 @@ void plant_keys(const PlantParams& p, const std::string& prefix, const std::set<
   const_cast<plant::EffectsParams&>(p.effects).Serialize(&a);  // the archive only reads
 }
 
-ResolvedValue number_value(double v) {
-  return {std::isinf(v) ? (v > 0 ? ".inf" : "-.inf") : validate::format_number(v), false};
-}
-
 // A plugin parameter as read: a number (its shortest text) or else a word.
 ResolvedValue parameter_value(const std::string& text) {
   char* end = nullptr;
@@ -636,8 +603,7 @@ ResolvedValue parameter_value(const std::string& text) {
 
 void controller_keys(const Scenario& s, ResolvedKeys& out) {
   const ControllerConfig& cc = s.controller;
-  out["controller.type"] = {fields::enum_name(cc.type), true};
-  out["controller.computation_delay"] = number_value(cc.computation_delay);
+  record_fields(cc, "controller", out);  // type, computation_delay
   switch (cc.type) {
     case ControllerType::kSlidingMode:
       record_fields(cc.sliding_mode, "controller", out);
@@ -655,17 +621,15 @@ void controller_keys(const Scenario& s, ResolvedKeys& out) {
       out["controller.file"] = {cc.open_loop_file, true};
       break;
     case ControllerType::kPlugin:
-      out["controller.library"] = {cc.plugin.library, true};
+      record_fields(cc.plugin, "controller", out);  // library, u_min, u_max
       for (const auto& [k, v] : cc.plugin.parameters) out["controller.parameters." + k] = parameter_value(v);
-      out["controller.u_min"] = number_value(cc.plugin.u_min);
-      out["controller.u_max"] = number_value(cc.plugin.u_max);
       plant_keys(cc.model, "controller.model", nullptr, out);
       break;
   }
 }
 
 void reference_keys(const ReferenceConfig& c, ResolvedKeys& out) {
-  out["reference.type"] = {fields::enum_name(c.type), true};
+  record_fields(c, "reference", out);  // type
   switch (c.type) {
     case ReferenceType::kNone: break;
     case ReferenceType::kSine: record_fields(c.sine, "reference", out); break;
@@ -681,15 +645,10 @@ void reference_keys(const ReferenceConfig& c, ResolvedKeys& out) {
 
 ResolvedKeys resolved_keys(const Scenario& s) {
   ResolvedKeys out;
-  out["name"] = {s.name, true};
-  out["duration"] = number_value(s.duration);
-  out["control_period"] = number_value(s.control_period);
+  record_fields(s, "", out);  // name, duration, control_period, analysis, output
   plant_keys(s.plant, "plant", &s.listed_effects, out);
   controller_keys(s, out);
   reference_keys(s.reference, out);
-  out["output.every"] = {std::to_string(s.output.every), false};
-  out["analysis.settled_after"] = number_value(s.analysis.settled_after);
-  out["analysis.settling_band"] = number_value(s.analysis.settling_band);
   return out;
 }
 

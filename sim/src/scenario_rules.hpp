@@ -18,7 +18,8 @@ plant::PlantParams model_of_plant(const plant::PlantParams& plant);
 /// The name goes into plot titles, summary.json and messages: printable UTF-8 of bounded length.
 void check_name(const std::string& name, const std::string& what);
 
-/// output.every >= 1, output.columns known and each once; `columns_given`: an empty list is an error.
+/// output.columns known and each once (output.every >= 1 is its list's range); `columns_given`: an empty list is an
+/// error.
 void check_output(const OutputConfig& out, bool columns_given);
 
 /// control_period <= duration and the run's step count within kMaxSteps; the messages quote
@@ -27,6 +28,9 @@ void check_timing(const Scenario& s, const std::string& duration, const std::str
 
 /// A file name of the scenario resolved against its folder (an absolute one as it is).
 std::string resolved_file(const std::string& base_dir, const std::string& file);
+
+/// controller.library as the plugin host opens it: resolved against the scenario's folder, normalised.
+std::string plugin_library(const std::string& base_dir, const std::string& file);
 
 /// A plugin parameter's name: letters, digits and _ only.
 bool parameter_name(const std::string& key);

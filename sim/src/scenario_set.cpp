@@ -52,9 +52,24 @@ std::string shown(const YAML::Node& v) {
   throw ScenarioError(key + " = " + shown(v) + ": " + why);
 }
 
+// A dotted key below `parent` ("" at the top level).
+std::string key_below(const std::string& parent, const std::string& name) {
+  return parent.empty() ? name : parent + "." + name;
+}
+
 [[noreturn]] void unknown(const std::string& parent, const std::string& name, const std::vector<std::string>& names,
                           const std::map<std::string, std::string>& aliases = {}) {
-  throw ScenarioError(parent + "." + name + ": unknown key" + did_you_mean(name, names, aliases));
+  throw ScenarioError(key_below(parent, name) + ": unknown key" + did_you_mean(name, names, aliases));
+}
+
+// A list's validate() (std::invalid_argument "KEY = VALUE: why") as the scenario's error.
+template <typename F>
+void checked(F f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
 }
 
 // A map of the one key `key` = v, for the reader's accessors.
@@ -103,7 +118,7 @@ class FieldSetArchive {
   [[noreturn]] void fail() const {
     if (!error_.empty()) throw ScenarioError(error_);
     if (found_ == Found::kBelowValue)
-      throw ScenarioError(parent_ + "." + rest_ + ": " + below_ +
+      throw ScenarioError(key_below(parent_, rest_) + ": " + below_ +
                           " is a single value in the scenario, not a map of keys");
     unknown(parent_, rest_.substr(0, rest_.find('.')), names_, aliases_);
   }
@@ -120,7 +135,7 @@ class FieldSetArchive {
         found_ = Found::kMap;
         return;
       }
-      FieldSetArchive a(parent_ + "." + head, rest_.substr(dot + 1), value_);
+      FieldSetArchive a(key_below(parent_, head), rest_.substr(dot + 1), value_);
       f.value->Serialize(&a);
       found_ = a.found_;
       if (found_ == Found::kNone || found_ == Found::kBelowValue) {
@@ -132,7 +147,7 @@ class FieldSetArchive {
       }
     } else if (dot != std::string::npos) {
       found_ = Found::kBelowValue;
-      below_ = parent_ + "." + head;
+      below_ = key_below(parent_, head);
     } else {
       MapReader r(one_key(head, value_), parent_);
       YamlReadArchive a(r);
@@ -347,7 +362,7 @@ std::vector<std::string> controller_names(const ControllerConfig& cc, Controller
     case ControllerType::kSlidingMode: return names_of(cc.sliding_mode, {"model"});
     case ControllerType::kCascade: return names_of(cc.cascade, {"model"});
     case ControllerType::kOpenLoop: return names_of(cc.open_loop, {"file"});
-    case ControllerType::kPlugin: return {"library", "parameters", "u_min", "u_max", "model"};
+    case ControllerType::kPlugin: return names_of(cc.plugin, {"parameters", "model"});
   }
   return {};
 }
@@ -365,13 +380,14 @@ void check_tuning(const Scenario& s) {
 
 // A type switch: the keys the scenario gives for the old type must be keys of the new one, where
 // they keep their values (`old`: the old type's keys, recorded from its struct); `set` sets one.
+// `common`: the section's keys of every type (its list: type, computation_delay), which stay.
 template <typename Set>
 void switch_keys(const Scenario& s, const std::string& section, const YAML::Node& v,
-                 const std::vector<std::string>& names, const ResolvedKeys& old, Set set) {
+                 const std::vector<std::string>& common, const std::vector<std::string>& names, const ResolvedKeys& old,
+                 Set set) {
   for (const std::string& k : given_children(s, section)) {
-    if (k == "type" || k == "computation_delay" || k == "model") {
-      if (k != "model" || std::find(names.begin(), names.end(), k) != names.end()) continue;
-    } else if (std::find(names.begin(), names.end(), k) != names.end()) {
+    if (std::find(common.begin(), common.end(), k) != common.end()) continue;
+    if (std::find(names.begin(), names.end(), k) != names.end()) {
       if (const auto it = old.find(k); it != old.end()) set(k, YAML::Node(it->second.text));
       continue;
     }
@@ -398,10 +414,7 @@ ResolvedKeys controller_values(const ControllerConfig& cc, ControllerType t) {
     case ControllerType::kSlidingMode: record_fields(cc.sliding_mode, "", keys); break;
     case ControllerType::kCascade: record_fields(cc.cascade, "", keys); break;
     case ControllerType::kOpenLoop: record_fields(cc.open_loop, "", keys); break;
-    case ControllerType::kPlugin:
-      keys["u_min"] = {validate::format_number(cc.plugin.u_min), false};
-      keys["u_max"] = {validate::format_number(cc.plugin.u_max), false};
-      break;
+    case ControllerType::kPlugin: record_fields(cc.plugin, "", keys, {"library"}); break;
   }
   return keys;
 }
@@ -417,20 +430,17 @@ void controller_type(Scenario& s, const YAML::Node& v) {
            "controller.model.effects is given: only the sliding_mode controller's model takes effects");
   const ResolvedKeys old = controller_values(cc, cc.type);
   cc.type = t;
-  switch_keys(s, "controller", v, controller_names(cc, t), old,
+  switch_keys(s, "controller", v, names_of(cc), controller_names(cc, t), old,
               [&](const std::string& k, const YAML::Node& value) { controller_key(s, k, value); });
   check_tuning(s);
 }
 
 void plugin_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   controller::PluginParams& p = s.controller.plugin;
-  MapReader r(one_key(rest, v), "controller");
-  if (rest == "library") {
-    std::string lib;
-    r.string(rest, lib);
-    p.library = fs::path(detail::resolved_file(s.base_dir, lib)).lexically_normal().string();
-  } else if (rest == "u_min" || rest == "u_max") {
-    r.number(rest, rest == "u_min" ? p.u_min : p.u_max);
+  const std::vector<std::string> listed = names_of(p);  // library, u_min, u_max
+  if (std::find(listed.begin(), listed.end(), rest) != listed.end()) {
+    set_value(p, "controller", rest, v);
+    if (rest == "library") p.library = detail::plugin_library(s.base_dir, p.library);
   } else if (rest == "parameters") {
     set_map(s, "controller.parameters", v, [&] { p.parameters.clear(); });
   } else if (rest.rfind("parameters.", 0) == 0) {
@@ -451,12 +461,10 @@ void plugin_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
 void controller_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   ControllerConfig& cc = s.controller;
   if (rest == "type") return controller_type(s, v);
-  if (rest == "computation_delay") {
-    double d = 0.0;
-    MapReader(one_key(rest, v), "controller").number(rest, d);
-    if (d < 0.0) refuse("controller.computation_delay", v, "must be >= 0");
-    cc.computation_delay = d;
-    return;
+  if (const std::vector<std::string> every_type = names_of(cc);  // the keys of every type
+      std::find(every_type.begin(), every_type.end(), rest) != every_type.end()) {
+    set_value(cc, "controller", rest, v);
+    return checked([&] { cc.validate("controller"); });
   }
   if (rest.rfind("model", 0) == 0 && (rest.size() == 5 || rest[5] == '.') && cc.type != ControllerType::kOpenLoop)
     return model_key(s, rest.size() > 5 ? rest.substr(6) : "", v);
@@ -511,7 +519,7 @@ void reference_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
     ResolvedKeys old;
     with_reference_params(c, c.type, [&](const auto& p) { record_fields(p, "", old); });
     c.type = t;
-    return switch_keys(s, "reference", v, reference_names(c, t), old,
+    return switch_keys(s, "reference", v, names_of(c), reference_names(c, t), old,
                        [&](const std::string& k, const YAML::Node& value) { reference_key(s, k, value); });
   }
   if (c.type == ReferenceType::kWaypoints && rest == "file") {
@@ -524,36 +532,23 @@ void reference_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   with_reference_params(c, c.type, [&](auto& p) { set_value(p, "reference", rest, v); });
 }
 
-void output_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
-  MapReader r(one_key(rest, v), "output");
-  if (rest == "every") return r.integer(rest, s.output.every);
-  if (rest == "columns") return r.string_list(rest, s.output.columns);
-  unknown("output", rest, {"every", "columns"});
-}
-
-void analysis_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
-  if (rest != "settled_after" && rest != "settling_band") unknown("analysis", rest, {"settled_after", "settling_band"});
-  double& x = rest == "settled_after" ? s.analysis.settled_after : s.analysis.settling_band;
-  MapReader(one_key(rest, v), "analysis").number(rest, x);
-  if (x < 0.0) refuse("analysis." + rest, v, "must be >= 0");
+// The sections read by rules of their own (set_node); every other top-level key is the list's
+// (Scenario::Serialize: name, duration, control_period, analysis.*, output.*).
+const std::vector<std::string>& sections() {
+  static const std::vector<std::string> names = {"plant", "controller", "reference"};
+  return names;
 }
 
 void top_key(Scenario& s, const std::string& key, const YAML::Node& v) {
-  static const std::vector<std::string> keys = {"name",       "duration",  "control_period", "plant",
-                                                "controller", "reference", "output",         "analysis"};
-  MapReader r(one_key(key, v), "");
-  if (key == "name") {
-    r.string(key, s.name);
-    detail::check_name(s.name, "name");
-  } else if (key == "duration" || key == "control_period") {
-    double& x = key == "duration" ? s.duration : s.control_period;
-    r.number(key, x);
-    if (!(x > 0.0)) refuse(key, v, "must be > 0");
-  } else if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+  const std::string head = key.substr(0, key.find('.'));
+  const std::vector<std::string> names = names_of(s, sections());
+  if (std::find(names.begin(), names.end(), head) == names.end()) unknown("", head, names);
+  if (head == key && std::find(sections().begin(), sections().end(), key) != sections().end())
     refuse(key, v, "a whole section is not set at once: set its keys (e.g. plant.mass=110)");
-  } else {
-    throw ScenarioError(key + ": unknown key" + did_you_mean(key, keys));
-  }
+  if (set_field(s, "", key, v) == Found::kMap)
+    refuse(key, v, "a whole section is not set at once: set its keys (e.g. output.every=10)");
+  if (key == "name") detail::check_name(s.name, "name");
+  checked([&] { s.validate(); });
 }
 
 void set_node(Scenario& s, const std::string& written, const YAML::Node& v) {
@@ -572,14 +567,8 @@ void set_node(Scenario& s, const std::string& written, const YAML::Node& v) {
     controller_key(s, rest, v);
   } else if (section == "reference") {
     reference_key(s, rest, v);
-  } else if (section == "output") {
-    output_key(s, rest, v);
-  } else if (section == "analysis") {
-    analysis_key(s, rest, v);
-  } else if (section == "name" || section == "duration" || section == "control_period") {
-    throw ScenarioError(key + ": " + section + " is a single value in the scenario, not a map of keys");
   } else {
-    top_key(s, section, v);  // unknown, with its hint
+    top_key(s, key, v);  // analysis.*, output.*, or unknown with its hint
   }
   give(s, key);
 }
@@ -665,6 +654,7 @@ void set_read_keys(Scenario& s, const std::vector<KeySetting>& sets) {
 
 void complete_read(Scenario& s) {
   check_required(s);
+  checked([&] { s.validate(); });
   detail::check_timing(s, validate::format_number(s.duration), validate::format_number(s.control_period));
   detail::check_output(s.output, gives(s, "output.columns"));
   detail::derive_and_check(s);

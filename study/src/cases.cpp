@@ -143,7 +143,8 @@ std::vector<std::size_t> probe_cases(const Study& s, std::size_t budget) {
 
 std::vector<std::string> varied_keys(const Study& s) {
   std::vector<std::string> out;
-  const auto add = [&](const std::string& k) {
+  const auto add = [&](const std::string& written) {
+    const std::string k = sim::canonical_key(written);  // an old spelling is its key's column
     if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
   };
   for (const Family& f : s.families) {
@@ -505,12 +506,14 @@ ResolvedCase Resolver::Impl::result(std::shared_ptr<const sim::Scenario> sc, Cas
   r.hash = sha256_hex(std::string(kCaseFormat) + code + r.yaml);
   // Every varied key of the study, with its effective value in this case (its nominal value
   // where this case does not vary it), so each row of results.csv places the case on every axis.
-  for (const std::string& k : varied) {
-    const auto it = keys.find(sim::canonical_key(k));
+  for (const std::string& k : varied) {  // canonical keys (varied_keys)
+    const auto it = keys.find(k);
     if (it != keys.end()) r.parameters[k] = it->second.text;
   }
-  for (const sim::KeySetting& v : settings.values)
-    if (!r.parameters.count(v.key)) r.parameters[v.key] = v.value;
+  for (const sim::KeySetting& v : settings.values) {
+    const std::string k = sim::canonical_key(v.key);
+    if (!r.parameters.count(k)) r.parameters[k] = v.value;
+  }
   r.settings = std::move(settings);
   return r;
 }

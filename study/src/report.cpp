@@ -1,6 +1,7 @@
 #include "feeddrive/study/report.hpp"
 
 #include "feeddrive/sim/key_tables.hpp"
+#include "feeddrive/sim/scenario.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -127,7 +128,8 @@ std::string metric_label(const std::string& metric, const std::string& unit) {
 bool log_axis(const Study& s, const std::string& key, const std::vector<double>& values) {
   for (const Family& f : s.families)
     for (const GridAxis& a : f.grid)
-      if (a.log && std::find(a.keys.begin(), a.keys.end(), key) != a.keys.end()) return true;
+      for (const std::string& k : a.keys)
+        if (a.log && sim::canonical_key(k) == key) return true;  // key: canonical (varied_keys)
   double lo = INFINITY, hi = 0.0;
   for (double v : values) {
     if (!std::isfinite(v)) continue;

@@ -347,7 +347,7 @@ class CaseStream {
       ++unresolved_;
       for (const Variation& v :
            c.spec.variations)  // its row shows the values given (a factor has no nominal value here)
-        if (!v.scale) c.resolved.parameters[v.key] = v.value;
+        if (!v.scale) c.resolved.parameters[sim::canonical_key(v.key)] = v.value;
       for (char& ch : out.error)
         if (ch == '\n' || ch == '\r') ch = ' ';
       finished(i, std::move(out));

@@ -368,7 +368,7 @@ TEST(Cli, OutputEveryAndColumnsKeepTheSummaryOfEveryStep) {
 
 TEST(Cli, BadOutputOptionsAndImpossibleRunsExitTwoBeforeAnyWork) {
   expect_bad_input(std::string(kGood) + "output: {columns: [t, speed]}\n", "output.columns: unknown column 'speed'");
-  expect_bad_input(std::string(kGood) + "output: {every: 0}\n", "output.every = 0: must be an integer >= 1");
+  expect_bad_input(std::string(kGood) + "output: {every: 0}\n", "output.every = 0: must be >= 1");
   expect_bad_input(std::string(kGood) + "output: {evry: 2}\n", "output.evry: unknown key (did you mean 'every'?)");
   std::string s = kGood;
   // 1e16 steps: was std::bad_alloc with exit 1

@@ -44,7 +44,7 @@ controller: {type: cascade, computation_delay: 1.5e-4}
 TEST(ComputationDelay, BadValuesAreOneLineErrors) {
   EXPECT_EQ(
       test::error_of("duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: cascade, computation_delay: -1e-4}\n"),
-      "s.yaml: controller.computation_delay = -1e-4: must be >= 0");
+      "s.yaml: controller.computation_delay = -1e-04: must be >= 0");
   EXPECT_EQ(test::error_of(
                 "duration: 0.01\ncontrol_period: 1e-4\ncontroller: {type: sliding_mode, compensate_delay: true}\n"),
             "s.yaml: controller.compensate_delay = true: needs motion_state: observer (the model predictor)");

@@ -140,7 +140,7 @@ TEST(Scenario, NonPositiveMassAndPeriod) {
   EXPECT_EQ(error_of(with("plant: {}", "plant: {mass: -3.5}")), "s.yaml: plant.mass = -3.5: must be > 0");
   EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: 0")), "s.yaml: control_period = 0: must be > 0");
   EXPECT_EQ(error_of(with("control_period: 1e-4", "control_period: -1e-4")),
-            "s.yaml: control_period = -1e-4: must be > 0");
+            "s.yaml: control_period = -1e-04: must be > 0");  // the shortest text of the value (to_chars)
 }
 
 TEST(Scenario, NanInfAndGarbage) {

@@ -203,12 +203,34 @@ families:
   Resolver r(s);
   const ResolvedCase c = r.resolve(cases[1]);
   EXPECT_DOUBLE_EQ(c.scenario->plant.effects.input_delay.delay, 2e-3);
-  EXPECT_EQ(c.parameters.at("plant.effects.input_delay.delay_s"), "0.002");
+  // results.csv's column is the key's canonical spelling, so an old and a new spelling of one
+  // key in two families are one column (varied_keys).
+  EXPECT_EQ(c.parameters.at("plant.effects.input_delay.delay"), "0.002");
+  EXPECT_EQ(c.parameters.count("plant.effects.input_delay.delay_s"), 0u);
   EXPECT_NE(c.yaml.find("delay: 0.002"), std::string::npos) << c.yaml;  // the case is written in the new key
   EXPECT_EQ(std::count(c.scenario->warnings.begin(), c.scenario->warnings.end(),
                        "plant.effects.input_delay.delay_s: old spelling of plant.effects.input_delay.delay "
                        "(deprecated: rename the key)"),
             1);
+}
+
+TEST(StudyCases, AnOldAndANewSpellingAreOneColumn) {
+  const Study s = parse_study(study_text(R"(
+families:
+  - name: old
+    grid:
+      - {key: plant.effects.input_delay.delay_s, values: [1.0e-3, 2.0e-3]}
+  - name: new
+    grid:
+      - {key: plant.effects.input_delay.delay, values: [3.0e-3]}
+)"),
+                              ".", "s.yaml");
+  EXPECT_EQ(varied_keys(s), std::vector<std::string>{"plant.effects.input_delay.delay"});
+  const auto cases = expand(s);
+  ASSERT_EQ(cases.size(), 3u);
+  Resolver r(s);
+  EXPECT_EQ(r.resolve(cases[0]).parameters.at("plant.effects.input_delay.delay"), "0.001");
+  EXPECT_EQ(r.resolve(cases[2]).parameters.at("plant.effects.input_delay.delay"), "0.003");
 }
 
 TEST(StudyCases, FollowsPlantRuleLetsTheModelFollow) {

@@ -65,6 +65,9 @@ struct Meta {
   /// vocabulary: docs/contributing.md, "How to rename a key"); "" when it has none. Giving both
   /// spellings is an error; did-you-mean and the docs' key tables know it.
   const char* alias{""};
+  /// The key must be given (no default): the reader refuses a scenario without it ("duration:
+  /// missing (required)"); the docs' Default cell says "required".
+  bool required{false};
   bool allow_inf() const { return check == Check::kNotPlusInf; }
 };
 
@@ -91,6 +94,10 @@ struct Field {
   /// An old spelling of the key (Meta::alias).
   Field alias(const char* old) const {
     return with([&](Meta& m) { m.alias = old; });
+  }
+  /// The key has no default (Meta::required).
+  Field required() const {
+    return with([](Meta& m) { m.required = true; });
   }
   Field unchecked() const {
     return with([](Meta& m) { m.check = Check::kNone; });
@@ -187,14 +194,11 @@ class CheckArchive {
       : prefix_(std::move(prefix)), skip_(std::move(skip)) {}
   template <typename T>
   void Visit(const Field<T>& f) {
-    if constexpr (std::is_same_v<T, double>) {
+    if constexpr (std::is_same_v<T, double> || std::is_same_v<T, long>) {
       for (const auto& s : skip_)
         if (s == f.meta.name) return;
-      check(prefix_ + "." + f.meta.name, *f.value, f.meta);
-    } else if constexpr (std::is_same_v<T, long>) {
-      for (const auto& s : skip_)
-        if (s == f.meta.name) return;
-      check(prefix_ + "." + f.meta.name, static_cast<double>(*f.value), f.meta);
+      check(prefix_.empty() ? std::string(f.meta.name) : prefix_ + "." + f.meta.name, static_cast<double>(*f.value),
+            f.meta);
     }
   }
   static void check(const std::string& key, double v, const Meta& m) {
@@ -396,6 +400,9 @@ class BytesArchive {
     } else if constexpr (std::is_same_v<T, std::string>) {
       out_->append(*f.value);
       out_->push_back('\0');
+    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      for (const std::string& e : *f.value) out_->append(e).push_back('\0');
+      out_->push_back('\1');
     } else if constexpr (is_serializable<T>::value) {
       f.value->Serialize(this);
     } else {

@@ -37,6 +37,17 @@ struct PluginParams {
   double u_min{-10.0};            ///< [V]
   double u_max{10.0};             ///< [V]
   double computation_delay{0.0};  ///< [s]
+  /// The scenario keys of type plugin with one value (controller.*); `parameters` (a map of the
+  /// plugin's own names) and `model` (the plant's list) are read by rules of their own, period and
+  /// computation_delay come from the scenario.
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(library).required().doc(
+        "the plugin's shared library, relative to the scenario's folder; opened when the scenario is loaded "
+        "(file, the five symbols, the ABI version)"));
+    a->Visit(FD_FIELD(u_min).unit("V").unchecked().doc("the command's lower limit passed to the plugin; < u_max"));
+    a->Visit(FD_FIELD(u_max).unit("V").unchecked().doc("the command's upper limit passed to the plugin; > u_min"));
+  }
   void validate(const std::string& prefix = "controller") const;
 };
 

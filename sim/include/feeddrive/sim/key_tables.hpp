@@ -13,8 +13,9 @@
 
 namespace feeddrive::sim {
 
-/// The tables by name, in document order: plant, plant.effects, controller.sliding_mode,
-/// controller.cascade, controller.open_loop, reference.<type> for every type with keys.
+/// The tables by name, in document order: scenario (the top level), plant, plant.effects,
+/// controller (every type), controller.sliding_mode, controller.cascade, controller.open_loop,
+/// controller.plugin, reference (every type), reference.<type> for every type with keys.
 std::vector<std::pair<std::string, std::string>> key_tables();
 
 /// The column table of timeseries.csv (marker name `columns`), from visit_record_columns.

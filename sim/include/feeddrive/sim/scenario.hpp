@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/controller/cascade.hpp"
 #include "feeddrive/controller/open_loop.hpp"
 #include "feeddrive/controller/plugin_host.hpp"
@@ -63,6 +64,14 @@ struct ReferenceConfig {
   trajectory::RampParams ramp;
   std::string waypoints_file;                   ///< resolved against the scenario file's folder
   std::vector<trajectory::Waypoint> waypoints;  ///< read from waypoints_file when loaded
+
+  /// The key of every reference type (docs/scenario.md "reference"); each type's keys are its
+  /// params struct's list (sine, step, ...), the waypoints' `file` a rule of its own (a path
+  /// resolved against the scenario's folder, the table read when loaded).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(type).doc("the profile (none: x_d = 0); its keys below"));
+  }
 };
 
 struct ControllerConfig {
@@ -85,6 +94,24 @@ struct ControllerConfig {
   /// controller.model was given (false: the model of sliding_mode, cascade and plugin is the
   /// plant's own parameters without its effects; summary.json says so as controller_model).
   bool model_given{false};
+
+  /// The keys of every controller type (the list; docs/scenario.md "controller"). The type's own
+  /// keys are its params struct's list (sliding_mode, cascade, open_loop, plugin), its model the
+  /// plant's.
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(type).required().doc("the controller: one of the three built-in laws or a plugin (below)"));
+    a->Visit(FD_FIELD(computation_delay)
+                 .unit("s")
+                 .non_negative()
+                 .plausible(0, 0.01, "ms", "", "a servo drive's delay")
+                 .doc("the command computed from the sample at t_k acts over [t_k + d, t_{k+1} + d), within or "
+                      "beyond the period; the drive applies it as an input delay (added to a "
+                      "plant.effects.input_delay), also in the lockstep service's plant process. The "
+                      "controller's own computation time, which it may know (compensate_delay)"));
+  }
+  /// The list's ranges (check_fields); the type's keys are validated by its params struct.
+  void validate(const std::string& prefix = "controller") const { fields::check_fields(*this, prefix); }
 };
 
 struct AnalysisConfig {
@@ -93,12 +120,40 @@ struct AnalysisConfig {
   /// Half-width [m] of the band the move's settling time is measured to (summary.hpp, "Move
   /// metrics"); 0 (default): 2 % of the move's distance (MATLAB stepinfo's SettlingTimeThreshold).
   double settling_band{0.0};
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(settled_after)
+                 .unit("s")
+                 .non_negative()
+                 .doc("start of the window of the *_settled metrics in summary.json (the tuning procedure's "
+                      "analysis window: 0.1 s, tuning.md)"));
+    a->Visit(FD_FIELD(settling_band)
+                 .unit("m")
+                 .non_negative()
+                 .doc("half-width of the band a move's settling time is measured to (Move and step metrics); "
+                      "0: 2 % of the move's distance (MATLAB stepinfo's default)"));
+  }
+  void validate(const std::string& prefix = "analysis") const { fields::check_fields(*this, prefix); }
 };
 
 /// What timeseries.csv records (the summary and the plots always cover every step).
 struct OutputConfig {
   long every{1};                     ///< keep rows k with k % every == 0
   std::vector<std::string> columns;  ///< the columns written, in this order; empty = all
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(FD_FIELD(every).at_least(1).doc(
+        "keep every N-th row of timeseries.csv: the steps k = 0, N, 2N, ... by their number, also in a record "
+        "with gaps (a log, an attached monitor); the summary and the plots still cover every step"));
+    a->Visit(FD_FIELD(columns).doc(
+        "the columns of timeseries.csv, in the order given, e.g. [t, xd, x, u]; an unknown or repeated name "
+        "is an error that lists the columns (empty: all)"));
+  }
+  /// every >= 1 (the list); the column names are checked against the record's columns by the
+  /// scenario loader (sim::record_columns).
+  void validate(const std::string& prefix = "output") const { fields::check_fields(*this, prefix); }
 };
 
 /// Largest run: steps = round(duration / control_period) <= kMaxSteps (docs/scenario.md,
@@ -156,6 +211,33 @@ struct Scenario {
   long steps() const;
   /// Time of step k: k * control_period (computed, never accumulated).
   double time_of(long k) const { return static_cast<double>(k) * control_period; }
+
+  /// The top-level keys (the list; docs/scenario.md "Top level"). The sections plant, controller
+  /// and reference are read by their own lists and rules (scenario.cpp).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(
+        FD_FIELD(name).doc("label used in plots and summary.json; printable UTF-8, at most 256 bytes; "
+                           "default: the file's stem"));
+    a->Visit(FD_FIELD(duration).unit("s").positive().required().doc(
+        "simulated time; the run has round(duration/control_period) steps (at most 1e10, Limits)"));
+    a->Visit(FD_FIELD(control_period)
+                 .unit("s")
+                 .positive()
+                 .required()
+                 .plausible(1e-6, 0.01, "ms", "", "a servo drive's sample period")
+                 .doc("the controller's sample period T; the input is held over each period"));
+    a->Visit(FD_FIELD(analysis).doc("the windows of summary.json's metrics"));
+    a->Visit(FD_FIELD(output).doc("what timeseries.csv records"));
+  }
+  /// The list's ranges (check_fields: duration, control_period > 0), analysis's and output's;
+  /// throws std::invalid_argument "KEY = VALUE: why". The run's length, the name and the sections
+  /// are checked by the loader (scenario.cpp).
+  void validate() const {
+    fields::check_fields(*this, "");
+    analysis.validate("analysis");
+    output.validate("output");
+  }
 };
 
 /// Loads and validates a scenario file. Throws ScenarioError("<file>: <key> = <value>: <why>").

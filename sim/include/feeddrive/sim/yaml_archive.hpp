@@ -8,17 +8,20 @@
 //   double                -> number (number_or_infinite where the list allows -.inf)
 //   bool / long / uint64  -> boolean / integer / unsigned_integer
 //   std::string           -> string
+//   std::vector<string>   -> a list of strings (output.columns)
 //   a named enum          -> its name (fields::enum_names), "expected one of ..." otherwise
 //   a nested params struct-> a child map, read the same way and finished (unknown keys refused)
 //
 // A field's old spelling (fields::Meta::alias) is read as the field, with a deprecation line
-// (MapReader::spelling); both spellings given is a one-line error.
+// (MapReader::spelling); both spellings given is a one-line error. A required field
+// (fields::Meta::required) not given is "KEY: missing (required)".
 
 #include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/validate.hpp"
@@ -35,6 +38,7 @@ class YamlReadArchive {
   void Visit(const fields::Field<T>& f) {
     if (skip_.count(f.meta.name)) return;
     const std::string key = r_.spelling(f.meta.name, f.meta.alias);  // the name, or its old spelling
+    if (f.meta.required && !r_.has(key)) r_.fail(key, ": missing (required)");
     T& v = *f.value;
     if constexpr (std::is_same_v<T, double>) {
       if (f.meta.allow_inf()) {
@@ -50,6 +54,8 @@ class YamlReadArchive {
       r_.unsigned_integer(key, v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       r_.string(key, v);
+    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      r_.string_list(key, v);
     } else if constexpr (fields::is_named_enum<T>::value) {
       std::string name = fields::enum_name(v);
       r_.string(key, name);
@@ -96,6 +102,9 @@ class KeyRecordArchive {
       out_[key] = {v, true};
     } else if constexpr (fields::is_named_enum<T>::value) {
       out_[key] = {fields::enum_name(v), true};
+    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      // A list (output.columns) says what is written, not what runs: it is no key of the run's
+      // description, which holds one scalar per key (resolved_yaml, a study case's hash).
     } else {
       static_assert(fields::is_serializable<T>::value, "a field type the key recorder does not know");
       KeyRecordArchive a(key, out_);

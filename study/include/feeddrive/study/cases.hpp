@@ -79,7 +79,8 @@ double draw_value(const DrawSpec& d, std::uint64_t seed, long draw, std::size_t 
 /// The uniform number in [0, 1) that a SplitMix64 stream keyed by (seed, a, b, c) gives: 53 bits.
 double unit_uniform(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c);
 
-/// Every key a grid axis or a Monte Carlo parameter of the study varies, in order of first
+/// Every key a grid axis or a Monte Carlo parameter of the study varies, in its canonical
+/// spelling (sim::canonical_key: an old spelling and its key are one column), in order of first
 /// appearance (the parameter columns of results.csv).
 std::vector<std::string> varied_keys(const Study& s);
 
