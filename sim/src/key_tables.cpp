@@ -10,6 +10,7 @@
 #include "feeddrive/common/validate.hpp"
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/simulation.hpp"
+#include "lists.hpp"
 
 namespace feeddrive::sim {
 namespace {
@@ -19,6 +20,7 @@ using fields::Meta;
 
 struct Row {
   std::string key, unit, def, valid, plausible, meaning;
+  std::string old_key{};  ///< the key in its old spelling (fields::Meta::alias), "" if it has none
 };
 
 std::string number(double v) {
@@ -63,6 +65,7 @@ class DocArchive {
     const Meta& m = f.meta;
     const std::string key = prefix_.empty() ? m.name : prefix_ + "." + m.name;
     const T& v = *f.value;
+    const std::size_t first = rows_->size();
     if constexpr (std::is_same_v<T, double>) {
       rows_->push_back({key, m.unit, default_text(m, number(v)), valid_text(m), plausible_text(m), meaning(m)});
     } else if constexpr (std::is_same_v<T, long> || std::is_same_v<T, std::uint64_t>) {
@@ -83,6 +86,8 @@ class DocArchive {
       DocArchive child(key, rows_);
       const_cast<T&>(v).Serialize(&child);
     }
+    if (*m.alias && rows_->size() > first)
+      (*rows_)[first].old_key = prefix_.empty() ? m.alias : prefix_ + "." + m.alias;
   }
 
  private:
@@ -99,115 +104,65 @@ std::string escape(const std::string& s) {
   return out;
 }
 
+// The rows of a list, its keys under `prefix` ("" for the table, whose rows are relative).
 template <typename S>
-std::string table(S obj, const std::string& prefix = "") {
+std::vector<Row> rows_of(S list, const std::string& prefix) {
   std::vector<Row> rows;
   DocArchive a(prefix, &rows);
-  obj.Serialize(&a);
+  list.Serialize(&a);
+  return rows;
+}
+
+template <typename S>
+std::string table(S list) {
   std::string t =
       "| Key | Unit | Default | Valid (else exit 2) | Plausible for a linear feed drive (else a warning) | Meaning |\n"
       "|---|---|---|---|---|---|\n";
-  for (const Row& r : rows)
+  for (const Row& r : rows_of(list, ""))
     t += "| `" + r.key + "` | " + r.unit + " | " + r.def + " | " + r.valid + " | " + r.plausible + " | " +
          escape(r.meaning) + " |\n";
   return t;
 }
 
-// The plant without its effects (a table of their own).
-struct PlantSections {
-  plant::PlantParams p;
-  template <class Archive>
-  void Serialize(Archive* a) {
-    Filter<Archive> f{a};
-    p.Serialize(&f);
-  }
-  template <class Archive>
-  struct Filter {
-    Archive* a;
-    template <typename T>
-    void Visit(const fields::Field<T>& f) {
-      if (std::string(f.meta.name) != "effects") a->Visit(f);
-    }
-  };
-};
-
-template <class F>
-void collect_keys(const std::string& text, F&& add) {
-  // Keys are the first backquoted cell of each row.
-  std::size_t i = 0;
-  while ((i = text.find("| `", i)) != std::string::npos) {
-    const std::size_t b = i + 3, e = text.find('`', b);
-    if (e == std::string::npos) break;
-    if (i == 0 || text[i - 1] == '\n') add(text.substr(b, e - b));
-    i = e;
-  }
-}
-
-// The key prefix of a table's rows: "" for the top level (scenario), the section for a
-// controller's or a reference's type (controller.cascade -> controller), else the table's name.
-std::string key_prefix(const std::string& table_name) {
-  if (table_name == "scenario") return "";
-  if (table_name.rfind("controller", 0) == 0) return "controller";
-  if (table_name.rfind("reference.", 0) == 0) return "reference";
-  return table_name;
-}
-
-std::string dotted(const std::string& prefix, const std::string& key) {
-  return prefix.empty() ? key : prefix + "." + key;
+// Every row of every list (detail::for_each_list), keys with their prefix: the units and the
+// listed keys, walked from the lists, not parsed from the rendered tables.
+const std::vector<Row>& all_rows() {
+  static const std::vector<Row> rows = [] {
+    std::vector<Row> out;
+    detail::for_each_list([&](const char*, const char* prefix, auto list) {
+      for (Row& r : rows_of(list, prefix)) out.push_back(std::move(r));
+    });
+    return out;
+  }();
+  return rows;
 }
 
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> key_tables() {
-  return {
-      {"scenario", table(Scenario{})},
-      {"plant", table(PlantSections{})},
-      {"plant.effects", table(plant::EffectsParams{})},
-      {"controller", table(ControllerConfig{})},
-      {"controller.sliding_mode", table(controller::SlidingModeParams{})},
-      {"controller.cascade", table(controller::CascadeParams{})},
-      {"controller.open_loop", table(controller::OpenLoopParams{})},
-      {"controller.plugin", table(controller::PluginParams{})},
-      {"reference", table(ReferenceConfig{})},
-      {"reference.sine", table(trajectory::SineParams{})},
-      {"reference.step", table(trajectory::StepParams{})},
-      {"reference.accel_limited", table(trajectory::AccelLimitedParams{})},
-      {"reference.scurve", table(trajectory::SCurveParams{})},
-      {"reference.ramp", table(trajectory::RampParams{})},
-  };
+  std::vector<std::pair<std::string, std::string>> out;
+  detail::for_each_list([&](const char* name, const char*, auto list) { out.emplace_back(name, table(list)); });
+  return out;
 }
-
-namespace {
-// key -> unit, from the tables' rows (| `key` | unit | ...).
-const std::map<std::string, std::string>& unit_map() {
-  static const std::map<std::string, std::string> units = [] {
-    std::map<std::string, std::string> m;
-    for (const auto& [name, text] : key_tables()) {
-      std::size_t i = 0;
-      while ((i = text.find("\n| `", i)) != std::string::npos) {
-        const std::size_t b = i + 4, e = text.find('`', b);
-        const std::size_t u = text.find("| ", e) + 2, ue = text.find(" |", u);
-        m[dotted(key_prefix(name), text.substr(b, e - b))] = text.substr(u, ue - u);
-        i = e;
-      }
-    }
-    return m;
-  }();
-  return units;
-}
-}  // namespace
 
 std::string key_unit(const std::string& key) {
   std::string k = key;
-  if (k.rfind("controller.model.", 0) == 0) k = "plant." + k.substr(17);
-  const auto it = unit_map().find(k);
-  return it == unit_map().end() ? std::string() : it->second;
+  if (k.rfind("controller.model.", 0) == 0) k = "plant." + k.substr(17);  // the model is the plant's list
+  for (const Row& r : all_rows())
+    if (r.key == k) return r.unit;
+  return {};
 }
 
 std::vector<std::string> listed_keys() {
   std::vector<std::string> out;
-  for (const auto& [name, text] : key_tables())
-    collect_keys(text, [&](const std::string& k) { out.push_back(dotted(key_prefix(name), k)); });
+  for (const Row& r : all_rows()) out.push_back(r.key);
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> listed_old_spellings() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const Row& r : all_rows())
+    if (!r.old_key.empty()) out.emplace_back(r.old_key, r.key);
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include "feeddrive/sim/scenario.hpp"
 #include "feeddrive/sim/yaml_archive.hpp"
 #include "feeddrive/sim/yaml_reader.hpp"
+#include "lists.hpp"
 #include "scenario_rules.hpp"
 
 namespace feeddrive::sim {
@@ -613,29 +614,27 @@ class SpellingArchive {
   bool found_{false}, renamed_{false};
 };
 
-// `key` below `prefix` respelled through the list of a default S (SpellingArchive), if it renames.
+// `key` below `prefix` ("" the top level) respelled through `list` (SpellingArchive), if it renames.
 template <typename S>
-bool respell(const std::string& prefix, const std::string& key, std::string& out) {
-  if (key.rfind(prefix + ".", 0) != 0) return false;
-  SpellingArchive a(key.substr(prefix.size() + 1));
-  S obj{};
-  obj.Serialize(&a);
-  if (a.renamed()) out = prefix + "." + a.path();
+bool respell(const std::string& prefix, S list, const std::string& key, std::string& out) {
+  if (!prefix.empty() && key.rfind(prefix + ".", 0) != 0) return false;
+  SpellingArchive a(prefix.empty() ? key : key.substr(prefix.size() + 1));
+  list.Serialize(&a);
+  if (a.renamed()) out = detail::dotted(prefix, a.path());
   return a.renamed();
 }
 
 }  // namespace
 
+// Every list of the scenario (detail::for_each_list), the plant's under each of its prefixes.
 std::string canonical_key(const std::string& key, std::string* note) {
-  using namespace controller;
-  using namespace trajectory;
   std::string out;
-  const bool renamed =
-      respell<plant::PlantParams>("plant", key, out) || respell<plant::PlantParams>("controller.model", key, out) ||
-      respell<SlidingModeParams>("controller", key, out) || respell<CascadeParams>("controller", key, out) ||
-      respell<OpenLoopParams>("controller", key, out) || respell<SineParams>("reference", key, out) ||
-      respell<StepParams>("reference", key, out) || respell<AccelLimitedParams>("reference", key, out) ||
-      respell<SCurveParams>("reference", key, out) || respell<RampParams>("reference", key, out);
+  bool renamed = false;
+  detail::for_each_list([&](const char*, const char* prefix, auto list) {
+    renamed = renamed || respell(prefix, list, key, out);
+  });
+  for (const char* prefix : detail::kPlantPrefixes)
+    renamed = renamed || respell(prefix, plant::PlantParams{}, key, out);
   if (!renamed) return key;
   if (note != nullptr) *note = renamed_key_note(key, out);
   return out;

@@ -77,6 +77,22 @@ TEST(Fields, EveryListedKeyIsReadAndEveryReadKeyIsListed) {
     EXPECT_NE(std::find(listed.begin(), listed.end(), k), listed.end()) << k;
 }
 
+// Every old spelling of every list is respelled to its key by canonical_key (--set and
+// feeddrive-study read it so), the registry of lists (sim/src/lists.hpp) being the key tables' one.
+TEST(Fields, EveryOldSpellingOfEveryListIsItsKey) {
+  const auto old = listed_old_spellings();
+  ASSERT_FALSE(old.empty());
+  for (const auto& [was, key] : old) {
+    std::string note;
+    EXPECT_EQ(canonical_key(was, &note), key) << was;
+    EXPECT_NE(note.find("old spelling of " + key), std::string::npos) << note;
+    EXPECT_EQ(canonical_key(key), key);
+  }
+  // The controller's model is the plant's list under another prefix.
+  EXPECT_EQ(canonical_key("controller.model.effects.cogging_ripple.amplitude_N"),
+            "controller.model.effects.cogging_ripple.cogging_amplitude");
+}
+
 // The one-line message of what f throws ("" and a failure if it does not throw).
 template <typename F>
 std::string thrown(F f) {

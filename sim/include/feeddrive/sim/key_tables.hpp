@@ -33,4 +33,8 @@ std::string key_unit(const std::string& key);
 /// Every scenario key a params list declares (dotted paths as under key_tables()), for tests.
 std::vector<std::string> listed_keys();
 
+/// Every old spelling a list declares (fields::Meta::alias) as (old key, key), for tests: each
+/// must be respelled by canonical_key, whatever list it is in.
+std::vector<std::pair<std::string, std::string>> listed_old_spellings();
+
 }  // namespace feeddrive::sim
