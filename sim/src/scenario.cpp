@@ -222,7 +222,8 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& fi
   read_fields(r, p);
   r.string("file", file);
   if (!file.empty()) file = detail::resolved_file(base_dir, file);
-  if (p.kind == controller::OpenLoopKind::kCsv && file.empty()) r.fail("file", " = '': kind = csv needs a file");
+  if (p.kind == controller::OpenLoopKind::kCsv && file.empty())
+    r.fail("file", " = '': kind = csv needs a file" + r.near_miss("file"));
 }
 
 // --- reference -----------------------------------------------------------------------------

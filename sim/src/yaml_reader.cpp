@@ -423,8 +423,25 @@ void MapReader::string_list(const std::string& key, std::vector<std::string>& ou
 
 std::string MapReader::required_string(const std::string& key) {
   const YAML::Node n = scalar(key);
-  if (!n.IsDefined()) fail(key, ": missing (required)");
+  if (!n.IsDefined()) missing(key);
   return n.Scalar();
+}
+
+void MapReader::missing(const std::string& key) const { fail(key, ": missing (required)" + near_miss(key)); }
+
+std::string MapReader::near_miss(const std::string& key) const {
+  // A key of the map within did_you_mean's distance of the missing one: a misspelt required key
+  // is reported as what it is, not only as missing.
+  std::string near;
+  std::size_t best = 3;
+  for (const std::string& given : keys()) {
+    const std::size_t d = edit_distance(given, key);
+    if (given != key && d < best) {
+      best = d;
+      near = given;
+    }
+  }
+  return near.empty() ? std::string() : "; '" + key_path(near) + "' is given: a misspelling of it?";
 }
 
 MapReader MapReader::child(const std::string& key) {

@@ -118,6 +118,15 @@ TEST(Fields, TopLevelKeysComeFromTheList) {
   EXPECT_EQ(error_of("control_period: 1e-4\ncontroller: {type: cascade}\n"), "s.yaml: duration: missing (required)");
   EXPECT_EQ(error_of("duration: 1\ncontrol_period: 1e-4\ncontroller: {}\n"),
             "s.yaml: controller.type: missing (required)");
+  // A misspelt required key is named (the review of issue 22: it was reported as missing only).
+  EXPECT_EQ(error_of("duration: 1\ncontrl_period: 1e-4\ncontroller: {type: cascade}\n"),
+            "s.yaml: control_period: missing (required); 'contrl_period' is given: a misspelling of it?");
+  EXPECT_EQ(error_of("duration: 1\ncontrol_period: 1e-4\ncontroller: {typ: cascade}\n"),
+            "s.yaml: controller.type: missing (required); 'controller.typ' is given: a misspelling of it?");
+  EXPECT_EQ(error_of(scenario("{type: open_loop, kind: csv, fiel: u.csv}", "{type: none}")),
+            "s.yaml: controller.file = '': kind = csv needs a file; 'controller.fiel' is given: a misspelling of it?");
+  EXPECT_EQ(error_of(scenario("{type: sliding_mode}", "{type: waypoints, fle: w.csv}")),
+            "s.yaml: reference.file: missing (required); 'reference.fle' is given: a misspelling of it?");
   EXPECT_EQ(error_of(good + "analysis: {setled_after: 0.1}\n"),
             "s.yaml: analysis.setled_after: unknown key (did you mean 'settled_after'?)");
   EXPECT_EQ(error_of(good + "analysis: {settled_after: -1}\n"), "s.yaml: analysis.settled_after = -1: must be >= 0");

@@ -38,7 +38,7 @@ class YamlReadArchive {
   void Visit(const fields::Field<T>& f) {
     if (skip_.count(f.meta.name)) return;
     const std::string key = r_.spelling(f.meta.name, f.meta.alias);  // the name, or its old spelling
-    if (f.meta.required && !r_.has(key)) r_.fail(key, ": missing (required)");
+    if (f.meta.required && !r_.has(key)) r_.missing(key);
     T& v = *f.value;
     if constexpr (std::is_same_v<T, double>) {
       if (f.meta.allow_inf()) {

@@ -63,6 +63,11 @@ class MapReader {
   std::vector<std::string> keys() const;
   /// A required string key.
   std::string required_string(const std::string& key);
+  /// Throws "KEY: missing (required)", naming a key of the map that is a near miss of it ("'contrl_period'
+  /// is given: a misspelling of it?").
+  [[noreturn]] void missing(const std::string& key) const;
+  /// "; 'KEY' is given: a misspelling of it?" for the map's key nearest to `key`, "" if none is near.
+  std::string near_miss(const std::string& key) const;
   /// A nested map (absent = empty).
   MapReader child(const std::string& key);
   /// If `key` holds a single value (not a map), its text in `out` and true.
