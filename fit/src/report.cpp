@@ -25,9 +25,10 @@ std::string fitted_scenario_yaml(const std::string& scenario_path, const plant::
   // The one YAML loader (its checks: recursive aliases, merge keys, duplicate keys, size).
   YAML::Node root = sim::load_yaml_strict(text::read_text_file<sim::ScenarioError>(scenario_path, "scenario file"));
   const fs::path base = fs::absolute(scenario_path).parent_path();
-  if (root["reference"] && root["reference"]["file"]) {
-    const fs::path f = root["reference"]["file"].as<std::string>();
-    if (f.is_relative()) root["reference"]["file"] = (base / f).lexically_normal().string();
+  for (const auto& [section, key] : sim::file_keys()) {  // the file names, valid from the output folder
+    if (!root[section].IsMap() || !root[section][key].IsScalar()) continue;
+    const fs::path f = root[section][key].Scalar();
+    if (f.is_relative()) root[section][key] = (base / f).lexically_normal().string();
   }
   if (!root["plant"]) root["plant"] = YAML::Node(YAML::NodeType::Map);
   YAML::Node effects = root["plant"]["effects"];

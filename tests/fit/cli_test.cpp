@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "../support/scratch.hpp"
+#include "feeddrive/fit/report.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace {
@@ -775,3 +776,34 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   expect_data_error("pos_jump.csv", make(1, 1, 1, 0, 0.05),
                     {"pos_jump.csv:2002: column 'x': the position jumps by 50 mm in one sample", "split the file"});
 }
+
+namespace feeddrive::fit {
+namespace {
+
+// model.fitted.yaml is written into the output folder: every file name of the scenario
+// (sim::file_keys: a waypoints table, an open-loop table, a plugin) must still name its file from
+// there (the review of issue 22 found controller.file left relative: the fitted model did not load).
+TEST(FitReport, FittedScenarioNamesItsFilesFromAnyFolder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("fd_fitted_files_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "in");
+  fs::create_directories(dir / "out");
+  std::ofstream(dir / "in" / "u.csv") << "t,u\n0,0\n1,0.1\n";
+  std::ofstream(dir / "in" / "w.csv") << "t,x\n0,0\n1,0.001\n";
+  std::ofstream(dir / "in" / "s.yaml")
+      << "duration: 0.01\ncontrol_period: 1e-3\ncontroller: {type: open_loop, kind: csv, file: u.csv}\n"
+         "reference: {type: waypoints, file: w.csv}\n";
+  plant::PlantParams fitted;
+  fitted.effects.constant_force.enabled = true;
+  fitted.effects.constant_force.force = 3.0;
+  const std::string yaml = fitted_scenario_yaml((dir / "in" / "s.yaml").string(), fitted);
+  const sim::Scenario s = sim::parse_scenario(yaml, (dir / "out").string(), "model.fitted.yaml");
+  EXPECT_EQ(fs::path(s.controller.open_loop_file), (dir / "in" / "u.csv").lexically_normal());
+  EXPECT_EQ(fs::path(s.reference.waypoints_file), (dir / "in" / "w.csv").lexically_normal());
+  EXPECT_DOUBLE_EQ(s.plant.effects.constant_force.force, 3.0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace feeddrive::fit

@@ -240,6 +240,16 @@ struct Scenario {
   }
 };
 
+/// The keys that name a file, resolved against the scenario's folder when loaded, as (section,
+/// key): reference.file (waypoints), controller.file (an open-loop table), controller.library (a
+/// plugin). A tool that writes a scenario elsewhere (feeddrive-fit's model.fitted.yaml) makes
+/// them absolute.
+inline const std::vector<std::pair<const char*, const char*>>& file_keys() {
+  static const std::vector<std::pair<const char*, const char*>> k = {
+      {"reference", "file"}, {"controller", "file"}, {"controller", "library"}};
+  return k;
+}
+
 /// Loads and validates a scenario file. Throws ScenarioError("<file>: <key> = <value>: <why>").
 /// `text`, if given, receives the file's bytes as read (a process that must prove it runs the
 /// same scenario as others hashes exactly these).
