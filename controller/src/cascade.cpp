@@ -18,7 +18,6 @@ void CascadeParams::validate(const std::string& prefix) const {
   fields::check_fields(*this, prefix);  // the list's ranges (cascade.hpp)
   require_non_negative(prefix + ".model.sensor.quantization", quantization);
   require_non_negative(prefix + ".computation_delay", computation_delay);
-  require_non_negative(prefix + ".velocity_filter_cutoff", velocity_filter_cutoff);
   if (adaptation_rate > 0.0 && !(disturbance_observer_bandwidth > 0.0))
     fail(prefix + ".adaptation_rate", adaptation_rate,
          "needs disturbance_observer_bandwidth > 0 (the residual d^ of the observer)");

@@ -91,6 +91,19 @@ std::string resolved_file(const std::string& base_dir, const std::string& file) 
   return fs::path(file).is_relative() ? (fs::path(base_dir) / file).string() : file;
 }
 
+const std::set<std::string>& keys_not_taken(controller::CascadeTuning t) {
+  static const std::set<std::string> rule = {"kp", "kv", "ki"}, manual = {"bandwidth_scale"};
+  return t == controller::CascadeTuning::kRule ? rule : manual;
+}
+
+void check_cascade_tuning(controller::CascadeTuning t, const std::function<bool(const std::string&)>& given) {
+  for (const std::string& k : keys_not_taken(t))
+    if (given(k))
+      throw ScenarioError("controller." + k +
+                          (t == controller::CascadeTuning::kRule ? ": set by tuning: rule (remove it, or use tuning: manual)"
+                                                                 : ": only with tuning: rule"));
+}
+
 std::string plugin_library(const std::string& base_dir, const std::string& file) {
   return std::filesystem::path(resolved_file(base_dir, file)).lexically_normal().string();
 }
@@ -199,21 +212,14 @@ void read_plugin(MapReader& r, controller::PluginParams& p, PlantParams& model, 
 
 // tuning: manual (kp, kv, ki as given) or rule (kp, kv, ki must then not be given; the gains are
 // set by derive() through controller::apply_tuning, not here); bandwidth_scale only with the rule.
+// The list's ranges are checked here, before derive() uses bandwidth_scale.
 void read_cascade(MapReader& r, controller::CascadeParams& p, PlantParams& model) {
-  std::string tuning = fields::enum_name(p.tuning);
-  r.string("tuning", tuning);
+  read_fields(r, p);
+  detail::check_cascade_tuning(p.tuning, [&r](const std::string& k) { return r.has(k); });
   try {
-    p.tuning = fields::enum_from_name<controller::CascadeTuning>(tuning);
+    fields::check_fields(p, "controller");
   } catch (const std::invalid_argument& e) {
-    r.fail("tuning", " = '" + tuning + "': " + e.what());
-  }
-  if (p.tuning == controller::CascadeTuning::kRule) {
-    for (const char* key : {"kp", "kv", "ki"})
-      if (r.has(key)) r.fail(key, ": set by tuning: rule (remove it, or use tuning: manual)");
-    read_fields(r, p, {"kp", "kv", "ki"});
-  } else {
-    if (r.has("bandwidth_scale")) r.fail("bandwidth_scale", ": only with tuning: rule");
-    read_fields(r, p, {"bandwidth_scale"});
+    throw ScenarioError(e.what());
   }
   read_plant(r.child("model"), model, nullptr);
 }
@@ -434,8 +440,6 @@ void read_controller(MapReader& top, Scenario& s, const std::string& base_dir) {
       break;
     case ControllerType::kCascade:
       read_cascade(c, cc.cascade, cc.model);
-      if (!(cc.cascade.bandwidth_scale > 0.0))  // derive()'s tuning rule divides by it
-        c.fail("bandwidth_scale", " = " + validate::format_number(cc.cascade.bandwidth_scale) + ": must be > 0");
       break;
     case ControllerType::kOpenLoop: read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir); break;
     case ControllerType::kPlugin: read_plugin(c, cc.plugin, cc.model, base_dir); break;
@@ -612,9 +616,7 @@ void controller_keys(const Scenario& s, ResolvedKeys& out) {
       break;
     case ControllerType::kCascade:
       // Under the tuning rule the gains are not keys of the run: the rule sets them.
-      record_fields(cc.cascade, "controller", out,
-                    cc.cascade.tuning == controller::CascadeTuning::kRule ? std::set<std::string>{"kp", "kv", "ki"}
-                                                                          : std::set<std::string>{"bandwidth_scale"});
+      record_fields(cc.cascade, "controller", out, detail::keys_not_taken(cc.cascade.tuning));
       plant_keys(cc.model, "controller.model", nullptr, out);
       break;
     case ControllerType::kOpenLoop:

@@ -2,6 +2,8 @@
 // The scenario reader's rules that the reader (scenario.cpp) and the struct's setter
 // (scenario_set.cpp) share: one place each.
 
+#include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -34,6 +36,15 @@ std::string plugin_library(const std::string& base_dir, const std::string& file)
 
 /// A plugin parameter's name: letters, digits and _ only.
 bool parameter_name(const std::string& key);
+
+/// The keys of the cascade's list a tuning does not take: under `rule` the gains kp, kv, ki (the
+/// rule sets them, controller::apply_tuning), under `manual` bandwidth_scale (a factor of the rule).
+const std::set<std::string>& keys_not_taken(controller::CascadeTuning t);
+
+/// Throws ScenarioError "controller.kp: set by tuning: rule (remove it, or use tuning: manual)" or
+/// "controller.bandwidth_scale: only with tuning: rule" for a key `given` says is given that the
+/// tuning does not take.
+void check_cascade_tuning(controller::CascadeTuning t, const std::function<bool(const std::string&)>& given);
 
 /// derive() and the whole-scenario checks of parse_scenario (each component's validate(), the
 /// files it names, the functions of time, the warnings) on a scenario as read.

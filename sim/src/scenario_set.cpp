@@ -369,14 +369,11 @@ std::vector<std::string> controller_names(const ControllerConfig& cc, Controller
 }
 
 // Under the cascade's tuning rule the gains are not keys; bandwidth_scale is only with the rule.
-void check_tuning(const Scenario& s) {
+// `just_set`: a key being set now (not yet among the given keys).
+void check_tuning(const Scenario& s, const std::string& just_set = "") {
   if (s.controller.type != ControllerType::kCascade) return;
-  const bool rule = s.controller.cascade.tuning == controller::CascadeTuning::kRule;
-  for (const char* k : {"kp", "kv", "ki"})
-    if (rule && gives(s, std::string("controller.") + k))
-      throw ScenarioError(std::string("controller.") + k + ": set by tuning: rule (remove it, or use tuning: manual)");
-  if (!rule && gives(s, "controller.bandwidth_scale"))
-    throw ScenarioError("controller.bandwidth_scale: only with tuning: rule");
+  detail::check_cascade_tuning(s.controller.cascade.tuning,
+                               [&](const std::string& k) { return k == just_set || gives(s, "controller." + k); });
 }
 
 // A type switch: the keys the scenario gives for the old type must be keys of the new one, where
@@ -471,17 +468,11 @@ void controller_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
     return model_key(s, rest.size() > 5 ? rest.substr(6) : "", v);
   switch (cc.type) {
     case ControllerType::kSlidingMode: return set_value(cc.sliding_mode, "controller", rest, v);
-    case ControllerType::kCascade: {
-      const bool rule = cc.cascade.tuning == controller::CascadeTuning::kRule;
-      if (rule && (rest == "kp" || rest == "kv" || rest == "ki"))
-        throw ScenarioError("controller." + rest + ": set by tuning: rule (remove it, or use tuning: manual)");
-      if (!rule && rest == "bandwidth_scale") throw ScenarioError("controller.bandwidth_scale: only with tuning: rule");
+    case ControllerType::kCascade:
+      if (rest != "tuning") check_tuning(s, rest);  // a gain under the rule, a rule's factor under manual
       set_value(cc.cascade, "controller", rest, v);
-      if (rest == "bandwidth_scale" && !(cc.cascade.bandwidth_scale > 0.0))
-        refuse("controller." + rest, v, "must be > 0");
       if (rest == "tuning") check_tuning(s);
-      return;
-    }
+      return checked([&] { fields::check_fields(cc.cascade, "controller"); });
     case ControllerType::kOpenLoop:
       if (rest != "file") return set_value(cc.open_loop, "controller", rest, v);
       MapReader(one_key(rest, v), "controller").string(rest, cc.open_loop_file);

@@ -105,6 +105,25 @@ std::string thrown(F f) {
   return "";
 }
 
+// The cascade's tuning keys: one rule (scenario_rules.hpp) for the file and --set, the list's
+// range for bandwidth_scale (its .positive()) checked before the rule divides by it.
+TEST(Fields, CascadeTuningKeysAreOneRule) {
+  EXPECT_EQ(error_of(scenario("{type: cascade, tuning: rule, kp: 10}", "{type: none}")),
+            "s.yaml: controller.kp: set by tuning: rule (remove it, or use tuning: manual)");
+  EXPECT_EQ(error_of(scenario("{type: cascade, bandwidth_scale: 2}", "{type: none}")),
+            "s.yaml: controller.bandwidth_scale: only with tuning: rule");
+  EXPECT_EQ(error_of(scenario("{type: cascade, tuning: rule, bandwidth_scale: 0}", "{type: none}")),
+            "s.yaml: controller.bandwidth_scale = 0: must be > 0");
+  Scenario s = read_scenario(scenario("{type: cascade, tuning: rule}", "{type: none}"));
+  EXPECT_EQ(thrown([&] { set_read_key(s, "controller.kv", "5"); }),
+            "controller.kv: set by tuning: rule (remove it, or use tuning: manual)");
+  EXPECT_EQ(thrown([&] { set_read_key(s, "controller.bandwidth_scale", "-1"); }),
+            "controller.bandwidth_scale = -1: must be > 0");
+  s = read_scenario(scenario("{type: cascade, kp: 100}", "{type: none}"));
+  EXPECT_EQ(thrown([&] { set_read_key(s, "controller.tuning", "rule"); }),
+            "controller.kp: set by tuning: rule (remove it, or use tuning: manual)");
+}
+
 // The top level's keys come from Scenario's list: the reader's required keys and ranges, the
 // setter's did-you-mean, the units (feeddrive-study's axes) and the docs' Default cell.
 TEST(Fields, TopLevelKeysComeFromTheList) {
