@@ -46,6 +46,7 @@
 #include "feeddrive/controller/delay_line.hpp"
 #include "feeddrive/controller/feedforward_adaptation.hpp"
 #include "feeddrive/controller/friction_observer.hpp"
+#include "feeddrive/controller/quantity.hpp"
 #include "feeddrive/controller/state_observer.hpp"
 #include "feeddrive/plant/params.hpp"
 
@@ -118,20 +119,9 @@ struct CascadeParams {
                  .non_negative()
                  .plausible(0, 1e5)
                  .doc("first-order low-pass on the velocity fed back; 0: none"));
-    a->Visit(FD_FIELD(adaptation_rate)
-                 .unit("1/s")
-                 .non_negative()
-                 .plausible(0, 200)
-                 .doc("rate of the friction and inertia feedforward adapted from the disturbance observer (needs "
-                      "disturbance_observer_bandwidth > 0 and friction_feedforward); 0: off; must be < "
-                      "2/control_period (stability "
-                      "of the normalised update); above 200 warns: gamma = 1000 gave 9.38 um vs 1.57 um without "
-                      "adaptation on the "
-                      "sine with Fs, Fc x0.5 (docs/controllers.md; measured 20 to 100)"));
-    a->Visit(
-        FD_FIELD(u_min).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; finite, < u_max"));
-    a->Visit(
-        FD_FIELD(u_max).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, upper; finite, > u_min"));
+    a->Visit(quantity::adaptation_rate(adaptation_rate));
+    a->Visit(quantity::u_min(u_min));
+    a->Visit(quantity::u_max(u_max));
   }
   void validate(const std::string& prefix = "controller") const;
 };

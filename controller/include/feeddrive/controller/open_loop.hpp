@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "feeddrive/controller/controller.hpp"
+#include "feeddrive/controller/quantity.hpp"
 
 namespace feeddrive::controller {
 
@@ -54,8 +55,8 @@ struct OpenLoopParams {
     a->Visit(FD_FIELD(offset).unit("N").plausible(-1e5, 1e5).doc("added to every kind"));
     a->Visit(FD_FIELD(rate).unit("N/s").plausible(-1e7, 1e7).doc("ramp slope"));
     a->Visit(FD_FIELD(start_time).unit("s").non_negative().doc("before it only the offset acts"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().doc("output saturation, lower; finite, < u_max"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().doc("output saturation, upper; finite, > u_min"));
+    a->Visit(quantity::u_min(u_min));
+    a->Visit(quantity::u_max(u_max));
   }
   void validate(const std::string& prefix = "controller") const;
 };

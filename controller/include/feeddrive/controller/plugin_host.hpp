@@ -18,6 +18,7 @@
 #include "feeddrive/common/fields.hpp"
 #include "feeddrive/controller/controller.hpp"
 #include "feeddrive/controller/plugin.h"
+#include "feeddrive/controller/quantity.hpp"
 #include "feeddrive/plant/params.hpp"
 
 namespace feeddrive::controller {
@@ -45,8 +46,8 @@ struct PluginParams {
     a->Visit(FD_FIELD(library).required().doc(
         "the plugin's shared library, relative to the scenario's folder; opened when the scenario is loaded "
         "(file, the five symbols, the ABI version)"));
-    a->Visit(FD_FIELD(u_min).unit("V").unchecked().doc("the command's lower limit passed to the plugin; < u_max"));
-    a->Visit(FD_FIELD(u_max).unit("V").unchecked().doc("the command's upper limit passed to the plugin; > u_min"));
+    a->Visit(quantity::u_min(u_min));
+    a->Visit(quantity::u_max(u_max));
   }
   void validate(const std::string& prefix = "controller") const;
 };
