@@ -100,8 +100,9 @@ void check_cascade_tuning(controller::CascadeTuning t, const std::function<bool(
   for (const std::string& k : keys_not_taken(t))
     if (given(k))
       throw ScenarioError("controller." + k +
-                          (t == controller::CascadeTuning::kRule ? ": set by tuning: rule (remove it, or use tuning: manual)"
-                                                                 : ": only with tuning: rule"));
+                          (t == controller::CascadeTuning::kRule
+                               ? ": set by tuning: rule (remove it, or use tuning: manual)"
+                               : ": only with tuning: rule"));
 }
 
 std::string plugin_library(const std::string& base_dir, const std::string& file) {
@@ -236,30 +237,15 @@ void read_open_loop(MapReader& r, controller::OpenLoopParams& p, std::string& fi
 
 void read_reference(MapReader r, ReferenceConfig& c, const std::string& base_dir) {
   read_fields(r, c);  // type
-  switch (c.type) {
-    case ReferenceType::kNone: break;
-    case ReferenceType::kSine: read_fields(r, c.sine); break;
-    case ReferenceType::kStep: read_fields(r, c.step); break;
-    case ReferenceType::kAccelLimited: read_fields(r, c.accel_limited); break;
-    case ReferenceType::kSCurve: read_fields(r, c.scurve); break;
-    case ReferenceType::kRamp: read_fields(r, c.ramp); break;
-    case ReferenceType::kWaypoints:
-      c.waypoints_file = detail::resolved_file(base_dir, r.required_string("file"));
-      break;
-  }
+  detail::with_reference_params(c, c.type, [&](auto& p) { read_fields(r, p); });
+  if (c.type == ReferenceType::kWaypoints)
+    c.waypoints_file = detail::resolved_file(base_dir, r.required_string("file"));
   r.finish();
 }
 
 void validate_reference(const ReferenceConfig& c) {
-  switch (c.type) {
-    case ReferenceType::kNone: break;
-    case ReferenceType::kSine: c.sine.validate("reference"); break;
-    case ReferenceType::kStep: c.step.validate("reference"); break;
-    case ReferenceType::kAccelLimited: c.accel_limited.validate("reference"); break;
-    case ReferenceType::kSCurve: c.scurve.validate("reference"); break;
-    case ReferenceType::kRamp: c.ramp.validate("reference"); break;
-    case ReferenceType::kWaypoints: break;  // read and checked in parse_node
-  }
+  // The waypoints are read and checked in check_scenario.
+  detail::with_reference_params(c, c.type, [](const auto& p) { p.validate("reference"); });
 }
 
 // The reference and an open-loop command are pure functions of t: a NaN or infinity they would
@@ -354,21 +340,10 @@ void find_warnings(Scenario& s) {
       if (w[i].rfind(key, 0) == 0) return true;
     return false;
   };
-  switch (s.controller.type) {
-    case ControllerType::kSlidingMode: add(fields::plausibility(s.controller.sliding_mode, "controller")); break;
-    case ControllerType::kCascade: add(fields::plausibility(s.controller.cascade, "controller")); break;
-    case ControllerType::kOpenLoop: add(fields::plausibility(s.controller.open_loop, "controller")); break;
-    case ControllerType::kPlugin: break;
-  }
-  switch (s.reference.type) {
-    case ReferenceType::kSine: add(fields::plausibility(s.reference.sine, "reference")); break;
-    case ReferenceType::kStep: add(fields::plausibility(s.reference.step, "reference")); break;
-    case ReferenceType::kAccelLimited: add(fields::plausibility(s.reference.accel_limited, "reference")); break;
-    case ReferenceType::kSCurve: add(fields::plausibility(s.reference.scurve, "reference")); break;
-    case ReferenceType::kRamp: add(fields::plausibility(s.reference.ramp, "reference")); break;
-    case ReferenceType::kNone:
-    case ReferenceType::kWaypoints: break;
-  }
+  detail::with_controller_params(s.controller, s.controller.type,
+                                 [&](const auto& p) { add(fields::plausibility(p, "controller")); });
+  detail::with_reference_params(s.reference, s.reference.type,
+                                [&](const auto& p) { add(fields::plausibility(p, "reference")); });
   const ReferenceType t = s.reference.type;
   if (t == ReferenceType::kAccelLimited || t == ReferenceType::kSCurve || t == ReferenceType::kWaypoints ||
       t == ReferenceType::kStep) {
@@ -438,9 +413,7 @@ void read_controller(MapReader& top, Scenario& s, const std::string& base_dir) {
       read_fields(c, cc.sliding_mode);
       read_plant(c.child("model"), cc.model, &s.listed_effects);
       break;
-    case ControllerType::kCascade:
-      read_cascade(c, cc.cascade, cc.model);
-      break;
+    case ControllerType::kCascade: read_cascade(c, cc.cascade, cc.model); break;
     case ControllerType::kOpenLoop: read_open_loop(c, cc.open_loop, cc.open_loop_file, base_dir); break;
     case ControllerType::kPlugin: read_plugin(c, cc.plugin, cc.model, base_dir); break;
   }
@@ -505,15 +478,8 @@ void check_scenario(Scenario& s, const YAML::Node& root) {
     if (s.controller.type == ControllerType::kOpenLoop && s.controller.open_loop.kind == controller::OpenLoopKind::kCsv)
       read_open_loop_file(s.controller.open_loop_file, s.controller.open_loop);
     s.plant.validate("plant");
-    switch (s.controller.type) {
-      case ControllerType::kSlidingMode: s.controller.sliding_mode.validate("controller"); break;
-      case ControllerType::kCascade: s.controller.cascade.validate("controller"); break;
-      case ControllerType::kOpenLoop: s.controller.open_loop.validate("controller"); break;
-      case ControllerType::kPlugin:
-        s.controller.plugin.validate("controller");
-        controller::PluginLibrary::open(s.controller.plugin.library);
-        break;
-    }
+    detail::with_controller_params(s.controller, s.controller.type, [](const auto& p) { p.validate("controller"); });
+    if (s.controller.type == ControllerType::kPlugin) controller::PluginLibrary::open(s.controller.plugin.library);
     validate_reference(s.reference);
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(e.what());
@@ -633,15 +599,8 @@ void controller_keys(const Scenario& s, ResolvedKeys& out) {
 
 void reference_keys(const ReferenceConfig& c, ResolvedKeys& out) {
   record_fields(c, "reference", out);  // type
-  switch (c.type) {
-    case ReferenceType::kNone: break;
-    case ReferenceType::kSine: record_fields(c.sine, "reference", out); break;
-    case ReferenceType::kStep: record_fields(c.step, "reference", out); break;
-    case ReferenceType::kAccelLimited: record_fields(c.accel_limited, "reference", out); break;
-    case ReferenceType::kSCurve: record_fields(c.scurve, "reference", out); break;
-    case ReferenceType::kRamp: record_fields(c.ramp, "reference", out); break;
-    case ReferenceType::kWaypoints: out["reference.file"] = {c.waypoints_file, true}; break;
-  }
+  detail::with_reference_params(c, c.type, [&](const auto& p) { record_fields(p, "reference", out); });
+  if (c.type == ReferenceType::kWaypoints) out["reference.file"] = {c.waypoints_file, true};
 }
 
 }  // namespace

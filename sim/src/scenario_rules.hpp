@@ -46,6 +46,34 @@ const std::set<std::string>& keys_not_taken(controller::CascadeTuning t);
 /// tuning does not take.
 void check_cascade_tuning(controller::CascadeTuning t, const std::function<bool(const std::string&)>& given);
 
+/// Calls f(params) with the params struct of the reference's type `t` (sine, step, accel_limited,
+/// scurve, ramp): the one mapping from a reference type to its list. none and waypoints have no
+/// list (f is not called; the waypoints' file is a rule of its own).
+template <typename C, typename F>
+void with_reference_params(C& c, ReferenceType t, F&& f) {
+  switch (t) {
+    case ReferenceType::kSine: return f(c.sine);
+    case ReferenceType::kStep: return f(c.step);
+    case ReferenceType::kAccelLimited: return f(c.accel_limited);
+    case ReferenceType::kSCurve: return f(c.scurve);
+    case ReferenceType::kRamp: return f(c.ramp);
+    case ReferenceType::kNone:
+    case ReferenceType::kWaypoints: return;
+  }
+}
+
+/// Calls f(params) with the params struct of the controller's type `t` (sliding_mode, cascade,
+/// open_loop, plugin): the one mapping from a controller type to its list.
+template <typename C, typename F>
+void with_controller_params(C& cc, ControllerType t, F&& f) {
+  switch (t) {
+    case ControllerType::kSlidingMode: return f(cc.sliding_mode);
+    case ControllerType::kCascade: return f(cc.cascade);
+    case ControllerType::kOpenLoop: return f(cc.open_loop);
+    case ControllerType::kPlugin: return f(cc.plugin);
+  }
+}
+
 /// derive() and the whole-scenario checks of parse_scenario (each component's validate(), the
 /// files it names, the functions of time, the warnings) on a scenario as read.
 void derive_and_check(Scenario& s);

@@ -408,12 +408,7 @@ E read_enum(const std::string& parent, const std::string& key, const YAML::Node&
 // A controller type's own keys as its struct has them (plugin: its limits).
 ResolvedKeys controller_values(const ControllerConfig& cc, ControllerType t) {
   ResolvedKeys keys;
-  switch (t) {
-    case ControllerType::kSlidingMode: record_fields(cc.sliding_mode, "", keys); break;
-    case ControllerType::kCascade: record_fields(cc.cascade, "", keys); break;
-    case ControllerType::kOpenLoop: record_fields(cc.open_loop, "", keys); break;
-    case ControllerType::kPlugin: record_fields(cc.plugin, "", keys, {"library"}); break;
-  }
+  detail::with_controller_params(cc, t, [&](const auto& p) { record_fields(p, "", keys); });
   return keys;
 }
 
@@ -482,23 +477,9 @@ void controller_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   }
 }
 
-// The reference's list for its type (none: no keys).
-template <typename F>
-void with_reference_params(ReferenceConfig& c, ReferenceType t, F f) {
-  switch (t) {
-    case ReferenceType::kSine: return f(c.sine);
-    case ReferenceType::kStep: return f(c.step);
-    case ReferenceType::kAccelLimited: return f(c.accel_limited);
-    case ReferenceType::kSCurve: return f(c.scurve);
-    case ReferenceType::kRamp: return f(c.ramp);
-    case ReferenceType::kNone:
-    case ReferenceType::kWaypoints: return;
-  }
-}
-
 std::vector<std::string> reference_names(ReferenceConfig& c, ReferenceType t) {
   std::vector<std::string> names;
-  with_reference_params(c, t, [&](auto& p) { names = names_of(p); });
+  detail::with_reference_params(c, t, [&](auto& p) { names = names_of(p); });
   if (t == ReferenceType::kWaypoints) names.push_back("file");
   return names;
 }
@@ -509,7 +490,7 @@ void reference_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
     const ReferenceType t = read_enum<ReferenceType>("reference", "type", v);
     if (t == c.type) return;
     ResolvedKeys old;
-    with_reference_params(c, c.type, [&](const auto& p) { record_fields(p, "", old); });
+    detail::with_reference_params(c, c.type, [&](const auto& p) { record_fields(p, "", old); });
     c.type = t;
     return switch_keys(s, "reference", v, names_of(c), reference_names(c, t), old,
                        [&](const std::string& k, const YAML::Node& value) { reference_key(s, k, value); });
@@ -521,7 +502,7 @@ void reference_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   }
   if (c.type == ReferenceType::kNone || c.type == ReferenceType::kWaypoints)
     unknown("reference", rest.substr(0, rest.find('.')), reference_names(c, c.type));
-  with_reference_params(c, c.type, [&](auto& p) { set_value(p, "reference", rest, v); });
+  detail::with_reference_params(c, c.type, [&](auto& p) { set_value(p, "reference", rest, v); });
 }
 
 // The sections read by rules of their own (set_node); every other top-level key is the list's
@@ -621,9 +602,8 @@ bool respell(const std::string& prefix, S list, const std::string& key, std::str
 std::string canonical_key(const std::string& key, std::string* note) {
   std::string out;
   bool renamed = false;
-  detail::for_each_list([&](const char*, const char* prefix, auto list) {
-    renamed = renamed || respell(prefix, list, key, out);
-  });
+  detail::for_each_list(
+      [&](const char*, const char* prefix, auto list) { renamed = renamed || respell(prefix, list, key, out); });
   for (const char* prefix : detail::kPlantPrefixes)
     renamed = renamed || respell(prefix, plant::PlantParams{}, key, out);
   if (!renamed) return key;
