@@ -201,6 +201,10 @@ JointFit fit_with(const Context& cx, const Search& s, const std::string& name, F
   // velocity: eps is fitted with it (cheap: no friction along the record is recomputed).
   fs.form = cx.opt.fit_form && s.current.friction.model != plant::FrictionModel::kStatic &&
             (name == "coulomb_friction" || name == "stribeck_friction");
+  // The Stribeck exponent is held here, refitted with the model form once an effect is in
+  // (recalibrate): free, it would be a parameter of the stribeck_friction candidate that its score
+  // does not count (the form is counted in no score), and coulomb_friction has no such parameter.
+  fs.exponent = false;
   // the single fit is a good start: the joint fit converges in a few tens of iterations
   JointFit jf = fit_jointly(cx.rec, trial, fs, nullptr, 40, cx.opt.stop);
   const Effect canon = canonical(effect_of(jf.params, name));
