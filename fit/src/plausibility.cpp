@@ -135,6 +135,14 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
       return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
                  0.5 * env.stick_velocity * 1e3, 0.5 * env.v_max * 1e3);
+    // The Stribeck curve is the fall of friction once the drive slides: a hump that has decayed
+    // before the sign sgn_eps(v) has changed (v_s below its transition velocity eps) only reshapes
+    // the sign change, the model form's job, and is no Stribeck effect the data resolve.
+    const double eps = model.friction.static_smoothing_velocity;
+    if (vs < eps)
+      return fmt("Stribeck velocity %.3g mm/s is below the Coulomb transition velocity %.3g mm/s: the hump lies "
+                 "within the sign change",
+                 vs * 1e3, eps * 1e3);
   }
   if (n == "presliding") {
     const double d = model.friction.coulomb_force / std::max(par(e, "bristle_stiffness"), 1e-300);
