@@ -189,13 +189,31 @@ std::string borderline(const Context& cx, const plant::PlantParams& p, const std
          fmt("; record a travel of at least 3 periods (%.3g mm) to confirm it", 3e3 * pitch);
 }
 
+// The effect already named that candidate `name` contains as a special case, or "": a Stribeck
+// curve whose static level equals its Coulomb level is Coulomb friction (docs/fit.md, "Swap moves").
+std::string contained_effect(const Search& s, const std::string& name) {
+  if (name == "stribeck_friction" && contains(s.free.effects, "coulomb_friction")) return "coulomb_friction";
+  return "";
+}
+
 // The candidate `name` fitted alone on the residual (the start), then jointly with every effect
-// the search refits, in `fs` (set here); in its canonical form unless the BIC says otherwise.
+// the search refits, in `fs` (set here); in its canonical form unless the BIC says otherwise. A
+// candidate that contains an effect already named replaces it (contained_effect): it starts from
+// the sum of the two (the Coulomb level added to both of the Stribeck curve's levels, the same
+// force), and the contained effect leaves the model.
 JointFit fit_with(const Context& cx, const Search& s, const std::string& name, FreeSet& fs) {
   const CandidateFit single = fit_candidate(cx.rec, s.current, name, s.r, cx.opt.stop);
   plant::PlantParams trial = s.current;
-  plant::set_effect(trial.effects, single.effect);
+  Effect start = single.effect;
   fs = s.free;
+  if (const std::string inner = contained_effect(s, name); !inner.empty()) {
+    const double fc = effect_of(s.current, inner).parameters.at("coulomb_force");
+    start.parameters.at("static_force") += fc;
+    start.parameters.at("coulomb_force") += fc;
+    plant::effect_enabled(trial.effects, inner) = false;
+    fs.effects.erase(std::find(fs.effects.begin(), fs.effects.end(), inner));
+  }
+  plant::set_effect(trial.effects, start);
   fs.effects.push_back(name);
   // A Coulomb-type candidate on a model without a Coulomb-type term (no static friction, or one
   // that presliding made LuGre) brings its own transition velocity: eps is fitted with it (cheap: no friction along the record is recomputed).
@@ -299,6 +317,8 @@ CandidateFit score_candidate(const Context& cx, const Search& s, const std::stri
   const auto t0 = std::chrono::steady_clock::now();
   FreeSet fs;
   JointFit jf = fit_with(cx, s, name, fs);
+  if (const std::string inner = contained_effect(s, name); !inner.empty())
+    c.swap = inner + " -> " + name + " (which contains it)";
   try {
     jf.params.validate();
   } catch (const std::invalid_argument& e) {
@@ -536,6 +556,10 @@ void accept(const Context& cx, const CandidateFit& c, const Choice& ch, Search& 
     cx.say("swap: " + c.swap + " (refitted with " + name + ")");
   }
   if (c.tentative) s.tentative[name] = c.caveat;
+  // an effect the candidate replaced (contained_effect) is no longer refitted: no longer named
+  s.added.erase(std::remove_if(s.added.begin(), s.added.end(),
+                               [&](const std::string& e) { return !contains(s.free.effects, e); }),
+                s.added.end());
   s.added.push_back(name);
   refresh(cx, s);
   try {
