@@ -441,6 +441,19 @@ const CandidateFit* short_ripple(const Context& cx, const std::vector<CandidateF
   return best;
 }
 
+// Whether candidate c is only a stand-in for the short ripple rip (short_ripple): with the
+// ripple in the model (as fitted, though its pitch is not resolved), c refitted jointly with it
+// no longer earns the threshold in BIC. The backward step of the stepwise selection, applied
+// before naming c: c would be removed once the ripple it stands in for is in.
+bool stands_in_for(const Context& cx, const CandidateFit& c, const CandidateFit& rip) {
+  plant::PlantParams p = c.joint;
+  plant::set_effect(p.effects, rip.effect);
+  FreeSet fs{c.free_effects, false};
+  if (!contains(fs.effects, rip.effect.name)) fs.effects.push_back(rip.effect.name);
+  const JointFit both = fit_jointly(cx.rec, p, fs, nullptr, 60, cx.opt.stop);
+  return rip.bic - bic_of(both.rss, fs.parameters(both.params), cx.n) < cx.opt.score_threshold;
+}
+
 // Stage 2: the best candidate (in ranking order) that is significant (score >= threshold),
 // confirmed out of sample (cv_verdict) and by the replay (the gap shrinks by min_gap_reduction).
 // The others are marked with the reason; st gets the winner's out-of-sample evidence.
@@ -462,7 +475,8 @@ Choice choose(const Context& cx, const Search& s, StepResult& st) {
       continue;
     }
     if (const CandidateFit* rip = short_ripple(cx, st.ranking);
-        rip && c.effect.name == "spring_force" && rip->score >= c.score + cx.opt.score_threshold) {
+        rip && rip->score >= c.score + cx.opt.score_threshold &&
+        (c.effect.name == "spring_force" || stands_in_for(cx, c, *rip))) {
       const double pitch = rip->effect.parameters.at("pitch");
       pass_over(c, Reason::kImplausible,
                 "stands in for a force periodic in position: " + rip->effect.name +
