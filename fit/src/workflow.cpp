@@ -216,9 +216,10 @@ JointFit fit_with(const Context& cx, const Search& s, const std::string& name, F
   plant::set_effect(trial.effects, start);
   fs.effects.push_back(name);
   // A Coulomb-type candidate on a model without a Coulomb-type term (no static friction, or one
-  // that presliding made LuGre) brings its own transition velocity: eps is fitted with it (cheap: no friction along the record is recomputed).
-  fs.form = cx.opt.fit_form && !has_coulomb_term(s.current) &&
-            (name == "coulomb_friction" || name == "stribeck_friction");
+  // that presliding made LuGre) brings its own transition velocity: eps is fitted with it
+  // (cheap: no friction along the record is recomputed).
+  fs.form =
+      cx.opt.fit_form && !has_coulomb_term(s.current) && (name == "coulomb_friction" || name == "stribeck_friction");
   // The Stribeck exponent is held here, refitted with the model form once an effect is in
   // (recalibrate): free, it would be a parameter of the stribeck_friction candidate that its score
   // does not count (the form is counted in no score), and coulomb_friction has no such parameter.
