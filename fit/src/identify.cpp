@@ -537,7 +537,7 @@ int FreeSet::parameters(const plant::PlantParams& model) const {
   int k = 0;
   for (const std::string& n : effects) k += spec(n).dim;
   if (form && has_coulomb_term(model)) k += spec(kSmoothing).dim;
-  if (form && has_stribeck_hump(model)) k += spec(kExponent).dim;
+  if (form && exponent && has_stribeck_hump(model)) k += spec(kExponent).dim;
   return k;
 }
 
@@ -562,7 +562,7 @@ std::pair<std::vector<Block>, Theta> joint_blocks(const plant::PlantParams& mode
     theta.push_back(std::log(model.friction.static_smoothing_velocity));
     theta.push_back(model.friction.static_smoothing_shape);
   }
-  if (free.form && has_stribeck_hump(model)) {
+  if (free.form && free.exponent && has_stribeck_hump(model)) {
     blocks.push_back({&spec(kExponent), static_cast<int>(theta.size())});
     theta.push_back(model.friction.stribeck_exponent);
   }

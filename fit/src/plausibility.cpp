@@ -44,6 +44,8 @@ Envelope envelope(const Record& rec, const plant::PlantParams& model) {
   e.filter_half_width = rec.bank.half_width;
   e.nominal_mass = plant::effective_params(model).mass;
   e.duration = d.t.back() - d.t.front();
+  e.resolution =
+      std::max(model.sensor.ideal() ? smallest_position_step(d) : model.sensor.quantization, model.sensor.noise_stddev);
   const double gain = thrust_per_input(rec, model);
   for (double u : d.input) e.peak_thrust = std::max(e.peak_thrust, std::abs(gain * u));
   e.stick_velocity = stick_velocity(model);
@@ -133,11 +135,28 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     if (vs < 0.5 * env.stick_velocity || vs > 0.5 * env.v_max)
       return fmt("Stribeck velocity %.3g mm/s is not resolved by the data (between %.3g and %.3g mm/s)", vs * 1e3,
                  0.5 * env.stick_velocity * 1e3, 0.5 * env.v_max * 1e3);
+    // The Stribeck curve is the fall of friction once the drive slides: a hump that has decayed
+    // before the sign sgn_eps(v) has changed (v_s below its transition velocity eps) only reshapes
+    // the sign change, the model form's job, and is no Stribeck effect the data resolve.
+    const double eps = model.friction.static_smoothing_velocity;
+    if (vs < eps)
+      return fmt(
+          "Stribeck velocity %.3g mm/s is below the Coulomb transition velocity %.3g mm/s: the hump lies "
+          "within the sign change",
+          vs * 1e3, eps * 1e3);
   }
   if (n == "presliding") {
     const double d = model.friction.coulomb_force / std::max(par(e, "bristle_stiffness"), 1e-300);
     if (d < 1e-8 || d > 1e-3)
       return fmt("presliding displacement Fc/sigma0 = %.3g um is outside 0.01 um .. 1 mm", d * 1e6);
+    // The bristles deflect by Fc/sigma0 before the drive slides: a deflection within one count of
+    // the sensor (or its noise) is not seen in the position record, and bristles that stiff only
+    // reshape the friction's sign change, the model form's job (docs/fit.md, "Plausibility").
+    if (d < env.resolution)
+      return fmt(
+          "presliding displacement Fc/sigma0 = %.3g um is below the sensor's resolution (%.3g um): the "
+          "bristles' deflection is not resolved by the record",
+          d * 1e6, env.resolution * 1e6);
   }
   if (n == "cogging_ripple") {
     const std::string p = ripple_pitch(env, par(e, "pitch"));

@@ -189,18 +189,41 @@ std::string borderline(const Context& cx, const plant::PlantParams& p, const std
          fmt("; record a travel of at least 3 periods (%.3g mm) to confirm it", 3e3 * pitch);
 }
 
+// The effect already named that candidate `name` contains as a special case, or "": a Stribeck
+// curve whose static level equals its Coulomb level is Coulomb friction (docs/fit.md, "Swap moves").
+std::string contained_effect(const Search& s, const std::string& name) {
+  if (name == "stribeck_friction" && contains(s.free.effects, "coulomb_friction")) return "coulomb_friction";
+  return "";
+}
+
 // The candidate `name` fitted alone on the residual (the start), then jointly with every effect
-// the search refits, in `fs` (set here); in its canonical form unless the BIC says otherwise.
+// the search refits, in `fs` (set here); in its canonical form unless the BIC says otherwise. A
+// candidate that contains an effect already named replaces it (contained_effect): it starts from
+// the sum of the two (the Coulomb level added to both of the Stribeck curve's levels, the same
+// force), and the contained effect leaves the model.
 JointFit fit_with(const Context& cx, const Search& s, const std::string& name, FreeSet& fs) {
   const CandidateFit single = fit_candidate(cx.rec, s.current, name, s.r, cx.opt.stop);
   plant::PlantParams trial = s.current;
-  plant::set_effect(trial.effects, single.effect);
+  Effect start = single.effect;
   fs = s.free;
+  if (const std::string inner = contained_effect(s, name); !inner.empty()) {
+    const double fc = effect_of(s.current, inner).parameters.at("coulomb_force");
+    start.parameters.at("static_force") += fc;
+    start.parameters.at("coulomb_force") += fc;
+    plant::effect_enabled(trial.effects, inner) = false;
+    fs.effects.erase(std::find(fs.effects.begin(), fs.effects.end(), inner));
+  }
+  plant::set_effect(trial.effects, start);
   fs.effects.push_back(name);
-  // A Coulomb-type candidate on a model without static friction brings its own transition
-  // velocity: eps is fitted with it (cheap: no friction along the record is recomputed).
-  fs.form = cx.opt.fit_form && s.current.friction.model != plant::FrictionModel::kStatic &&
-            (name == "coulomb_friction" || name == "stribeck_friction");
+  // A Coulomb-type candidate on a model without a Coulomb-type term (no static friction, or one
+  // that presliding made LuGre) brings its own transition velocity: eps is fitted with it
+  // (cheap: no friction along the record is recomputed).
+  fs.form =
+      cx.opt.fit_form && !has_coulomb_term(s.current) && (name == "coulomb_friction" || name == "stribeck_friction");
+  // The Stribeck exponent is held here, refitted with the model form once an effect is in
+  // (recalibrate): free, it would be a parameter of the stribeck_friction candidate that its score
+  // does not count (the form is counted in no score), and coulomb_friction has no such parameter.
+  fs.exponent = false;
   // the single fit is a good start: the joint fit converges in a few tens of iterations
   JointFit jf = fit_jointly(cx.rec, trial, fs, nullptr, 40, cx.opt.stop);
   const Effect canon = canonical(effect_of(jf.params, name));
@@ -295,6 +318,8 @@ CandidateFit score_candidate(const Context& cx, const Search& s, const std::stri
   const auto t0 = std::chrono::steady_clock::now();
   FreeSet fs;
   JointFit jf = fit_with(cx, s, name, fs);
+  if (const std::string inner = contained_effect(s, name); !inner.empty())
+    c.swap = inner + " -> " + name + " (which contains it)";
   try {
     jf.params.validate();
   } catch (const std::invalid_argument& e) {
@@ -417,6 +442,19 @@ const CandidateFit* short_ripple(const Context& cx, const std::vector<CandidateF
   return best;
 }
 
+// Whether candidate c is only a stand-in for the short ripple rip (short_ripple): with the
+// ripple in the model (as fitted, though its pitch is not resolved), c refitted jointly with it
+// no longer earns the threshold in BIC. The backward step of the stepwise selection, applied
+// before naming c: c would be removed once the ripple it stands in for is in.
+bool stands_in_for(const Context& cx, const CandidateFit& c, const CandidateFit& rip) {
+  plant::PlantParams p = c.joint;
+  plant::set_effect(p.effects, rip.effect);
+  FreeSet fs{c.free_effects, false};
+  if (!contains(fs.effects, rip.effect.name)) fs.effects.push_back(rip.effect.name);
+  const JointFit both = fit_jointly(cx.rec, p, fs, nullptr, 60, cx.opt.stop);
+  return rip.bic - bic_of(both.rss, fs.parameters(both.params), cx.n) < cx.opt.score_threshold;
+}
+
 // Stage 2: the best candidate (in ranking order) that is significant (score >= threshold),
 // confirmed out of sample (cv_verdict) and by the replay (the gap shrinks by min_gap_reduction).
 // The others are marked with the reason; st gets the winner's out-of-sample evidence.
@@ -438,7 +476,8 @@ Choice choose(const Context& cx, const Search& s, StepResult& st) {
       continue;
     }
     if (const CandidateFit* rip = short_ripple(cx, st.ranking);
-        rip && c.effect.name == "spring_force" && rip->score >= c.score + cx.opt.score_threshold) {
+        rip && rip->score >= c.score + cx.opt.score_threshold &&
+        (c.effect.name == "spring_force" || stands_in_for(cx, c, *rip))) {
       const double pitch = rip->effect.parameters.at("pitch");
       pass_over(c, Reason::kImplausible,
                 "stands in for a force periodic in position: " + rip->effect.name +
@@ -532,6 +571,10 @@ void accept(const Context& cx, const CandidateFit& c, const Choice& ch, Search& 
     cx.say("swap: " + c.swap + " (refitted with " + name + ")");
   }
   if (c.tentative) s.tentative[name] = c.caveat;
+  // an effect the candidate replaced (contained_effect) is no longer refitted: no longer named
+  s.added.erase(std::remove_if(s.added.begin(), s.added.end(),
+                               [&](const std::string& e) { return !contains(s.free.effects, e); }),
+                s.added.end());
   s.added.push_back(name);
   refresh(cx, s);
   try {

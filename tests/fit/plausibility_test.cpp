@@ -77,6 +77,38 @@ TEST(Plausibility, PreslidingNeedsFrictionAndStickPhasesOrReversals) {
   EXPECT_EQ(prerequisite(e, stat, "presliding", {}), "");
 }
 
+// Bristles that deflect by less than one count of the sensor before the drive slides are not seen
+// in the position record (docs/fit.md, "Plausibility"): 20 N of Coulomb friction on a 200 nm
+// encoder; sigma0 = 1e8 N/m deflects 0.2 um (one count: resolved), 1e9 N/m 0.02 um (not).
+TEST(Plausibility, PreslidingDisplacementMustBeResolvedByTheSensor) {
+  Envelope e = drive();
+  e.resolution = 200e-9;
+  plant::PlantParams stat;
+  stat.friction.model = plant::FrictionModel::kStatic;
+  stat.friction.coulomb_force = 20.0;
+  const auto bristles = [](double sigma0) {
+    return plant::NamedEffect{"presliding", {{"bristle_stiffness", sigma0}, {"bristle_damping", 1e3}}};
+  };
+  EXPECT_EQ(implausible(e, stat, bristles(1e7)), "");     // 2 um
+  EXPECT_EQ(implausible(e, stat, bristles(0.99e8)), "");  // just above one count
+  EXPECT_NE(implausible(e, stat, bristles(1e9)).find("below the sensor's resolution"), std::string::npos);
+}
+
+// A Stribeck hump that has decayed before the smoothed sign has changed (v_s below eps) only
+// reshapes the sign change: eps = 0.5 mm/s here; v_s = 2 mm/s is a hump, 0.2 mm/s is not. (Both
+// within the stick-velocity and peak-speed bounds of the envelope: 0.05 .. 50 mm/s.)
+TEST(Plausibility, StribeckHumpMustLieBeyondTheSignChange) {
+  const Envelope e = drive();
+  plant::PlantParams m;
+  m.friction.static_smoothing_velocity = 5e-4;
+  const auto hump = [](double vs) {
+    return plant::NamedEffect{"stribeck_friction",
+                              {{"static_force", 30.0}, {"coulomb_force", 20.0}, {"stribeck_velocity", vs}}};
+  };
+  EXPECT_EQ(implausible(e, m, hump(2e-3)), "");
+  EXPECT_NE(implausible(e, m, hump(2e-4)).find("below the Coulomb transition velocity"), std::string::npos);
+}
+
 TEST(Plausibility, MassWithinAFactorOfTwo) {
   const Envelope e = drive();
   const plant::PlantParams m;

@@ -79,6 +79,10 @@ struct FreeSet {
   /// > 0: also a model-form offset |F| <= offset_bound, carried by constant_force (not named):
   /// a direction asymmetry of the friction, which moving data cannot tell from a constant force.
   double offset_bound{0.0};
+  /// With `form`: whether the Stribeck exponent is refitted too (false: held at the model's). The
+  /// candidate fits hold it (workflow.cpp, fit_with): a free exponent is a parameter no score
+  /// counts, which a stribeck_friction candidate would have and coulomb_friction not.
+  bool exponent{true};
   int parameters(const plant::PlantParams& model) const;  ///< k of the BIC
 };
 bool has_coulomb_term(const plant::PlantParams& model);

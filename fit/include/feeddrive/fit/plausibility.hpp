@@ -36,6 +36,9 @@ struct Envelope {
   int reversals{0};                            ///< sign changes of v^ between |v^| above the stick velocity
   double nominal_mass{0.0};                    ///< the model's mass [kg]
   double duration{0.0};                        ///< [s]
+  /// The smallest position change the sensor resolves [m]: one count (plant.sensor's quantization,
+  /// or the record's smallest position step if the scenario gives no sensor) or its noise, the larger.
+  double resolution{0.0};
   /// Shortest ripple pitch the data resolves [m]: at the peak speed a period must span at least
   /// 8 samples and 4 filter half-widths (the filter passes it), and at least 1 mm.
   double min_pitch() const;
