@@ -1,8 +1,11 @@
 #include "drivegen.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <random>
 #include <set>
@@ -611,6 +614,50 @@ std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed) {
     out[i].grinding_process = std::find(h.begin(), h.end(), "grinding_force") != h.end();
   }
   return out;
+}
+
+namespace {
+
+// The whole of `text` as a number > 0 (or >= 0 with zero_ok), finite.
+double checked_number(const std::string& name, const std::string& text, bool zero_ok) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(v))
+    throw std::invalid_argument(name + " = '" + text + "': not a number");
+  if (v < 0.0 || (v == 0.0 && !zero_ok))
+    throw std::invalid_argument(name + " = '" + text + "': must be " + (zero_ok ? ">= 0" : "> 0"));
+  return v;
+}
+
+}  // namespace
+
+CaseSpec parse_command_line(const std::vector<std::string>& args) {
+  if (args.size() < 2) throw std::invalid_argument("expected at least SEED DIR");
+  CaseSpec spec;
+  const std::string& seed = args[0];
+  char* end = nullptr;
+  errno = 0;
+  spec.seed = std::strtoull(seed.c_str(), &end, 10);
+  if (seed.empty() || !std::isdigit(static_cast<unsigned char>(seed[0])) || *end != '\0' || errno == ERANGE)
+    throw std::invalid_argument("SEED = '" + seed + "': not a non-negative integer");
+  if (args.size() > 2) spec.duration = checked_number("DURATION_S", args[2], false);
+  if (args.size() > 3) {
+    std::stringstream ss(args[3]);
+    std::string e;
+    while (std::getline(ss, e, ','))
+      if (!e.empty() && e != "none") spec.hidden.push_back(e);
+  }
+  for (std::size_t a = 4; a < args.size(); ++a) {
+    const std::string& w = args[a];
+    if (w == "grinding") spec.grinding_process = true;
+    else if (w == "noform")
+      spec.form_deviation = false;  // the model's friction form: no transition, asymmetry or exponent change
+    else if (w == "onedir") spec.one_direction = true;
+    else if (w.rfind("periods=", 0) == 0) spec.ripple_periods = checked_number("periods", w.substr(8), true);
+    else if (w.rfind("bw=", 0) == 0) spec.bandwidth_hz = checked_number("bw", w.substr(3), true);
+    else throw std::invalid_argument("'" + w + "': expected one of grinding, noform, onedir, periods=P, bw=HZ");
+  }
+  return spec;
 }
 
 }  // namespace fdgen

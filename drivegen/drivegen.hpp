@@ -66,6 +66,13 @@ struct Generated {
 
 Generated generate(const CaseSpec& spec);
 
+/// The case of fd-drivegen's command line, its arguments after the program's name:
+///   SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] [bw=HZ]
+/// (DIR is the caller's). Every number is checked whole: throws std::invalid_argument, one line
+/// naming the argument and its value ("DURATION_S = '1x': not a number"), for a bad number, a
+/// word that is none of the above or fewer than two arguments.
+CaseSpec parse_command_line(const std::vector<std::string>& args);
+
 /// A seeded mix of n cases: about 12 % effect-free, every effect alone at least n/20 times, the
 /// rest pairs of distinct effects (not coulomb + stribeck, which is one Stribeck curve).
 std::vector<CaseSpec> standard_cases(int n, std::uint64_t seed);

@@ -6,39 +6,28 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "drivegen.hpp"
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr,
-                 "usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] [periods=P] "
-                 "[bw=HZ]\n");
-    return 2;
-  }
+  const std::vector<std::string> args(argv + 1, argv + argc);
   fdgen::CaseSpec spec;
-  spec.seed = std::strtoull(argv[1], nullptr, 10);
-  if (argc > 3) spec.duration = std::atof(argv[3]);
-  if (argc > 4) {
-    std::stringstream ss(argv[4]);
-    std::string e;
-    while (std::getline(ss, e, ','))
-      if (!e.empty() && e != "none") spec.hidden.push_back(e);
-  }
-  for (int a = 5; a < argc; ++a) {
-    const std::string w = argv[a];
-    if (w == "grinding") spec.grinding_process = true;
-    if (w == "noform")
-      spec.form_deviation = false;  // the model's friction form: no transition, asymmetry or exponent change
-    if (w == "onedir") spec.one_direction = true;
-    if (w.rfind("periods=", 0) == 0) spec.ripple_periods = std::atof(w.c_str() + 8);
-    if (w.rfind("bw=", 0) == 0) spec.bandwidth_hz = std::atof(w.c_str() + 3);
+  try {
+    spec = fdgen::parse_command_line(args);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr,
+                 "error: %s (usage: fd-drivegen SEED DIR [DURATION_S] [EFFECT[,EFFECT]] [grinding] [noform] [onedir] "
+                 "[periods=P] [bw=HZ])\n",
+                 e.what());
+    return 2;
   }
   try {
     const fdgen::Generated g = fdgen::generate(spec);
-    std::filesystem::create_directories(argv[2]);
-    const std::string dir = argv[2];
+    std::filesystem::create_directories(args[1]);
+    const std::string& dir = args[1];
     std::ofstream(dir + "/data.csv") << g.csv();
     std::ofstream(dir + "/model.yaml") << g.scenario_yaml;
     std::ofstream t(dir + "/truth.txt");

@@ -59,11 +59,8 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "with --key: the run's nonce, which binds the run id on the wire to this run (docs/security.md); "
                  "default: feeddrive-launch draws it, a plant started alone draws it, the others take the plant's")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
-  app.add_option_function<std::string>(
-         "--on-conflict", [&opt](const std::string& v) { opt.on_conflict = parse_conflict_policy(v); },
-         "a second, different message for a step: fail (default) or keep-first (count and log it)")
-      ->check(CLI::IsMember({"fail", "keep-first"}))
-      ->type_name("fail|keep-first");
+  tool::add_enum_option(app, "--on-conflict", opt.on_conflict,
+                        "a second, different message for a step: fail (default) or keep-first (count and log it)");
 }
 
 RunScenario load_run_scenario(const std::string& path, const NodeOptions& opt) {

@@ -35,12 +35,6 @@ struct Diff {
 
 }  // namespace
 
-ConflictPolicy parse_conflict_policy(const std::string& text) {
-  if (text == "fail") return ConflictPolicy::kFail;
-  if (text == "keep-first") return ConflictPolicy::kKeepFirst;
-  throw std::invalid_argument("--on-conflict " + text + ": expected fail or keep-first");
-}
-
 std::string differing_fields(const control_command_t& a, const control_command_t& b) {
   Diff d;
   d.i("seq", a.seq, b.seq);

@@ -50,7 +50,8 @@ std::vector<std::string> common_args(const NodeOptions& opt) {
   if (!opt.scenario_hash.empty()) a.insert(a.end(), {"--scenario-hash", opt.scenario_hash});
   if (!opt.key_file.empty()) a.insert(a.end(), {"--key", opt.key_file});
   if (!opt.key_file.empty() && opt.run_nonce != 0) a.insert(a.end(), {"--run-nonce", std::to_string(opt.run_nonce)});
-  if (opt.on_conflict == ConflictPolicy::kKeepFirst) a.insert(a.end(), {"--on-conflict", "keep-first"});
+  if (opt.on_conflict != ConflictPolicy::kFail)
+    a.insert(a.end(), {"--on-conflict", fields::enum_name(opt.on_conflict)});
   for (const std::string& set : opt.sets) a.insert(a.end(), {"--set", set});
   return a;
 }

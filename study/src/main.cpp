@@ -74,17 +74,10 @@ int main(int argc, char** argv) {
   app.add_flag("--retry-failed", o.retry_failed, "run again the cases that failed in an earlier run into DIR");
   app.add_flag("--list", o.list, "print the resolved cases and exit");
   app.add_flag("--quiet,-q", o.quiet, "no progress, print only errors");
-  // Not tool::run: every rank parses the same arguments, and only rank 0 (or the process alone)
-  // speaks; then the one mapping of every tool (tool::report).
+  // Not tool::run: every rank parses the same arguments (tool::parse), and only rank 0 (or the
+  // process alone) speaks; then the one mapping of every tool (tool::report).
   const bool speaks = !transport || transport->rank() == 0;
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (!speaks) return e.get_exit_code() == 0 ? 0 : 2;
-    if (e.get_exit_code() == 0) return app.exit(e);
-    return feeddrive::tool::report(
-        std::make_exception_ptr(feeddrive::BadInput(std::string(e.what()) + " (see --help)")));
-  }
+  if (const std::optional<int> rc = feeddrive::tool::parse(app, argc, argv, speaks)) return *rc;
   if (o.out.empty() && !o.list) {
     if (!speaks) return 2;
     return feeddrive::tool::report(

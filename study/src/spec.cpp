@@ -6,8 +6,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "feeddrive/common/text.hpp"
 #include "feeddrive/common/text_file.hpp"
@@ -135,11 +137,14 @@ GridAxis read_axis(const std::string& where, const YAML::Node& n) {
   return a;
 }
 
-Distribution distribution_from(const std::string& where, const std::string& s) {
-  if (s == "uniform") return Distribution::kUniform;
-  if (s == "normal") return Distribution::kNormal;
-  if (s == "lognormal") return Distribution::kLognormal;
-  fail(where, " = '" + s + "': expected one of uniform, normal, lognormal");
+// The enum named `name`, the value of `key` of `r`: "KEY = 'x': expected one of a, b, c" otherwise.
+template <typename E>
+E enum_named(const MapReader& r, const std::string& key, const std::string& name) {
+  try {
+    return fields::enum_from_name<E>(name);
+  } catch (const std::invalid_argument& e) {
+    r.fail(key, " = '" + name + "': " + e.what());
+  }
 }
 
 DrawSpec read_draw(const std::string& where, const YAML::Node& n) {
@@ -150,10 +155,11 @@ DrawSpec read_draw(const std::string& where, const YAML::Node& n) {
   MapReader r(n, where);
   r.known("key");  // read above; marked known
   r.known("keys");
-  d.distribution = distribution_from(where + ".distribution", r.required_string("distribution"));
+  d.distribution = enum_named<Distribution>(r, "distribution", r.required_string("distribution"));
   r.boolean("scale", d.scale);
   auto need = [&](const char* k, double& out) {
-    if (!r.has(k)) r.fail(k, std::string(": missing (required by distribution ") + to_string(d.distribution) + ")");
+    if (!r.has(k))
+      r.fail(k, std::string(": missing (required by distribution ") + fields::enum_name(d.distribution) + ")");
     r.number(k, out);
   };
   switch (d.distribution) {
@@ -276,16 +282,29 @@ ControllerEntry read_controller(const std::string& where, const YAML::Node& n, c
   return c;
 }
 
-}  // namespace
-
-const char* to_string(Distribution d) {
-  switch (d) {
-    case Distribution::kUniform: return "uniform";
-    case Distribution::kNormal: return "normal";
-    case Distribution::kLognormal: return "lognormal";
-  }
-  return "?";
+// Within one family each key is varied once, whatever its spelling (sim::canonical_key): a key
+// of two grid axes, or of an axis and a Monte Carlo parameter, would silently take only the
+// later's values. `sweep`: the axes are feeddrive-study's --sweep options, and are named so.
+void check_varied_once(const Family& f, const std::string& where, bool sweep) {
+  std::map<std::string, std::pair<std::string, std::string>> seen;  // canonical key -> (its varier, spelling)
+  const auto vary = [&](const std::string& varier, const std::string& key) {
+    const std::string c = sim::canonical_key(key);
+    const auto [it, fresh] = seen.emplace(c, std::make_pair(varier, key));
+    if (fresh) return;
+    const auto& [first, spelling] = it->second;
+    fail(where.empty() ? first + " " + spelling : where + ": " + first + " " + spelling,
+         " and " + varier + " " + key + (spelling != c || key != c ? " (both " + c + ")" : "") + ": one key " +
+             (sweep ? "swept" : "varied") + " twice in family '" + f.name + "' (give all its values in one " +
+             (sweep ? "--sweep)" : "axis or parameter)"));
+  };
+  for (std::size_t i = 0; i < f.grid.size(); ++i)
+    for (const std::string& k : f.grid[i].keys) vary(sweep ? "--sweep" : "grid[" + std::to_string(i) + "]", k);
+  for (std::size_t i = 0; i < f.monte_carlo.parameters.size(); ++i)
+    for (const std::string& k : f.monte_carlo.parameters[i].keys)
+      vary("monte_carlo.parameters[" + std::to_string(i) + "]", k);
 }
+
+}  // namespace
 
 long Study::family_cases(std::size_t f) const {
   long n = 1;
@@ -317,6 +336,7 @@ void Study::validate() const {
     const std::string where = "families[" + std::to_string(i) + "]";
     if (f.name.empty()) fail(where + ".name", ": must not be empty");
     if (!names.insert(f.name).second) fail(where + ".name", " = '" + f.name + "': used twice");
+    check_varied_once(f, where, false);
     long n = std::max(1L, f.monte_carlo.draws);
     for (const GridAxis& a : f.grid) {
       if (a.values.empty()) fail(where + ".grid", ": empty grid axis");
@@ -387,15 +407,9 @@ Study parse_study(const std::string& yaml_text, const std::string& base_dir, con
     }
     top.known("set");
     s.set = read_settings("set", root["set"]);
-    std::string model = "nominal";
+    std::string model = fields::enum_name(s.model);
     top.string("model", model);
-    if (model == "nominal") {
-      s.model = ModelRule::kNominal;
-    } else if (model == "follows_plant") {
-      s.model = ModelRule::kFollowsPlant;
-    } else {
-      fail("model", " = '" + model + "': expected nominal or follows_plant");
-    }
+    s.model = enum_named<ModelRule>(top, "model", model);
     top.known("controllers");
     const YAML::Node cs = root["controllers"];
     if (cs.IsDefined() && !cs.IsNull()) {
@@ -514,14 +528,10 @@ Study sweep_study(const std::string& scenario_path, const std::vector<GridAxis>&
       throw StudyError("--sweep takes a scenario file, not a study file (" + scenario_path + " has " + study_keys +
                        ")");
   }
-  for (std::size_t i = 0; i < axes.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      for (const std::string& k : axes[i].keys)
-        if (std::find(axes[j].keys.begin(), axes[j].keys.end(), k) != axes[j].keys.end())
-          throw StudyError("--sweep " + k + ": the key is swept twice (give all its values in one --sweep)");
   s.base_dir = p.parent_path().empty() ? "." : p.parent_path().string();
   s.controllers.push_back({"base", "", {}, {}});
   s.families.push_back(Family{"sweep", {}, axes, {}});
+  check_varied_once(s.families.back(), "", true);  // named as the --sweep options (validate() would say grid[i])
   try {
     s.validate();
   } catch (const std::invalid_argument& e) {

@@ -22,6 +22,12 @@ KNOWN = {"sim", "launch", "plant", "controller", "trajectory", "monitor", "log2c
 SHARED = "Options of every run process"
 
 
+def tool_names(bindir):
+    """Every feeddrive-* executable in bindir, without the prefix: "sim", "study", ..."""
+    return sorted(p.name[len("feeddrive-"):] for p in Path(bindir).glob("feeddrive-*")
+                  if p.is_file() and os.access(p, os.X_OK))
+
+
 def help_options(exe):
     out = subprocess.run([str(exe), "--help"], capture_output=True, text=True, timeout=60)
     if out.returncode != 0:
@@ -53,8 +59,7 @@ def main():
     page = src / "docs" / "cli.md"
     sections = doc_sections(page)
     failures = []
-    tools = sorted(p.name[len("feeddrive-"):] for p in bindir.glob("feeddrive-*")
-                   if p.is_file() and os.access(p, os.X_OK))
+    tools = tool_names(bindir)
     for t in sorted(KNOWN - set(tools)):
         failures.append(f"{bindir}/feeddrive-{t} does not exist")
     for heading in sorted(h for h in sections if h.startswith("feeddrive-")):

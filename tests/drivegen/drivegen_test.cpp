@@ -5,6 +5,9 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "drivegen.hpp"
 
@@ -105,6 +108,41 @@ TEST(DriveGen, StandardCasesCoverEveryEffectPairsAndEffectFreeRecords) {
   EXPECT_GE(free, 10);
   EXPECT_GE(pairs, 20);
   for (const auto& e : fdgen::vocabulary()) EXPECT_GE(alone[e], 5) << e;
+}
+
+}  // namespace
+
+namespace {
+
+// fd-drivegen's command line: every number checked whole (atof once read "1x" as 1 and "abc" as
+// 0), every word known; one line naming the argument and its value.
+TEST(DriveGen, TheCommandLineIsCheckedWhole) {
+  const fdgen::CaseSpec s =
+      fdgen::parse_command_line({"7", "dir", "2.5", "cogging_ripple,none", "onedir", "periods=1.6", "bw=40"});
+  EXPECT_EQ(s.seed, 7u);
+  EXPECT_EQ(s.duration, 2.5);
+  EXPECT_EQ(s.hidden, std::vector<std::string>{"cogging_ripple"});
+  EXPECT_TRUE(s.one_direction);
+  EXPECT_EQ(s.ripple_periods, 1.6);
+  EXPECT_EQ(s.bandwidth_hz, 40.0);
+  const auto error = [](const std::vector<std::string>& args) {
+    try {
+      fdgen::parse_command_line(args);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error({"x1", "dir"}), "SEED = 'x1': not a non-negative integer");
+  EXPECT_EQ(error({"-1", "dir"}), "SEED = '-1': not a non-negative integer");
+  EXPECT_EQ(error({"99999999999999999999999", "dir"}), "SEED = '99999999999999999999999': not a non-negative integer");
+  EXPECT_EQ(error({"1", "dir", "1x"}), "DURATION_S = '1x': not a number");
+  EXPECT_EQ(error({"1", "dir", "0"}), "DURATION_S = '0': must be > 0");
+  EXPECT_EQ(error({"1", "dir", "1", "none", "periods=abc"}), "periods = 'abc': not a number");
+  EXPECT_EQ(error({"1", "dir", "1", "none", "bw=-5"}), "bw = '-5': must be >= 0");
+  EXPECT_EQ(error({"1", "dir", "1", "none", "grindng"}),
+            "'grindng': expected one of grinding, noform, onedir, periods=P, bw=HZ");
+  EXPECT_EQ(error({"1"}), "expected at least SEED DIR");
 }
 
 }  // namespace

@@ -194,7 +194,10 @@ TEST(NodeAdmit, ConflictFailsByDefaultOrKeepsTheFirst) {
   EXPECT_TRUE(keep_node.admit(ledger2, "FD_CMD", 3, command(3, 0.5)));
   EXPECT_FALSE(keep_node.admit(ledger2, "FD_CMD", 3, command(3, 3.0)));
   EXPECT_EQ(keep_node.conflicts, 1);
-  EXPECT_THROW(parse_conflict_policy("ignore"), std::invalid_argument);
+  // --on-conflict's names are its one table (fields::enum_names): read, written, listed.
+  EXPECT_EQ(fields::enum_from_name<ConflictPolicy>("keep-first"), ConflictPolicy::kKeepFirst);
+  EXPECT_STREQ(fields::enum_name(ConflictPolicy::kFail), "fail");
+  EXPECT_THROW(fields::enum_from_name<ConflictPolicy>("ignore"), std::invalid_argument);
 }
 
 // An observer's failure never stops a run: a "monitor-attached" (or any role outside the run)

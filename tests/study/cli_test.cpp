@@ -152,7 +152,15 @@ TEST(StudyCli, BadStudiesAndFoldersExit2WithOneLine) {
   const fs::path mc = write_file(
       "mc.yaml", feeddrive::study::test::study_text("families:\n  - name: f\n    monte_carlo: {draws: 2, seed: 1, "
                                                     "parameters: [{key: plant.mass, distribution: weibull}]}\n"));
-  EXPECT_NE(one_line(study(mc.string() + " --out " + (scratch() / "x").string())).find("distribution = 'weibull'"),
+  EXPECT_NE(one_line(study(mc.string() + " --out " + (scratch() / "x").string()))
+                .find("distribution = 'weibull': expected one of uniform, normal, lognormal"),
+            std::string::npos);
+  // A key of two axes of one family (review of issue 22): once exit 0 and duplicate cases.
+  const fs::path twice = write_file(
+      "twice.yaml", feeddrive::study::test::study_text("families:\n  - {name: f, grid: [{key: plant.mass, values: "
+                                                       "[100, 120]}, {key: plant.mass, values: [3]}]}\n"));
+  EXPECT_NE(one_line(study(twice.string() + " --out " + (scratch() / "x").string()))
+                .find("families[0]: grid[0] plant.mass and grid[1] plant.mass: one key varied twice in family 'f'"),
             std::string::npos);
   EXPECT_NE(one_line(study((scratch() / "missing.yaml").string() + " --out " + (scratch() / "x").string()))
                 .find("cannot read the study file"),
@@ -289,7 +297,13 @@ TEST(StudyCli, SweepRefusesAStudyFileAndAKeySweptTwice) {
            {st.string() + " --sweep plant.mass=1,2",
             "--sweep takes a scenario file, not a study file (" + st.string() + " has base/families)"},
            {scen + " --sweep plant.mass=80,100 --sweep plant.mass=1,2",
-            "--sweep plant.mass: the key is swept twice"}}) {
+            "--sweep plant.mass and --sweep plant.mass: one key swept twice in family 'sweep'"},
+           // The old spelling of the key is the key: once 2 cases, both with 3, and exit 0.
+           {scen + " --sweep plant.effects.cogging_ripple.amplitude_N=1,2 --sweep "
+                   "plant.effects.cogging_ripple.cogging_amplitude=3",
+            "--sweep plant.effects.cogging_ripple.amplitude_N and --sweep "
+            "plant.effects.cogging_ripple.cogging_amplitude (both plant.effects.cogging_ripple.cogging_amplitude): one "
+            "key swept twice in family 'sweep'"}}) {
     const ProcResult b = study(args + " --out " + (scratch() / "bad_sweep2").string());
     EXPECT_EQ(b.code, 2) << args << ": " << b.err;
     EXPECT_NE(b.err.find(expected), std::string::npos) << b.err;

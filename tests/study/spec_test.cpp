@@ -169,18 +169,76 @@ TEST(StudySpec, SweepRefusesAStudyFileAndAKeySweptTwice) {
               std::string::npos)
         << e.what();
   }
-  try {
-    sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.mass=1,2")});
-    ADD_FAILURE() << "a key swept twice was accepted";
-  } catch (const StudyError& e) {
-    EXPECT_EQ(std::string(e.what()), "--sweep plant.mass: the key is swept twice (give all its values in one --sweep)");
-  }
+  const auto sweep_error = [&](const std::vector<std::string>& sweeps) {
+    std::vector<GridAxis> axes;
+    for (const std::string& w : sweeps) axes.push_back(parse_sweep(w));
+    try {
+      sweep_study(scen, axes);
+    } catch (const StudyError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(sweep_error({"plant.mass=80,100", "plant.mass=1,2"}),
+            "--sweep plant.mass and --sweep plant.mass: one key swept twice in family 'sweep' (give all its values in "
+            "one --sweep)");
+  // The old spelling of a key is that key (sim::canonical_key): two cases both with 3 before.
+  EXPECT_EQ(
+      sweep_error({"plant.effects.cogging_ripple.amplitude_N=1,2", "plant.effects.cogging_ripple.cogging_amplitude=3"}),
+      "--sweep plant.effects.cogging_ripple.amplitude_N and --sweep "
+      "plant.effects.cogging_ripple.cogging_amplitude (both plant.effects.cogging_ripple.cogging_amplitude): "
+      "one key swept twice in family 'sweep' (give all its values in one --sweep)");
   // Different keys make a grid; a log sweep is marked for the report's log axis.
   const Study s =
       sweep_study(scen, {parse_sweep("plant.mass=80,100"), parse_sweep("plant.sensor.quantization=log:1e-9:1e-6:3")});
   EXPECT_EQ(s.total_cases(), 6);
   EXPECT_FALSE(s.families[0].grid[0].log);
   EXPECT_TRUE(s.families[0].grid[1].log);
+}
+}  // namespace
+}  // namespace feeddrive::study
+
+namespace feeddrive::study {
+namespace {
+// Review of issue 22 (item 2): within one family a key is varied once, whatever its spelling, in
+// a study file as with --sweep: a key of two axes, or of an axis and a Monte Carlo parameter,
+// once exited 0 with duplicate cases (the later axis' values only).
+TEST(StudySpec, AKeyVariedTwiceInOneFamilyIsRefusedWhateverItsSpelling) {
+  const std::string fam = "families:\n  - name: f\n";
+  EXPECT_EQ(study_error(study_text(fam + "    grid: [{key: plant.mass, values: [100, 120]}, {key: plant.mass, "
+                                         "values: [3]}]\n")),
+            "s.yaml: families[0]: grid[0] plant.mass and grid[1] plant.mass: one key varied twice in family 'f' "
+            "(give all its values in one axis or parameter)");
+  EXPECT_EQ(study_error(study_text(fam + "    grid: [{keys: [plant.mass, plant.effects.cogging_ripple.amplitude_N], "
+                                         "values: [[1, 2]]}]\n    monte_carlo: {draws: 2, seed: 1, parameters: "
+                                         "[{key: plant.effects.cogging_ripple.cogging_amplitude, distribution: "
+                                         "uniform, low: 1, high: 2}]}\n")),
+            "s.yaml: families[0]: grid[0] plant.effects.cogging_ripple.amplitude_N and monte_carlo.parameters[0] "
+            "plant.effects.cogging_ripple.cogging_amplitude (both plant.effects.cogging_ripple.cogging_amplitude): "
+            "one key varied twice in family 'f' (give all its values in one axis or parameter)");
+  EXPECT_NE(study_error(study_text("families:\n  - name: a\n  - name: g\n    grid: [{keys: "
+                                   "[plant.effects.constant_force.force, plant.effects.constant_force.force_N], "
+                                   "values: [[1, 2]]}]\n"))
+                .find("families[1]: grid[0] plant.effects.constant_force.force and grid[0] "
+                      "plant.effects.constant_force.force_N (both plant.effects.constant_force.force)"),
+            std::string::npos);
+  // One key in two families is two families' cases, not a mistake.
+  const Study s = parse_study(study_text("families:\n  - {name: a, grid: [{key: plant.mass, values: [1, 2]}]}\n"
+                                         "  - {name: b, grid: [{key: plant.mass, values: [3]}]}\n"),
+                              ".", "s.yaml");
+  EXPECT_EQ(s.total_cases(), 3);
+}
+
+// Review of issue 22 (item 2): the study's enums are read and written through their one table.
+TEST(StudySpec, ModelAndDistributionAreEnumsOfOneTable) {
+  EXPECT_EQ(parse_study(study_text("model: follows_plant\n"), ".", "s.yaml").model, ModelRule::kFollowsPlant);
+  EXPECT_EQ(study_error(study_text("model: follow_plant\n")),
+            "s.yaml: model = 'follow_plant': expected one of nominal, follows_plant");
+  for (const auto& [d, name] : enum_names(Distribution{})) {
+    EXPECT_EQ(fields::enum_from_name<Distribution>(name), d);
+    EXPECT_STREQ(fields::enum_name(d), name);
+  }
+  EXPECT_EQ(fields::enum_choices<Distribution>(), "uniform, normal, lognormal");
 }
 }  // namespace
 }  // namespace feeddrive::study

@@ -81,24 +81,32 @@ int report(std::exception_ptr e, const std::string& interrupt_detail) {
   }
 }
 
-std::optional<int> parse(CLI::App& app, int argc, char** argv) {
+namespace {
+
+// The one line of a parse error. CLI11 checks the required options before the unknown ones: a
+// misspelt option would only read "scenario is required", and an argument it could not place
+// "The following argument was not expected: --bogus". The first argument it could not place
+// names the real mistake: an option the tool does not have, else an argument too many.
+std::string parse_error_line(CLI::App& app, const CLI::ParseError& e) {
+  const std::vector<std::string> extra = app.remaining(true);
+  const bool extras_only = dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr;
+  for (const std::string& a : extra)
+    if (a.size() > 1 && a[0] == '-') return a + ": no such option";
+  if (extra.empty()) return e.what();
+  return extra.front() + ": unexpected argument" + (extras_only ? std::string() : std::string("; ") + e.what());
+}
+
+}  // namespace
+
+std::optional<int> parse(CLI::App& app, int argc, char** argv, bool speak) {
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {  // one line, as for every bad input
-    // CLI11 checks the required options before the unknown ones: a misspelt option would only
-    // read "scenario is required". The arguments it could not place name the real mistake.
-    const std::vector<std::string> extra = app.remaining(true);
-    if (!extra.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr) {
-      const std::string& a = extra.front();
-      if (a.size() > 1 && a[0] == '-') std::fprintf(stderr, "error: %s: no such option (see --help)\n", a.c_str());
-      else std::fprintf(stderr, "error: %s: unexpected argument; %s (see --help)\n", a.c_str(), e.what());
-      return kExitBadInput;
-    }
-    std::fprintf(stderr, "error: %s (see --help)\n", e.what());
+  } catch (const CLI::ParseError& e) {
+    const bool help = e.get_exit_code() == 0;  // --help
+    if (!speak) return help ? 0 : kExitBadInput;
+    if (help) return app.exit(e);
+    std::fprintf(stderr, "error: %s (see --help)\n",
+                 parse_error_line(app, e).c_str());  // one line, as for every bad input
     return kExitBadInput;
   }
   return std::nullopt;

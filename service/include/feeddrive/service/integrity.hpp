@@ -21,8 +21,10 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/control_command_t.hpp"
 #include "feeddrive/drive_state_t.hpp"
 #include "feeddrive/reference_t.hpp"
@@ -34,8 +36,12 @@ enum class ConflictPolicy {
   kFail,       ///< default: the run fails with one line naming channel, step and fields
   kKeepFirst,  ///< keep the first message, drop the second; counted and logged each time
 };
-/// "fail" / "keep-first"; throws std::invalid_argument naming the value otherwise.
-ConflictPolicy parse_conflict_policy(const std::string& text);
+/// The names of --on-conflict (fields::enum_name, enum_from_name, enum_choices).
+inline const std::vector<std::pair<ConflictPolicy, const char*>>& enum_names(ConflictPolicy) {
+  static const std::vector<std::pair<ConflictPolicy, const char*>> k{{ConflictPolicy::kFail, "fail"},
+                                                                     {ConflictPolicy::kKeepFirst, "keep-first"}};
+  return k;
+}
 
 /// The fields of two messages for the same step that differ, comma-separated in declaration
 /// order ("u, u_unsaturated"); "" when identical. Doubles compare bit for bit (a re-published

@@ -38,9 +38,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/fields.hpp"
 
 namespace feeddrive::study {
 
@@ -65,7 +67,12 @@ struct GridAxis {
 };
 
 enum class Distribution { kUniform, kNormal, kLognormal };
-const char* to_string(Distribution d);
+/// The names of `distribution:` (fields::enum_name, enum_from_name, enum_choices).
+inline const std::vector<std::pair<Distribution, const char*>>& enum_names(Distribution) {
+  static const std::vector<std::pair<Distribution, const char*>> k{
+      {Distribution::kUniform, "uniform"}, {Distribution::kNormal, "normal"}, {Distribution::kLognormal, "lognormal"}};
+  return k;
+}
 
 /// A Monte Carlo parameter: one draw per case sets every key to the same number (with `scale`,
 /// each key is its nominal value times the draw).
@@ -122,6 +129,12 @@ enum class ModelRule {
   kNominal,       ///< the controller's model is the case without the plant.* variations
   kFollowsPlant,  ///< the scenario loader's rule: the model defaults to the (varied) plant
 };
+/// The names of `model:` (fields::enum_name, enum_from_name, enum_choices).
+inline const std::vector<std::pair<ModelRule, const char*>>& enum_names(ModelRule) {
+  static const std::vector<std::pair<ModelRule, const char*>> k{{ModelRule::kNominal, "nominal"},
+                                                                {ModelRule::kFollowsPlant, "follows_plant"}};
+  return k;
+}
 
 inline constexpr long kMaxCases = 1000000;
 

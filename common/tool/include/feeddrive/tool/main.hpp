@@ -9,9 +9,11 @@
 #include <exception>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "feeddrive/common/errors.hpp"
+#include "feeddrive/common/fields.hpp"
 #include "feeddrive/common/interrupt.hpp"
 
 namespace feeddrive::tool {
@@ -42,8 +44,31 @@ int report_interrupt(const interrupt::Interrupted& e, const std::string& detail 
 int report(std::exception_ptr e, const std::string& interrupt_detail = "");
 
 /// Parses the command line. nullopt: go on; else the exit code: 0 after --help, 2 after a parse
-/// error, reported in one line "error: <what> (see --help)".
-std::optional<int> parse(CLI::App& app, int argc, char** argv);
+/// error, reported in one line "error: <what> (see --help)"; an option the tool does not have is
+/// "error: --bogus: no such option (see --help)". speak = false prints nothing, neither help nor
+/// error (the MPI ranks but rank 0 of feeddrive-study: one process speaks).
+std::optional<int> parse(CLI::App& app, int argc, char** argv, bool speak = true);
+
+/// An option whose value is the name of an enum listed by enum_names (feeddrive/common/fields.hpp):
+/// read into `target` by fields::enum_from_name, its type shown as "a|b|c"; any other name is the
+/// parse error "--name = 'x': expected one of a, b, c" (exit 2).
+template <typename E>
+CLI::Option* add_enum_option(CLI::App& app, const std::string& name, E& target, const std::string& description) {
+  std::string choices;
+  for (const auto& [v, n] : enum_names(E{})) choices += (choices.empty() ? "" : "|") + std::string(n);
+  return app
+      .add_option_function<std::string>(
+          name,
+          [&target, name](const std::string& v) {
+            try {
+              target = fields::enum_from_name<E>(v);
+            } catch (const std::invalid_argument& e) {
+              throw CLI::ValidationError(name + " = '" + v + "': " + e.what());
+            }
+          },
+          description)
+      ->type_name(choices);
+}
 
 /// The one logging style: spdlog on stderr, "[HH:MM:SS.mmm] [name] [level] message"; quiet:
 /// warnings and errors only.
