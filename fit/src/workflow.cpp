@@ -787,7 +787,9 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
               FitResult& out) {
   out.floor = noise_floor(cx.rec, model, FloorOptions{cx.opt.stamp_error, cx.opt.replay_window});
   const double gap_final = out.replay_final.gap, force_final = out.force_rms_final;
-  const bool final_within = within_floor(out.floor, gap_final, force_final);
+  // Without plant.sensor the floor is a guess from the record (its smallest position step), which a
+  // record that never slows down makes large: it never gives an all-clear (issue 20's review).
+  const bool final_within = within_floor(out.floor, gap_final, force_final) && out.floor.from_scenario;
   const std::string floor_text = fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.0fx)",
                                      out.floor.gap * 1e6, out.floor.force, kFloorFactor);
   if (added.empty() && final_within) {
@@ -803,8 +805,13 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
   } else {
     out.verdict = Verdict::kUnexplained;
     out.conclusion = "unexplained discrepancy: " +
-                     fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) +
-                     floor_text;
+                     (out.floor.from_scenario || !within_floor(out.floor, gap_final, force_final)
+                          ? fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) +
+                                floor_text
+                          : fmt("gap %.4g um and force residual %.4g N RMS cannot be judged: the scenario gives no "
+                                "sensor (plant.sensor), so the noise floor is not known; give plant.sensor (the "
+                                "encoder's quantization and noise) to settle it",
+                                gap_final * 1e6, force_final));
     if (!added.empty())
       out.conclusion +=
           "; named:" + named_list(added, out) +

@@ -535,6 +535,18 @@ TEST(FitVerdict, ExplainedNoDiscrepancyAndTheirExitCodes) {
   EXPECT_EQ(jf["verdict"], "no_discrepancy") << jf["conclusion"];
   EXPECT_TRUE(jf["effects"].empty());
   EXPECT_NE(jf["conclusion"].get<std::string>().find("within its noise"), std::string::npos);
+  // The same record against a model without a sensor: the floor is a guess from the record (its
+  // smallest position step), so no all-clear: unexplained, exit 3, saying what would settle it.
+  const fs::path out3 = scratch() / "verdict_no_sensor";
+  const ProcResult n = run_fit("--scenario " + model4().string() + " --data " + free_data.string() + " --out " +
+                               out3.string() +
+                               " --position-column x_measured --no-plots -q --set plant.sensor.quantization=0"
+                               " --set plant.sensor.noise_stddev=0");
+  ASSERT_EQ(n.code, 3) << n.err << n.out;
+  const auto jn = findings(out3);
+  EXPECT_EQ(jn["verdict"], "unexplained") << jn["conclusion"];
+  EXPECT_NE(jn.dump().find("give plant.sensor"), std::string::npos) << jn.dump();
+  EXPECT_EQ(jn["conclusion"].get<std::string>().find("within its noise"), std::string::npos);
 }
 
 // The independent generator (fd-drivegen), as a user would run it: files on disk, the CLI.
