@@ -74,7 +74,27 @@ void check_time_scale(const MeasuredData& d, double T, double control_period) {
 // 3. the position scale: travel and speed a feed drive can have (kMaxTravel, kMaxSpeed). The
 // travel is the range between the 0.1th and 99.9th percentiles and the speed the 99th percentile:
 // an isolated outlier is no unit (it is named by the jump check, or by prepare()'s finiteness check).
-void check_position_scale(const MeasuredData& d) {
+// The position column holds whole numbers only (before its unit's factor): encoder counts, more
+// likely than a power of 1000 of a metre.
+bool whole_numbers(const MeasuredData& d) {
+  for (double x : d.x) {
+    const double r = x / d.position_factor;
+    if (std::abs(r - std::round(r)) > 1e-9 * std::max(1.0, std::abs(r))) return false;
+  }
+  return true;
+}
+
+// The hint for counts: the encoder's step from plant.sensor.quantization when the scenario gives it.
+std::string counts_hint(double quantization) {
+  return quantization > 0 ? fmt(": whole numbers: likely encoder counts (--units x=counts:%.6g, the step of "
+                                "plant.sensor.quantization)",
+                                quantization)
+                          : std::string(
+                                ": whole numbers: likely encoder counts (--units x=counts:STEP, STEP the "
+                                "encoder's step in m)");
+}
+
+void check_position_scale(const MeasuredData& d, double quantization) {
   const std::size_t n = d.size();
   std::vector<double> xs = d.x;
   std::sort(xs.begin(), xs.end());
@@ -92,7 +112,9 @@ void check_position_scale(const MeasuredData& d) {
                   fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
                       "%.3g m, %.3g m/s)",
                       travel, v99, kMaxTravel, kMaxSpeed) +
-                  (h.empty() ? ": is the position in metres?" : h));
+                  (whole_numbers(d) ? counts_hint(quantization)
+                   : h.empty()      ? ": is the position in metres?"
+                                    : h));
 }
 
 // The sample whose second difference |x''_k| (three-point, unequal steps) most exceeds the larger
@@ -168,7 +190,7 @@ void check_record(const MeasuredData& d, const plant::PlantParams& model, double
   const double T = d.median_period();
   check_time_steps(d, T);
   check_time_scale(d, T, control_period);
-  check_position_scale(d);
+  check_position_scale(d, model.sensor.quantization);
   check_position_jumps(d, model);
 }
 
@@ -211,7 +233,9 @@ void check_force_scale(const Record& rec, const plant::PlantParams& model) {
                       "and a friction)",
                       alpha, mass) +
                   (h.empty() ? ": is the input in the model's unit (N for a force, V for a command)?" : h) +
-                  (k > 0 ? std::string(", or the position is in larger units than declared") : std::string()));
+                  (k > 0   ? std::string(", or the position is in larger units than declared")
+                   : k < 0 ? std::string(", or the position is in smaller units than declared (mm read as m?)")
+                           : std::string()));
 }
 
 }  // namespace feeddrive::fit

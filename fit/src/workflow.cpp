@@ -804,14 +804,14 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
                       floor_text;
   } else {
     out.verdict = Verdict::kUnexplained;
-    out.conclusion = "unexplained discrepancy: " +
-                     (out.floor.from_scenario || !within_floor(out.floor, gap_final, force_final)
-                          ? fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) +
-                                floor_text
-                          : fmt("gap %.4g um and force residual %.4g N RMS cannot be judged: the scenario gives no "
-                                "sensor (plant.sensor), so the noise floor is not known; give plant.sensor (the "
-                                "encoder's quantization and noise) to settle it",
-                                gap_final * 1e6, force_final));
+    out.conclusion =
+        "unexplained discrepancy: " +
+        (out.floor.from_scenario || !within_floor(out.floor, gap_final, force_final)
+             ? fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) + floor_text
+             : fmt("gap %.4g um and force residual %.4g N RMS cannot be judged: the scenario gives no "
+                   "sensor (plant.sensor), so the noise floor is not known; give plant.sensor (the "
+                   "encoder's quantization and noise) to settle it",
+                   gap_final * 1e6, force_final));
     if (!added.empty())
       out.conclusion +=
           "; named:" + named_list(added, out) +

@@ -538,10 +538,10 @@ TEST(FitVerdict, ExplainedNoDiscrepancyAndTheirExitCodes) {
   // The same record against a model without a sensor: the floor is a guess from the record (its
   // smallest position step), so no all-clear: unexplained, exit 3, saying what would settle it.
   const fs::path out3 = scratch() / "verdict_no_sensor";
-  const ProcResult n = run_fit("--scenario " + model4().string() + " --data " + free_data.string() + " --out " +
-                               out3.string() +
-                               " --position-column x_measured --no-plots -q --set plant.sensor.quantization=0"
-                               " --set plant.sensor.noise_stddev=0");
+  const ProcResult n =
+      run_fit("--scenario " + model4().string() + " --data " + free_data.string() + " --out " + out3.string() +
+              " --position-column x_measured --no-plots -q --set plant.sensor.quantization=0"
+              " --set plant.sensor.noise_stddev=0");
   ASSERT_EQ(n.code, 3) << n.err << n.out;
   const auto jn = findings(out3);
   EXPECT_EQ(jn["verdict"], "unexplained") << jn["conclusion"];
@@ -778,6 +778,16 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   };
   expect_data_error("pos_mm.csv", make(1, 1e3, 1, 0, 0),
                     {"column 'x'", "beyond a feed drive", "likely in mm (--units x=mm)"});
+  // Encoder counts (whole numbers) are named as counts with the scenario's encoder step, not as a
+  // power of 1000 of a metre (issue 20's review: "likely in um" was 9.4x off).
+  expect_data_error("pos_counts.csv",
+                    derived({"t", "x", "force_N"},
+                            [](const auto& c, std::size_t k) {
+                              return std::vector<std::string>{g17(num(c.at("t")[k])),
+                                                              g17(std::round(num(c.at("x_measured")[k]) / 5e-8)),
+                                                              g17(num(c.at("f_thrust")[k]))};
+                            }),
+                    {"column 'x'", "whole numbers: likely encoder counts (--units x=counts:5e-08"});
   expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0),
                     {"column 't'", "control period", "likely in ms (--units t=ms)"});
   expect_data_error("force_kN.csv", make(1, 1, 1e-3, 0, 0), {"column 'force_N'", "likely in kN (--units force=kN)"});
