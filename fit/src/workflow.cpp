@@ -674,6 +674,43 @@ bool run_step(const Context& cx, Search& s, StepResult& st) {
   return true;
 }
 
+// The swap move on the final model (issue 20's review): an effect named in an earlier step that
+// the later refits (a later step's joint fit, the model form) collapsed into a simpler one, so that
+// its fitted values are now implausible (a spring without slope, its rest position far outside the
+// travel), is replaced by its simpler form and the model refitted jointly (swap_move), as a swap
+// within a step is; kept when the refit is valid and the model replays. One at a time, until none.
+void final_swaps(const Context& cx, Search& s) {
+  for (std::size_t round = 0; round < s.added.size(); ++round) {
+    bool swapped = false;
+    for (const std::string& name : s.added) {
+      const Effect e = effect_of(s.current, name);
+      if (implausible(cx.env, s.current, e).empty() || !simpler_form(e, cx.x_mean).has_value()) continue;
+      JointFit jf{s.current};
+      FreeSet fs = s.free;
+      CandidateFit c;
+      if (!swap_move(cx, name, jf, fs, c)) continue;
+      Replay rp;
+      try {
+        rp = replay(cx.rec, jf.params, cx.opt.replay_window, cx.opt.stop);
+      } catch (const std::exception&) {  // the simpler model cannot be replayed: keep the effect
+        continue;
+      }
+      s.current = jf.params;
+      s.free = fs;
+      s.tentative.erase(name);
+      s.added.erase(std::find(s.added.begin(), s.added.end(), name));
+      for (const std::string& f : s.free.effects)
+        if (!contains(s.added, f)) s.added.push_back(f);
+      refresh(cx, s);
+      s.rp = rp;
+      cx.say("swap: " + c.swap + " (the final model)");
+      swapped = true;
+      break;
+    }
+    if (!swapped) return;
+  }
+}
+
 // The fitted model and what the search named into out: the final metrics, the named effects with
 // their 95 % intervals and caveats, and the ties that no later step resolved (the other candidate
 // was not named after all).
@@ -856,6 +893,7 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
     if (!added) break;
     ++additions;
   }
+  final_swaps(cx, s);
   collect(cx, model, s, out);
   conclude(cx, model, s.added, out);
   return out;

@@ -666,6 +666,18 @@ TEST(FitVerdict, BorderlinePitchIsTentativeAndASpringWithoutSlopeIsSwapped) {
 // two periods), and a spring, whose slope matches the sinusoid over part of the travel, scored 51
 // against the ripple's ~3000 and was named before. Now the spring is passed over as the ripple's
 // stand-in, and the verdict is unexplained with what would settle it.
+// The swap on the final model (issue 20's review): on a one-direction record of a hidden constant
+// force, the spring named at step 1 collapses under the model form's refit into a force without
+// slope (its rest position metres outside the travel, implausible); it is swapped for the
+// constant force it has become, and the spring is not named.
+TEST(FitVerdict, ASpringCollapsedByTheLastRefitsIsSwappedForItsConstantForce) {
+  const GeneratedFit g = generate_and_fit("swap_final", "1554002451 10 constant_force onedir");
+  ASSERT_TRUE(g.run.code == 0 || g.run.code == 3) << g.run.err;
+  std::vector<std::string> named;
+  for (const auto& e : g.findings["effects"]) named.push_back(e["name"]);
+  EXPECT_EQ(named, std::vector<std::string>{"constant_force"}) << g.findings["conclusion"];
+}
+
 TEST(FitVerdict, ASpringIsNotNamedForARippleSeenOverFewerThanTwoPeriods) {
   using namespace issue20;
   const GeneratedFit g =
