@@ -461,6 +461,12 @@ void controller_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
   }
   if (rest.rfind("model", 0) == 0 && (rest.size() == 5 || rest[5] == '.') && cc.type != ControllerType::kOpenLoop)
     return model_key(s, rest.size() > 5 ? rest.substr(6) : "", v);
+  // An unknown key gets the hint of every key the section takes for its type (as the file's reader).
+  if (std::vector<std::string> names = controller_names(cc, cc.type);
+      std::find(names.begin(), names.end(), rest.substr(0, rest.find('.'))) == names.end()) {
+    for (const std::string& n : names_of(cc)) names.push_back(n);
+    unknown("controller", rest.substr(0, rest.find('.')), names);
+  }
   switch (cc.type) {
     case ControllerType::kSlidingMode: return set_value(cc.sliding_mode, "controller", rest, v);
     case ControllerType::kCascade:
@@ -500,8 +506,12 @@ void reference_key(Scenario& s, const std::string& rest, const YAML::Node& v) {
     c.waypoints_file = detail::resolved_file(s.base_dir, c.waypoints_file);
     return;
   }
-  if (c.type == ReferenceType::kNone || c.type == ReferenceType::kWaypoints)
-    unknown("reference", rest.substr(0, rest.find('.')), reference_names(c, c.type));
+  // An unknown key gets the hint of every key the section takes for its type (as the file's reader).
+  if (std::vector<std::string> names = reference_names(c, c.type);
+      std::find(names.begin(), names.end(), rest.substr(0, rest.find('.'))) == names.end()) {
+    for (const std::string& n : names_of(c)) names.push_back(n);
+    unknown("reference", rest.substr(0, rest.find('.')), names);
+  }
   detail::with_reference_params(c, c.type, [&](auto& p) { set_value(p, "reference", rest, v); });
 }
 
@@ -616,6 +626,13 @@ void set_read_key(Scenario& s, const std::string& key, const std::string& value)
 }
 
 void set_read_keys(Scenario& s, const std::vector<KeySetting>& sets) {
+  // One key in both spellings is refused, as in a file (set_map).
+  std::map<std::string, std::string> spelled;  // canonical key -> as written
+  for (const KeySetting& k : sets) {
+    const auto [it, fresh] = spelled.emplace(canonical_key(k.key), k.key);
+    if (!fresh && it->second != k.key)
+      throw ScenarioError(both_spellings_error(it->second == it->first ? k.key : it->second, it->first));
+  }
   std::vector<KeySetting> ordered = sets;
   std::stable_sort(ordered.begin(), ordered.end(),
                    [](const KeySetting& a, const KeySetting& b) { return rank(a.key) < rank(b.key); });

@@ -175,21 +175,21 @@ CheckedStudy check_study(const Options& o, Transport* t) {
 
 // --list: the resolved cases, one line each.
 void list_cases(const CheckedStudy& c, const interrupt::StopToken& stop, Reporter& reporter) {
+  // A case that does not resolve throws its typed error (StudyError, ScenarioError: bad input, exit
+  // 2); any other error is the tool's own and reaches its exit code as such.
   reporter.listed(std::to_string(c.total) + " cases");
-  try {
-    for (std::size_t i = 0; i < c.total; ++i) {
-      stop.check();
-      const CaseSpec cs = case_at(c.study, i);
-      const ResolvedCase r = c.resolver->resolve(cs);
-      std::string line = std::to_string(i) + " " + r.hash.substr(0, 16) + " " +
-                         c.study.controllers[cs.controller].name + " " + c.study.families[cs.family].name;
-      for (const auto& v : cs.variations) line += " " + v.key + "=" + r.parameters.at(v.key);
-      reporter.listed(line);
+  for (std::size_t i = 0; i < c.total; ++i) {
+    stop.check();
+    const CaseSpec cs = case_at(c.study, i);
+    const ResolvedCase r = c.resolver->resolve(cs);
+    std::string line = std::to_string(i) + " " + r.hash.substr(0, 16) + " " + c.study.controllers[cs.controller].name +
+                       " " + c.study.families[cs.family].name;
+    // The parameters are keyed by the canonical spelling (varied_keys); the line shows the key as written.
+    for (const auto& v : cs.variations) {
+      const auto it = r.parameters.find(sim::canonical_key(v.key));
+      line += " " + v.key + "=" + (it == r.parameters.end() ? std::string("?") : it->second);
     }
-  } catch (const interrupt::Interrupted&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw BadInput(e.what());
+    reporter.listed(line);
   }
 }
 

@@ -155,6 +155,17 @@ TEST(Fields, TopLevelKeysComeFromTheList) {
             "analysis.settling_band = -1: must be >= 0");
   EXPECT_EQ(thrown([&] { set_read_key(s, "output", "{every: 2}"); }),
             "output = {every: 2}: a whole section is not set at once: set its keys (e.g. output.every=10)");
+  // --set's unknown keys get the hint of every key the section takes, as the file's reader gives.
+  EXPECT_EQ(thrown([&] { set_read_key(s, "controller.computation_dely", "1e-4"); }),
+            "controller.computation_dely: unknown key (did you mean 'computation_delay'?)");
+  EXPECT_EQ(thrown([&] { set_read_key(s, "reference.tpye", "sine"); }),
+            "reference.tpye: unknown key (did you mean 'type'?)");
+  // One key in both spellings, in two settings, is refused as in a file.
+  EXPECT_NE(thrown([&] {
+              set_read_keys(s, {{"plant.effects.cogging_ripple.amplitude_N", "3"},
+                                {"plant.effects.cogging_ripple.cogging_amplitude", "2"}});
+            }).find("cogging_amplitude"),
+            std::string::npos);
   s = read_scenario(good);  // a failed setting leaves its value: the caller stops (exit 2)
   set_read_key(s, "output.every", "5");
   set_read_key(s, "analysis.settled_after", "0.1");

@@ -259,6 +259,7 @@ TEST(StudyCli, SweepWithoutAStudyFileReportsTheMetricAgainstEachValue) {
     EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
   }
 }
+
 }  // namespace
 
 namespace {
@@ -309,5 +310,20 @@ TEST(StudyCli, SweepRefusesAStudyFileAndAKeySweptTwice) {
     EXPECT_NE(b.err.find(expected), std::string::npos) << b.err;
     EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
   }
+}
+
+// --list with a key in its old spelling: the cases are listed with the values (issue 22's review:
+// the lookup by the written spelling failed with "error: map::at", exit 2).
+TEST(StudyCli, ListShowsAnOldSpellingsValues) {
+  const std::string scen = feeddrive::study::test::scenarios() + "/smc_bl_jerk_limited.yaml";
+  const fs::path out = scratch() / "list_old_spelling.txt";
+  const int status = std::system(
+      (kStudy + " " + scen + " --list --sweep plant.effects.cogging_ripple.amplitude_N=1,2 > " + out.string() + " 2>&1")
+          .c_str());
+  const std::string text = slurp(out);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << text;
+  EXPECT_NE(text.find("plant.effects.cogging_ripple.amplitude_N=1"), std::string::npos) << text;
+  EXPECT_NE(text.find("plant.effects.cogging_ripple.amplitude_N=2"), std::string::npos) << text;
+  EXPECT_EQ(text.find("map::at"), std::string::npos) << text;
 }
 }  // namespace
