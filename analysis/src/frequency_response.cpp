@@ -256,7 +256,7 @@ void FrequencyResponseOptions::validate(const sim::Scenario& s) const {
   if (!(settle_cycles >= 0.0) || !(settle_time >= 0.0) || !std::isfinite(settle_time))
     bad("--fr-settle", settle_time, "must be >= 0 and finite [s]");
   if (block_cycles < 1) bad("block_cycles", block_cycles, "must be >= 1");
-  if (jobs < 1 || jobs > 256) bad("--jobs", jobs, "must be 1 to 256");
+  if (jobs < 1 || jobs > 256) bad("--jobs", jobs, "is outside [1, 256]");
   // A frequency moved to whole cycles (M/(N T)) must stay below Nyquist: on it, sin(pi k) = 0.
   for (double f : requested(s)) {
     const PlanSize p = plan_size(f, s.control_period, *this);

@@ -30,22 +30,6 @@ struct Args {
   bool no_plots = false, quiet = false;
 };
 
-// A finite number in [lo, hi] (CLI::Range lets NaN through), or exactly 0 where `zero` says so.
-CLI::Validator within(double lo, double hi, bool zero) {
-  return CLI::Validator(
-      [=](std::string& s) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return "'" + s + "' is not a finite number";
-        if (zero && v == 0.0) return "";
-        if (v < lo || v > hi)
-          return "'" + s + "' is outside [" + validate::format_number(lo) + ", " + validate::format_number(hi) + "]" +
-                 (zero ? " (or 0 for the default)" : "");
-        return "";
-      },
-      "");
-}
-
 // The model, the data and the output folder.
 void add_input_options(CLI::App& app, Args& a) {
   app.add_option("--scenario,-s", a.scenario_path, "the model: a feeddrive scenario YAML")->required();
@@ -63,26 +47,26 @@ void add_input_options(CLI::App& app, Args& a) {
 void add_search_options(CLI::App& app, fit::FitOptions& opt) {
   app.add_option("--max-effects", opt.max_effects, "most effects to add")
       ->capture_default_str()
-      ->check(CLI::Range(0, 11));
+      ->check(tool::within(0, 11, true));
   app.add_option("--score-threshold", opt.score_threshold, "least BIC score of a significant effect")
       ->capture_default_str()
-      ->check(within(0.0, 1e9, false));
+      ->check(tool::within(0.0, 1e9, false, false));
   app.add_option("--min-gap-reduction", opt.min_gap_reduction,
                  "least fraction by which an effect must shrink the replay gap")
       ->capture_default_str()
-      ->check(within(0.0, 0.99, false));
+      ->check(tool::within(0.0, 0.99, false, false));
   app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")
       ->capture_default_str()
-      ->check(within(1e-3, 1e3, true));
+      ->check(tool::within(1e-3, 1e3, false, true));
   app.add_option("--filter-half-width", opt.record.filter_half_width,
                  "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
       ->capture_default_str()
-      ->check(within(1e-5, 10.0, true));
+      ->check(tool::within(1e-5, 10.0, false, true));
   app.add_option(
          "--time-stamp-error", opt.stamp_error,
          "standard deviation of the record's time stamps [s], for the noise floor (0: not known, not in the floor)")
       ->capture_default_str()
-      ->check(within(1e-12, 1e-2, true));
+      ->check(tool::within(1e-12, 1e-2, false, true));
 }
 
 // The record's layout: the channel prefix of a log, the columns, separator and units of a CSV.
@@ -117,7 +101,7 @@ void add_other_options(CLI::App& app, Args& a) {
       ->check(CLI::IsMember(plant::effect_names()));
   app.add_option("--cv-folds", a.opt.cv_folds, "blocks of time of the out-of-sample check")
       ->capture_default_str()
-      ->check(CLI::Range(2, 50));
+      ->check(tool::within(2, 50, true));
   app.add_flag(
       "--no-form-fit", [&a](std::int64_t) { a.opt.fit_form = false; }, "keep the model's Coulomb transition velocity");
   app.add_flag("--no-plots", a.no_plots, "skip the PNG plots");

@@ -35,19 +35,19 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
                  "lockstep: at most this many steps per second (0: unpaced); the stock lcm-logger records "
                  "without loss at 1000 (docs/lcm-contract.md)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(tool::within(0, 1e300));
   app.add_option("--max-bad-commands", opt.max_bad_commands,
                  "real time: missed or invalid commands in a row before the plant goes to zero thrust")
       ->capture_default_str();
   app.add_option("--spin-us", opt.realtime_spin_us,
                  "real time: busy-wait this many us before each period start (timer wake-up latency)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1000));
+      ->check(tool::within(0, 1000));
   app.add_flag("--quiet,-q", opt.quiet, "log only warnings and errors");
   app.add_option("--run-id", opt.run_id,
                  "identity of the run (nonzero; docs/security.md); default: the plant draws one, the others join "
                  "the plant's")
-      ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+      ->check(tool::within(1, 9.2e18, true));
   app.add_option("--scenario-hash", opt.scenario_hash,
                  "hex SHA-256 of the scenario file as the launcher read it (run_info_t.scenario_hash; feeddrive-launch "
                  "passes it)")
@@ -58,7 +58,7 @@ void add_node_options(CLI::App& app, NodeOptions& opt) {
   app.add_option("--run-nonce", opt.run_nonce,
                  "with --key: the run's nonce, which binds the run id on the wire to this run (docs/security.md); "
                  "default: feeddrive-launch draws it, a plant started alone draws it, the others take the plant's")
-      ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
+      ->check(tool::within(1, 9.2e18, true));
   tool::add_enum_option(app, "--on-conflict", opt.on_conflict,
                         "a second, different message for a step: fail (default) or keep-first (count and log it)");
 }

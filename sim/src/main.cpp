@@ -41,7 +41,9 @@ void add_frequency_response_options(CLI::App& app, analysis::FrequencyResponseOp
   app.add_option("--fr-velocity", fr.feed_velocity, "constant feed velocity under the excitation [m/s]")
       ->capture_default_str();
   app.add_option("--fr-settle", fr.settle_time, "least settling time dropped per frequency [s]")->capture_default_str();
-  app.add_option("--jobs,-j", fr.jobs, "frequencies measured in parallel")->capture_default_str();
+  app.add_option("--jobs,-j", fr.jobs, "frequencies measured in parallel")
+      ->check(tool::within(1, 256, true))
+      ->capture_default_str();
 }
 
 // --frequency-response: measures the closed loop's response, prints its table (unless quiet) and

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
   app.add_option("--out,-o", o.out, "output folder; a rerun into it skips the finished cases (not needed with --list)");
   app.add_option("-j,--jobs", o.jobs,
                  "worker threads (default: every core; per MPI rank: the host's cores / its ranks)")
-      ->check(CLI::Range(1, 4096));
+      ->check(feeddrive::tool::within(1, 4096, true));
   app.add_flag("--no-plots", no_plots, "skip the plots");
   app.add_flag("--retry-failed", o.retry_failed, "run again the cases that failed in an earlier run into DIR");
   app.add_flag("--list", o.list, "print the resolved cases and exit");

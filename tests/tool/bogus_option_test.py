@@ -36,6 +36,23 @@ def main():
                 failures.append(f"feeddrive-{tool} {' '.join(args)}: exit {r.returncode}, stderr {r.stderr!r}, "
                                 f"stdout {r.stdout[:200]!r}; expected exit 2 and {EXPECTED!r}")
         print(f"feeddrive-{tool}: checked")
+    # A numeric option's bad value: one wording in every tool (tool::within), not CLI11's own.
+    for tool, args, line in (
+            ("sim", ["x.yaml", "--frequency-response", "-j", "abc"], "error: --jobs: 'abc' is not a finite number"),
+            ("sim", ["x.yaml", "--frequency-response", "-j", "0"], "error: --jobs: '0' is outside [1, 256]"),
+            ("study", ["x.yaml", "-j", "1.5"], "error: --jobs: '1.5' is not an integer"),
+            ("study", ["x.yaml", "-j", "0"], "error: --jobs: '0' is outside [1, 4096]"),
+            ("fit", ["--scenario", "x", "--data", "y", "--out", "z", "--max-effects", "abc"],
+             "error: --max-effects: 'abc' is not a finite number"),
+            ("fit", ["--scenario", "x", "--data", "y", "--out", "z", "--score-threshold", "-1"],
+             "error: --score-threshold: '-1' is outside [0, 1e+09]")):
+        exe = bindir / f"feeddrive-{tool}"
+        if not exe.exists():
+            continue
+        r = run([exe] + args)
+        if r.returncode != 2 or not r.stderr.startswith(line) or r.stderr.count("\n") != 1:
+            failures.append(f"feeddrive-{tool} {' '.join(args)}: exit {r.returncode}, stderr {r.stderr!r}; "
+                            f"expected exit 2 and {line!r}")
     gen = bindir / "fd-drivegen"
     if gen.exists():
         with tempfile.TemporaryDirectory() as tmp:  # an fd-drivegen that took "1x" would write there

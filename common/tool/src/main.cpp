@@ -1,5 +1,10 @@
 #include "feeddrive/tool/main.hpp"
 
+#include <cmath>
+#include <cstdlib>
+
+#include "feeddrive/common/validate.hpp"
+
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -97,6 +102,22 @@ std::string parse_error_line(CLI::App& app, const CLI::ParseError& e) {
 }
 
 }  // namespace
+
+CLI::Validator within(double lo, double hi, bool integer, bool zero_default) {
+  return CLI::Validator(
+      [=](std::string& s) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return "'" + s + "' is not a finite number";
+        if (integer && v != std::floor(v)) return "'" + s + "' is not an integer";
+        if (zero_default && v == 0.0) return "";
+        if (v < lo || v > hi)
+          return "'" + s + "' is outside [" + validate::format_number(lo) + ", " + validate::format_number(hi) + "]" +
+                 (zero_default ? " (or 0 for the default)" : "");
+        return "";
+      },
+      "");
+}
 
 std::optional<int> parse(CLI::App& app, int argc, char** argv, bool speak) {
   try {

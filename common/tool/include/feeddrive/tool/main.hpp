@@ -70,6 +70,12 @@ CLI::Option* add_enum_option(CLI::App& app, const std::string& name, E& target, 
       ->type_name(choices);
 }
 
+/// The one range check of a numeric option, for every tool: a finite number (an integer where
+/// `integer`) in [lo, hi], or exactly 0 where `zero_default` (0 = the default). Otherwise the parse
+/// error "--name: '1.5' is not an integer" / "'abc' is not a finite number" / "'0' is outside
+/// [1, 256]" (exit 2); CLI::Range's wording and its NaN are not used.
+CLI::Validator within(double lo, double hi, bool integer = false, bool zero_default = false);
+
 /// The one logging style: spdlog on stderr, "[HH:MM:SS.mmm] [name] [level] message"; quiet:
 /// warnings and errors only.
 void setup_logging(const std::string& name, bool quiet);
