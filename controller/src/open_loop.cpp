@@ -9,7 +9,6 @@
 namespace feeddrive::controller {
 
 std::string to_string(OpenLoopKind k) { return fields::enum_name(k); }
-OpenLoopKind open_loop_kind_from_string(const std::string& s) { return fields::enum_from_name<OpenLoopKind>(s); }
 
 void OpenLoopParams::validate(const std::string& prefix) const {
   using namespace detail;

@@ -13,9 +13,7 @@
 namespace feeddrive::controller {
 
 std::string to_string(Switching s) { return fields::enum_name(s); }
-Switching switching_from_string(const std::string& s) { return fields::enum_from_name<Switching>(s); }
 std::string to_string(StateSource s) { return fields::enum_name(s); }
-StateSource state_source_from_string(const std::string& s) { return fields::enum_from_name<StateSource>(s); }
 
 void SlidingModeParams::validate(const std::string& prefix) const {
   using namespace detail;

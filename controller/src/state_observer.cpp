@@ -8,7 +8,6 @@
 namespace feeddrive::controller {
 
 std::string to_string(MotionSource s) { return fields::enum_name(s); }
-MotionSource motion_source_from_string(const std::string& s) { return fields::enum_from_name<MotionSource>(s); }
 
 StateObserver::StateObserver(double bandwidth, double period, bool with_disturbance, double quantization)
     : period_(period), half_cell_(0.5 * quantization) {

@@ -175,8 +175,8 @@ TEST(OpenLoop, ValidateAndNames) {
   expect_invalid(p, "controller.file: kind = csv needs a table of at least one row");
 
   for (OpenLoopKind k : {OpenLoopKind::kStep, OpenLoopKind::kSine, OpenLoopKind::kRamp, OpenLoopKind::kCsv})
-    EXPECT_EQ(open_loop_kind_from_string(to_string(k)), k);
-  EXPECT_THROW(open_loop_kind_from_string("square"), std::invalid_argument);
+    EXPECT_EQ(fields::enum_from_name<OpenLoopKind>(to_string(k)), k);
+  EXPECT_THROW(fields::enum_from_name<OpenLoopKind>("square"), std::invalid_argument);
 }
 
 }  // namespace

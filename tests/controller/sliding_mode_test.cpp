@@ -378,14 +378,14 @@ TEST(SlidingModeValidate, MessagesNameTheKeyAndValue) {
 
 TEST(SlidingModeValidate, EnumNamesRoundTrip) {
   for (Switching s : {Switching::kSign, Switching::kSaturation, Switching::kTanh})
-    EXPECT_EQ(switching_from_string(to_string(s)), s);
+    EXPECT_EQ(fields::enum_from_name<Switching>(to_string(s)), s);
   for (StateSource s : {StateSource::kTrue, StateSource::kObserver})
-    EXPECT_EQ(state_source_from_string(to_string(s)), s);
+    EXPECT_EQ(fields::enum_from_name<StateSource>(to_string(s)), s);
   for (MotionSource s : {MotionSource::kMeasured, MotionSource::kObserver})
-    EXPECT_EQ(motion_source_from_string(to_string(s)), s);
-  EXPECT_THROW(switching_from_string("sign"), std::invalid_argument);
-  EXPECT_THROW(state_source_from_string("estimated"), std::invalid_argument);
-  EXPECT_THROW(motion_source_from_string("encoder"), std::invalid_argument);
+    EXPECT_EQ(fields::enum_from_name<MotionSource>(to_string(s)), s);
+  EXPECT_THROW(fields::enum_from_name<Switching>("sign"), std::invalid_argument);
+  EXPECT_THROW(fields::enum_from_name<StateSource>("estimated"), std::invalid_argument);
+  EXPECT_THROW(fields::enum_from_name<MotionSource>("encoder"), std::invalid_argument);
 }
 
 }  // namespace

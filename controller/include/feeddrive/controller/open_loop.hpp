@@ -26,7 +26,6 @@ inline const std::vector<std::pair<OpenLoopKind, const char*>>& enum_names(OpenL
   return n;
 }
 std::string to_string(OpenLoopKind k);
-OpenLoopKind open_loop_kind_from_string(const std::string& s);  ///< "step"|"sine"|"ramp"|"csv"
 
 struct OpenLoopParams {
   OpenLoopKind kind{OpenLoopKind::kStep};

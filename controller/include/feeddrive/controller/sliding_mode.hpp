@@ -75,7 +75,6 @@ inline const std::vector<std::pair<Switching, const char*>>& enum_names(Switchin
   return n;
 }
 std::string to_string(Switching s);
-Switching switching_from_string(const std::string& s);  ///< "sgn" | "sat" | "tanh"
 
 /// Where the friction estimate F^f gets its bristle state.
 enum class StateSource {
@@ -88,7 +87,6 @@ inline const std::vector<std::pair<StateSource, const char*>>& enum_names(StateS
   return n;
 }
 std::string to_string(StateSource s);
-StateSource state_source_from_string(const std::string& s);  ///< "true" | "observer"
 
 struct SlidingModeParams {
   double eta{5.0};      ///< [m/s^2]

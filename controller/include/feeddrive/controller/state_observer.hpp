@@ -41,7 +41,6 @@ inline const std::vector<std::pair<MotionSource, const char*>>& enum_names(Motio
   return n;
 }
 std::string to_string(MotionSource s);
-MotionSource motion_source_from_string(const std::string& s);  ///< "measured" | "observer"
 
 class StateObserver {
  public:

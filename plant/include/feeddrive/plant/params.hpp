@@ -31,7 +31,6 @@ inline const std::vector<std::pair<FrictionModel, const char*>>& enum_names(Fric
 }
 std::string to_string(FrictionModel m);
 /// Parses "lugre" | "static" | "none"; throws std::invalid_argument otherwise.
-FrictionModel friction_model_from_string(const std::string& s);
 
 // Every struct below lists its keys once, in Serialize (common/fields.hpp): name, unit, validity
 // rule, plausible range for a linear feed drive, one line of meaning. The scenario reader,
