@@ -95,6 +95,10 @@ struct Field {
   Field alias(const char* old) const {
     return with([&](Meta& m) { m.alias = old; });
   }
+  /// The same field under another name (two keys of one kind, e.g. a range's two ends).
+  Field with_name(const char* n) const {
+    return with([&](Meta& m) { m.name = n; });
+  }
   /// The key has no default (Meta::required).
   Field required() const {
     return with([](Meta& m) { m.required = true; });

@@ -10,22 +10,11 @@ namespace feeddrive::controller::quantity {
 using fields::field;
 using fields::Field;
 
-/// The output saturation [V], lower: finite and < u_max (validate()'s require_range).
+/// The output saturation [V], lower and upper: finite, u_min < u_max (validate()'s require_range).
 inline Field<double> u_min(double& v) {
-  return field("u_min", v)
-      .unit("V")
-      .unchecked()
-      .plausible(-1000, 1000)
-      .doc("output saturation, lower; finite, < u_max");
+  return field("u_min", v).unit("V").unchecked().plausible(-1000, 1000).doc("output saturation, lower; < u_max");
 }
-/// The output saturation [V], upper: finite and > u_min.
-inline Field<double> u_max(double& v) {
-  return field("u_max", v)
-      .unit("V")
-      .unchecked()
-      .plausible(-1000, 1000)
-      .doc("output saturation, upper; finite, > u_min");
-}
+inline Field<double> u_max(double& v) { return u_min(v).with_name("u_max").doc("output saturation, upper; > u_min"); }
 
 /// gamma [1/s] of the feedforward adaptation (feedforward_adaptation.hpp); what it needs of the
 /// controller's other keys is checked, and named, by its validate().
