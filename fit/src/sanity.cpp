@@ -118,8 +118,9 @@ void check_position_scale(const MeasuredData& d, double quantization) {
 }
 
 // The sample whose second difference |x''_k| (three-point, unequal steps) most exceeds the larger
-// of 20x what the peak thrust gives the mass, 50x the sensor's own (a quantum and three noise
-// deviations per step) and 20x the record's own 99th percentile (one jump does not move it);
+// of 4x what the peak thrust gives the mass (a mass error of 2x and the friction's share stay
+// below it), 50x the sensor's own (a quantum and three noise deviations per step) and 5x the
+// record's own 99th percentile (one jump does not move it; jitter's tail stays within 2x of it);
 // 0 if none exceeds it.
 std::size_t find_jump(const MeasuredData& d, double peak, double mass, double sensor) {
   const std::size_t n = d.size();
@@ -134,7 +135,7 @@ std::size_t find_jump(const MeasuredData& d, double peak, double mass, double se
   for (std::size_t k = 1; k + 1 < n; ++k) {
     const double h0 = d.t[k] - d.t[k - 1], h1 = d.t[k + 1] - d.t[k];
     const double a = acc[k];
-    const double limit = std::max({20.0 * peak / mass, 50.0 * sensor / (h0 * h1), 20.0 * typical});
+    const double limit = std::max({4.0 * peak / mass, 50.0 * sensor / (h0 * h1), 5.0 * typical});
     if (a > limit && a / limit > jump_a) {
       jump = k;
       jump_a = a / limit;
@@ -161,7 +162,7 @@ std::size_t find_jump(const MeasuredData& d, double peak, double mass, double se
   const double before = k >= 2 ? d.x[k - 1] - d.x[k - 2] : 0.0, after = k + 1 < n ? d.x[k + 1] - d.x[k] : 0.0;
   const double size = d.x[k] - d.x[k - 1] - 0.5 * (before + after);
   throw DataError(d.where(k) + ": column '" + d.position_name + "'" +
-                  fmt(": the position jumps by %.4g mm in one sample (t = %.9g s), an acceleration beyond 20x what "
+                  fmt(": the position jumps by %.4g mm in one sample (t = %.9g s), an acceleration beyond 4x what "
                       "the peak thrust of %.4g N gives the %.4g kg mass",
                       size * 1e3, d.t[k] + d.time_offset, peak, mass) +
                   ": two recordings joined, or an encoder glitch? The fit needs one continuous recording: split the "

@@ -807,6 +807,10 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
                     {"joined.csv:2002: column 't': the time jumps by 1000 s", "two recordings joined"});
   expect_data_error("joined_offset.csv", make(1, 1, 1, 1000, 0.05),
                     {"joined_offset.csv:2002:", "the time jumps by 1000 s"});
+  // A jump of 50 um, 250x the record's 0.2 um of motion noise (issue 20's review: it passed
+  // under the 20x-peak-thrust limit).
+  expect_data_error("pos_jump_50um.csv", make(1, 1, 1, 0, 50e-6),
+                    {"pos_jump_50um.csv:2002: column 'x': the position jumps by 0.050", "mm in one sample"});
   expect_data_error("pos_jump.csv", make(1, 1, 1, 0, 0.05),
                     {"pos_jump.csv:2002: column 'x': the position jumps by 50 mm in one sample", "split the file"});
 }
