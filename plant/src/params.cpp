@@ -16,7 +16,6 @@ using validate::require_positive;
 
 std::string to_string(FrictionModel m) { return fields::enum_name(m); }
 
-
 // Each validate(): the ranges of the struct's list (Serialize, params.hpp), then the rules that
 // tie fields together.
 
