@@ -63,7 +63,7 @@ class DocArchive {
   template <typename T>
   void Visit(const fields::Field<T>& f) {
     const Meta& m = f.meta;
-    const std::string key = prefix_.empty() ? m.name : prefix_ + "." + m.name;
+    const std::string key = detail::dotted(prefix_, m.name);
     const T& v = *f.value;
     const std::size_t first = rows_->size();
     if constexpr (std::is_same_v<T, double>) {
@@ -86,8 +86,7 @@ class DocArchive {
       DocArchive child(key, rows_);
       const_cast<T&>(v).Serialize(&child);
     }
-    if (*m.alias && rows_->size() > first)
-      (*rows_)[first].old_key = prefix_.empty() ? m.alias : prefix_ + "." + m.alias;
+    if (*m.alias && rows_->size() > first) (*rows_)[first].old_key = detail::dotted(prefix_, m.alias);
   }
 
  private:

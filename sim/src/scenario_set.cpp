@@ -53,14 +53,9 @@ std::string shown(const YAML::Node& v) {
   throw ScenarioError(key + " = " + shown(v) + ": " + why);
 }
 
-// A dotted key below `parent` ("" at the top level).
-std::string key_below(const std::string& parent, const std::string& name) {
-  return parent.empty() ? name : parent + "." + name;
-}
-
 [[noreturn]] void unknown(const std::string& parent, const std::string& name, const std::vector<std::string>& names,
                           const std::map<std::string, std::string>& aliases = {}) {
-  throw ScenarioError(key_below(parent, name) + ": unknown key" + did_you_mean(name, names, aliases));
+  throw ScenarioError(detail::dotted(parent, name) + ": unknown key" + did_you_mean(name, names, aliases));
 }
 
 // A list's validate() (std::invalid_argument "KEY = VALUE: why") as the scenario's error.
@@ -119,7 +114,7 @@ class FieldSetArchive {
   [[noreturn]] void fail() const {
     if (!error_.empty()) throw ScenarioError(error_);
     if (found_ == Found::kBelowValue)
-      throw ScenarioError(key_below(parent_, rest_) + ": " + below_ +
+      throw ScenarioError(detail::dotted(parent_, rest_) + ": " + below_ +
                           " is a single value in the scenario, not a map of keys");
     unknown(parent_, rest_.substr(0, rest_.find('.')), names_, aliases_);
   }
@@ -136,7 +131,7 @@ class FieldSetArchive {
         found_ = Found::kMap;
         return;
       }
-      FieldSetArchive a(key_below(parent_, head), rest_.substr(dot + 1), value_);
+      FieldSetArchive a(detail::dotted(parent_, head), rest_.substr(dot + 1), value_);
       f.value->Serialize(&a);
       found_ = a.found_;
       if (found_ == Found::kNone || found_ == Found::kBelowValue) {
@@ -148,7 +143,7 @@ class FieldSetArchive {
       }
     } else if (dot != std::string::npos) {
       found_ = Found::kBelowValue;
-      below_ = key_below(parent_, head);
+      below_ = detail::dotted(parent_, head);
     } else {
       MapReader r(one_key(head, value_), parent_);
       YamlReadArchive a(r);
