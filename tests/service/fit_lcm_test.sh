@@ -45,12 +45,18 @@ jq -e '.gap_initial > 0 and .gap_final < .gap_initial / 5' "$f" > /dev/null \
 [ -s "$TMP/fit/model.fitted.yaml" ] && [ -s "$TMP/fit/report.md" ] || fail "model.fitted.yaml or report.md missing"
 pass "fit of the log: constant_force = $force N, gap $(json "$f" .gap_initial) -> $(json "$f" .gap_final) m"
 
-# A log cut in the middle of an event (60 % of it plus an odd 7 bytes: an event boundary there
-# would be a coincidence; checked below), as a logger killed or out of disk leaves it: a shorter
+# A log cut in the middle of an event, as a logger killed or out of disk leaves it: a shorter
 # record, fitted with exit 0, the cut event noted with its byte offset and the steps it still
-# has; the hidden force is still found first.
-size=$(stat -c %s "$LOGDIR/run.lcmlog")
-head -c $(( size * 6 / 10 + 7 )) "$LOGDIR/run.lcmlog" > "$TMP/cut.lcmlog"
+# has; the hidden force is still found first. The cut is halfway between the first event start
+# (the LCM log's sync word 0xEDA1DA01) after 60 % of the log and the next one: always inside an
+# event (a fixed fraction of the size once landed on a boundary, and the test failed).
+cut=$(python3 -c '
+import sys
+d = open(sys.argv[1], "rb").read()
+sync = bytes.fromhex("eda1da01")
+i = d.index(sync, len(d) * 6 // 10)
+print((i + d.index(sync, i + 4)) // 2)' "$LOGDIR/run.lcmlog")
+head -c "$cut" "$LOGDIR/run.lcmlog" > "$TMP/cut.lcmlog"
 set +e
 timeout 600 feeddrive-fit --scenario "$TMP/model.yaml" --data "$TMP/cut.lcmlog" --out "$TMP/cut" -q --no-plots \
   > "$TMP/cut.out" 2> "$TMP/cut.err"; rc=$?
