@@ -126,7 +126,9 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"quantization_m", f.quantization},
           {"noise_m", f.noise},
           {"position_sigma_m", f.position},
-          {"factor", kFloorFactor},
+          {"gap_factor", f.gap_factor},
+          {"force_factor", f.force_factor},
+          {"force_points", f.force_points},
           {"from_scenario", f.from_scenario},
           {"source", f.source},
           {"force_noise_N", f.force_noise},
@@ -197,6 +199,7 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
   j["noise_floor"] = floor_json(r.floor);
   j["unexplained"] = r.unexplained;
   j["ties"] = r.ties;
+  j["unconfirmed"] = r.unconfirmed;
   j["conclusion"] = r.conclusion;
   j["model_form"] = {{"coulomb_transition_velocity_initial_mps", r.smoothing_initial},
                      {"coulomb_transition_velocity_final_mps", r.smoothing_final},
@@ -311,13 +314,16 @@ void md_head(std::ostringstream& md, const std::string& scenario_path, const Rec
 
 // report.md: the noise floor, and a "## title" section with one item per line (none if empty).
 void md_floor(std::ostringstream& md, const NoiseFloor& f) {
-  char a[160], b[200];
+  char a[160], b[600];
   std::snprintf(a, sizeof a, "\nNoise floor: gap %.3g um, force residual %.3g N RMS (sigma_x = %.3g nm; ", f.gap * 1e6,
                 f.force, f.position * 1e9);
-  std::snprintf(b, sizeof b,
-                "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
-                "most %.0fx the floor.\n\n",
-                f.force_noise, f.force_discretisation, kFloorFactor);
+  std::snprintf(
+      b, sizeof b,
+      "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
+      "most %.3gx the force floor (the 99.9 %% bound of an RMS of %ld filter points, times %.2f for the floor's "
+      "first-order terms) and %.3gx the gap floor (the replay's unobserved friction state and fitted parameters' "
+      "drift).\n\n",
+      f.force_noise, f.force_discretisation, f.force_factor, f.force_points, kFirstOrderAllowance, f.gap_factor);
   md << a << f.source << b;
 }
 void md_list(std::ostringstream& md, const char* title, const std::vector<std::string>& items) {
@@ -419,6 +425,7 @@ std::string report_md(const std::string& scenario_path, const Record& rec, const
   md_floor(md, r.floor);
   md_list(md, "Unexplained discrepancy", r.unexplained);
   md_list(md, "Ties", r.ties);
+  md_list(md, "Named in a step, removed by the final confirmation", r.unconfirmed);
   md_effects(md, r);
   md_envelope(md, r.envelope);
   int k = 0;
@@ -492,6 +499,7 @@ std::string result_table(const FitResult& r, const std::string& out_dir) {
   s += r.conclusion + "\n";
   for (const auto& [name, caveat] : r.tentative) s += "tentative " + name + ": " + caveat + "\n";
   for (const std::string& t : r.ties) s += "tie: " + t + "\n";
+  for (const std::string& u : r.unconfirmed) s += "removed by the final confirmation: " + u + "\n";
   for (const std::string& u : r.unexplained) s += "  " + u + "\n";
   return s + "results: " + out_dir + "/{findings.json,model.fitted.yaml,report.md}\n";
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 
 namespace feeddrive::fit {
@@ -166,6 +167,7 @@ void force_floor(const Record& rec, const SampleErrors& se, NoiseFloor& f) {
   f.force_noise = count ? std::sqrt(noise_sum / nc) : 0.0;
   f.force_discretisation = count ? std::sqrt(bias_sum / nc) : 0.0;
   f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
+  f.force_points = count;
 }
 
 }  // namespace
@@ -175,11 +177,21 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
   const SampleErrors se = sample_errors(rec, model, f);
   f.gap = gap_floor(rec, se, opt.replay_window, f.position);
   force_floor(rec, se, f);
+  f.gap_factor = kGapAllowance;
+  f.force_factor = kFirstOrderAllowance * rms_bound(f.force_points);
   return f;
 }
 
+double rms_bound(long nu) {
+  if (nu < 1) return std::numeric_limits<double>::infinity();
+  constexpr double z = 3.0902;  // the standard normal's 99.9 % quantile
+  const double v = static_cast<double>(nu), c = 2.0 / (9.0 * v);
+  const double q = v * std::pow(std::max(0.0, 1.0 - c + z * std::sqrt(c)), 3);
+  return std::sqrt(q / v);
+}
+
 bool within_floor(const NoiseFloor& f, double gap, double force_rms) {
-  return gap <= kFloorFactor * f.gap && force_rms <= kFloorFactor * f.force;
+  return gap <= f.gap_factor * f.gap && force_rms <= f.force_factor * f.force;
 }
 
 const char* verdict_name(Verdict v) {

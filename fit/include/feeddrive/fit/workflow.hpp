@@ -10,7 +10,11 @@
 //      cross-validation, one-standard-error rule) and it shrinks the replay gap;
 //   3. backward: every earlier effect whose removal (the others refitted) costs less than the
 //      threshold in BIC is removed, the least costly first;
-//   repeat until no candidate is added or max_effects effects are in.
+//   repeat until no candidate is added or max_effects effects are in;
+//   4. final confirmation: every named effect must still meet the criteria it entered on (2), with
+//      all the others in the model: the removal criterion equals the entry criterion (Efroymson
+//      1960; Draper & Smith 1998, sec. 15.2: F-to-remove <= F-to-enter); one that fails them is
+//      removed, the weakest first, until all pass.
 // Pure computation: no files are read or written here.
 
 #include <functional>
@@ -87,6 +91,8 @@ struct FitResult {
   /// Ties of the named effects that no later step resolved: "a or b: the record cannot separate
   /// them; <what would>".
   std::vector<std::string> ties;
+  /// Effects named in a step but removed by the final confirmation (stage 4), each "name: why".
+  std::vector<std::string> unconfirmed;
 };
 
 /// The options against the record (e.g. a replay window of at least 10 sample periods). Throws
