@@ -666,9 +666,18 @@ std::vector<double> cross_validate(const Record& rec, const plant::PlantParams& 
   return out;
 }
 
+double& form_parameter(plant::PlantParams& p, const std::string& key) {
+  if (key == "coulomb_transition_velocity") return p.friction.static_smoothing_velocity;
+  if (key == "coulomb_transition_shape") return p.friction.static_smoothing_shape;
+  if (key == "stribeck_exponent") return p.friction.stribeck_exponent;
+  if (key == "direction_asymmetry") return p.effects.constant_force.force;
+  throw std::invalid_argument("form_parameter: unknown model-form parameter '" + key + "'");
+}
+
 std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec,
                                                                           const plant::PlantParams& fitted,
-                                                                          const std::vector<std::string>& effects) {
+                                                                          const std::vector<std::string>& effects,
+                                                                          const std::vector<std::string>& form) {
   std::map<std::string, std::map<std::string, double>> out;
   std::vector<std::pair<std::string, std::string>> keys;
   std::vector<Effect> named;
@@ -678,6 +687,7 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
         named.push_back(e);
         for (const auto& [k, v] : e.parameters) keys.emplace_back(name, k);
       }
+  for (const std::string& key : form) keys.emplace_back("model_form", key);
   if (keys.empty()) return out;
   const Eigen::VectorXd r0 = force_residual(rec, fitted);
   const long n = rec.active_points();
@@ -685,18 +695,24 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
   Eigen::MatrixXd J(r0.size(), k);
   for (long c = 0; c < k; ++c) {
     const auto& [name, key] = keys[static_cast<std::size_t>(c)];
+    const bool is_form = name == "model_form";
     Effect e;
     for (const Effect& x : named)
       if (x.name == name) e = x;
-    const double v = e.parameters.at(key);
+    plant::PlantParams base = fitted;
+    const double v = is_form ? form_parameter(base, key) : e.parameters.at(key);
     // a phase moves by 1e-4 rad; anything else by 1e-5 of itself (or of a typical size)
     const double h = key.find("phase") != std::string::npos ? 1e-4 : 1e-5 * std::max(std::abs(v), 1e-3);
     Eigen::VectorXd rp, rm;
     for (int s : {1, -1}) {
-      Effect moved = e;
-      moved.parameters[key] = v + s * h;
       plant::PlantParams p = fitted;
-      plant::set_effect(p.effects, moved);
+      if (is_form) {
+        form_parameter(p, key) = v + s * h;
+      } else {
+        Effect moved = e;
+        moved.parameters[key] = v + s * h;
+        plant::set_effect(p.effects, moved);
+      }
       (s > 0 ? rp : rm) = force_residual(rec, p);
     }
     J.col(c) = (rp - rm) / (2 * h);

@@ -91,6 +91,15 @@ nlohmann::json bins_json(const std::vector<Bin>& bins) {
   return a;
 }
 
+// The 95 % half-widths of one group of r.ci95 (an effect's parameters, or "model_form"): a number,
+// or "undetermined" (NaN: e.g. the phase of a vanishing amplitude).
+nlohmann::json ci_json(const FitResult& r, const std::string& group) {
+  nlohmann::json ci = nlohmann::json::object();
+  if (const auto it = r.ci95.find(group); it != r.ci95.end())
+    for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
+  return ci;
+}
+
 // A named effect of findings.json: its final (jointly refitted) parameters with their 95 %
 // intervals ("undetermined" where not finite), any caveat, and the evidence of the step that
 // brought it in: the step that added it, or the one whose swap move turned an earlier effect into it.
@@ -101,9 +110,7 @@ nlohmann::json effect_json(const FitResult& r, const Effect& final) {
     const std::string into = st.swap.empty() ? "" : st.swap.substr(st.swap.rfind(' ') + 1);
     if (st.effect.name == final.name || into == final.name) from = &st;
   }
-  nlohmann::json ci = nlohmann::json::object();
-  if (const auto it = r.ci95.find(final.name); it != r.ci95.end())
-    for (const auto& [k, v] : it->second) ci[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json("undetermined");
+  const nlohmann::json ci = ci_json(r, final.name);
   const auto tent = r.tentative.find(final.name);
   nlohmann::json e = {{"name", final.name},
                       {"parameters", params_json(final)},
@@ -207,7 +214,9 @@ std::string findings_json(const FitResult& r, const MeasuredData* data) {
                      {"coulomb_transition_shape_final", r.shape_final},
                      {"stribeck_exponent_initial", r.exponent_initial},
                      {"stribeck_exponent_final", r.exponent_final},
-                     {"fitted", r.smoothing_fitted}};
+                     {"direction_asymmetry_N", r.asymmetry_offset},
+                     {"fitted", r.smoothing_fitted},
+                     {"ci95", ci_json(r, "model_form")}};
   j["record"] = envelope_json(r.envelope);
   nlohmann::json steps = nlohmann::json::array();
   for (const StepResult& st : r.steps) steps.push_back(step_json(st));

@@ -802,7 +802,12 @@ void collect(const Context& cx, const plant::PlantParams& model, Search& s, FitR
   out.force_rms_final = rms(s.r, cx.n);
   out.final_localisation = localise(cx.rec, s.r, s.rp);
   for (const std::string& name : s.added) out.effects.push_back(effect_of(s.current, name));
-  out.ci95 = confidence_intervals(cx.rec, s.current, s.added);
+  std::vector<std::string> form;  // the model-form parameters that were fitted (their intervals too)
+  if (out.smoothing_final != out.smoothing_initial) form.push_back("coulomb_transition_velocity");
+  if (out.shape_final != out.shape_initial) form.push_back("coulomb_transition_shape");
+  if (out.exponent_final != out.exponent_initial) form.push_back("stribeck_exponent");
+  if (out.asymmetry_offset != 0.0) form.push_back("direction_asymmetry");
+  out.ci95 = confidence_intervals(cx.rec, s.current, s.added, form);
   for (const auto& [name, caveat] : s.tentative)
     if (contains(s.added, name)) out.tentative[name] = caveat;
   for (const StepResult& st : out.steps) {
@@ -880,6 +885,29 @@ void explain_unexplained(const Context& cx, FitResult& out) {
   if (!out.floor.from_scenario) out.unexplained.push_back("noise floor: " + out.floor.source);
 }
 
+// The model-form changes for the conclusion, each fitted value with its 95 % half-width
+// (collect: out.ci95["model_form"]).
+std::string model_form_text(const FitResult& out) {
+  const auto pm = [&](const char* key, double scale) {
+    const auto g = out.ci95.find("model_form");
+    if (g == out.ci95.end() || !g->second.count(key) || !std::isfinite(g->second.at(key))) return std::string();
+    return fmt(" +- %.2g", g->second.at(key) * scale);
+  };
+  std::string s;
+  if (out.asymmetry_offset != 0.0)
+    s += fmt("; model form: friction direction asymmetry %.3g", out.asymmetry_offset) + pm("direction_asymmetry", 1.0) +
+         " N (carried as constant_force)";
+  if (out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial)
+    s += fmt("; model form: Coulomb transition velocity %.3g -> %.3g", out.smoothing_initial * 1e3,
+             out.smoothing_final * 1e3) +
+         pm("coulomb_transition_velocity", 1e3) + fmt(" mm/s, shape %.2g -> %.2g", out.shape_initial, out.shape_final) +
+         pm("coulomb_transition_shape", 1.0) + " (0 tanh, 1 algebraic)";
+  if (out.exponent_final != out.exponent_initial)
+    s += fmt("; model form: Stribeck exponent %.3g -> %.3g", out.exponent_initial, out.exponent_final) +
+         pm("stribeck_exponent", 1.0);
+  return s;
+}
+
 // The named effects, each with " (tentative)" where it is: " a b (tentative)".
 std::string named_list(const std::vector<std::string>& added, const FitResult& out) {
   std::string s;
@@ -927,15 +955,7 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
     else out.conclusion += "; no candidate could be named with confidence";
     explain_unexplained(cx, out);
   }
-  if (out.asymmetry_offset != 0.0)
-    out.conclusion +=
-        fmt("; model form: friction direction asymmetry %.3g N (carried as constant_force)", out.asymmetry_offset);
-  if (out.smoothing_final != out.smoothing_initial || out.shape_final != out.shape_initial)
-    out.conclusion +=
-        fmt("; model form: Coulomb transition velocity %.3g -> %.3g mm/s, shape %.2g -> %.2g (0 tanh, 1 algebraic)",
-            out.smoothing_initial * 1e3, out.smoothing_final * 1e3, out.shape_initial, out.shape_final);
-  if (out.exponent_final != out.exponent_initial)
-    out.conclusion += fmt("; model form: Stribeck exponent %.3g -> %.3g", out.exponent_initial, out.exponent_final);
+  out.conclusion += model_form_text(out);
   cx.say(out.conclusion);
 }
 

@@ -174,6 +174,17 @@ TEST(ModelForm, StribeckExponentIsRefittedNotNamedAsAnEffect) {
   // the hump's shape was most of the gap (measured: 11.2 um held at 2, 0.63 um refitted)
   EXPECT_LT(r.replay_final.gap, 0.2 * r.replay_initial.gap) << r.conclusion;
   EXPECT_NE(r.conclusion.find("Stribeck exponent"), std::string::npos) << r.conclusion;
+  // Issue 20: every fitted parameter has its 95 % interval, the model form's too. The exponent's
+  // must be finite, positive and narrower than its distance from 2, the value it was refitted from
+  // (0.7: the fit moved it by that, so an interval of that width would not say it moved at all).
+  const auto form = r.ci95.find("model_form");
+  ASSERT_NE(form, r.ci95.end()) << r.conclusion;
+  ASSERT_TRUE(form->second.count("stribeck_exponent")) << r.conclusion;
+  const double ci = form->second.at("stribeck_exponent");
+  EXPECT_GT(ci, 0.0);
+  EXPECT_LT(ci, std::abs(2.0 - r.exponent_final)) << r.conclusion;
+  EXPECT_NE(r.conclusion.find("Stribeck exponent 2 -> "), std::string::npos);
+  EXPECT_NE(r.conclusion.find(" +- "), std::string::npos) << r.conclusion;
 }
 
 }  // namespace
