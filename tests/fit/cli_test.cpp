@@ -803,6 +803,27 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0),
                     {"column 't'", "control period", "likely in ms (--units t=ms)"});
   expect_data_error("force_kN.csv", make(1, 1, 1e-3, 0, 0), {"column 'force_N'", "likely in kN (--units force=kN)"});
+  // Every column both ways, each named alone (issue 20's review: a time divided by 1000 was named
+  // as column 'x', a position divided by 1000 as the force). A time 1000x too short: the time is
+  // named (its period against the control period, confirmed by a speed no drive reaches), in ks,
+  // which --units gives as counts.
+  expect_data_error("time_ks.csv", make(1e-3, 1, 1, 0, 0),
+                    {"time_ks.csv: column 't': median sample period 1e-06 s", "speeds up to",
+                     "likely in ks (--units t=counts:1000: 1000 s per unit)"});
+  // a position 1000x too small: its steps are 1/1000 of the scenario's 50 nm encoder step
+  expect_data_error("pos_km.csv", make(1, 1e-3, 1, 0, 0),
+                    {"pos_km.csv: column 'x': its smallest step 5e-11 m is 0.001 times the scenario's encoder step",
+                     "likely in km (--units x=counts:1000: 1000 m per unit)"});
+  // a force 1000x too large: the position's steps are the encoder's, so the force alone is named
+  expect_data_error("force_mN.csv", make(1, 1, 1e3, 0, 0),
+                    {"force_mN.csv: column 'force_N': the thrust is", "likely in mN (--units force=mN)"});
+  // the same, against units declared wrongly: the likely unit is the one the file is in
+  expect_data_error("time_s_as_ms.csv", make(1, 1, 1, 0, 0),
+                    {"time_s_as_ms.csv: column 't'", "likely in s (--units t=s)"}, "--units t=ms");
+  expect_data_error("pos_m_as_um.csv", make(1, 1, 1, 0, 0),
+                    {"pos_m_as_um.csv: column 'x'", "likely in m (--units x=m)"}, "--units x=um");
+  expect_data_error("force_N_as_kN.csv", make(1, 1, 1, 0, 0),
+                    {"force_N_as_kN.csv: column 'force_N'", "likely in N (--units force=N)"}, "--units force=kN");
   expect_data_error("joined.csv", make(1, 1, 1, 1000, 0),
                     {"joined.csv:2002: column 't': the time jumps by 1000 s", "two recordings joined"});
   expect_data_error("joined_offset.csv", make(1, 1, 1, 1000, 0.05),
