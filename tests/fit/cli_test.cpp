@@ -20,6 +20,7 @@
 
 #include "../support/scratch.hpp"
 #include "feeddrive/fit/report.hpp"
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace {
@@ -630,6 +631,87 @@ TEST(FitVerdict, StampErrorRaisesTheFloorAndHidesNoEffect) {
               f1["force_rms_N"].get<double>(), 1e-9 * f1["force_rms_N"].get<double>());
   EXPECT_EQ(j["verdict"], "unexplained");
   EXPECT_GT(j["gap_final"].get<double>(), 100.0 * f1["gap_m"].get<double>());
+}
+
+// The settings cannot buy an all-clear (issue 20's review): a 0.5 N constant force hidden in the CI
+// record's 4 s. A replay window of 10 ms and a filter half-width of 2 ms (each 10 and 2 sample
+// periods, the shortest allowed) raise the smallest constant force the record shows from 0.02 N
+// to 2 N: the force sits below both floors, and the tool said "no discrepancy". Now the fitted
+// model is judged also at the defaults, which see the force: unexplained, exit 3, naming both
+// settings. At the defaults the verdict is as before (the model form carries the 0.5 N as the
+// friction's direction asymmetry, within 3 % of the friction level: no discrepancy).
+TEST(FitVerdict, ShortWindowAndFilterGiveNoFalseAllClear) {
+  using namespace issue20;
+  const fs::path data = [] {
+    const fs::path truth =
+        write_file("truth_half_newton.yaml", short_scenario("  effects:\n    constant_force: {force: 0.5}\n"));
+    const fs::path o = scratch() / "sim_half_newton";
+    const ProcResult s = run(kSim, truth.string() + " --out " + o.string() + " --no-plots --quiet");
+    if (s.code != 0) throw std::runtime_error("feeddrive-sim failed: " + s.err);
+    return o / "timeseries.csv";
+  }();
+  const auto fit = [&](const std::string& name, const std::string& args) {
+    const fs::path out = scratch() / name;
+    const ProcResult r = run_fit("--scenario " + model4().string() + " --data " + data.string() + " --out " +
+                                 out.string() + " --position-column x_measured --no-plots -q " + args);
+    return std::make_pair(r, fs::exists(out / "findings.json") ? findings(out) : nlohmann::json());
+  };
+  // the defaults: unchanged, and the detection limit stated (no second limit: these are the defaults)
+  const auto [d, jd] = fit("short_settings_default", "");
+  ASSERT_EQ(d.code, 0) << d.err << d.out;
+  EXPECT_EQ(jd["verdict"], "no_discrepancy") << jd["conclusion"];
+  const std::string cd = jd["conclusion"];
+  EXPECT_NE(cd.find("friction direction asymmetry 0.49"), std::string::npos) << cd;
+  EXPECT_NE(cd.find("the smallest constant force it shows: 0.0203 N at W = 0.1 s, L = 10 ms"), std::string::npos) << cd;
+  const auto& fd = jd["noise_floor"];
+  EXPECT_TRUE(fd["detection_limit_default_N"].is_null());
+  // the limit by the gap: 3 gap floors times 2 m sqrt(180) / W^2 (verdict.hpp), m the model's mass
+  // (with the motor's: effective_params); only rounding separates the two (1e-12)
+  const double m = feeddrive::plant::effective_params(feeddrive::sim::load_scenario(model4().string()).plant).mass;
+  EXPECT_NEAR(fd["detection_limit_gap_N"].get<double>(),
+              3.0 * fd["gap_m"].get<double>() * 2.0 * m * std::sqrt(180.0) / (0.1 * 0.1),
+              1e-12 * fd["detection_limit_gap_N"].get<double>());
+  EXPECT_DOUBLE_EQ(fd["detection_limit_force_N"].get<double>(), 3.0 * fd["force_rms_N"].get<double>());
+  EXPECT_DOUBLE_EQ(fd["detection_limit_N"].get<double>(),
+                   std::min(fd["detection_limit_gap_N"].get<double>(), fd["detection_limit_force_N"].get<double>()));
+  EXPECT_LT(fd["detection_limit_N"].get<double>(), 0.5);  // the defaults see the force
+  // The gap's formula on the force itself: without the model form the 0.5 N stays in the model's
+  // residual, and the initial gap is the drift of 0.5 N W^2/(2m)/sqrt(180) = 1.83 um (measured
+  // 1.91 um). 10 %: the sensor's 0.02 um adds in quadrature, and the model's friction answers the
+  // drift's small change of speed (the formula is the free mass's).
+  const auto [n, jn] = fit("short_settings_default_no_form", "--no-form-fit");
+  ASSERT_EQ(n.code, 3) << n.err << n.out;
+  const double drift = 0.5 * 0.1 * 0.1 / (2.0 * m) / std::sqrt(180.0);
+  EXPECT_NEAR(jn["gap_initial"].get<double>(), drift, 0.1 * drift);
+  // the shortest W and L, with and without the model form (without it the force is no asymmetry:
+  // the defaults leave it in the residual, 1.9 um of gap)
+  for (const std::string form : {"", "--no-form-fit"}) {
+    SCOPED_TRACE(form);
+    const auto [t, jt] = fit("short_settings" + form, "--replay-window 0.01 --filter-half-width 0.002 " + form);
+    ASSERT_EQ(t.code, 3) << t.err << t.out;
+    EXPECT_EQ(jt["verdict"], "unexplained");
+    const std::string c = jt["conclusion"];
+    EXPECT_NE(c.find("the chosen settings (--replay-window 0.01 s, --filter-half-width 2 ms) hide a discrepancy the "
+                     "defaults (W = 0.1 s, L = 10 ms) see"),
+              std::string::npos)
+        << c;
+    EXPECT_NE(c.find("the smallest constant force the record shows is 2.03 N with them, 0.0203 N with the defaults"),
+              std::string::npos)
+        << c;
+    EXPECT_EQ(c.find("within its noise"), std::string::npos) << c;
+    const auto& ft = jt["noise_floor"];
+    EXPECT_DOUBLE_EQ(ft["replay_window_s"].get<double>(), 0.01);
+    EXPECT_DOUBLE_EQ(ft["filter_half_width_s"].get<double>(), 0.002);
+    // W 10x shorter: the gap's limit 100x higher (the gap floor is sigma_x at any W without stamp
+    // errors); the default limit is the default run's
+    EXPECT_NEAR(ft["detection_limit_gap_N"].get<double>() / fd["detection_limit_gap_N"].get<double>(), 100.0, 1e-9);
+    EXPECT_DOUBLE_EQ(ft["detection_limit_default_N"].get<double>(), fd["detection_limit_N"].get<double>());
+    EXPECT_GT(ft["detection_limit_N"].get<double>(), 0.5);  // these settings cannot show the force
+    EXPECT_NE(slurp(scratch() / ("short_settings" + form) / "report.md")
+                  .find("Detection limit: the smallest constant force this record shows at W = 0.01 s, L = 2 ms is "
+                        "2.03 N"),
+              std::string::npos);
+  }
 }
 
 // The issue's first case: a 40.2 mm ripple over 78.7 mm (pitch 2.2 % above travel/2) and a
