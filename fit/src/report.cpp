@@ -137,7 +137,7 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"detection_limit_N", f.limit},
           {"detection_limit_gap_N", f.limit_gap},
           {"detection_limit_force_N", f.limit_force},
-          {"detection_limit_default_N", f.limit_default > 0 ? nlohmann::json(f.limit_default) : nlohmann::json()}};
+          {"detection_limit_default_N", f.limit_default}};
 }
 
 // findings.json's "record": what the record spans (the plausibility rules' envelope).
@@ -330,7 +330,7 @@ void md_floor(std::ostringstream& md, const NoiseFloor& f) {
                 "Detection limit: the smallest constant force this record shows at W = %.3g s, L = %.3g ms is %.3g N "
                 "(by the gap %.3g N, by the force residual %.3g N)",
                 f.window, f.half_width * 1e3, f.limit, f.limit_gap, f.limit_force);
-  if (f.limit_default > 0)
+  if (f.limit_default > 0 && (f.window_default != f.window || f.half_width_default != f.half_width))
     std::snprintf(d, sizeof d, "; at the defaults (W = %.3g s, L = %.3g ms) %.3g N", f.window_default,
                   f.half_width_default * 1e3, f.limit_default);
   md << c << d << ".\n\n";

@@ -826,12 +826,16 @@ std::string named_list(const std::vector<std::string>& added, const FitResult& o
 // verdict if they see it above their floor, else "".
 std::string hidden_by_settings(const Context& cx, const plant::PlantParams& model, bool within, FitResult& out) {
   const double W = cx.opt.replay_window, L = cx.opt.record.filter_half_width;
+  out.floor.limit_default = out.floor.limit;
+  out.floor.window_default = out.floor.window;
+  out.floor.half_width_default = out.floor.half_width;
   if (!(W > 0) && !(L > 0)) return "";  // the defaults
   std::optional<Record> rebuilt;
   if (L > 0) {
     try {
       rebuilt = prepare(*cx.rec.data, RecordOptions{0.0, cx.opt.record.motion_half_window});
     } catch (const DataError&) {  // too short for the default filter: the settings are the record's only ones
+      out.floor.limit_default = 0.0;
       return "";
     }
     mask_stiction(*rebuilt, model);

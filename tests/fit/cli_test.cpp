@@ -656,7 +656,7 @@ TEST(FitVerdict, ShortWindowAndFilterGiveNoFalseAllClear) {
                                  out.string() + " --position-column x_measured --no-plots -q " + args);
     return std::make_pair(r, fs::exists(out / "findings.json") ? findings(out) : nlohmann::json());
   };
-  // the defaults: unchanged, and the detection limit stated (no second limit: these are the defaults)
+  // the defaults: unchanged, and the detection limit stated (the limit at the defaults is its own)
   const auto [d, jd] = fit("short_settings_default", "");
   ASSERT_EQ(d.code, 0) << d.err << d.out;
   EXPECT_EQ(jd["verdict"], "no_discrepancy") << jd["conclusion"];
@@ -664,7 +664,7 @@ TEST(FitVerdict, ShortWindowAndFilterGiveNoFalseAllClear) {
   EXPECT_NE(cd.find("friction direction asymmetry 0.49"), std::string::npos) << cd;
   EXPECT_NE(cd.find("the smallest constant force it shows: 0.0203 N at W = 0.1 s, L = 10 ms"), std::string::npos) << cd;
   const auto& fd = jd["noise_floor"];
-  EXPECT_TRUE(fd["detection_limit_default_N"].is_null());
+  EXPECT_DOUBLE_EQ(fd["detection_limit_default_N"].get<double>(), fd["detection_limit_N"].get<double>());
   // the limit by the gap: 3 gap floors times 2 m sqrt(180) / W^2 (verdict.hpp), m the model's mass
   // (with the motor's: effective_params); only rounding separates the two (1e-12)
   const double m = feeddrive::plant::effective_params(feeddrive::sim::load_scenario(model4().string()).plant).mass;

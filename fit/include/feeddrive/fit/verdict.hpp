@@ -77,8 +77,8 @@ struct NoiseFloor {
   double limit_gap{0.0};             ///< [N] the smallest constant force the gap shows (header)
   double limit_force{0.0};           ///< [N] the smallest constant force the force residual shows
   double limit{0.0};                 ///< [N] the detection limit: the smaller of the two
-  /// The detection limit at the default W and L and those defaults (limit_default 0: the settings
-  /// are the defaults; set by run_fit).
+  /// The detection limit at the default W and L and those defaults (the settings' own when they
+  /// are the defaults; limit_default 0: the record is too short for the default filter; set by run_fit).
   double limit_default{0.0}, window_default{0.0}, half_width_default{0.0};
 };
 
