@@ -850,9 +850,10 @@ std::string hidden_by_settings(const Context& cx, const plant::PlantParams& mode
                                    out.floor.window, out.floor.half_width * 1e3);
   const std::string defaults = fmt("the defaults (W = %.3g s, L = %.3g ms)", fd.window, fd.half_width * 1e3);
   const std::string limits =
-      fmt(": the smallest constant force the record shows is %.3g N with them, %.3g N with the "
+      fmt(": the smallest constant force the record shows is %.3g N with them", out.floor.limit) +
+      fmt(" (where the fitted model is within their floor: gap %.4g um, force residual %.4g N RMS), %.3g N with the "
           "defaults",
-          out.floor.limit, fd.limit);
+          out.replay_final.gap * 1e6, out.force_rms_final, fd.limit);
   double gap = 0.0;
   try {
     gap = replay(rd, out.fitted, 0.0, cx.opt.stop).gap;

@@ -695,9 +695,11 @@ TEST(FitVerdict, ShortWindowAndFilterGiveNoFalseAllClear) {
                      "defaults (W = 0.1 s, L = 10 ms) see"),
               std::string::npos)
         << c;
-    EXPECT_NE(c.find("the smallest constant force the record shows is 2.03 N with them, 0.0203 N with the defaults"),
+    EXPECT_NE(c.find("the smallest constant force the record shows is 2.03 N with them (where the fitted model is "
+                     "within their floor: gap "),
               std::string::npos)
         << c;
+    EXPECT_NE(c.find("), 0.0203 N with the defaults, where the fitted model leaves a gap of "), std::string::npos) << c;
     EXPECT_EQ(c.find("within its noise"), std::string::npos) << c;
     const auto& ft = jt["noise_floor"];
     EXPECT_DOUBLE_EQ(ft["replay_window_s"].get<double>(), 0.01);
