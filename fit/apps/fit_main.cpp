@@ -55,11 +55,14 @@ void add_search_options(CLI::App& app, fit::FitOptions& opt) {
                  "least fraction by which an effect must shrink the replay gap")
       ->capture_default_str()
       ->check(tool::within(0.0, 0.99, false, false));
-  app.add_option("--replay-window", opt.replay_window, "replay window W [s] (0: 0.1 s)")
+  app.add_option("--replay-window", opt.replay_window,
+                 "replay window W [s] (0: 0.1 s); shorter: the gap shows only larger forces (1/W^2), and an "
+                 "all-clear is checked at the default")
       ->capture_default_str()
       ->check(tool::within(1e-3, 1e3, false, true));
   app.add_option("--filter-half-width", opt.record.filter_half_width,
-                 "half-width L of the force filter [s] (0: max(10 ms, 10 periods))")
+                 "half-width L of the force filter [s] (0: max(10 ms, 10 periods)); shorter: a higher force floor, "
+                 "and an all-clear is checked at the default")
       ->capture_default_str()
       ->check(tool::within(1e-5, 10.0, false, true));
   app.add_option(

@@ -15,10 +15,14 @@ double rms(const Eigen::VectorXd& r, long n_active) {
   return n ? std::sqrt(r.squaredNorm() / static_cast<double>(n)) : 0.0;
 }
 
+double window_length(const Record& rec, double window) {
+  return window > 0 ? window : std::max(0.1, 20.0 * rec.period);
+}
+
 Replay replay(const Record& rec, const plant::PlantParams& model, double window, const interrupt::StopToken& stop) {
   const MeasuredData& d = *rec.data;
   const long n = static_cast<long>(d.size());
-  const double W = window > 0 ? window : std::max(0.1, 20.0 * rec.period);
+  const double W = window_length(rec, window);
   Internal in;
   force_residual(rec, model, &in);
   plant::PlantParams p = model;

@@ -140,7 +140,13 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"source", f.source},
           {"force_noise_N", f.force_noise},
           {"force_discretisation_N", f.force_discretisation},
-          {"stamp_error_s", f.stamp_error}};
+          {"stamp_error_s", f.stamp_error},
+          {"replay_window_s", f.window},
+          {"filter_half_width_s", f.half_width},
+          {"detection_limit_N", f.limit},
+          {"detection_limit_gap_N", f.limit_gap},
+          {"detection_limit_force_N", f.limit_force},
+          {"detection_limit_default_N", f.limit_default}};
 }
 
 // findings.json's "record": what the record spans (the plausibility rules' envelope).
@@ -334,6 +340,15 @@ void md_floor(std::ostringstream& md, const NoiseFloor& f) {
       "drift).\n\n",
       f.force_noise, f.force_discretisation, f.force_factor, f.force_points, kFirstOrderAllowance, f.gap_factor);
   md << a << f.source << b;
+  char c[240], d[120] = "";
+  std::snprintf(c, sizeof c,
+                "Detection limit: the smallest constant force this record shows at W = %.3g s, L = %.3g ms is %.3g N "
+                "(by the gap %.3g N, by the force residual %.3g N)",
+                f.window, f.half_width * 1e3, f.limit, f.limit_gap, f.limit_force);
+  if (f.limit_default > 0 && (f.window_default != f.window || f.half_width_default != f.half_width))
+    std::snprintf(d, sizeof d, "; at the defaults (W = %.3g s, L = %.3g ms) %.3g N", f.window_default,
+                  f.half_width_default * 1e3, f.limit_default);
+  md << c << d << ".\n\n";
 }
 void md_list(std::ostringstream& md, const char* title, const std::vector<std::string>& items) {
   if (items.empty()) return;

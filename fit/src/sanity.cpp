@@ -18,9 +18,25 @@ namespace {
 // The power of 1000 nearest to r: round(log10(r) / 3).
 int thousands(double r) { return static_cast<int>(std::lround(std::log10(r) / 3.0)); }
 
+// The SI unit of a role with the prefix of `factor` (a power of 1000: "ks", "km", "GN"), or "".
+std::string prefixed_unit(const std::string& role, double factor) {
+  const std::string base = role == "t" ? "s" : role == "x" || role == "xd" ? "m" : role == "force" ? "N" : "V";
+  const int k = thousands(factor);
+  static const char* const prefix[] = {"p", "n", "u", "m", "", "k", "M", "G", "T"};
+  if (k < -4 || k > 4 || std::abs(std::log10(factor) - 3.0 * k) > 0.01) return "";
+  return prefix[k + 4] + base;
+}
+
+// ": likely in UNIT (--units ROLE=UNIT)" for a unit --units names; for one it does not (a time in
+// ks, a position in km), the unit and its factor as counts (--units ROLE=counts:FACTOR); "" if the
+// factor is no power of 1000.
 std::string hint(const std::string& role, double factor) {
   const std::string u = unit_name(role, factor);
-  return u.empty() ? std::string() : ": likely in " + u + " (--units " + role + "=" + u + ")";
+  if (!u.empty()) return ": likely in " + u + " (--units " + role + "=" + u + ")";
+  const std::string p = prefixed_unit(role, factor);
+  return p.empty() ? std::string()
+                   : ": likely in " + p + " (--units " + role + fmt("=counts:%g: %g ", factor, factor) +
+                         prefixed_unit(role, 1.0) + " per unit)";
 }
 
 }  // namespace
@@ -58,22 +74,35 @@ void check_time_steps(const MeasuredData& d, double T) {
             d.t[worst] + d.time_offset));
 }
 
-// 2. the time scale: a median period T a power of 1000 away from the control period.
+// The 99th percentile of the speed |x_k - x_k-1| / (t_k - t_k-1) [m/s]: an isolated outlier is no
+// unit (it is named by the jump check, or by prepare()'s finiteness check).
+double speed_p99(const MeasuredData& d) {
+  std::vector<double> speed;
+  speed.reserve(d.size());
+  for (std::size_t k = 1; k < d.size(); ++k) speed.push_back(std::abs(d.x[k] - d.x[k - 1]) / (d.t[k] - d.t[k - 1]));
+  return order_statistic(speed, static_cast<std::size_t>(0.99 * static_cast<double>(speed.size() - 1)));
+}
+
+// 2. the time scale: a median period T a power of 1000 away from the control period. A period
+// 1000x shorter in a unit --units has no name for (t in s, the values in ks) is refused only when
+// the speed confirms it (beyond kMaxSpeed: time divided by 1000 multiplies it by 1000): a logger
+// may sample 30x faster than the controller runs. Checked before the position, whose speed check
+// the same record fails (issue 20's review: it named column x).
 void check_time_scale(const MeasuredData& d, double T, double control_period) {
   if (!(control_period > 0 && T > 0)) return;
   const int k = thousands(T / control_period);
   if (k == 0) return;
   const double factor = d.time_factor * std::pow(1000.0, -k);
   const std::string h = hint("t", factor);
-  if (!h.empty())
-    throw DataError(
-        d.source + ": column '" + d.time_name + "'" +
-        fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) + h);
+  if (h.empty() || (k < 0 && unit_name("t", factor).empty() && !(speed_p99(d) > kMaxSpeed))) return;
+  throw DataError(d.source + ": column '" + d.time_name + "'" +
+                  fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) +
+                  (k < 0 ? fmt(", speeds up to %.4g m/s (99th percentile)", speed_p99(d)) : std::string()) + h);
 }
 
 // 3. the position scale: travel and speed a feed drive can have (kMaxTravel, kMaxSpeed). The
-// travel is the range between the 0.1th and 99.9th percentiles and the speed the 99th percentile:
-// an isolated outlier is no unit (it is named by the jump check, or by prepare()'s finiteness check).
+// travel is the range between the 0.1th and 99.9th percentiles and the speed the 99th percentile
+// (speed_p99). A position 1000x too small is the force check's (check_force_scale).
 // The position column holds whole numbers only (before its unit's factor): encoder counts, more
 // likely than a power of 1000 of a metre.
 bool whole_numbers(const MeasuredData& d) {
@@ -100,10 +129,7 @@ void check_position_scale(const MeasuredData& d, double quantization) {
   std::sort(xs.begin(), xs.end());
   const double travel = xs[static_cast<std::size_t>(0.999 * static_cast<double>(n - 1))] -
                         xs[static_cast<std::size_t>(0.001 * static_cast<double>(n - 1))];
-  std::vector<double> speed;
-  speed.reserve(n);
-  for (std::size_t k = 1; k < n; ++k) speed.push_back(std::abs(d.x[k] - d.x[k - 1]) / (d.t[k] - d.t[k - 1]));
-  const double v99 = order_statistic(speed, static_cast<std::size_t>(0.99 * static_cast<double>(speed.size() - 1)));
+  const double v99 = speed_p99(d);
   if (!(travel > kMaxTravel || v99 > kMaxSpeed)) return;
   int k = 0;
   while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
@@ -184,6 +210,35 @@ void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model
   if (jump > 0) throw_jump(d, jump, peak, mass);
 }
 
+// The DataError of a thrust alpha times m a (alpha ~ 1000^k). The ratio cannot tell a force 1000x
+// off from a position 1000x off the other way; the scenario's encoder step q can: a position in
+// the declared unit moves in steps of q (its smallest step within 1000^(+-1/2) of q), one 1000x
+// off in steps of q 1000^(+-1). The position is named when its steps are off by 1000^-k; the
+// force alone when they are q; both are offered when the scenario gives no q.
+[[noreturn]] void throw_force_scale(const MeasuredData& d, const plant::PlantParams& model, double alpha, double mass) {
+  const int k = thousands(std::abs(alpha));
+  const double q = model.sensor.quantization, step = smallest_position_step(d);
+  const int kx = q > 0 && step > 0 ? thousands(step / q) : 0;
+  const std::string ratio = fmt(
+      "the thrust is %.3g times mass x acceleration (%.4g kg; fitted over the record with a constant and a friction)",
+      alpha, mass);
+  if (q > 0 && kx != 0 && kx == -k)
+    throw DataError(d.source + ": column '" + d.position_name + "'" +
+                    fmt(": its smallest step %.3g m is %.3g times the scenario's encoder step (plant.sensor."
+                        "quantization %.3g m), and ",
+                        step, step / q, q) +
+                    ratio + hint("x", d.position_factor * std::pow(1000.0, -kx)));
+  const bool force = d.input_kind == InputKind::kForce;
+  const std::string h = hint(force ? "force" : "u", d.input_factor * std::pow(1000.0, -k));
+  const bool position_agrees = q > 0 && kx == 0;  // its steps are the encoder's: the position is not off
+  throw DataError(d.source + ": column '" + d.input_name + "': " + ratio +
+                  (h.empty() ? ": is the input in the model's unit (N for a force, V for a command)?" : h) +
+                  (position_agrees ? std::string()
+                   : k > 0         ? std::string(", or the position is in larger units than declared")
+                   : k < 0         ? std::string(", or the position is in smaller units than declared (mm read as m?)")
+                                   : std::string()));
+}
+
 }  // namespace
 
 void check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period) {
@@ -225,18 +280,7 @@ void check_force_scale(const Record& rec, const plant::PlantParams& model) {
   const double r2 = 1.0 - res.squaredNorm() / std::max(thrust.squaredNorm(), 1e-300);
   if (!(r2 > 0.5) || !(std::abs(alpha) > 0)) return;
   if (std::abs(alpha) <= kMaxForceRatio && std::abs(alpha) >= 1.0 / kMaxForceRatio) return;
-  const int k = thousands(std::abs(alpha));
-  const bool force = d.input_kind == InputKind::kForce;
-  const std::string role = force ? "force" : "u";
-  const std::string h = hint(role, d.input_factor * std::pow(1000.0, -k));
-  throw DataError(d.source + ": column '" + d.input_name + "'" +
-                  fmt(": the thrust is %.3g times mass x acceleration (%.4g kg; fitted over the record with a constant "
-                      "and a friction)",
-                      alpha, mass) +
-                  (h.empty() ? ": is the input in the model's unit (N for a force, V for a command)?" : h) +
-                  (k > 0   ? std::string(", or the position is in larger units than declared")
-                   : k < 0 ? std::string(", or the position is in smaller units than declared (mm read as m?)")
-                           : std::string()));
+  throw_force_scale(d, model, alpha, mass);
 }
 
 }  // namespace feeddrive::fit

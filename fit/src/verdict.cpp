@@ -1,6 +1,7 @@
 #include "feeddrive/fit/verdict.hpp"
 #include "text.hpp"
 
+#include "feeddrive/fit/replay.hpp"
 #include "feeddrive/plant/effects.hpp"
 
 #include <algorithm>
@@ -99,7 +100,7 @@ void add_stamp_drift(const std::vector<double>& t, long s, long e, const SampleE
 double gap_floor(const Record& rec, const SampleErrors& se, double replay_window, double position) {
   const auto& t = rec.data->t;
   const long n = static_cast<long>(t.size());
-  const double W = replay_window > 0 ? replay_window : std::max(0.1, 20.0 * rec.period);
+  const double W = window_length(rec, replay_window);
   double sum = 0.0;
   long count = 0;
   long s = 0;
@@ -179,6 +180,12 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
   force_floor(rec, se, f);
   f.gap_factor = kGapAllowance;
   f.force_factor = kFirstOrderAllowance * rms_bound(f.force_points);
+  // the detection limit (header)
+  f.window = window_length(rec, opt.replay_window);
+  f.half_width = rec.bank.half_width;
+  f.limit_gap = f.gap_factor * f.gap * 2.0 * se.mass * std::sqrt(180.0) / (f.window * f.window);
+  f.limit_force = f.force_factor * f.force;
+  f.limit = std::min(f.limit_gap, f.limit_force);
   return f;
 }
 
@@ -188,6 +195,13 @@ double rms_bound(long nu) {
   const double v = static_cast<double>(nu), c = 2.0 / (9.0 * v);
   const double q = v * std::pow(std::max(0.0, 1.0 - c + z * std::sqrt(c)), 3);
   return std::sqrt(q / v);
+}
+
+std::string describe(const NoiseFloor& f) {
+  return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.3gx and %.3gx", f.gap * 1e6,
+             f.force, f.gap_factor, f.force_factor) +
+         fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms)", f.limit, f.window,
+             f.half_width * 1e3);
 }
 
 bool within_floor(const NoiseFloor& f, double gap, double force_rms) {

@@ -915,6 +915,61 @@ std::string named_list(const std::vector<std::string>& added, const FitResult& o
   return s;
 }
 
+// The settings against the defaults (verdict.hpp, "Detection limit"; docs/fit.md, "Verdicts"): a
+// --replay-window W or --filter-half-width L other than the default gets the detection limit at
+// the defaults into out.floor (the record's filter bank rebuilt at the default L). When the
+// settings' limit is worse and the verdict at them an all-clear (`within`), the fitted model is
+// judged also at the defaults (replayed at the default W, its force residual at the default L
+// with the stiction mask run_fit applies, against the floor there): the reason for an unexplained
+// verdict if they see it above their floor, else "".
+std::string hidden_by_settings(const Context& cx, const plant::PlantParams& model, bool within, FitResult& out) {
+  const double W = cx.opt.replay_window, L = cx.opt.record.filter_half_width;
+  out.floor.limit_default = out.floor.limit;
+  out.floor.window_default = out.floor.window;
+  out.floor.half_width_default = out.floor.half_width;
+  if (!(W > 0) && !(L > 0)) return "";  // the defaults
+  std::optional<Record> rebuilt;
+  if (L > 0) {
+    try {
+      rebuilt = prepare(*cx.rec.data, RecordOptions{0.0, cx.opt.record.motion_half_window});
+    } catch (const DataError&) {  // too short for the default filter: the settings are the record's only ones
+      out.floor.limit_default = 0.0;
+      return "";
+    }
+    mask_stiction(*rebuilt, model);
+  }
+  const Record& rd = rebuilt ? *rebuilt : cx.rec;
+  const NoiseFloor fd = noise_floor(rd, model, FloorOptions{cx.opt.stamp_error, 0.0});
+  out.floor.limit_default = fd.limit;
+  out.floor.window_default = fd.window;
+  out.floor.half_width_default = fd.half_width;
+  if (!within || !(out.floor.limit > fd.limit)) return "";
+  const std::string settings = fmt("the chosen settings (--replay-window %.3g s, --filter-half-width %.3g ms)",
+                                   out.floor.window, out.floor.half_width * 1e3);
+  const std::string defaults = fmt("the defaults (W = %.3g s, L = %.3g ms)", fd.window, fd.half_width * 1e3);
+  const std::string limits =
+      fmt(": the smallest constant force the record shows is %.3g N with them", out.floor.limit) +
+      fmt(" (where the fitted model is within their floor: gap %.4g um, force residual %.4g N RMS), %.3g N with the "
+          "defaults",
+          out.replay_final.gap * 1e6, out.force_rms_final, fd.limit);
+  double gap = 0.0;
+  try {
+    gap = replay(rd, out.fitted, 0.0, cx.opt.stop).gap;
+  } catch (const std::exception& e) {  // not judged at the defaults: no all-clear
+    return settings + " may hide a discrepancy " + defaults + " see" + limits +
+           ", and the fitted model cannot be replayed at the defaults (" + e.what() + "): fit with the defaults";
+  }
+  const double force = rms(force_residual(rd, out.fitted), rd.active_points());
+  if (within_floor(fd, gap, force)) return "";
+  cx.say(fmt("at the defaults: gap %.4g um, force residual %.4g N RMS", gap * 1e6, force));
+  return settings + " hide a discrepancy " + defaults + " see" + limits +
+         fmt(", where the fitted model leaves a gap of %.4g um and a force residual of %.4g N RMS, above their ",
+             gap * 1e6, force) +
+         fmt("noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.3gx and %.3gx)", fd.gap * 1e6,
+             fd.force, fd.gap_factor, fd.force_factor) +
+         "; fit with the defaults, or a W and L at least as long";
+}
+
 // The verdict against the sensor's noise floor (verdict.hpp): no discrepancy (nothing named, the
 // final gap and force residual within the floor), explained (effects named, within), or
 // unexplained (above it: explain_unexplained), with the model-form changes; one conclusion line.
@@ -924,10 +979,11 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
   const double gap_final = out.replay_final.gap, force_final = out.force_rms_final;
   // Without plant.sensor the floor is a guess from the record (its smallest position step), which a
   // record that never slows down makes large: it never gives an all-clear (issue 20's review).
-  const bool final_within = within_floor(out.floor, gap_final, force_final) && out.floor.from_scenario;
-  const std::string floor_text =
-      fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.3gx and %.3gx)",
-          out.floor.gap * 1e6, out.floor.force, out.floor.gap_factor, out.floor.force_factor);
+  const bool within = within_floor(out.floor, gap_final, force_final) && out.floor.from_scenario;
+  // nor do a W or L that hide from the floor what the defaults see (issue 20's review)
+  const std::string hidden = hidden_by_settings(cx, model, within, out);
+  const bool final_within = within && hidden.empty();
+  const std::string floor_text = describe(out.floor);
   if (added.empty() && final_within) {
     out.verdict = Verdict::kNoDiscrepancy;
     out.conclusion = "no discrepancy: the model explains the data to within its noise: gap " +
@@ -942,7 +998,8 @@ void conclude(const Context& cx, const plant::PlantParams& model, const std::vec
     out.verdict = Verdict::kUnexplained;
     out.conclusion =
         "unexplained discrepancy: " +
-        (out.floor.from_scenario || !within_floor(out.floor, gap_final, force_final)
+        (!hidden.empty() ? hidden
+         : out.floor.from_scenario || !within_floor(out.floor, gap_final, force_final)
              ? fmt("gap %.4g um and force residual %.4g N RMS stay above ", gap_final * 1e6, force_final) + floor_text
              : fmt("gap %.4g um and force residual %.4g N RMS cannot be judged: the scenario gives no "
                    "sensor (plant.sensor), so the noise floor is not known; give plant.sensor (the "

@@ -20,6 +20,7 @@
 
 #include "../support/scratch.hpp"
 #include "feeddrive/fit/report.hpp"
+#include "feeddrive/plant/effects.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace {
@@ -660,6 +661,92 @@ TEST(FitVerdict, StampErrorRaisesTheFloorAndHidesNoEffect) {
   EXPECT_GT(j["gap_final"].get<double>(), 100.0 * f1["gap_m"].get<double>());
 }
 
+// The settings cannot buy an all-clear (issue 20's review): a 0.5 N constant force hidden in the CI
+// record's 4 s. A replay window of 10 ms and a filter half-width of 2 ms (each 10 and 2 sample
+// periods, the shortest allowed) raise the smallest constant force the record shows from 0.02 N
+// to 2 N: the force sits below both floors, and the tool said "no discrepancy". Now the fitted
+// model is judged also at the defaults, which see the force: unexplained, exit 3, naming both
+// settings. At the defaults the verdict is as before (the model form carries the 0.5 N as the
+// friction's direction asymmetry, within 3 % of the friction level: no discrepancy).
+TEST(FitVerdict, ShortWindowAndFilterGiveNoFalseAllClear) {
+  using namespace issue20;
+  const fs::path data = [] {
+    const fs::path truth =
+        write_file("truth_half_newton.yaml", short_scenario("  effects:\n    constant_force: {force: 0.5}\n"));
+    const fs::path o = scratch() / "sim_half_newton";
+    const ProcResult s = run(kSim, truth.string() + " --out " + o.string() + " --no-plots --quiet");
+    if (s.code != 0) throw std::runtime_error("feeddrive-sim failed: " + s.err);
+    return o / "timeseries.csv";
+  }();
+  const auto fit = [&](const std::string& name, const std::string& args) {
+    const fs::path out = scratch() / name;
+    const ProcResult r = run_fit("--scenario " + model4().string() + " --data " + data.string() + " --out " +
+                                 out.string() + " --position-column x_measured --no-plots -q " + args);
+    return std::make_pair(r, fs::exists(out / "findings.json") ? findings(out) : nlohmann::json());
+  };
+  // the defaults: unchanged, and the detection limit stated (the limit at the defaults is its own)
+  const auto [d, jd] = fit("short_settings_default", "");
+  ASSERT_EQ(d.code, 0) << d.err << d.out;
+  EXPECT_EQ(jd["verdict"], "no_discrepancy") << jd["conclusion"];
+  const std::string cd = jd["conclusion"];
+  EXPECT_NE(cd.find("friction direction asymmetry 0.49"), std::string::npos) << cd;
+  EXPECT_NE(cd.find("the smallest constant force it shows: 0.0203 N at W = 0.1 s, L = 10 ms"), std::string::npos) << cd;
+  const auto& fd = jd["noise_floor"];
+  EXPECT_DOUBLE_EQ(fd["detection_limit_default_N"].get<double>(), fd["detection_limit_N"].get<double>());
+  // the limit by the gap: gap_factor (3) gap floors times 2 m sqrt(180) / W^2 (verdict.hpp), m the
+  // model's mass (with the motor's: effective_params); only rounding separates the two (1e-12);
+  // by the force residual: force_factor (its 99.9 % bound, ~1.27 here) force floors
+  const double m = feeddrive::plant::effective_params(feeddrive::sim::load_scenario(model4().string()).plant).mass;
+  EXPECT_DOUBLE_EQ(fd["gap_factor"].get<double>(), 3.0);
+  EXPECT_NEAR(fd["detection_limit_gap_N"].get<double>(),
+              3.0 * fd["gap_m"].get<double>() * 2.0 * m * std::sqrt(180.0) / (0.1 * 0.1),
+              1e-12 * fd["detection_limit_gap_N"].get<double>());
+  EXPECT_DOUBLE_EQ(fd["detection_limit_force_N"].get<double>(),
+                   fd["force_factor"].get<double>() * fd["force_rms_N"].get<double>());
+  EXPECT_DOUBLE_EQ(fd["detection_limit_N"].get<double>(),
+                   std::min(fd["detection_limit_gap_N"].get<double>(), fd["detection_limit_force_N"].get<double>()));
+  EXPECT_LT(fd["detection_limit_N"].get<double>(), 0.5);  // the defaults see the force
+  // The gap's formula on the force itself: without the model form the 0.5 N stays in the model's
+  // residual, and the initial gap is the drift of 0.5 N W^2/(2m)/sqrt(180) = 1.83 um (measured
+  // 1.91 um). 10 %: the sensor's 0.02 um adds in quadrature, and the model's friction answers the
+  // drift's small change of speed (the formula is the free mass's).
+  const auto [n, jn] = fit("short_settings_default_no_form", "--no-form-fit");
+  ASSERT_EQ(n.code, 3) << n.err << n.out;
+  const double drift = 0.5 * 0.1 * 0.1 / (2.0 * m) / std::sqrt(180.0);
+  EXPECT_NEAR(jn["gap_initial"].get<double>(), drift, 0.1 * drift);
+  // the shortest W and L, with and without the model form (without it the force is no asymmetry:
+  // the defaults leave it in the residual, 1.9 um of gap)
+  for (const std::string form : {"", "--no-form-fit"}) {
+    SCOPED_TRACE(form);
+    const auto [t, jt] = fit("short_settings" + form, "--replay-window 0.01 --filter-half-width 0.002 " + form);
+    ASSERT_EQ(t.code, 3) << t.err << t.out;
+    EXPECT_EQ(jt["verdict"], "unexplained");
+    const std::string c = jt["conclusion"];
+    EXPECT_NE(c.find("the chosen settings (--replay-window 0.01 s, --filter-half-width 2 ms) hide a discrepancy the "
+                     "defaults (W = 0.1 s, L = 10 ms) see"),
+              std::string::npos)
+        << c;
+    EXPECT_NE(c.find("the smallest constant force the record shows is 2.03 N with them (where the fitted model is "
+                     "within their floor: gap "),
+              std::string::npos)
+        << c;
+    EXPECT_NE(c.find("), 0.0203 N with the defaults, where the fitted model leaves a gap of "), std::string::npos) << c;
+    EXPECT_EQ(c.find("within its noise"), std::string::npos) << c;
+    const auto& ft = jt["noise_floor"];
+    EXPECT_DOUBLE_EQ(ft["replay_window_s"].get<double>(), 0.01);
+    EXPECT_DOUBLE_EQ(ft["filter_half_width_s"].get<double>(), 0.002);
+    // W 10x shorter: the gap's limit 100x higher (the gap floor is sigma_x at any W without stamp
+    // errors); the default limit is the default run's
+    EXPECT_NEAR(ft["detection_limit_gap_N"].get<double>() / fd["detection_limit_gap_N"].get<double>(), 100.0, 1e-9);
+    EXPECT_DOUBLE_EQ(ft["detection_limit_default_N"].get<double>(), fd["detection_limit_N"].get<double>());
+    EXPECT_GT(ft["detection_limit_N"].get<double>(), 0.5);  // these settings cannot show the force
+    EXPECT_NE(slurp(scratch() / ("short_settings" + form) / "report.md")
+                  .find("Detection limit: the smallest constant force this record shows at W = 0.01 s, L = 2 ms is "
+                        "2.03 N"),
+              std::string::npos);
+  }
+}
+
 // The issue's first case: a 40.2 mm ripple over 78.7 mm (pitch 2.2 % above travel/2) and a
 // 10.7 N constant force. The ripple is named as tentative with its caveat; a spring named first
 // for the ripple's remnant turns into a constant force once the ripple is in (swap move), and the
@@ -831,6 +918,27 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0),
                     {"column 't'", "control period", "likely in ms (--units t=ms)"});
   expect_data_error("force_kN.csv", make(1, 1, 1e-3, 0, 0), {"column 'force_N'", "likely in kN (--units force=kN)"});
+  // Every column both ways, each named alone (issue 20's review: a time divided by 1000 was named
+  // as column 'x', a position divided by 1000 as the force). A time 1000x too short: the time is
+  // named (its period against the control period, confirmed by a speed no drive reaches), in ks,
+  // which --units gives as counts.
+  expect_data_error("time_ks.csv", make(1e-3, 1, 1, 0, 0),
+                    {"time_ks.csv: column 't': median sample period 1e-06 s", "speeds up to",
+                     "likely in ks (--units t=counts:1000: 1000 s per unit)"});
+  // a position 1000x too small: its steps are 1/1000 of the scenario's 50 nm encoder step
+  expect_data_error("pos_km.csv", make(1, 1e-3, 1, 0, 0),
+                    {"pos_km.csv: column 'x': its smallest step 5e-11 m is 0.001 times the scenario's encoder step",
+                     "likely in km (--units x=counts:1000: 1000 m per unit)"});
+  // a force 1000x too large: the position's steps are the encoder's, so the force alone is named
+  expect_data_error("force_mN.csv", make(1, 1, 1e3, 0, 0),
+                    {"force_mN.csv: column 'force_N': the thrust is", "likely in mN (--units force=mN)"});
+  // the same, against units declared wrongly: the likely unit is the one the file is in
+  expect_data_error("time_s_as_ms.csv", make(1, 1, 1, 0, 0),
+                    {"time_s_as_ms.csv: column 't'", "likely in s (--units t=s)"}, "--units t=ms");
+  expect_data_error("pos_m_as_um.csv", make(1, 1, 1, 0, 0),
+                    {"pos_m_as_um.csv: column 'x'", "likely in m (--units x=m)"}, "--units x=um");
+  expect_data_error("force_N_as_kN.csv", make(1, 1, 1, 0, 0),
+                    {"force_N_as_kN.csv: column 'force_N'", "likely in N (--units force=N)"}, "--units force=kN");
   expect_data_error("joined.csv", make(1, 1, 1, 1000, 0),
                     {"joined.csv:2002: column 't': the time jumps by 1000 s", "two recordings joined"});
   expect_data_error("joined_offset.csv", make(1, 1, 1, 1000, 0.05),

@@ -24,7 +24,11 @@ struct Replay {
   std::vector<double> error;  ///< x_sim - x at every sample [m] (0 at window starts)
 };
 
-/// window: W [s]; 0 picks 0.1 s (at least 20 samples).
+/// The replay window W [s] of a `window` setting: window itself, or for 0 the default: 0.1 s (at
+/// least 20 samples).
+double window_length(const Record& rec, double window);
+
+/// window: W [s]; 0 picks the default (window_length).
 Replay replay(const Record& rec, const plant::PlantParams& model, double window = 0.0,
               const interrupt::StopToken& stop = {});
 

@@ -3,7 +3,8 @@
 // A record that cannot be what the scenario describes is refused with one line (DataError, exit 2)
 // naming the column and the likely unit, or the row and the size of a jump:
 //   * time: a step of more than kMaxGap median periods is a gap or a jump (two recordings joined);
-//     a median period ~1000x or ~1e6x the scenario's control period is a time column in ms or us;
+//     a median period ~1000x or ~1e6x the scenario's control period is a time column in ms or us,
+//     ~1/1000 of it one in ks (or s read as ms) when the speed confirms it;
 //   * position: a travel above kMaxTravel or a speed above kMaxSpeed is beyond a feed drive (a
 //     column in mm, um or nm); a step whose acceleration is beyond 20x what the peak thrust gives
 //     the mass (and beyond 50x the sensor's own second difference and 20x the record's 99th
@@ -11,7 +12,9 @@
 //   * force: the thrust must move the model's mass. The filtered thrust is regressed on
 //     m * (filtered acceleration), a constant, sgn v and v (the modulating-function balance of
 //     model.hpp with a generic friction); the ratio of thrust to m*a must lie within a factor
-//     kMaxForceRatio of 1 (a 2x mass error passes; a force in kN read as N gives 0.001).
+//     kMaxForceRatio of 1 (a 2x mass error passes; a force in kN read as N gives 0.001). The
+//     position's smallest step against the scenario's encoder step tells which column is off: the
+//     position when its steps are 1000x off, the force when they are the encoder's.
 
 #include <string>
 

@@ -52,6 +52,20 @@
 //     does not see either, is below what this record can show: the report states that limit.
 // The scenario's plant.sensor gives q and sigma_n; without one, q is the record's smallest
 // position step (its resolution) and sigma_n = 0, and the report says so.
+//
+// Detection limit: the smallest constant force F the record can show at the settings used, i.e.
+// that takes the gap or the force residual of an exact model beyond its bound (gap_factor, force_factor).
+//   * by the gap: F over a replay window W moves the drive by F t^2/(2m); the window's start
+//     correction removes its least-squares line, which leaves W^2/(2m) (u^2 - u + 1/6) on
+//     u = t/W in [0, 1], of RMS W^2/(2m)/sqrt(180) per unit force. F_gap = gap_factor gap
+//     2m sqrt(180) / W^2: the limit grows as 1/W^2 (0.02 N at W = 0.1 s, 2 N at W = 10 ms on the
+//     CI record);
+//   * by the force residual: F enters every filter point's residual as F (the kernel has unit
+//     area): F_force = force_factor force. The force floor grows as the filter shrinks (its
+//     noise as L^-2.5, its discretisation as L^-2).
+// The limit is the smaller of the two (either above its floor refuses "within"). A replay window
+// or filter half-width that makes it worse than at the defaults can hide a discrepancy the
+// defaults see: run_fit then decides also at the defaults (docs/fit.md, "Verdicts").
 
 #include <string>
 #include <vector>
@@ -76,6 +90,14 @@ struct NoiseFloor {
   double force_factor{1.0};          ///< within = force residual <= force_factor * force (header)
   long force_points{0};              ///< nu of the force residual bound: the active filter points
   std::string source;                ///< one line: where q and sigma_n come from
+  double window{0.0};                ///< W [s] of the replay the gap floor is for
+  double half_width{0.0};            ///< L [s] of the filter the force floor is for
+  double limit_gap{0.0};             ///< [N] the smallest constant force the gap shows (header)
+  double limit_force{0.0};           ///< [N] the smallest constant force the force residual shows
+  double limit{0.0};                 ///< [N] the detection limit: the smaller of the two
+  /// The detection limit at the default W and L and those defaults (the settings' own when they
+  /// are the defaults; limit_default 0: the record is too short for the default filter; set by run_fit).
+  double limit_default{0.0}, window_default{0.0}, half_width_default{0.0};
 };
 
 /// The largest excess of the force residual over its floor measured where the model is the drive (header).
@@ -92,6 +114,9 @@ struct FloorOptions {
 };
 NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt = {});
 bool within_floor(const NoiseFloor& f, double gap, double force_rms);
+/// "the noise floor (gap G um, force residual F N RMS; within = at most 3x; the smallest constant
+/// force it shows: X N at W = .., L = ..)": the floor and its detection limit in a conclusion.
+std::string describe(const NoiseFloor& f);
 
 enum class Verdict { kExplained, kNoDiscrepancy, kUnexplained };
 /// "explained", "no_discrepancy", "unexplained" (findings.json's `verdict`).
