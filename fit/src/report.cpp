@@ -135,7 +135,6 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"position_sigma_m", f.position},
           {"gap_factor", f.gap_factor},
           {"force_factor", f.force_factor},
-          {"force_points", f.force_points},
           {"from_scenario", f.from_scenario},
           {"source", f.source},
           {"force_noise_N", f.force_noise},
@@ -335,10 +334,9 @@ void md_floor(std::ostringstream& md, const NoiseFloor& f) {
   std::snprintf(
       b, sizeof b,
       "; force: %.3g N of the sensor and stamps, %.3g N of the filter's discretisation); \"within\" means at "
-      "most %.3gx the force floor (the 99.9 %% bound of an RMS of %ld filter points, times %.2f for the floor's "
-      "first-order terms) and %.3gx the gap floor (the replay's unobserved friction state and fitted parameters' "
-      "drift).\n\n",
-      f.force_noise, f.force_discretisation, f.force_factor, f.force_points, kFirstOrderAllowance, f.gap_factor);
+      "most %.3gx the force floor (friction changing sign within a sample at reversals) and %.3gx the gap floor "
+      "(the replay's unobserved friction state and fitted parameters' drift).\n\n",
+      f.force_noise, f.force_discretisation, f.force_factor, f.gap_factor);
   md << a << f.source << b;
   char c[240], d[120] = "";
   std::snprintf(c, sizeof c,

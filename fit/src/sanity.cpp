@@ -91,6 +91,14 @@ double speed_p99(const MeasuredData& d) {
 void check_time_scale(const MeasuredData& d, double T, double control_period) {
   if (!(control_period > 0 && T > 0)) return;
   const int k = thousands(T / control_period);
+  // a record sampled slower than the controller runs: the thrust changes between two samples,
+  // while the force residual and the replay hold each sample's over its interval (issue 20's review)
+  if (k == 0 && T > kMaxSamplePeriodRatio * control_period)
+    throw DataError(d.source + ": column '" + d.time_name + "'" +
+                    fmt(": median sample period %.4g s is %.3g times the scenario's control period %.4g s: the "
+                        "thrust changes between samples, which the fit takes as held over each; record at the "
+                        "control rate (every control period), or give the scenario the logger's period",
+                        T, T / control_period, control_period));
   if (k == 0) return;
   const double factor = d.time_factor * std::pow(1000.0, -k);
   const std::string h = hint("t", factor);
@@ -254,6 +262,13 @@ void check_force_scale(const Record& rec, const plant::PlantParams& model) {
   const MeasuredData& d = *rec.data;
   const long n = static_cast<long>(rec.bank.tau.size());
   if (n < 8) return;
+  // a constant input while the drive moves (a channel switched off): nothing drives the model
+  const auto [lo, hi] = std::minmax_element(rec.input.data(), rec.input.data() + rec.input.size());
+  if (rec.input.size() > 0 && *lo == *hi && rec.v_max_abs > 0)
+    throw DataError(d.source + ": column '" + d.input_name + "'" +
+                    fmt(": constant (%.4g) over the whole record while the drive moves (up to %.4g mm/s): a "
+                        "channel switched off or the wrong column; the fit needs the thrust or the command",
+                        *lo + 0.0, rec.v_max_abs * 1e3));  // + 0.0: -0 prints as 0
   const double mass = plant::effective_params(model).mass;
   const double gain = thrust_per_input(rec, model);
   const Eigen::VectorXd thrust = apply(rec.bank, gain * rec.input);
@@ -279,6 +294,13 @@ void check_force_scale(const Record& rec, const plant::PlantParams& model) {
   const Eigen::VectorXd res = thrust - A * beta;
   const double r2 = 1.0 - res.squaredNorm() / std::max(thrust.squaredNorm(), 1e-300);
   if (!(r2 > 0.5) || !(std::abs(alpha) > 0)) return;
+  // a thrust against the acceleration: the direction of one column is reversed (issue 20's review)
+  if (alpha < 0)
+    throw DataError(d.source + ": columns '" + d.input_name + "' and '" + d.position_name + "'" +
+                    fmt(": the thrust is %.3g times mass x acceleration (%.4g kg): it pushes against the motion, "
+                        "so the sign of one of them is reversed (the encoder counting the other way, or the force "
+                        "logged with the opposite sign): negate one column",
+                        alpha, mass));
   if (std::abs(alpha) <= kMaxForceRatio && std::abs(alpha) >= 1.0 / kMaxForceRatio) return;
   throw_force_scale(d, model, alpha, mass);
 }

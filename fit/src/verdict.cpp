@@ -168,7 +168,6 @@ void force_floor(const Record& rec, const SampleErrors& se, NoiseFloor& f) {
   f.force_noise = count ? std::sqrt(noise_sum / nc) : 0.0;
   f.force_discretisation = count ? std::sqrt(bias_sum / nc) : 0.0;
   f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
-  f.force_points = count;
 }
 
 }  // namespace
@@ -179,7 +178,7 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
   f.gap = gap_floor(rec, se, opt.replay_window, f.position);
   force_floor(rec, se, f);
   f.gap_factor = kGapAllowance;
-  f.force_factor = kFirstOrderAllowance * rms_bound(f.force_points);
+  f.force_factor = kForceAllowance;
   // the detection limit (header)
   f.window = window_length(rec, opt.replay_window);
   f.half_width = rec.bank.half_width;
@@ -189,17 +188,14 @@ NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const
   return f;
 }
 
-double rms_bound(long nu) {
-  if (nu < 1) return std::numeric_limits<double>::infinity();
-  constexpr double z = 3.0902;  // the standard normal's 99.9 % quantile
-  const double v = static_cast<double>(nu), c = 2.0 / (9.0 * v);
-  const double q = v * std::pow(std::max(0.0, 1.0 - c + z * std::sqrt(c)), 3);
-  return std::sqrt(q / v);
+std::string within_text(const NoiseFloor& f) {
+  return f.gap_factor == f.force_factor
+             ? fmt("within = at most %.3gx", f.gap_factor)
+             : fmt("within = at most %.3gx (gap) and %.3gx (force)", f.gap_factor, f.force_factor);
 }
 
 std::string describe(const NoiseFloor& f) {
-  return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.3gx and %.3gx", f.gap * 1e6,
-             f.force, f.gap_factor, f.force_factor) +
+  return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; ", f.gap * 1e6, f.force) + within_text(f) +
          fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms)", f.limit, f.window,
              f.half_width * 1e3);
 }

@@ -965,8 +965,7 @@ std::string hidden_by_settings(const Context& cx, const plant::PlantParams& mode
   return settings + " hide a discrepancy " + defaults + " see" + limits +
          fmt(", where the fitted model leaves a gap of %.4g um and a force residual of %.4g N RMS, above their ",
              gap * 1e6, force) +
-         fmt("noise floor (gap %.3g um, force residual %.3g N RMS; within = at most %.3gx and %.3gx)", fd.gap * 1e6,
-             fd.force, fd.gap_factor, fd.force_factor) +
+         fmt("noise floor (gap %.3g um, force residual %.3g N RMS; ", fd.gap * 1e6, fd.force) + within_text(fd) + ")" +
          "; fit with the defaults, or a W and L at least as long";
 }
 

@@ -4,7 +4,8 @@
 // naming the column and the likely unit, or the row and the size of a jump:
 //   * time: a step of more than kMaxGap median periods is a gap or a jump (two recordings joined);
 //     a median period ~1000x or ~1e6x the scenario's control period is a time column in ms or us,
-//     ~1/1000 of it one in ks (or s read as ms) when the speed confirms it;
+//     ~1/1000 of it one in ks (or s read as ms) when the speed confirms it; one above
+//     kMaxSamplePeriodRatio control periods samples slower than the thrust changes;
 //   * position: a travel above kMaxTravel or a speed above kMaxSpeed is beyond a feed drive (a
 //     column in mm, um or nm); a step whose acceleration is beyond 20x what the peak thrust gives
 //     the mass (and beyond 50x the sensor's own second difference and 20x the record's 99th
@@ -14,7 +15,9 @@
 //     model.hpp with a generic friction); the ratio of thrust to m*a must lie within a factor
 //     kMaxForceRatio of 1 (a 2x mass error passes; a force in kN read as N gives 0.001). The
 //     position's smallest step against the scenario's encoder step tells which column is off: the
-//     position when its steps are 1000x off, the force when they are the encoder's.
+//     position when its steps are 1000x off, the force when they are the encoder's. A negative
+//     ratio is a column whose sign is reversed; a constant input while the drive moves, a channel
+//     switched off.
 
 #include <string>
 
@@ -28,6 +31,8 @@ constexpr double kMaxGap = 10.0;         ///< a time step longer than this many 
 constexpr double kMaxTravel = 10.0;      ///< [m] no feed drive travels further
 constexpr double kMaxSpeed = 10.0;       ///< [m/s] nor faster (fast linear motors reach ~5 m/s)
 constexpr double kMaxForceRatio = 30.0;  ///< thrust / (m a) outside [1/30, 30]: a unit off by 1000
+/// a median sample period above this many control periods: the thrust is not held over a sample
+constexpr double kMaxSamplePeriodRatio = 1.5;
 
 /// The time and position checks on the raw record (before prepare()). control_period <= 0: no
 /// time-scale check. Throws DataError.

@@ -33,14 +33,15 @@
 // In the force residual the same impulse enters the filtered thrust as dF_k d_k h(tau_i - t_k).
 // Both add in quadrature to the sensor's terms (per sample variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2).
 // Within the floor (within_floor):
-//   * force residual: a statistical test, not a margin. Under the floor's model it is an RMS of
-//     nu independent errors (the filter points, whose windows of 2L do not overlap), so
-//     (RMS/floor)^2 ~ chi^2_nu / nu; "within" is below its 99.9 % bound sqrt(q_0.999(chi^2_nu)/nu)
-//     (Wilson & Hilferty 1931 for the quantile; 1.1-1.2 on records of 200-1000 points), times
-//     kFirstOrderAllowance, the largest excess measured where the model is the drive but for the
-//     generator's integrator and the floor's first-order terms (NoiseFloor.
-//     PerfectModelRecordsSitAtTheFloor: 0.99-1.10x). Any force the model misses, however small,
-//     adds to it in quadrature: a 0.1 N force on a 0.07 N floor is 1.7x, above.
+//   * force residual: at most kForceAllowance times its floor. Where the model is the drive but
+//     for the generator's integrator, without friction, it ends at 0.99-1.10x
+//     (NoiseFloor.PerfectModelRecordsSitAtTheFloor), but the floor has no term for a friction that
+//     changes sign inside a sample interval at a reversal: on feeddrive's own plant, with the
+//     model exact, it ends at 1.12-1.22x (scenarios/fit/model.yaml over sensor seeds 7, 11-13)
+//     and at 2.05x with a 20 N Coulomb friction named right (the rest concentrated 13-fold at the
+//     reversals). A 99.9 % chi-square bound on the filter points (1.1-1.3x) called those exact
+//     models discrepancies (issue 20's review, 27 November), so it was not kept; a force below
+//     the allowance is what the detection limit below states the record cannot show.
 //   * gap: at most kGapAllowance times its floor. The floor is a perfect model's with a known
 //     state; the replay restarts each window from the measured position and speed, but not from
 //     the friction's internal state (the bristle deflection of LuGre, unobserved), and with
@@ -88,7 +89,6 @@ struct NoiseFloor {
   bool from_scenario{true};          ///< false: q estimated from the record
   double gap_factor{1.0};            ///< within = gap <= gap_factor * gap (header)
   double force_factor{1.0};          ///< within = force residual <= force_factor * force (header)
-  long force_points{0};              ///< nu of the force residual bound: the active filter points
   std::string source;                ///< one line: where q and sigma_n come from
   double window{0.0};                ///< W [s] of the replay the gap floor is for
   double half_width{0.0};            ///< L [s] of the filter the force floor is for
@@ -100,13 +100,10 @@ struct NoiseFloor {
   double limit_default{0.0}, window_default{0.0}, half_width_default{0.0};
 };
 
-/// The largest excess of the force residual over its floor measured where the model is the drive (header).
-constexpr double kFirstOrderAllowance = 1.10;
+/// The force residual of a model fitted to the record may be this many times its floor (header).
+constexpr double kForceAllowance = 3.0;
 /// The replay gap may be this many times its floor (header).
 constexpr double kGapAllowance = 3.0;
-/// sqrt(q_0.999(chi^2_nu) / nu): the 99.9 % bound of an RMS of nu independent errors over their
-/// standard deviation (Wilson-Hilferty approximation of the chi-square quantile).
-double rms_bound(long nu);
 
 struct FloorOptions {
   double stamp_error{0.0};    ///< sigma_t [s] of the record's time stamps (1 sigma; 0: not known)
@@ -114,6 +111,8 @@ struct FloorOptions {
 };
 NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt = {});
 bool within_floor(const NoiseFloor& f, double gap, double force_rms);
+/// "within = at most 3x" (or each floor's allowance when they differ).
+std::string within_text(const NoiseFloor& f);
 /// "the noise floor (gap G um, force residual F N RMS; within = at most 3x; the smallest constant
 /// force it shows: X N at W = .., L = ..)": the floor and its detection limit in a conclusion.
 std::string describe(const NoiseFloor& f);
