@@ -31,6 +31,8 @@ constexpr double kMaxGap = 10.0;         ///< a time step longer than this many 
 constexpr double kMaxTravel = 10.0;      ///< [m] no feed drive travels further
 constexpr double kMaxSpeed = 10.0;       ///< [m/s] nor faster (fast linear motors reach ~5 m/s)
 constexpr double kMaxForceRatio = 30.0;  ///< thrust / (m a) outside [1/30, 30]: a unit off by 1000
+/// thrust / (m a) at or below -1/this: a column's sign reversed (a mass error of 2x gives 0.5-2)
+constexpr double kMaxSignRatio = 2.0;
 /// a median sample period above this many control periods: the thrust is not held over a sample
 constexpr double kMaxSamplePeriodRatio = 1.5;
 
