@@ -115,6 +115,7 @@ csv::Options csv_options(const CsvOptions& opt) {
   o.decimal_comma = opt.decimal_comma;
   o.columns_by_index = true;
   o.separator_option = "--separator";
+  o.decimal_comma_option = "--decimal-comma";
   o.columns = {{{opt.time_column}},
                {{opt.position_column}},
                {{opt.command_column, opt.force_column}},

@@ -104,6 +104,39 @@ TEST(CsvReader, EachErrorIsOneLineNamingFileLineColumnAndValue) {
   }
 }
 
+// A logger's decimal comma in a ';'-separated file read without decimal_comma: the value is named
+// with the hint, and the caller's option when it gives one (issue 20's review: "not a number:
+// '0,0'" alone). A value that is no number either way gets no hint.
+TEST(CsvReader, ADecimalCommaNotAskedForIsHinted) {
+  Options o = tx();
+  o.separator = ';';
+  const std::string path = write_temp("decimal_comma.csv", "t;x\n0;0\n1;0,25\n");
+  EXPECT_EQ(error_of(path, o), path +
+                                   ":3:3: column 'x': not a number: '0,25'; a decimal comma? (it is read only "
+                                   "when asked for)");
+  o.decimal_comma_option = "--decimal-comma";
+  EXPECT_EQ(error_of(path, o), path +
+                                   ":3:3: column 'x': not a number: '0,25'; a decimal comma? (give it with "
+                                   "--decimal-comma)");
+  const std::string other = write_temp("comma_text.csv", "t;x\n0;0\n1;a,b\n");
+  EXPECT_EQ(error_of(other, o), other + ":3:3: column 'x': not a number: 'a,b'");
+  o.decimal_comma = true;
+  EXPECT_EQ(error_of(path, o), "");
+}
+
+// A column asked for by an index beyond the header names the range (issue 20's review: "missing
+// column '9'" alone).
+TEST(CsvReader, AColumnIndexBeyondTheHeaderNamesTheRange) {
+  Options o;
+  o.columns = {{{"t"}}, {{"9"}}};
+  o.columns_by_index = true;
+  o.limits.min_rows = 2;
+  const std::string path = write_temp("index.csv", "t,a,b\n0,0,0\n1,1,1\n");
+  EXPECT_EQ(error_of(path, o), path + ":1: missing column '9' in the header 't,a,b'; a column index is 1 to 3 here");
+  o.columns = {{{"t"}}, {{"3"}}};
+  EXPECT_EQ(error_of(path, o), "");
+}
+
 TEST(CsvReader, FilesThatCannotBeRead) {
   const std::string missing = ::testing::TempDir() + "feeddrive_csv_does_not_exist.csv";
   EXPECT_EQ(error_of(missing), missing + ": cannot open the file: No such file or directory");

@@ -156,8 +156,15 @@ class Parser {
       }
       if (index_[c] < 0 && opt_.columns[c].required) {
         std::string alts;
-        for (const std::string& n : opt_.columns[c].names) alts += (alts.empty() ? "'" : " or '") + n + "'";
-        fail_line(0, "missing column " + alts + " in the header '" + header_text_ + "'" + hint);
+        bool index_given = false;  // a column asked for by an index the header does not reach
+        for (const std::string& n : opt_.columns[c].names) {
+          alts += (alts.empty() ? "'" : " or '") + n + "'";
+          index_given = index_given ||
+                        (opt_.columns_by_index && !n.empty() && n.find_first_not_of("0123456789") == std::string::npos);
+        }
+        const std::string range =
+            index_given ? "; a column index is 1 to " + std::to_string(header_.size()) + " here" : "";
+        fail_line(0, "missing column " + alts + " in the header '" + header_text_ + "'" + hint + range);
       }
     }
   }
@@ -183,6 +190,21 @@ class Parser {
     table_.lines.push_back(line_no_);
   }
 
+  // "; a decimal comma? ..." for a value that would be a number with its comma read as the point
+  // (only without decimal_comma: a logger's "0,25" in a ';'-separated file); "" otherwise.
+  std::string decimal_comma_hint(std::string_view text) const {
+    if (opt_.decimal_comma || text.find(',') == std::string_view::npos) return "";
+    std::string t(text);
+    std::replace(t.begin(), t.end(), ',', '.');
+    double v = 0.0;
+    const char* first = t.data() + (t.front() == '+' ? 1 : 0);
+    const auto res = std::from_chars(first, t.data() + t.size(), v);
+    if (res.ec != std::errc() || res.ptr != t.data() + t.size()) return "";
+    return "; a decimal comma?" + (opt_.decimal_comma_option.empty()
+                                       ? std::string(" (it is read only when asked for)")
+                                       : " (give it with " + opt_.decimal_comma_option + ")");
+  }
+
   double number(const Field& f, const std::string& name) const {
     const std::string where = "column '" + name + "': ";
     const std::size_t col = f.column + bom_;
@@ -202,7 +224,7 @@ class Parser {
     double v = 0.0;
     const auto res = std::from_chars(first, last, v);
     if (first == last || res.ptr != last || (res.ec != std::errc() && res.ec != std::errc::result_out_of_range))
-      fail_line(col, where + "not a number: '" + shown(f.text) + "'");
+      fail_line(col, where + "not a number: '" + shown(f.text) + "'" + decimal_comma_hint(text));
     if (res.ec == std::errc::result_out_of_range)
       fail_line(col, where + "out of the range of a double: '" + shown(f.text) + "'");
     if (!std::isfinite(v)) fail_line(col, where + "not a finite number: '" + shown(f.text) + "'");

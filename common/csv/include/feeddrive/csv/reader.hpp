@@ -70,6 +70,9 @@ struct Options {
   bool columns_by_index{false};
   /// Named in the hint when a header seems split by another separator (e.g. "--separator").
   std::string separator_option;
+  /// Named in the hint when a value that is not a number looks like one with a decimal comma
+  /// ("0,25" without decimal_comma; e.g. "--decimal-comma").
+  std::string decimal_comma_option;
   /// Index into columns of a column that must increase strictly (time), or -1.
   int increasing{-1};
   Limits limits;
