@@ -586,6 +586,24 @@ void accept(const Context& cx, const CandidateFit& c, const Choice& ch, Search& 
   }
 }
 
+// The model without effect e, the others refitted: the fit, its free set and the loss in BIC of
+// taking e out (backward step and final confirmation alike).
+struct Without {
+  JointFit fit;
+  FreeSet free;
+  double loss{0.0};
+};
+Without refit_without(const Context& cx, const Search& s, const std::string& e) {
+  Without w;
+  w.free = s.free;
+  w.free.effects.erase(std::find(w.free.effects.begin(), w.free.effects.end(), e));
+  plant::PlantParams p = s.current;
+  plant::effect_enabled(p.effects, e) = false;
+  w.fit = fit_jointly(cx.rec, p, w.free, nullptr, 100, cx.opt.stop);
+  w.loss = bic_of(w.fit.rss, w.free.parameters(w.fit.params), cx.n) - s.bic;
+  return w;
+}
+
 // The earlier effect (not `name`, just added) whose removal, the others refitted, costs least in
 // BIC, if that is less than the threshold: {effect, the fit without it, its cost}; effect "" if none.
 struct Removal {
@@ -598,16 +616,11 @@ Removal cheapest_removal(const Context& cx, const Search& s, const std::string& 
   best.loss = cx.opt.score_threshold;
   for (const std::string& e : s.free.effects) {
     if (e == name) continue;
-    FreeSet fr = s.free;
-    fr.effects.erase(std::find(fr.effects.begin(), fr.effects.end(), e));
-    plant::PlantParams p = s.current;
-    plant::effect_enabled(p.effects, e) = false;
-    const JointFit jf = fit_jointly(cx.rec, p, fr, nullptr, 100, cx.opt.stop);
-    const double loss = bic_of(jf.rss, fr.parameters(jf.params), cx.n) - s.bic;
-    if (loss < best.loss) {
-      best.loss = loss;
+    Without w = refit_without(cx, s, e);
+    if (w.loss < best.loss) {
+      best.loss = w.loss;
       best.drop = e;
-      best.without = jf;
+      best.without = std::move(w.fit);
     }
   }
   return best;
@@ -717,30 +730,24 @@ void final_swaps(const Context& cx, Search& s) {
 // min_gap_reduction: the three criteria it entered on (choose). `why` is empty when it passes, or
 // when the model without it cannot be replayed (then it is kept: nothing to compare).
 struct Confirmation {
-  JointFit without;
-  FreeSet free;
+  Without without;
   Replay rp;
-  double loss{0.0};
   std::string why;
 };
 Confirmation confirm(const Context& cx, const Search& s, const std::string& e, const std::vector<double>& cv_with) {
-  Confirmation c;
-  c.free = s.free;
-  c.free.effects.erase(std::find(c.free.effects.begin(), c.free.effects.end(), e));
-  plant::PlantParams p = s.current;
-  plant::effect_enabled(p.effects, e) = false;
-  c.without = fit_jointly(cx.rec, p, c.free, nullptr, 100, cx.opt.stop);
+  Confirmation c{refit_without(cx, s, e), {}, {}};
+  const JointFit& w = c.without.fit;
   try {
-    c.without.params.validate();
-    c.rp = replay(cx.rec, c.without.params, cx.opt.replay_window, cx.opt.stop);
+    w.params.validate();
+    c.rp = replay(cx.rec, w.params, cx.opt.replay_window, cx.opt.stop);
   } catch (const std::exception&) {  // the model without it cannot be replayed: keep it
     return c;
   }
-  c.loss = bic_of(c.without.rss, c.free.parameters(c.without.params), cx.n) - s.bic;
+  const double loss = c.without.loss;
   const CvVerdict v =
-      cv_verdict(cross_validate(cx.rec, c.without.params, c.free, cx.opt.cv_folds, cx.opt.stop), cv_with);
-  if (!(c.loss >= cx.opt.score_threshold))
-    c.why = fmt("with the others in it is worth only %.3g in BIC (threshold %.3g)", c.loss, cx.opt.score_threshold);
+      cv_verdict(cross_validate(cx.rec, w.params, c.without.free, cx.opt.cv_folds, cx.opt.stop), cv_with);
+  if (!(loss >= cx.opt.score_threshold))
+    c.why = fmt("with the others in it is worth only %.3g in BIC (threshold %.3g)", loss, cx.opt.score_threshold);
   else if (!v.confirmed)
     c.why =
         fmt("with the others in it is not confirmed out of sample (mean reduction per block %.3g N^2, "
@@ -764,14 +771,14 @@ void final_confirmation(const Context& cx, Search& s, FitResult& out) {
     for (const std::string& e : s.added) {
       if (!contains(s.free.effects, e)) continue;
       Confirmation c = confirm(cx, s, e, cv_with);
-      if (!c.why.empty() && (!weakest || c.loss < weakest->loss)) {
+      if (!c.why.empty() && (!weakest || c.without.loss < weakest->without.loss)) {
         weakest = std::move(c);
         name = e;
       }
     }
     if (!weakest) return;
-    s.current = weakest->without.params;
-    s.free = weakest->free;
+    s.current = weakest->without.fit.params;
+    s.free = weakest->without.free;
     s.added.erase(std::find(s.added.begin(), s.added.end(), name));
     s.tentative.erase(name);
     refresh(cx, s);

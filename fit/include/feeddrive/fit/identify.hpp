@@ -54,7 +54,7 @@ struct CandidateFit {
 /// Regression, 1989, sec. 5.1), s^2 = RSS/(n - k) over the n independent filter points, J the
 /// central-difference Jacobian of the filtered residual in the vocabulary's own parameters
 /// (pseudo-inverse: a phase of a vanishing amplitude is undetermined and gets NaN).
-/// `form`: the model-form parameters that were fitted too (kFormParameters' keys), in the same
+/// `form`: the model-form parameters that were fitted too (form_parameter's keys), in the same
 /// covariance (they correlate with the effects'), returned under "model_form".
 /// Returns {effect: {parameter: 1.96 sigma}}.
 std::map<std::string, std::map<std::string, double>> confidence_intervals(const Record& rec,
@@ -65,8 +65,6 @@ std::map<std::string, std::map<std::string, double>> confidence_intervals(const 
 /// [m/s] and shape b [-] of sgn_eps, the Stribeck exponent delta [-], and the friction's direction
 /// asymmetry [N] (carried as constant_force when that is not named).
 double& form_parameter(plant::PlantParams& p, const std::string& key);
-inline const std::vector<std::string> kFormParameters{"coulomb_transition_velocity", "coulomb_transition_shape",
-                                                      "stribeck_exponent", "direction_asymmetry"};
 
 /// BIC of a residual vector with k parameters over n_active points (0: all of r).
 double bic(const Eigen::VectorXd& r, int k, long n_active = 0);
