@@ -218,6 +218,7 @@ Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Int
   }
   const Eigen::Map<const Eigen::VectorXd> accel(r.bank.accel.data(), static_cast<long>(r.bank.accel.size()));
   Eigen::VectorXd res = pe.mass * accel - thrust_f + c.friction_filtered + c.grinding_filtered + apply(r.bank, force);
+  if (internal) internal->unmasked = res;
   for (std::size_t i = 0; i < r.masked.size(); ++i)
     if (r.masked[i]) res[static_cast<long>(i)] = 0.0;
   return res;

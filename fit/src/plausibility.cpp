@@ -100,6 +100,10 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
 }
 
 // long-function: a flat list of rules, one or two per effect, each independent of the others.
+bool small_mass_change(const Envelope& env, const plant::NamedEffect& e) {
+  return e.name == "mass_error" && std::abs(par(e, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass;
+}
+
 std::string implausible(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e) {
   const std::string& n = e.name;
   const double F = env.peak_thrust;
@@ -199,9 +203,11 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     if (m < 0.5 * env.nominal_mass || m > 2.0 * env.nominal_mass)
       return fmt("mass %.4g kg is not within a factor of two of the nominal %.4g kg", m, env.nominal_mass);
     // A drive's moving mass is known to a few per cent (payload, cables, bearings); a smaller
-    // change is no mass error but the mass absorbing model-form error of friction at reversals.
-    if (std::abs(m - env.nominal_mass) < 0.02 * env.nominal_mass)
-      return fmt("mass %.4g kg is within 2 %% of the nominal %.4g kg: no mass error worth naming", m, env.nominal_mass);
+    // change is, unless the record shows it away from low speed too, the mass absorbing model-form
+    // error of friction at reversals.
+    if (small_mass_change(env, e))
+      return fmt("mass %.4g kg is within %.0f %% of the nominal %.4g kg", m, 100 * kSmallMassChange, env.nominal_mass) +
+             ", and the record does not show it away from low speed, where friction's form cannot fake it";
   }
   if (n == "input_delay") {
     const double d = par(e, "delay");

@@ -140,6 +140,7 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"force_noise_N", f.force_noise},
           {"force_discretisation_N", f.force_discretisation},
           {"stamp_error_s", f.stamp_error},
+          {"stamp_error_given_s", f.stamp_given > 0 ? f.stamp_given : f.stamp_error},
           {"replay_window_s", f.window},
           {"filter_half_width_s", f.half_width},
           {"detection_limit_N", f.limit},

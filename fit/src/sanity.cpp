@@ -53,12 +53,6 @@ std::string unit_name(const std::string& role, double factor) {
 
 namespace {
 
-// The k-th smallest value of v (0-based).
-double order_statistic(std::vector<double> v, std::size_t k) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
-}
-
 // 1. gaps and jumps in time: the largest time step, against kMaxGap median periods T.
 void check_time_steps(const MeasuredData& d, double T) {
   std::size_t worst = 1;

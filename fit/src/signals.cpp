@@ -8,6 +8,11 @@
 
 namespace feeddrive::fit {
 
+double order_statistic(std::vector<double> v, std::size_t k) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
 double kernel(double s, double L) {
   const double u = s / L;
   if (u <= -1.0 || u >= 1.0) return 0.0;

@@ -169,10 +169,75 @@ void force_floor(const Record& rec, const SampleErrors& se, NoiseFloor& f) {
   f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
 }
 
+// The time-stamp error the record itself allows (header, "Time stamps"): a sample stamped d_k
+// off lies v_k d_k off the smooth motion, which the cubic through its four neighbours (Lagrange,
+// on the recorded stamps) does not follow: e_k = x_k - P_k(t_k) has the variance (1 + sum_j w_j^2)
+// (sigma_x^2 + v_k^2 sigma_t^2), w_j the cubic's weights (34/36 on equal steps). Over the samples at
+// speed (|v| at least half the record's 95th percentile, at least kMinSamples of them), the median
+// of e_k^2 / (1 + sum w^2) is 0.455 s^2 for Gaussian errors (the median of chi^2 with one degree of
+// freedom) and 0.75 s^2 for a uniform one; s^2 = median / 0.455 overstates s by at most 1.3x.
+// Returns the largest sigma_t the record allows, kStampMargin max(s, sigma_x) / v (v their median
+// speed): a larger one would make them at least 3x more scattered than they are. A thrust that
+// changes each sample by dF leaves the cubic off by about (dF/m) dt^2 / 4 (0.25 nm for 1 N on
+// 100 kg at 1 ms), far below the sensor's. {-1, ...}: too few samples at speed to say.
+struct StampCheck {
+  double allowed{-1.0}, scatter{0.0}, speed{0.0};
+};
+StampCheck stamp_check(const Record& rec, double sigma_x) {
+  constexpr double kStampMargin = 3.0;
+  constexpr std::size_t kMinSamples = 50;
+  const auto& t = rec.data->t;
+  const auto& x = rec.data->x;
+  const auto& v = rec.motion.v;
+  const std::size_t n = t.size();
+  if (n < kMinSamples + 4) return {};
+  std::vector<double> speed(v.begin(), v.end());
+  for (double& s : speed) s = std::abs(s);
+  const double v95 = order_statistic(speed, static_cast<std::size_t>(0.95 * static_cast<double>(n - 1)));
+  std::vector<double> e2, at_speed;
+  for (std::size_t k = 2; k + 2 < n; ++k) {
+    if (!(speed[k] >= 0.5 * v95) || !(v95 > 0)) continue;
+    const std::size_t nb[4] = {k - 2, k - 1, k + 1, k + 2};
+    double p = 0.0, w2 = 0.0;
+    for (std::size_t a = 0; a < 4; ++a) {
+      double w = 1.0;
+      for (std::size_t b = 0; b < 4; ++b)
+        if (b != a) w *= (t[k] - t[nb[b]]) / (t[nb[a]] - t[nb[b]]);
+      p += w * x[nb[a]];
+      w2 += w * w;
+    }
+    e2.push_back((x[k] - p) * (x[k] - p) / (1.0 + w2));
+    at_speed.push_back(speed[k]);
+  }
+  if (e2.size() < kMinSamples) return {};
+  StampCheck c;
+  c.scatter = std::sqrt(order_statistic(e2, e2.size() / 2) / 0.455);
+  c.speed = order_statistic(at_speed, at_speed.size() / 2);
+  c.allowed = kStampMargin * std::max(c.scatter, sigma_x) / c.speed;
+  return c;
+}
+
+// A --time-stamp-error beyond what the record allows (stamp_check) is taken at that bound: the
+// floor it would give is larger than the record's own scatter, and an all-clear on it false
+// (issue 20's review: 20 us on a record stamped to 1e-15 s hid a 1.5 % mass error).
+void bound_stamp_error(const Record& rec, NoiseFloor& f) {
+  if (!(f.stamp_error > 0)) return;
+  const StampCheck c = stamp_check(rec, f.position);
+  if (!(c.allowed > 0) || f.stamp_error <= c.allowed) return;
+  f.stamp_given = f.stamp_error;
+  f.stamp_error = c.allowed;
+  f.source += fmt(", taken as %.3g us: the record's positions at speed (median %.3g mm/s) scatter by %.3g nm about "
+                  "the cubic through their neighbours",
+                  c.allowed * 1e6, c.speed * 1e3, c.scatter * 1e9) +
+              fmt(", and %.3g us would make them scatter by %.3g nm", f.stamp_given * 1e6,
+                  std::hypot(f.position, c.speed * f.stamp_given) * 1e9);
+}
+
 }  // namespace
 
 NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt) {
   NoiseFloor f = sensor_floor(*rec.data, model, opt.stamp_error);
+  bound_stamp_error(rec, f);
   const SampleErrors se = sample_errors(rec, model, f);
   f.gap = gap_floor(rec, se, opt.replay_window, f.position);
   force_floor(rec, se, f);
@@ -195,8 +260,13 @@ std::string within_text(const NoiseFloor& f) {
 
 std::string describe(const NoiseFloor& f) {
   return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; ", f.gap * 1e6, f.force) + within_text(f) +
-         fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms)", f.limit, f.window,
-             f.half_width * 1e3);
+         fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms", f.limit, f.window,
+             f.half_width * 1e3) +
+         (f.stamp_given > 0 ? fmt("; --time-stamp-error %.3g us taken as %.3g us, the most the record's own scatter "
+                                  "at speed allows",
+                                  f.stamp_given * 1e6, f.stamp_error * 1e6)
+                            : std::string()) +
+         ")";
 }
 
 bool within_floor(const NoiseFloor& f, double gap, double force_rms) {

@@ -649,6 +649,23 @@ TEST(FitVerdict, StampErrorRaisesTheFloorAndHidesNoEffect) {
               f1["force_rms_N"].get<double>(), 1e-9 * f1["force_rms_N"].get<double>());
   EXPECT_EQ(j["verdict"], "unexplained");
   EXPECT_GT(j["gap_final"].get<double>(), 100.0 * f1["gap_m"].get<double>());
+  // The true error given is what the record shows: taken as given (above, stamp_error_s). One 35x
+  // too large (20 us; issue 20's review: it raised the floor past a 1.5 % mass error and gave "no
+  // discrepancy") would scatter the positions at speed 35x more than they are: it is taken at
+  // the most the record allows (3x its scatter over the speed, verdict.cpp stamp_check): above
+  // the true 0.58 us, and below 5x it (the 3x margin, up to 1.3x from the median of a uniform
+  // rather than Gaussian scatter, and the sensor's share; 3.5x here), far below 20 us.
+  const fs::path out_big = scratch() / "verdict_stamps_big";
+  const ProcResult big =
+      run_fit("--scenario " + (dir / "model.yaml").string() + " --data " + (dir / "data.csv").string() + " --out " +
+              out_big.string() + " --no-plots -q --time-stamp-error 2e-5");
+  ASSERT_EQ(big.code, 3) << big.err << big.out;
+  const auto jb = findings(out_big);
+  const auto& f2 = jb["noise_floor"];
+  EXPECT_DOUBLE_EQ(f2["stamp_error_given_s"].get<double>(), 2e-5);
+  EXPECT_GT(f2["stamp_error_s"].get<double>(), 5.7735e-7);
+  EXPECT_LT(f2["stamp_error_s"].get<double>(), 5.0 * 5.7735e-7);
+  EXPECT_NE(jb["conclusion"].get<std::string>().find("--time-stamp-error 20 us taken as"), std::string::npos);
 }
 
 // The settings cannot buy an all-clear (issue 20's review): a 0.5 N constant force hidden in the CI

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "feeddrive/sim/scenario.hpp"
@@ -66,6 +68,35 @@ TEST(FitClosedLoop, TheFittedModelCutsTheTrackingErrorOnTheDriveItCameFrom) {
   EXPECT_GT(before, 1e-6) << "the hidden effects must matter, or the test shows nothing";
   EXPECT_LT(after, before / 10.0) << "before " << before * 1e6 << " um, after " << after * 1e6 << " um";
   EXPECT_LT(after, 0.8e-6);
+  fs::remove_all(dir);
+}
+
+// The loop scenario's own record fitted with that same scenario (issue 20's review): 1.5 s at
+// 10 kHz under the sliding-mode controller, ending at rest at 100 mm against the model's own 15 N
+// constant force. The model is exact, so the verdict is "no discrepancy". It was "unexplained" at
+// a gap of 1.73 um (70x the floor), all of it in the 0.3 s at rest: each replay window started
+// with the bristle deflection integrated along the smoothed measured motion, which left the static
+// friction out of balance and made the model creep (fit/src/replay.cpp, bristle_at_rest). The
+// conclusion also called the model's own 15 N a "friction direction asymmetry" the fit had added.
+// Tolerance: the gap of an exact model ends within 1.2-2.0x its floor (fit/verdict.hpp); 1.36x here.
+TEST(FitClosedLoop, TheLoopScenariosOwnRecordShowsNoDiscrepancy) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("feeddrive-fit-own-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scenario = (kScenarios / "closed_loop.yaml").string();
+  ASSERT_EQ(run(kBin + "feeddrive-sim " + scenario + " --out " + (dir / "sim").string() + " --no-plots"), 0);
+  ASSERT_EQ(run(kBin + "feeddrive-fit --scenario " + scenario + " --data " + (dir / "sim" / "timeseries.csv").string() +
+                " --position-column x_measured --no-plots -q --out " + (dir / "fit").string()),
+            0);
+  std::ifstream in(dir / "fit" / "findings.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["verdict"], "no_discrepancy") << j["conclusion"];
+  EXPECT_LT(j["gap_final"].get<double>(), 2.0 * j["noise_floor"]["gap_m"].get<double>()) << j["conclusion"];
+  EXPECT_TRUE(j["effects"].empty()) << j["conclusion"];
+  EXPECT_EQ(j["model_form"]["direction_asymmetry_N"].get<double>(), 0.0) << j["conclusion"];
+  EXPECT_EQ(j["conclusion"].get<std::string>().find("asymmetry"), std::string::npos) << j["conclusion"];
+  const feeddrive::sim::Scenario fitted = feeddrive::sim::load_scenario((dir / "fit" / "model.fitted.yaml").string());
+  EXPECT_DOUBLE_EQ(fitted.plant.effects.constant_force.force, 15.0);  // the model's own, kept as given
   fs::remove_all(dir);
 }
 

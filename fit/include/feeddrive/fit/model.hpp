@@ -76,9 +76,11 @@ double thrust_per_input(const Record& r, const plant::PlantParams& p);
 /// The internal states along the motion at every sample (for replay initial states).
 struct Internal {
   std::vector<double> z, fg;
+  Eigen::VectorXd unmasked;  ///< r_i at every filter point, the masked (sticking) ones included
 };
 
-/// r_i above, for model p. If internal != nullptr it receives z and Fg at the samples.
+/// r_i above, for model p. If internal != nullptr it receives z and Fg at the samples, and r
+/// before the stiction mask.
 Eigen::VectorXd force_residual(const Record& r, const plant::PlantParams& p, Internal* internal = nullptr);
 
 }  // namespace feeddrive::fit

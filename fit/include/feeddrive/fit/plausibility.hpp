@@ -52,6 +52,12 @@ Envelope envelope(const Record& rec, const plant::PlantParams& model);
 /// drive moves it is a constant force of up to that size, which the fit carries as such (not
 /// named as an effect; docs/fit.md, "Model form").
 constexpr double kAsymmetryTolerance = 0.03;
+/// A mass change below this fraction of the nominal mass is what friction's model-form error at low
+/// speed can fake: implausible() refuses it unless the caller has confirmed it away from low speed
+/// (workflow.cpp, small_mass_confirmed; docs/fit.md, "Plausibility").
+constexpr double kSmallMassChange = 0.02;
+/// True for a mass_error whose mass is within kSmallMassChange of the nominal.
+bool small_mass_change(const Envelope& env, const plant::NamedEffect& e);
 /// The friction level a direction asymmetry scales: the static levels of the model's static
 /// friction and of its Coulomb-type effects [N].
 double friction_level(const plant::PlantParams& model);

@@ -33,6 +33,9 @@ struct Motion {
   std::vector<double> t_mid;         ///< interval midpoints [s]
   std::vector<double> dt;            ///< interval lengths t_j+1 - t_j [s]
 };
+/// The k-th smallest value of v (0-based, k < v.size()).
+double order_statistic(std::vector<double> v, std::size_t k);
+
 /// half_window: M, the samples on each side of the local cubic (>= 2).
 Motion estimate_motion(const std::vector<double>& t, const std::vector<double>& x, int half_window);
 

@@ -32,6 +32,9 @@
 // dF_k d_k (t - t_k)/m, of which the window's least-squares line takes the part in span{1, t}.
 // In the force residual the same impulse enters the filtered thrust as dF_k d_k h(tau_i - t_k).
 // Both add in quadrature to the sensor's terms (per sample variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2).
+// A sigma_t the record contradicts is not taken as given: stamps that far off would scatter the
+// positions at speed about the smooth motion, and a record whose positions there scatter 3x less
+// bounds sigma_t (verdict.cpp, stamp_check); the floor then uses that bound and says so.
 // Within the floor (within_floor):
 //   * force residual: at most kForceAllowance times its floor. Where the model is the drive but
 //     for the generator's integrator, without friction, it ends at 0.99-1.10x
@@ -83,7 +86,8 @@ struct NoiseFloor {
   double position{0.0};              ///< sigma_x [m]
   double gap{0.0};                   ///< [m]
   double force{0.0};                 ///< [N]: sqrt(force_noise^2 + force_discretisation^2)
-  double stamp_error{0.0};           ///< sigma_t of the time stamps [s] (FloorOptions)
+  double stamp_error{0.0};           ///< sigma_t of the time stamps [s] (FloorOptions, at most what the record allows)
+  double stamp_given{0.0};           ///< the FloorOptions' sigma_t when the record allows less (else 0)
   double force_noise{0.0};           ///< of the sensor's noise (and stamp errors) through the filter [N]
   double force_discretisation{0.0};  ///< of the filter's discretisation on this record [N]
   bool from_scenario{true};          ///< false: q estimated from the record
