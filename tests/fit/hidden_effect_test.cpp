@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "feeddrive/fit/workflow.hpp"
 #include "fit_util.hpp"
@@ -189,6 +190,34 @@ TEST(ModelForm, StribeckExponentIsRefittedNotNamedAsAnEffect) {
   EXPECT_LT(ci, std::abs(2.0 - r.exponent_final)) << r.conclusion;
   EXPECT_NE(r.conclusion.find("Stribeck exponent 2 -> "), std::string::npos);
   EXPECT_NE(r.conclusion.find(" +- "), std::string::npos) << r.conclusion;
+}
+
+}  // namespace
+}  // namespace feeddrive::fit
+
+namespace feeddrive::fit {
+namespace {
+
+// A model-form value whose 95 % interval is wider than the value is not a measured value (issue
+// 20's review: "Coulomb transition velocity 0.01 -> 0.33 +- 48 mm/s", "exponent 2 -> 3 +- 240"):
+// the conclusion says so. One whose interval is narrower keeps its "+-".
+TEST(ModelForm, AnIntervalWiderThanTheValueIsNotIdentified) {
+  FitResult r;
+  r.smoothing_initial = 1e-5;
+  r.smoothing_final = 3.3e-4;
+  r.exponent_initial = 2.0;
+  r.exponent_final = 3.0;
+  r.asymmetry_offset = 0.5;
+  r.ci95["model_form"] = {
+      {"coulomb_transition_velocity", 4.8e-2}, {"stribeck_exponent", 240.0}, {"direction_asymmetry", 0.01}};
+  const std::string s = model_form_text(r);
+  EXPECT_NE(s.find("0.01 -> 0.33 mm/s (not identified by this record)"), std::string::npos) << s;
+  EXPECT_NE(s.find("Stribeck exponent 2 -> 3 (not identified by this record)"), std::string::npos) << s;
+  EXPECT_NE(s.find("asymmetry 0.5 +- 0.01 N"), std::string::npos) << s;
+  r.ci95["model_form"]["stribeck_exponent"] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(model_form_text(r).find("2 -> 3 (not identified"), std::string::npos);
+  r.ci95["model_form"]["stribeck_exponent"] = 0.2;
+  EXPECT_NE(model_form_text(r).find("2 -> 3 +- 0.2"), std::string::npos);
 }
 
 }  // namespace

@@ -99,6 +99,11 @@ struct FitResult {
 /// DataError. run_fit calls it first; feeddrive-fit calls it before the sanity checks.
 void check_options(const Record& rec, const FitOptions& opt);
 
+/// The conclusion's model-form part: "; model form: ..." for each refitted form parameter, with
+/// its 95 % half-width from r.ci95["model_form"], or "(not identified by this record)" where that
+/// exceeds the value or is not finite.
+std::string model_form_text(const FitResult& r);
+
 using Log = std::function<void(const std::string&)>;
 FitResult run_fit(const Record& rec, const plant::PlantParams& model, const FitOptions& opt, const Log& log = {});
 
