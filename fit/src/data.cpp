@@ -81,7 +81,12 @@ Units parse_units(const std::string& spec) {
                      : role == "force" ? &u.force
                      : role == "u"     ? &u.u
                                        : nullptr;
-    if (!target) bad("unknown role '" + csv::shown(role) + "'");
+    // a logger's file often has a velocity column: the fit uses none (it takes the motion from
+    // the position), so it needs no unit; either way the roles it does use are named
+    const std::string roles = "the roles are t (time), x (position), xd (reference), force (thrust), u (command)";
+    if (!target && (role == "v" || role == "velocity" || role == "speed"))
+      bad("the fit uses no velocity column (it takes the motion from the position): leave it out of --units; " + roles);
+    if (!target) bad("unknown role '" + csv::shown(role) + "': " + roles);
     if (unit.empty()) bad("no unit");
     static const std::map<std::string, std::map<std::string, double>> table{
         {"t", {{"s", 1.0}, {"ms", 1e-3}, {"us", 1e-6}}},

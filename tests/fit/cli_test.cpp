@@ -80,9 +80,9 @@ std::string csv(const std::string& header, const std::vector<std::string>& rows)
 }
 
 // The data file `data` (written as `name`) must be refused: exit 2, one line on stderr containing
-// every string of `expected`, no output folder.
-void expect_data_error(const std::string& name, const std::string& data, const std::vector<std::string>& expected,
-                       const std::string& extra_args = "") {
+// every string of `expected`, no output folder. Returns the line.
+std::string expect_data_error(const std::string& name, const std::string& data,
+                              const std::vector<std::string>& expected, const std::string& extra_args = "") {
   SCOPED_TRACE(name);
   const fs::path file = write_file(name, data);
   const fs::path out = scratch() / ("out_" + name);
@@ -93,6 +93,7 @@ void expect_data_error(const std::string& name, const std::string& data, const s
   EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
   for (const auto& e : expected) EXPECT_NE(r.err.find(e), std::string::npos) << "want '" << e << "' in: " << r.err;
   EXPECT_FALSE(fs::exists(out)) << "no output folder on bad input";
+  return r.err;
 }
 
 TEST(FitCli, MissingPositionColumn) {
@@ -492,6 +493,16 @@ std::string g17(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", v);
   return b;
+}
+
+// The CI record as "t,x,force_N", each row (k, t, x, force) as `edit` leaves it; a row for which
+// it returns false is left out (a gap, every other row).
+std::string edited(const std::function<bool(std::size_t, double&, double&, double&)>& edit) {
+  return derived({"t", "x", "force_N"}, [&](const auto& c, std::size_t k) {
+    double t = num(c.at("t")[k]), x = num(c.at("x_measured")[k]), f = num(c.at("f_thrust")[k]);
+    if (!edit(k, t, x, f)) return std::vector<std::string>{};
+    return std::vector<std::string>{g17(t), g17(x), g17(f)};
+  });
 }
 
 nlohmann::json findings(const fs::path& out) {
@@ -935,24 +946,22 @@ TEST(FitData, LoggerFilesWithTheirOwnSeparatorDecimalCommaUnitsAndColumns) {
 TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   using namespace issue20;
   const auto make = [&](double t_scale, double x_scale, double f_scale, double t_jump, double x_jump) {
-    return derived({"t", "x", "force_N"}, [=](const auto& c, std::size_t k) {
+    return edited([=](std::size_t k, double& t, double& x, double& f) {
       const bool after = k >= 2000;  // the second recording starts at row 2000 (file line 2002)
-      return std::vector<std::string>{g17(num(c.at("t")[k]) * t_scale + (after ? t_jump : 0.0)),
-                                      g17(num(c.at("x_measured")[k]) * x_scale + (after ? x_jump : 0.0)),
-                                      g17(num(c.at("f_thrust")[k]) * f_scale)};
+      t = t * t_scale + (after ? t_jump : 0.0);
+      x = x * x_scale + (after ? x_jump : 0.0);
+      f *= f_scale;
+      return true;
     });
   };
   expect_data_error("pos_mm.csv", make(1, 1e3, 1, 0, 0),
                     {"column 'x'", "beyond a feed drive", "likely in mm (--units x=mm)"});
   // Encoder counts (whole numbers) are named as counts with the scenario's encoder step, not as a
   // power of 1000 of a metre (issue 20's review: "likely in um" was 9.4x off).
-  expect_data_error("pos_counts.csv",
-                    derived({"t", "x", "force_N"},
-                            [](const auto& c, std::size_t k) {
-                              return std::vector<std::string>{g17(num(c.at("t")[k])),
-                                                              g17(std::round(num(c.at("x_measured")[k]) / 5e-8)),
-                                                              g17(num(c.at("f_thrust")[k]))};
-                            }),
+  expect_data_error("pos_counts.csv", edited([](std::size_t, double&, double& x, double&) {
+                      x = std::round(x / 5e-8);
+                      return true;
+                    }),
                     {"column 'x'", "whole numbers: likely encoder counts (--units x=counts:5e-08"});
   expect_data_error("time_ms.csv", make(1e3, 1, 1, 0, 0),
                     {"column 't'", "control period", "likely in ms (--units t=ms)"});
@@ -995,14 +1004,59 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
   expect_data_error("force_reversed.csv", make(1, 1, -1, 0, 0), {"sign of one of them is reversed"});
   expect_data_error("force_zero.csv", make(1, 1, 0, 0, 0),
                     {"column 'force_N': constant (0) over the whole record while the drive moves"});
-  expect_data_error("every_other.csv",
-                    derived({"t", "x", "force_N"},
-                            [](const auto& c, std::size_t k) {
-                              if (k % 2) return std::vector<std::string>{};  // every other row: 500 Hz of 1 kHz
-                              return std::vector<std::string>{g17(num(c.at("t")[k])), g17(num(c.at("x_measured")[k])),
-                                                              g17(num(c.at("f_thrust")[k]))};
-                            }),
+  expect_data_error("every_other.csv", edited([](std::size_t k, double&, double&, double&) {
+                      return k % 2 == 0;  // every other row: 500 Hz of 1 kHz
+                    }),
                     {"column 't': median sample period 0.002 s is 2 times the scenario's control period 0.001 s"});
+}
+
+// A step of the position of a few um, one sample off, and a gap in time with an offset (issue 34's
+// review of the sanity checks): a 5 or 10 um step passed (its acceleration stays within what the
+// peak thrust gives) and was fitted as a force; a 10 um spike was named one row late as "two
+// recordings joined"; a 9-period gap with a 1 mm offset named only the position. Each is now
+// named at its own row with its size: the step by its doublet in the second difference (+J then
+// -J, fit/sanity.cpp find_step), the spike as an outlier, the gap with both columns.
+TEST(FitData, SmallStepsSpikesAndGapsAreNamedAtTheirRow) {
+  using namespace issue20;
+  const auto step = [](double J) {
+    return edited([=](std::size_t k, double&, double& x, double&) {
+      x += k >= 2000 ? J : 0.0;  // from row 2000 (file line 2002) on
+      return true;
+    });
+  };
+  // The size in the line, against the size made: within 0.2 um, four of the record's 50 nm encoder
+  // steps (the step less the motion around it, from the velocities on either side, and the spike
+  // against the cubic through its neighbours, each a few quantized samples).
+  const auto size_mm = [](const std::string& line, const std::string& before) {
+    const auto at = line.find(before);
+    return at == std::string::npos ? NAN : std::stod(line.substr(at + before.size()));
+  };
+  for (const double J : {5e-6, -10e-6}) {
+    const std::string line = expect_data_error("step.csv", step(J),
+                                               {"step.csv:2002: column 'x': the position jumps by ", "mm in one sample",
+                                                "a step no thrust gives", "split the file"});
+    EXPECT_NEAR(size_mm(line, "the position jumps by "), J * 1e3, 0.2e-3) << line;
+  }
+  const std::string spike = edited([](std::size_t k, double&, double& x, double&) {
+    x += k == 2000 ? 10e-6 : 0.0;  // row 2000 only, file line 2002
+    return true;
+  });
+  const std::string spiked = expect_data_error(
+      "spike.csv", spike, {"spike.csv:2002: column 'x': position", "is an outlier, ", "mm off the course"});
+  EXPECT_NEAR(size_mm(spiked, "is an outlier, "), 10e-3, 0.2e-3) << spiked;
+  EXPECT_EQ(spiked.find("joined"), std::string::npos) << spiked;
+  // rows 1992-1999 left out (a 9-period step of the time) and 1 mm added from row 2000 (file line 1994)
+  const std::string gap = edited([](std::size_t k, double&, double& x, double&) {
+    x += k >= 2000 ? 1e-3 : 0.0;
+    return k < 1992 || k >= 2000;
+  });
+  const std::string gapped = expect_data_error(
+      "gap_offset.csv", gap,
+      {"gap_offset.csv:1994: columns 't' and 'x': the time jumps by 0.009 s (9 sample periods of 0.001 s) and the "
+       "position by "});
+  // within 1 um: the motion over the 9 ms the gap hides is taken from the velocities on either side
+  // (exact for a constant acceleration; the thrust changes within 9 ms: here 0.4 um)
+  EXPECT_NEAR(size_mm(gapped, "and the position by "), 1.0, 1e-3) << gapped;
 }
 
 namespace feeddrive::fit {

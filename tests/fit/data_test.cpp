@@ -33,6 +33,21 @@ TEST(FitUnits, EveryUnitIsAFactorToSI) {
   EXPECT_DOUBLE_EQ(parse_units("x=counts:5e-8").x, 5e-8);  // a 50 nm encoder
   for (const std::string bad : {"x=inch", "speed=mm", "x=", "x=counts:-1", "x=counts:abc", "t"})
     EXPECT_THROW(parse_units(bad), DataError) << bad;
+  // a velocity column (a logger's file often has one): the fit uses none, and says so with the
+  // roles it does use (issue 34's review: "unknown role 'v'" left the user guessing)
+  for (const std::string v : {"v=mm", "x=mm,velocity=mm/s", "speed=m"}) {
+    try {
+      parse_units(v);
+      ADD_FAILURE() << v << " was accepted";
+    } catch (const DataError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("the fit uses no velocity column (it takes the motion from the position)"), std::string::npos)
+          << m;
+      EXPECT_NE(m.find("the roles are t (time), x (position), xd (reference), force (thrust), u (command)"),
+                std::string::npos)
+          << m;
+    }
+  }
   try {
     parse_units("t=ms,x=furlong");
   } catch (const DataError& e) {

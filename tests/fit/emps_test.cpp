@@ -11,19 +11,36 @@
 #include <set>
 
 #include "feeddrive/fit/data.hpp"
+#include "feeddrive/fit/sanity.hpp"
 #include "feeddrive/fit/workflow.hpp"
 #include "feeddrive/sim/scenario.hpp"
 
 namespace feeddrive::fit {
 namespace {
 
-TEST(Emps, NamesThePublishedModelAndNothingForeign) {
+// The record as the fit reads it (its columns by name).
+MeasuredData emps_data() {
   CsvOptions csv;
   csv.time_column = "t_s";
   csv.position_column = "position_m";
   csv.force_column = "motor_force_N";
   csv.reference_column = "reference_m";
-  const MeasuredData data = load_csv(FEEDDRIVE_SOURCE_DIR "/data/emps/emps_estimation.csv", csv);
+  return load_csv(FEEDDRIVE_SOURCE_DIR "/data/emps/emps_estimation.csv", csv);
+}
+
+// A real record passes the sanity checks before fitting (fit/sanity.hpp): its 50 nm steps, no
+// sensor in the scenario (the record's own step is the quantum, noise unknown), a closed loop's
+// thrust. Its strongest doublet in the second difference is 7.0 sensor steps and 1.8x its own
+// scale, within the position-step check's 20 and 8.
+TEST(Emps, PassesTheSanityChecks) {
+  const MeasuredData data = emps_data();
+  const sim::Scenario model = sim::load_scenario(FEEDDRIVE_SOURCE_DIR "/scenarios/fit/emps.yaml");
+  EXPECT_NO_THROW(check_record(data, model.plant, model.control_period));
+  EXPECT_NO_THROW(check_force_scale(prepare(data), model.plant));
+}
+
+TEST(Emps, NamesThePublishedModelAndNothingForeign) {
+  const MeasuredData data = emps_data();
   const sim::Scenario model = sim::load_scenario(FEEDDRIVE_SOURCE_DIR "/scenarios/fit/emps.yaml");
   EXPECT_FALSE(model.grinding_process);
   FitOptions opt;

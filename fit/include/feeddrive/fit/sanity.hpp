@@ -7,9 +7,13 @@
 //     ~1/1000 of it one in ks (or s read as ms) when the speed confirms it; one above
 //     kMaxSamplePeriodRatio control periods samples slower than the thrust changes;
 //   * position: a travel above kMaxTravel or a speed above kMaxSpeed is beyond a feed drive (a
-//     column in mm, um or nm); a step whose acceleration is beyond 20x what the peak thrust gives
-//     the mass (and beyond 50x the sensor's own second difference and 20x the record's 99th
-//     percentile of it) is a discontinuity;
+//     column in mm, um or nm); a step whose acceleration is beyond 4x what the peak thrust gives
+//     the mass (and beyond 50x the sensor's own second difference and 5x the record's 99th
+//     percentile of it) is a discontinuity, and so is a smaller step of a few um: a doublet in the
+//     second difference (+J then -J, where a step of the thrust changes its level once) beyond 20
+//     sensor steps (q + 3 noise sigma) and 8x the record's own scale of it. Either is named at its
+//     row with its size: an isolated outlier (one sample off) as an outlier, a step as a step,
+//     with the time's gap when the time jumps there too;
 //   * force: the thrust must move the model's mass. The filtered thrust is regressed on
 //     m * (filtered acceleration), a constant, sgn v and v (the modulating-function balance of
 //     model.hpp with a generic friction); the ratio of thrust to m*a must lie within a factor
