@@ -99,11 +99,11 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
   return "";
 }
 
-// long-function: a flat list of rules, one or two per effect, each independent of the others.
 bool small_mass_change(const Envelope& env, const plant::NamedEffect& e) {
   return e.name == "mass_error" && std::abs(par(e, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass;
 }
 
+// long-function: a flat list of rules, one or two per effect, each independent of the others.
 std::string implausible(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e) {
   const std::string& n = e.name;
   const double F = env.peak_thrust;
