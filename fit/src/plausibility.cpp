@@ -204,7 +204,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
       return fmt("mass %.4g kg is not within a factor of two of the nominal %.4g kg", m, env.nominal_mass);
     // A drive's moving mass is known to a few per cent (payload, cables, bearings); a smaller
     // change is, unless the record shows it away from low speed too, the mass absorbing model-form
-    // error of friction at reversals.
+    // error of friction at reversals; one below kLeastMassChange is never named (plausibility.hpp).
+    if (std::abs(m - env.nominal_mass) < kLeastMassChange * env.nominal_mass)
+      return fmt("mass %.4g kg is within %.0f %% of the nominal %.4g kg: no mass error worth naming", m,
+                 100 * kLeastMassChange, env.nominal_mass);
     if (small_mass_change(env, e))
       return fmt("mass %.4g kg is within %.0f %% of the nominal %.4g kg", m, 100 * kSmallMassChange, env.nominal_mass) +
              ", and the record does not show it away from low speed, where friction's form cannot fake it";

@@ -323,6 +323,12 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
         "a friction that depends on speed: record moves at several constant speeds (from %.3g to %.3g mm/s), "
         "%.3g s or more",
         0.05 * env.v_max * 1e3, env.v_max * 1e3, longer);
+  if (n == "mass_error" && why == Reason::kImplausible && c.effect.parameters.count("mass") &&
+      std::abs(par(c.effect, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass)
+    return fmt(
+        "a mass change of %.2g %%: weigh the moving parts (plant.mass), or record strong accelerations and "
+        "decelerations at speed, away from reversals and stops (where friction's form can fake a small mass)",
+        100 * (par(c.effect, "mass") - env.nominal_mass) / env.nominal_mass);
   if (n == "mass_error" || n == "input_delay")
     return fmt(
         "a force proportional to the acceleration or a delay: record stronger and faster changes of the thrust "

@@ -295,17 +295,18 @@ std::vector<double> away_from_low_speed(const Record& rec, long& kept) {
   return w;
 }
 
-// A mass change below kSmallMassChange (plausibility.hpp) is named only when the record shows it
-// away from low speed too (issue 20's review: a true 1.5 % mass error, score 2396, was refused by
-// the 2 % rule): the joint fit on the points away from low speed alone (away_from_low_speed, at
-// least kMinAwayPoints of them) moves the mass the same way, by half to twice as much. A mass
-// that only absorbs friction's form error at the reversals moves much less there, or the other way.
+// A mass change below kSmallMassChange (plausibility.hpp), and at least kLeastMassChange, is named
+// only when the record shows it away from low speed too (issue 20's review: a true 1.5 % mass error, score 2396, was
+// refused by the 2 % rule): the joint fit on the points away from low speed alone (away_from_low_speed, at least
+// kMinAwayPoints of them) moves the mass the same way, by half to twice as much. A mass that only absorbs friction's
+// form error at the reversals moves much less there, or the other way.
 bool small_mass_confirmed(const Context& cx, const JointFit& jf, const FreeSet& fs) {
   constexpr long kMinAwayPoints = 20;
   long kept = 0;
   const std::vector<double> w = away_from_low_speed(cx.rec, kept);
   if (kept < kMinAwayPoints) return false;
   const double m0 = cx.env.nominal_mass, dm = par(effect_of(jf.params, "mass_error"), "mass") - m0;
+  if (std::abs(dm) < kLeastMassChange * m0) return false;
   const JointFit away = fit_jointly(cx.rec, jf.params, fs, &w, 60, cx.opt.stop);
   const double da = par(effect_of(away.params, "mass_error"), "mass") - m0;
   cx.say(fmt("mass change %.3g kg over the record, %.3g kg away from low speed (%.0f points)", dm, da,
