@@ -132,6 +132,7 @@ nlohmann::json floor_json(const NoiseFloor& f) {
           {"force_rms_N", f.force},
           {"quantization_m", f.quantization},
           {"noise_m", f.noise},
+          {"noise_given_m", f.noise_given > 0 ? f.noise_given : f.noise},
           {"position_sigma_m", f.position},
           {"gap_factor", f.gap_factor},
           {"force_factor", f.force_factor},

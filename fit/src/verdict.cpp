@@ -169,22 +169,20 @@ void force_floor(const Record& rec, const SampleErrors& se, NoiseFloor& f) {
   f.force = std::sqrt(f.force_noise * f.force_noise + f.force_discretisation * f.force_discretisation);
 }
 
-// The time-stamp error the record itself allows (header, "Time stamps"): a sample stamped d_k
-// off lies v_k d_k off the smooth motion, which the cubic through its four neighbours (Lagrange,
-// on the recorded stamps) does not follow: e_k = x_k - P_k(t_k) has the variance (1 + sum_j w_j^2)
-// (sigma_x^2 + v_k^2 sigma_t^2), w_j the cubic's weights (34/36 on equal steps). Over the samples at
-// speed (|v| at least half the record's 95th percentile, at least kMinSamples of them), the median
-// of e_k^2 / (1 + sum w^2) is 0.455 s^2 for Gaussian errors (the median of chi^2 with one degree of
-// freedom) and 0.75 s^2 for a uniform one; s^2 = median / 0.455 overstates s by at most 1.3x.
-// Returns the largest sigma_t the record allows, kStampMargin max(s, sigma_x) / v (v their median
-// speed): a larger one would make them at least 3x more scattered than they are. A thrust that
-// changes each sample by dF leaves the cubic off by about (dF/m) dt^2 / 4 (0.25 nm for 1 N on
-// 100 kg at 1 ms), far below the sensor's. {-1, ...}: too few samples at speed to say.
-struct StampCheck {
-  double allowed{-1.0}, scatter{0.0}, speed{0.0};
+// The record's own scatter at speed (header, "What the record allows"): a sample off the smooth
+// motion by an error of standard deviation s_k = sqrt(sigma_x^2 + v_k^2 sigma_t^2) is off the cubic
+// through its four neighbours (Lagrange, on the recorded stamps) by e_k = x_k - P_k(t_k), of
+// variance (1 + sum_j w_j^2) s_k^2, w_j the cubic's weights (34/36 on equal steps). Over the
+// samples at speed (|v| at least half the record's 95th percentile, at least kMinSamples of them:
+// there a quantized position is white), the median of e_k^2 / (1 + sum w^2) is 0.455 s^2 for
+// Gaussian errors (the median of chi^2 with one degree of freedom) and 0.75 s^2 for a uniform one:
+// s^2 = median / 0.455 overstates s by at most 1.3x. A thrust that changes each sample by dF
+// leaves the cubic off by about (dF/m) dt^2 / 4 (0.25 nm for 1 N on 100 kg at 1 ms), far below
+// any sensor's. {0, 0}: too few samples at speed to say.
+struct Scatter {
+  double scatter{0.0}, speed{0.0};
 };
-StampCheck stamp_check(const Record& rec, double sigma_x) {
-  constexpr double kStampMargin = 3.0;
+Scatter scatter_at_speed(const Record& rec) {
   constexpr std::size_t kMinSamples = 50;
   const auto& t = rec.data->t;
   const auto& x = rec.data->x;
@@ -210,25 +208,42 @@ StampCheck stamp_check(const Record& rec, double sigma_x) {
     at_speed.push_back(speed[k]);
   }
   if (e2.size() < kMinSamples) return {};
-  StampCheck c;
-  c.scatter = std::sqrt(order_statistic(e2, e2.size() / 2) / 0.455);
-  c.speed = order_statistic(at_speed, at_speed.size() / 2);
-  c.allowed = kStampMargin * std::max(c.scatter, sigma_x) / c.speed;
-  return c;
+  return {std::sqrt(order_statistic(e2, e2.size() / 2) / 0.455), order_statistic(at_speed, at_speed.size() / 2)};
 }
 
-// A --time-stamp-error beyond what the record allows (stamp_check) is taken at that bound: the
-// floor it would give is larger than the record's own scatter, and an all-clear on it false
-// (issue 20's review: 20 us on a record stamped to 1e-15 s hid a 1.5 % mass error).
-void bound_stamp_error(const Record& rec, NoiseFloor& f) {
-  if (!(f.stamp_error > 0)) return;
-  const StampCheck c = stamp_check(rec, f.position);
-  if (!(c.allowed > 0) || f.stamp_error <= c.allowed) return;
+// A stated error at least kRecordMargin times what the record's own scatter allows is taken at
+// that bound (header, "What the record allows").
+constexpr double kRecordMargin = 3.0;
+
+// plant.sensor's noise sigma_n, when sigma_x = sqrt(sigma_n^2 + q^2/12) exceeds kRecordMargin
+// times the scatter at speed s: taken as sqrt((3 s)^2 - q^2/12) (0 when the quantum alone
+// explains 3 s). The quantum is the encoder's, not a claim: it is kept.
+void bound_sensor_noise(const Scatter& c, NoiseFloor& f) {
+  if (!f.from_scenario || !(c.scatter > 0) || !(f.position > kRecordMargin * c.scatter) || !(f.noise > 0)) return;
+  f.noise_given = f.noise;
+  const double allowed = kRecordMargin * c.scatter;
+  f.noise = std::sqrt(std::max(0.0, allowed * allowed - f.quantization * f.quantization / 12.0));
+  f.position = std::sqrt(f.noise * f.noise + f.quantization * f.quantization / 12.0);
+  f.source +=
+      fmt("; noise taken as %.3g nm: the record's positions at speed scatter by %.3g nm about the cubic "
+          "through their neighbours, and %.3g nm of noise would make them scatter by more than 3x that",
+          f.noise * 1e9, c.scatter * 1e9, f.noise_given * 1e9);
+}
+
+// A --time-stamp-error beyond what the record allows, kRecordMargin max(s, sigma_x) / v (v the
+// median speed of the samples at speed): stamps that far off would scatter them at least 3x more
+// than they are. Taken at that bound: the floor it would give is larger than the record's own
+// scatter, and an all-clear on it false (issue 20's review: 20 us on a record stamped to 1e-15 s
+// hid a 1.5 % mass error).
+void bound_stamp_error(const Scatter& c, NoiseFloor& f) {
+  if (!(f.stamp_error > 0) || !(c.speed > 0)) return;
+  const double allowed = kRecordMargin * std::max(c.scatter, f.position) / c.speed;
+  if (f.stamp_error <= allowed) return;
   f.stamp_given = f.stamp_error;
-  f.stamp_error = c.allowed;
+  f.stamp_error = allowed;
   f.source += fmt(", taken as %.3g us: the record's positions at speed (median %.3g mm/s) scatter by %.3g nm about "
                   "the cubic through their neighbours",
-                  c.allowed * 1e6, c.speed * 1e3, c.scatter * 1e9) +
+                  allowed * 1e6, c.speed * 1e3, c.scatter * 1e9) +
               fmt(", and %.3g us would make them scatter by %.3g nm", f.stamp_given * 1e6,
                   std::hypot(f.position, c.speed * f.stamp_given) * 1e9);
 }
@@ -237,7 +252,9 @@ void bound_stamp_error(const Record& rec, NoiseFloor& f) {
 
 NoiseFloor noise_floor(const Record& rec, const plant::PlantParams& model, const FloorOptions& opt) {
   NoiseFloor f = sensor_floor(*rec.data, model, opt.stamp_error);
-  bound_stamp_error(rec, f);
+  const Scatter c = scatter_at_speed(rec);
+  bound_sensor_noise(c, f);
+  bound_stamp_error(c, f);
   const SampleErrors se = sample_errors(rec, model, f);
   f.gap = gap_floor(rec, se, opt.replay_window, f.position);
   force_floor(rec, se, f);
@@ -262,6 +279,10 @@ std::string describe(const NoiseFloor& f) {
   return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; ", f.gap * 1e6, f.force) + within_text(f) +
          fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms", f.limit, f.window,
              f.half_width * 1e3) +
+         (f.noise_given > 0 ? fmt("; plant.sensor's noise %.3g nm taken as %.3g nm, the most the record's own "
+                                  "scatter at speed allows",
+                                  f.noise_given * 1e9, f.noise * 1e9)
+                            : std::string()) +
          (f.stamp_given > 0 ? fmt("; --time-stamp-error %.3g us taken as %.3g us, the most the record's own scatter "
                                   "at speed allows",
                                   f.stamp_given * 1e6, f.stamp_error * 1e6)

@@ -656,6 +656,34 @@ TEST(FitVerdict, ARippleTooShortForTheFilterIsWhatTheRestResembles) {
   EXPECT_EQ(all.find("no candidate of the vocabulary"), std::string::npos) << all;
 }
 
+// A plant.sensor noise the record contradicts is taken at the most the record allows (fit/verdict.hpp,
+// "What the record allows"): the CI record (20 nm noise, 50 nm steps: sigma_x = 24.7 nm) fitted with
+// a scenario that claims 1 um of noise. Its floor would be 40x too high; an all-clear on it could
+// hide a force 40x larger than the record shows. The record's positions at speed scatter by about
+// sigma_x (up to 1.3x over for a uniform rather than Gaussian error), so the noise is taken below
+// 3 x 1.3 x 24.7 = 96 nm and above the true 20 nm.
+TEST(FitVerdict, ASensorNoiseTheRecordContradictsIsTakenAtItsBound) {
+  using namespace issue20;
+  std::string yaml = short_scenario("");
+  const auto at = yaml.find("noise_stddev: 2.0e-8");
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, 20, "noise_stddev: 1.0e-6");
+  const fs::path scenario = write_file("noisy_sensor.yaml", yaml);
+  const fs::path out = scratch() / "noisy_sensor";
+  const ProcResult r = run_fit("--scenario " + scenario.string() + " --data " + simulated_data().string() +
+                               " --position-column x_measured --out " + out.string() + " --no-plots -q");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto j = findings(out);
+  const auto& f = j["noise_floor"];
+  EXPECT_DOUBLE_EQ(f["noise_given_m"].get<double>(), 1e-6);
+  EXPECT_GT(f["noise_m"].get<double>(), 20e-9);
+  EXPECT_LT(f["noise_m"].get<double>(), 96e-9);
+  EXPECT_NE(j["conclusion"].get<std::string>().find("plant.sensor's noise 1e+03 nm taken as"), std::string::npos)
+      << j["conclusion"];
+  // the 15 N constant force of the record is found as it is with the true sensor
+  EXPECT_EQ(j["effects"].size(), 1u) << j["conclusion"];
+}
+
 // The noise floor's terms (fit/verdict.hpp): the same record with its time stamps' error given
 // (the generator's +-1 us, uniform: 0.577 us, DIR/knobs.txt) gets a higher floor -- v d_k per
 // sample and the thrust's jumps switched early or late -- which findings.json carries with the

@@ -32,9 +32,12 @@
 // dF_k d_k (t - t_k)/m, of which the window's least-squares line takes the part in span{1, t}.
 // In the force residual the same impulse enters the filtered thrust as dF_k d_k h(tau_i - t_k).
 // Both add in quadrature to the sensor's terms (per sample variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2).
-// A sigma_t the record contradicts is not taken as given: stamps that far off would scatter the
-// positions at speed about the smooth motion, and a record whose positions there scatter 3x less
-// bounds sigma_t (verdict.cpp, stamp_check); the floor then uses that bound and says so.
+// What the record allows: a sigma_t, or a plant.sensor noise sigma_n, the record contradicts is
+// not taken as given. Errors that large would scatter the positions at speed about the smooth
+// motion; a record whose positions there scatter 3x less bounds them (verdict.cpp,
+// scatter_at_speed): the floor then uses the bound and says so. An overstated floor gives a
+// false all-clear (issue 20's review: 20 us of stamp error given for stamps exact to 1e-15 s hid a
+// 1.5 % mass error).
 // Within the floor (within_floor):
 //   * force residual: at most kForceAllowance times its floor. Where the model is the drive but
 //     for the generator's integrator, without friction, it ends at 0.99-1.10x
@@ -82,7 +85,8 @@ namespace feeddrive::fit {
 
 struct NoiseFloor {
   double quantization{0.0};          ///< q [m]
-  double noise{0.0};                 ///< sigma_n [m]
+  double noise{0.0};                 ///< sigma_n [m] (plant.sensor's, at most what the record allows)
+  double noise_given{0.0};           ///< plant.sensor's sigma_n when the record allows less (else 0)
   double position{0.0};              ///< sigma_x [m]
   double gap{0.0};                   ///< [m]
   double force{0.0};                 ///< [N]: sqrt(force_noise^2 + force_discretisation^2)
