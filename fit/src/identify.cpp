@@ -484,6 +484,7 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
     std::vector<double> grid;
     for (const Theta& t : starts) grid.push_back(t[static_cast<std::size_t>(f)]);
     std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());  // starts that share a value (grinding)
     const auto it = std::lower_bound(grid.begin(), grid.end(), best.theta[static_cast<std::size_t>(f)]);
     const std::size_t i = static_cast<std::size_t>(it - grid.begin());
     double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
