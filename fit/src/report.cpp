@@ -131,6 +131,7 @@ nlohmann::json floor_json(const NoiseFloor& f) {
   return {{"gap_m", f.gap},
           {"force_rms_N", f.force},
           {"quantization_m", f.quantization},
+          {"quantization_given_m", f.quantization_given > 0 ? f.quantization_given : f.quantization},
           {"noise_m", f.noise},
           {"noise_given_m", f.noise_given > 0 ? f.noise_given : f.noise},
           {"position_sigma_m", f.position},
@@ -177,6 +178,8 @@ nlohmann::json step_json(const StepResult& st) {
                   {"fit_seconds", c.seconds}});
   return {{"accepted", st.accepted},
           {"verdict", st.verdict},
+          {"gap_before_m", st.gap_before},
+          {"gap_after_m", st.accepted ? nlohmann::json(st.gap_after) : nlohmann::json()},
           {"ranking", rk},
           {"removed", st.removed},
           {"swap", st.swap},

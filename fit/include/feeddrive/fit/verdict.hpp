@@ -32,7 +32,7 @@
 // dF_k d_k (t - t_k)/m, of which the window's least-squares line takes the part in span{1, t}.
 // In the force residual the same impulse enters the filtered thrust as dF_k d_k h(tau_i - t_k).
 // Both add in quadrature to the sensor's terms (per sample variance s_k^2 = sigma_x^2 + v_k^2 sigma_t^2).
-// What the record allows: a sigma_t, or a plant.sensor noise sigma_n, the record contradicts is
+// What the record allows: a sigma_t, or a plant.sensor noise sigma_n or quantum q, the record contradicts is
 // not taken as given. Errors that large would scatter the positions at speed about the smooth
 // motion; a record whose positions there scatter 3x less bounds them (verdict.cpp,
 // scatter_at_speed): the floor then uses the bound and says so. An overstated floor gives a
@@ -84,7 +84,8 @@
 namespace feeddrive::fit {
 
 struct NoiseFloor {
-  double quantization{0.0};          ///< q [m]
+  double quantization{0.0};          ///< q [m] (plant.sensor's, at most what the record allows)
+  double quantization_given{0.0};    ///< plant.sensor's q when the record allows less (else 0)
   double noise{0.0};                 ///< sigma_n [m] (plant.sensor's, at most what the record allows)
   double noise_given{0.0};           ///< plant.sensor's sigma_n when the record allows less (else 0)
   double position{0.0};              ///< sigma_x [m]
