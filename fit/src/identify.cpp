@@ -444,6 +444,50 @@ double bic(const Eigen::VectorXd& r, int k, long n_active) {
   return n * std::log(rss / n) + k * std::log(n);
 }
 
+namespace {
+
+// A scanned parameter (held by Ceres, e.g. the contact position): golden-section search between
+// the neighbouring distinct start values of the best one, refitting the others at each probe;
+// `best` becomes the result when it fits better.
+void refine_scanned(const Record& rec, const plant::PlantParams& model, const std::vector<Block>& blocks, const Spec& s,
+                    const std::vector<Theta>& starts, const Ctx& ctx, Solved& best) {
+  const int f = s.fixed.front();
+  std::vector<double> grid;
+  for (const Theta& t : starts) grid.push_back(t[static_cast<std::size_t>(f)]);
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());  // starts that share a value (grinding)
+  const auto it = std::lower_bound(grid.begin(), grid.end(), best.theta[static_cast<std::size_t>(f)]);
+  const std::size_t i = static_cast<std::size_t>(it - grid.begin());
+  double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
+  const auto probe = [&](double v) {
+    Theta t = best.theta;
+    t[static_cast<std::size_t>(f)] = v;
+    return solve(rec, model, blocks, t, ctx, 10);
+  };
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+  Solved sa = probe(a), sb = probe(b);
+  for (int k = 0; k < 12; ++k) {
+    if (sa.rss < sb.rss) {
+      hi = b;
+      b = a;
+      sb = sa;
+      a = hi - g * (hi - lo);
+      sa = probe(a);
+    } else {
+      lo = a;
+      a = b;
+      sa = sb;
+      b = lo + g * (hi - lo);
+      sb = probe(b);
+    }
+  }
+  const Solved& cand = sa.rss < sb.rss ? sa : sb;
+  if (cand.rss < best.rss) best = solve(rec, model, blocks, cand.theta, ctx, 100);
+}
+
+}  // namespace
+
 CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, const std::string& name,
                            const Eigen::VectorXd& residual0, const interrupt::StopToken& stop) {
   const Spec& s = spec(name);
@@ -477,43 +521,7 @@ CandidateFit fit_candidate(const Record& rec, const plant::PlantParams& model, c
       if (a.rss <= best.rss * (1.0 + 1e-3)) best = a;
     }
   }
-  // A scanned parameter (held by Ceres, e.g. the contact position): golden-section search
-  // between the neighbouring start values of the best one, refitting the others at each probe.
-  if (s.fixed.size() == 1 && starts.size() > 2) {
-    const int f = s.fixed.front();
-    std::vector<double> grid;
-    for (const Theta& t : starts) grid.push_back(t[static_cast<std::size_t>(f)]);
-    std::sort(grid.begin(), grid.end());
-    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());  // starts that share a value (grinding)
-    const auto it = std::lower_bound(grid.begin(), grid.end(), best.theta[static_cast<std::size_t>(f)]);
-    const std::size_t i = static_cast<std::size_t>(it - grid.begin());
-    double lo = grid[i > 0 ? i - 1 : 0], hi = grid[std::min(i + 1, grid.size() - 1)];
-    const auto probe = [&](double v) {
-      Theta t = best.theta;
-      t[static_cast<std::size_t>(f)] = v;
-      return solve(rec, model, blocks, t, ctx, 10);
-    };
-    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
-    Solved sa = probe(a), sb = probe(b);
-    for (int k = 0; k < 12; ++k) {
-      if (sa.rss < sb.rss) {
-        hi = b;
-        b = a;
-        sb = sa;
-        a = hi - g * (hi - lo);
-        sa = probe(a);
-      } else {
-        lo = a;
-        a = b;
-        sa = sb;
-        b = lo + g * (hi - lo);
-        sb = probe(b);
-      }
-    }
-    const Solved& cand = sa.rss < sb.rss ? sa : sb;
-    if (cand.rss < best.rss) best = solve(rec, model, blocks, cand.theta, ctx, 100);
-  }
+  if (s.fixed.size() == 1 && starts.size() > 2) refine_scanned(rec, model, blocks, s, starts, ctx, best);
   out.effect = s.to_effect(best.theta, ctx);
   plant::PlantParams p = model;
   plant::set_effect(p.effects, out.effect);
