@@ -125,8 +125,8 @@ int fit_record(Args& a) {
   a.opt.plausibility.grinding_process =
       scenario.grinding_process || std::find(a.ask.begin(), a.ask.end(), "grinding_force") != a.ask.end();
   if (!a.units.empty()) a.csv.units = fit::parse_units(a.units);
-  const fit::MeasuredData data = fit::load_data(a.data_path, a.prefix, a.csv, tool::stop_token());
-  fit::check_record(data, scenario.plant, scenario.control_period);
+  fit::MeasuredData data = fit::load_data(a.data_path, a.prefix, a.csv, tool::stop_token());
+  for (std::string& n : fit::check_record(data, scenario.plant, scenario.control_period)) data.notes.push_back(n);
   const fit::Record rec = fit::prepare(data, a.opt.record);
   fit::check_options(rec, a.opt);
   fit::check_force_scale(rec, scenario.plant);

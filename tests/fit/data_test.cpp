@@ -34,7 +34,7 @@ TEST(FitUnits, EveryUnitIsAFactorToSI) {
   for (const std::string bad : {"x=inch", "speed=mm", "x=", "x=counts:-1", "x=counts:abc", "t"})
     EXPECT_THROW(parse_units(bad), DataError) << bad;
   // a velocity column (a logger's file often has one): the fit uses none, and says so with the
-  // roles it does use (issue 34's review: "unknown role 'v'" left the user guessing)
+  // roles it does use (issue 20's review: "unknown role 'v'" left the user guessing)
   for (const std::string v : {"v=mm", "x=mm,velocity=mm/s", "speed=m"}) {
     try {
       parse_units(v);

@@ -41,8 +41,9 @@ constexpr double kMaxSignRatio = 2.0;
 constexpr double kMaxSamplePeriodRatio = 1.5;
 
 /// The time and position checks on the raw record (before prepare()). control_period <= 0: no
-/// time-scale check. Throws DataError.
-void check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period);
+/// time-scale check. Throws DataError. Returns what passed but the report should say (data
+/// notes: time gaps shorter than kMaxGap periods, which the fit takes as they are).
+std::vector<std::string> check_record(const MeasuredData& d, const plant::PlantParams& model, double control_period);
 
 /// The force-scale check on a prepared record. Throws DataError.
 void check_force_scale(const Record& rec, const plant::PlantParams& model);
