@@ -1077,7 +1077,7 @@ TEST(FitData, ScaleOffByAThousandAndJumpsAreRefusedBeforeFitting) {
                     {"column 't': median sample period 0.002 s is 2 times the scenario's control period 0.001 s"});
 }
 
-// A step of the position of a few um, one sample off, and a gap in time with an offset (issue 34's
+// A step of the position of a few um, one sample off, and a gap in time with an offset (issue 20's
 // review of the sanity checks): a 5 or 10 um step passed (its acceleration stays within what the
 // peak thrust gives) and was fitted as a force; a 10 um spike was named one row late as "two
 // recordings joined"; a 9-period gap with a 1 mm offset named only the position. Each is now
