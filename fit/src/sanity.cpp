@@ -95,7 +95,14 @@ void check_time_scale(const MeasuredData& d, double T, double control_period) {
                         T, T / control_period, control_period));
   if (k == 0) return;
   const double factor = d.time_factor * std::pow(1000.0, -k);
-  const std::string h = hint("t", factor);
+  std::string h = hint("t", factor);
+  // a ratio no power of 1000 gives (beyond 25 %: e.g. 100 us ticks read as s, 1e4): the unit that
+  // makes the period one control period, which is what a logger of the loop records (issue 20's
+  // review: 100 us ticks were "likely in ms")
+  const double ratio = T / control_period / std::pow(1000.0, k);
+  if (k > 0 && std::abs(std::log(ratio)) > std::log(1.25))
+    h = fmt(": no power of 1000; one sample per control period makes its unit %.3g s (--units t=counts:%.3g)",
+            d.time_factor * control_period / T, d.time_factor * control_period / T);
   if (h.empty() || (k < 0 && unit_name("t", factor).empty() && !(speed_p99(d) > kMaxSpeed))) return;
   throw DataError(d.source + ": column '" + d.time_name + "'" +
                   fmt(": median sample period %.4g s against the scenario's control period %.4g s", T, control_period) +
@@ -125,7 +132,73 @@ std::string counts_hint(double quantization) {
                                 "encoder's step in m)");
 }
 
-void check_position_scale(const MeasuredData& d, double quantization) {
+// The thrust against mass x acceleration (alpha, 1 for a record in the model's units), fitted over
+// the record with a constant and a generic friction (sign and viscous) by the modulating-function
+// balance, on the filter points; NaN where the acceleration does not carry half the thrust's
+// variance (R^2 <= 0.5: no evidence either way).
+double balance_ratio(const Record& rec, const plant::PlantParams& model) {
+  const long n = static_cast<long>(rec.bank.tau.size());
+  const double mass = plant::effective_params(model).mass;
+  const double gain = thrust_per_input(rec, model);
+  const Eigen::VectorXd thrust = apply(rec.bank, gain * rec.input);
+  const long ni = static_cast<long>(rec.motion.v_mid.size());
+  Eigen::VectorXd sg(ni), v(ni), one = Eigen::VectorXd::Ones(ni);
+  const double v_small = std::max(1e-5, 0.01 * rec.v_max_abs);
+  for (long j = 0; j < ni; ++j) {
+    v[j] = rec.motion.v_mid[static_cast<std::size_t>(j)];
+    sg[j] = std::tanh(v[j] / v_small);
+  }
+  Eigen::MatrixXd A(n, 4);
+  A.col(0) = mass * Eigen::Map<const Eigen::VectorXd>(rec.bank.accel.data(), n);
+  A.col(1) = apply(rec.bank, one);
+  A.col(2) = apply(rec.bank, sg);
+  A.col(3) = apply(rec.bank, v);
+  // scale the columns: the solve must not depend on the units of the others
+  Eigen::VectorXd s(4);
+  for (int c = 0; c < 4; ++c) s[c] = std::max(A.col(c).norm(), 1e-300);
+  const Eigen::MatrixXd As = A * s.cwiseInverse().asDiagonal();
+  const Eigen::VectorXd beta = As.colPivHouseholderQr().solve(thrust).cwiseQuotient(s);
+  const double alpha = beta[0];
+  // only a well-determined ratio: the acceleration column must carry the thrust (R^2 of the fit)
+  const Eigen::VectorXd res = thrust - A * beta;
+  const double r2 = 1.0 - res.squaredNorm() / std::max(thrust.squaredNorm(), 1e-300);
+  return r2 > 0.5 && std::abs(alpha) > 0 ? alpha : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The position's unit from the thrust balance, when the range check refuses it (issue 20's review:
+// a position in cm was "likely in mm", snapped to a power of 1000): with the acceleration in the
+// file's unit, alpha = F / (m a) is that unit in metres (0.01 for cm), to the mass error's share (a
+// 2x mass error gives 2x). Named when within 25 % of a common unit, else given as counts:SCALE;
+// "" when the balance cannot say (the record too short to filter, or R^2 <= 0.5).
+std::string balance_unit_hint(const MeasuredData& d, const plant::PlantParams& model) {
+  double alpha = std::numeric_limits<double>::quiet_NaN();
+  try {
+    alpha = balance_ratio(prepare(d), model);
+  } catch (const std::exception&) {
+    return "";
+  }
+  if (!(alpha > 0)) return "";
+  const double unit = alpha * d.position_factor;  // metres per unit of the file
+  struct Named {
+    const char* name;
+    double metres;
+    const char* option;
+  };
+  static const Named known[] = {{"mm", 1e-3, "x=mm"},
+                                {"um", 1e-6, "x=um"},
+                                {"nm", 1e-9, "x=nm"},
+                                {"cm", 1e-2, "x=counts:0.01"},
+                                {"inches", 0.0254, "x=counts:0.0254"},
+                                {"0.1 mm", 1e-4, "x=counts:0.0001"}};
+  const std::string said = fmt(": the thrust balance makes its unit about %.3g m", unit);
+  for (const Named& k : known)
+    if (std::abs(std::log(unit / k.metres)) < std::log(1.25))
+      return said + ": likely in " + k.name + " (--units " + k.option + ")";
+  return said + fmt(" (--units x=counts:%.2g)", unit);
+}
+
+void check_position_scale(const MeasuredData& d, const plant::PlantParams& model) {
+  const double quantization = model.sensor.quantization;
   const std::size_t n = d.size();
   std::vector<double> xs = d.x;
   std::sort(xs.begin(), xs.end());
@@ -135,7 +208,8 @@ void check_position_scale(const MeasuredData& d, double quantization) {
   if (!(travel > kMaxTravel || v99 > kMaxSpeed)) return;
   int k = 0;
   while (k < 4 && (travel * std::pow(1e-3, k) > kMaxTravel || v99 * std::pow(1e-3, k) > kMaxSpeed)) ++k;
-  const std::string h = hint("x", d.position_factor * std::pow(1e-3, k));
+  std::string h = balance_unit_hint(d, model);
+  if (h.empty()) h = hint("x", d.position_factor * std::pow(1e-3, k));
   throw DataError(d.source + ": column '" + d.position_name + "'" +
                   fmt(": a travel of %.4g m at speeds up to %.4g m/s (99th percentile) is beyond a feed drive (at most "
                       "%.3g m, %.3g m/s)",
@@ -346,6 +420,16 @@ void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model
                         step, step / q, q) +
                     ratio + hint("x", d.position_factor * std::pow(1000.0, -kx)));
   const bool force = d.input_kind == InputKind::kForce;
+  // a ratio no power of 1000 gives (within 25 %: a mass error's share): the unit is named by the
+  // ratio itself (issue 20's review: a position in inches was "likely in mm"), both ways
+  if (std::abs(std::log(std::abs(alpha) / std::pow(1000.0, k))) > std::log(1.25))
+    throw DataError(d.source + ": columns '" + d.input_name + "' and '" + d.position_name + "': " + ratio +
+                    fmt(", no power of 1000: the input's unit is about %.3g of the model's", 1.0 / alpha) +
+                    " (--units " + (force ? "force" : "u") + fmt("=counts:%.2g)", d.input_factor / alpha) +
+                    (alpha * d.position_factor < 0.5  // a position unit below a metre (cm, inches)
+                         ? fmt(", or the position's %.3g m (--units x=counts:%.2g)", alpha * d.position_factor,
+                               alpha * d.position_factor)
+                         : std::string()));
   const std::string h = hint(force ? "force" : "u", d.input_factor * std::pow(1000.0, -k));
   const bool position_agrees = q > 0 && kx == 0;  // its steps are the encoder's: the position is not off
   throw DataError(d.source + ": column '" + d.input_name + "': " + ratio +
@@ -391,7 +475,7 @@ std::vector<std::string> check_record(const MeasuredData& d, const plant::PlantP
   const double T = d.median_period();
   check_time_steps(d, T);
   check_time_scale(d, T, control_period);
-  check_position_scale(d, model.sensor.quantization);
+  check_position_scale(d, model);
   check_position_jumps(d, model, T);
   return gap_notes(d, T);
 }
@@ -408,30 +492,8 @@ void check_force_scale(const Record& rec, const plant::PlantParams& model) {
                         "channel switched off or the wrong column; the fit needs the thrust or the command",
                         *lo + 0.0, rec.v_max_abs * 1e3));  // + 0.0: -0 prints as 0
   const double mass = plant::effective_params(model).mass;
-  const double gain = thrust_per_input(rec, model);
-  const Eigen::VectorXd thrust = apply(rec.bank, gain * rec.input);
-  const long ni = static_cast<long>(rec.motion.v_mid.size());
-  Eigen::VectorXd sg(ni), v(ni), one = Eigen::VectorXd::Ones(ni);
-  const double v_small = std::max(1e-5, 0.01 * rec.v_max_abs);
-  for (long j = 0; j < ni; ++j) {
-    v[j] = rec.motion.v_mid[static_cast<std::size_t>(j)];
-    sg[j] = std::tanh(v[j] / v_small);
-  }
-  Eigen::MatrixXd A(n, 4);
-  A.col(0) = mass * Eigen::Map<const Eigen::VectorXd>(rec.bank.accel.data(), n);
-  A.col(1) = apply(rec.bank, one);
-  A.col(2) = apply(rec.bank, sg);
-  A.col(3) = apply(rec.bank, v);
-  // scale the columns: the solve must not depend on the units of the others
-  Eigen::VectorXd s(4);
-  for (int c = 0; c < 4; ++c) s[c] = std::max(A.col(c).norm(), 1e-300);
-  const Eigen::MatrixXd As = A * s.cwiseInverse().asDiagonal();
-  const Eigen::VectorXd beta = As.colPivHouseholderQr().solve(thrust).cwiseQuotient(s);
-  const double alpha = beta[0];
-  // only a well-determined ratio: the acceleration column must carry the thrust (R^2 of the fit)
-  const Eigen::VectorXd res = thrust - A * beta;
-  const double r2 = 1.0 - res.squaredNorm() / std::max(thrust.squaredNorm(), 1e-300);
-  if (!(r2 > 0.5) || !(std::abs(alpha) > 0)) return;
+  const double alpha = balance_ratio(rec, model);
+  if (!std::isfinite(alpha)) return;
   // a thrust against the acceleration: the direction of one column is reversed (issue 20's review).
   // Only a ratio in the band a mass error gives, mirrored (-1/kMaxSignRatio and beyond; a negated
   // column gives -1): a small negative one is no evidence, only an acceleration that explains

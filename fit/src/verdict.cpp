@@ -365,6 +365,12 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
         "%.3g s or more",
         0.05 * env.v_max * 1e3, env.v_max * 1e3, longer);
   if (n == "mass_error" && why == Reason::kImplausible && c.effect.parameters.count("mass") &&
+      (par(c.effect, "mass") < 0.5 * env.nominal_mass || par(c.effect, "mass") > 2.0 * env.nominal_mass))
+    return fmt(
+        "a mass %.3g times the nominal: check the units of the position and the input (one off by about that "
+        "factor, e.g. inches or cm read as m, looks like this: --units), and the scenario's plant.mass",
+        par(c.effect, "mass") / env.nominal_mass);
+  if (n == "mass_error" && why == Reason::kImplausible && c.effect.parameters.count("mass") &&
       std::abs(par(c.effect, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass)
     return fmt(
         "a mass change of %.2g %%: weigh the moving parts (plant.mass), or record strong accelerations and "
