@@ -354,6 +354,12 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
     return "a grinding force: describe the grinding process (plant.grinding) or ask for it with --effects "
            "grinding_force";
   if (why == Reason::kPrerequisite) return "";
+  // a constant force within the friction's direction asymmetry: moving data cannot tell them apart,
+  // whatever the reversals (issue 20's review: "record reversals" for a record with 17 of them)
+  if (n == "constant_force" && why == Reason::kImplausible && c.passed_over.find("asymmetry") != std::string::npos)
+    return "a constant force or a friction that differs between the directions: only the drive at rest tells them "
+           "apart (a constant force pushes at rest, a friction does not): record holds at rest, with the thrust, at "
+           "several positions";
   if (n == "constant_force" || n == "coulomb_friction")
     return fmt(
         "a force that depends on the direction of motion or not: record moves in both directions (reversals), "

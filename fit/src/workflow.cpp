@@ -1008,6 +1008,17 @@ void explain_unexplained(const Context& cx, FitResult& out) {
     }
   }
   if (!out.floor.from_scenario) out.unexplained.push_back("noise floor: " + out.floor.source);
+  // an encoder step the record does not have: its positions move in steps of at least 1.8 q (a
+  // quantized position moves in multiples of q; 1.8: a step of 2 q read back with rounding)
+  // (issue 20's review: a 5 nm encoder declared for 50 nm steps, and counts read at 2x the step,
+  // were blamed on friction and on the thrust)
+  const double step = smallest_position_step(*cx.rec.data);
+  if (out.floor.from_scenario && out.floor.quantization > 0 && step >= 1.8 * out.floor.quantization)
+    out.unexplained.push_back(
+        fmt("noise floor: the record's smallest position step %.3g nm is %.3g times plant.sensor.quantization (%.3g "
+            "nm): the floor is that much too low, or the position's scale is off (--units x=counts:STEP); give the "
+            "encoder's step",
+            step * 1e9, step / out.floor.quantization, out.floor.quantization * 1e9));
 }
 
 // The named effects, each with " (tentative)" where it is: " a b (tentative)".

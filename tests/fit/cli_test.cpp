@@ -721,6 +721,21 @@ TEST(FitVerdict, ASensorNoiseTheRecordContradictsIsTakenAtItsBound) {
   EXPECT_DOUBLE_EQ(jq["noise_floor"]["quantization_given_m"].get<double>(), 5e-6);
   EXPECT_NEAR(jq["noise_floor"]["quantization_m"].get<double>(), 50e-9, 1e-9);  // the record's step
   EXPECT_LT(jq["noise_floor"]["gap_m"].get<double>(), 0.1e-6) << jq["conclusion"];
+  // A 5 nm encoder with 2 nm noise declared for the record's 50 nm steps: the floor is 10x too low, and the
+  // unexplained verdict says so (it blamed friction), rather than pass a claim the record refutes.
+  std::string fine = short_scenario("");
+  fine.replace(fine.find("quantization: 5.0e-8"), 20, "quantization: 5.0e-9");
+  fine.replace(fine.find("noise_stddev: 2.0e-8"), 20, "noise_stddev: 2.0e-9");
+  const fs::path out_f = scratch() / "fine_sensor";
+  const ProcResult rf =
+      run_fit("--scenario " + write_file("fine_sensor.yaml", fine).string() + " --data " + simulated_data().string() +
+              " --position-column x_measured --out " + out_f.string() + " --no-plots -q");
+  ASSERT_EQ(rf.code, 3) << rf.err << rf.out;
+  std::string lines;
+  const auto jf = findings(out_f);
+  for (const auto& u : jf["unexplained"]) lines += u.get<std::string>() + "\n";
+  EXPECT_NE(lines.find("smallest position step 50 nm is 10 times plant.sensor.quantization (5 nm)"), std::string::npos)
+      << lines;
 }
 
 // The noise floor's terms (fit/verdict.hpp): the same record with its time stamps' error given
