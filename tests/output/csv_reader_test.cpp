@@ -54,6 +54,24 @@ TEST(CsvReader, ColumnsInAnyOrderCommentsBlanksCrlfQuotesAndByteOrderMark) {
   EXPECT_EQ(t.lines, (std::vector<long>{4, 6, 8}));
 }
 
+// A logger's separator after the last field of every line (issue 20's review: "t<tab>x<tab>F<tab>"
+// was refused as an empty column name): no column; rows may end with it or not. An empty name
+// inside the header stays an error (EachErrorIsOneLine...), and so does a row with a value there.
+TEST(CsvReader, ASeparatorAfterTheLastFieldIsNoColumn) {
+  Options o = tx();
+  o.separator = '\t';
+  const Table t = read_file(write_temp("trailing_tab.csv", "t\tx\t\n0\t1\t\n0.5\t2\n1\t3\t\n"), o);
+  ASSERT_EQ(t.rows(), 3u);
+  EXPECT_EQ(t.values[0], (std::vector<double>{0.0, 0.5, 1.0}));
+  EXPECT_EQ(t.values[1], (std::vector<double>{1.0, 2.0, 3.0}));
+  try {
+    read_file(write_temp("trailing_value.csv", "t,x,\n0,1,\n1,2,7\n"), tx());
+    ADD_FAILURE() << "a value under no column must be refused";
+  } catch (const CsvError& e) {
+    EXPECT_NE(std::string(e.what()).find(":3: 3 fields, the header has 2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CsvReader, AlternativeAndOptionalColumns) {
   Options o;
   o.columns = {{{"t"}}, {{"force_N", "u"}}, {{"xd"}, false}};

@@ -113,6 +113,10 @@ class Parser {
     have_header_ = true;
     header_text_ = shown(trim(l), 60);
     std::map<std::string, std::size_t> seen;
+    // a separator after the last name (a logger's "t;x;F;"): no column, and rows may end with one
+    // too (issue 20's review); an empty name elsewhere stays an error
+    trailing_ = fields_.size() > 1 && unquote(fields_.back().text).empty();
+    if (trailing_) fields_.pop_back();
     for (std::size_t i = 0; i < fields_.size(); ++i) {
       const std::string name = unquote(fields_[i].text);
       if (name.empty())
@@ -170,6 +174,7 @@ class Parser {
   }
 
   void row() {
+    if (trailing_ && fields_.size() == header_.size() + 1 && trim(fields_.back().text).empty()) fields_.pop_back();
     if (fields_.size() != header_.size())
       fail_line(0, std::to_string(fields_.size()) + " fields, the header has " + std::to_string(header_.size()) +
                        " (truncated or extra field?)");
@@ -236,6 +241,7 @@ class Parser {
   Table table_;
   std::vector<long> index_;
   std::vector<std::string> header_;
+  bool trailing_{false};  // the header ends with a separator
   std::string header_text_, previous_text_;
   std::vector<Field> fields_;
   long line_no_{0};
