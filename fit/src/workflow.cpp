@@ -756,8 +756,8 @@ bool run_step(const Context& cx, Search& s, StepResult& st) {
   st.force_rms_before = rms(s.r, cx.n);
   // The model is within the noise floor: what is left is what the sensor leaves on an exact model
   // (residual analysis, Ljung 1999, ch. 16: stop when the residual is at the noise level). An
-  // effect named beyond it fits that noise (issue 20's point 7: an input delay and a viscous
-  // friction named on seed-777 records already within the floor, 2.6x and 2.2x of their gaps).
+  // effect named beyond it fits that noise (issue 20's point 7: an input delay, score 16.6, named
+  // on seed-777 record 1554002369 with the gap already at 2.6x its floor).
   if (cx.floor && within_floor(*cx.floor, s.rp.gap, st.force_rms_before)) {
     st.verdict = fmt("within the noise floor (gap %.4g um, force residual %.4g N RMS): nothing more is named",
                      s.rp.gap * 1e6, st.force_rms_before);
