@@ -179,7 +179,7 @@ nlohmann::json step_json(const StepResult& st) {
   return {{"accepted", st.accepted},
           {"verdict", st.verdict},
           {"gap_before_m", st.gap_before},
-          {"gap_after_m", st.accepted ? nlohmann::json(st.gap_after) : nlohmann::json()},
+          {"gap_after_m", st.accepted ? st.gap_after : st.gap_before},  // a step that adds nothing keeps it
           {"ranking", rk},
           {"removed", st.removed},
           {"swap", st.swap},
