@@ -18,6 +18,11 @@ namespace {
 // The power of 1000 nearest to r: round(log10(r) / 3).
 int thousands(double r) { return static_cast<int>(std::lround(std::log10(r) / 3.0)); }
 
+// a and b (> 0) within 25 % of each other: a measured unit factor that names a unit (a mass error
+// or a logger's rate moves it by less); beyond, the factor itself is given (issue 20's review: cm,
+// inches and 100 us ticks were snapped to a power of 1000)
+bool within_factor(double a, double b) { return std::abs(std::log(a / b)) < std::log(1.25); }
+
 // The SI unit of a role with the prefix of `factor` (a power of 1000: "ks", "km", "GN"), or "".
 std::string prefixed_unit(const std::string& role, double factor) {
   const std::string base = role == "t" ? "s" : role == "x" || role == "xd" ? "m" : role == "force" ? "N" : "V";
@@ -53,11 +58,17 @@ std::string unit_name(const std::string& role, double factor) {
 
 namespace {
 
-// 1. gaps and jumps in time: the largest time step, against kMaxGap median periods T.
-void check_time_steps(const MeasuredData& d, double T) {
+// The sample k >= 1 after the largest time step t_k - t_k-1.
+std::size_t largest_time_step(const MeasuredData& d) {
   std::size_t worst = 1;
   for (std::size_t k = 1; k < d.size(); ++k)
     if (d.t[k] - d.t[k - 1] > d.t[worst] - d.t[worst - 1]) worst = k;
+  return worst;
+}
+
+// 1. gaps and jumps in time: the largest time step, against kMaxGap median periods T.
+void check_time_steps(const MeasuredData& d, double T) {
+  const std::size_t worst = largest_time_step(d);
   const double gap = d.t[worst] - d.t[worst - 1];
   if (gap > kMaxGap * T)
     throw DataError(
@@ -96,11 +107,10 @@ void check_time_scale(const MeasuredData& d, double T, double control_period) {
   if (k == 0) return;
   const double factor = d.time_factor * std::pow(1000.0, -k);
   std::string h = hint("t", factor);
-  // a ratio no power of 1000 gives (beyond 25 %: e.g. 100 us ticks read as s, 1e4): the unit that
+  // a ratio no power of 1000 gives (within_factor: e.g. 100 us ticks read as s, 1e4): the unit that
   // makes the period one control period, which is what a logger of the loop records (issue 20's
   // review: 100 us ticks were "likely in ms")
-  const double ratio = T / control_period / std::pow(1000.0, k);
-  if (k > 0 && std::abs(std::log(ratio)) > std::log(1.25))
+  if (k > 0 && !within_factor(T / control_period, std::pow(1000.0, k)))
     h = fmt(": no power of 1000; one sample per control period makes its unit %.3g s (--units t=counts:%.3g)",
             d.time_factor * control_period / T, d.time_factor * control_period / T);
   if (h.empty() || (k < 0 && unit_name("t", factor).empty() && !(speed_p99(d) > kMaxSpeed))) return;
@@ -168,7 +178,7 @@ double balance_ratio(const Record& rec, const plant::PlantParams& model) {
 // The position's unit from the thrust balance, when the range check refuses it (issue 20's review:
 // a position in cm was "likely in mm", snapped to a power of 1000): with the acceleration in the
 // file's unit, alpha = F / (m a) is that unit in metres (0.01 for cm), to the mass error's share (a
-// 2x mass error gives 2x). Named when within 25 % of a common unit, else given as counts:SCALE;
+// 2x mass error gives 2x). Named when within_factor of a common unit, else given as counts:SCALE;
 // "" when the balance cannot say (the record too short to filter, or R^2 <= 0.5).
 std::string balance_unit_hint(const MeasuredData& d, const plant::PlantParams& model) {
   double alpha = std::numeric_limits<double>::quiet_NaN();
@@ -192,8 +202,7 @@ std::string balance_unit_hint(const MeasuredData& d, const plant::PlantParams& m
                                 {"0.1 mm", 1e-4, "x=counts:0.0001"}};
   const std::string said = fmt(": the thrust balance makes its unit about %.3g m", unit);
   for (const Named& k : known)
-    if (std::abs(std::log(unit / k.metres)) < std::log(1.25))
-      return said + ": likely in " + k.name + " (--units " + k.option + ")";
+    if (within_factor(unit, k.metres)) return said + ": likely in " + k.name + " (--units " + k.option + ")";
   return said + fmt(" (--units x=counts:%.2g)", unit);
 }
 
@@ -219,18 +228,30 @@ void check_position_scale(const MeasuredData& d, const plant::PlantParams& model
                                     : h));
 }
 
+// The offset o_j of sample j from the straight line through its two neighbours, at t_j: -a h0 h1 / 2
+// for a smooth motion of acceleration a, without squaring x (an outlier of 1e308 m stays finite).
+// A step of the position by J between samples k-1 and k gives the doublet o_(k-1) = -J/2,
+// o_k = +J/2 (equal periods); a spike of J at sample j the triplet -J/2, +J, -J/2; a step of the
+// thrust only a change of level. 0 at both ends.
+std::vector<double> offsets(const MeasuredData& d) {
+  std::vector<double> o(d.size(), 0.0);
+  for (std::size_t j = 1; j + 1 < d.size(); ++j) {
+    const double h0 = d.t[j] - d.t[j - 1], h1 = d.t[j + 1] - d.t[j];
+    o[j] = d.x[j] - (h1 / (h0 + h1)) * d.x[j - 1] - (h0 / (h0 + h1)) * d.x[j + 1];
+  }
+  return o;
+}
+
 // The sample whose second difference |x''_k| (three-point, unequal steps) most exceeds the larger
 // of 4x what the peak thrust gives the mass (a mass error of 2x and the friction's share stay
 // below it), 50x the sensor's own (a quantum and three noise deviations per step) and 5x the
 // record's own 99th percentile (one jump does not move it; jitter's tail stays within 2x of it);
 // 0 if none exceeds it.
-std::size_t find_jump(const MeasuredData& d, double peak, double mass, double sensor) {
+std::size_t find_jump(const MeasuredData& d, const std::vector<double>& o, double peak, double mass, double sensor) {
   const std::size_t n = d.size();
   std::vector<double> acc(n, 0.0);
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    const double h0 = d.t[k] - d.t[k - 1], h1 = d.t[k + 1] - d.t[k];
-    acc[k] = std::abs((d.x[k + 1] - d.x[k]) / h1 - (d.x[k] - d.x[k - 1]) / h0) / (0.5 * (h0 + h1));
-  }
+  for (std::size_t k = 1; k + 1 < n; ++k)  // |x''_k| = 2 |o_k| / (h0 h1) (offsets)
+    acc[k] = 2.0 * std::abs(o[k]) / ((d.t[k] - d.t[k - 1]) * (d.t[k + 1] - d.t[k]));
   const double typical = order_statistic(acc, static_cast<std::size_t>(0.99 * static_cast<double>(n - 1)));
   std::size_t jump = 0;
   double jump_a = 0.0;
@@ -244,20 +265,6 @@ std::size_t find_jump(const MeasuredData& d, double peak, double mass, double se
     }
   }
   return jump;
-}
-
-// The offset o_j of sample j from the straight line through its two neighbours, at t_j: -a h0 h1 / 2
-// for a smooth motion of acceleration a, without squaring x (an outlier of 1e308 m stays finite).
-// A step of the position by J between samples k-1 and k gives the doublet o_(k-1) = -J/2,
-// o_k = +J/2 (equal periods); a spike of J at sample j the triplet -J/2, +J, -J/2; a step of the
-// thrust only a change of level. 0 at both ends.
-std::vector<double> offsets(const MeasuredData& d) {
-  std::vector<double> o(d.size(), 0.0);
-  for (std::size_t j = 1; j + 1 < d.size(); ++j) {
-    const double h0 = d.t[j] - d.t[j - 1], h1 = d.t[j + 1] - d.t[j];
-    o[j] = d.x[j] - (h1 / (h0 + h1)) * d.x[j - 1] - (h0 / (h0 + h1)) * d.x[j + 1];
-  }
-  return o;
 }
 
 double median3(double a, double b, double c) { return std::max(std::min(a, b), std::min(std::max(a, b), c)); }
@@ -354,7 +361,7 @@ double step_size(const MeasuredData& d, std::size_t k) {
     const std::size_t s = std::min(k, j);  // the spike's sample
     if (best.strength > 0 && partner.strength >= 0.5 * best.strength && partner.size * best.size < 0 && s >= 2 &&
         s + 2 < n) {
-      const double off = d.x[s] - (4.0 * (d.x[s - 1] + d.x[s + 1]) - d.x[s - 2] - d.x[s + 2]) / 6.0;
+      const double off = cubic_gap(d.t, d.x, s);
       throw DataError(d.where(s) + ": column '" + d.position_name + "'" +
                       fmt(": position %.6g m at t = %.6g s is an outlier, %.4g mm off the course of its neighbours "
                           "(one sample off, the samples around it agree): is the position column in metres and free "
@@ -391,7 +398,7 @@ void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model
   if (q == 0.0) q = smallest_position_step(d);
   const double sensor = q + 3.0 * model.sensor.noise_stddev;
   const std::vector<double> o = offsets(d);
-  if (const std::size_t jump = find_jump(d, peak, mass, sensor))
+  if (const std::size_t jump = find_jump(d, o, peak, mass, sensor))
     throw_jump(d, o, jump, T,
                fmt("an acceleration beyond 4x what the peak thrust of %.4g N gives the %.4g kg mass", peak, mass));
   if (const Step step = find_step(o, sensor); step.k > 0)
@@ -420,9 +427,9 @@ void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model
                         step, step / q, q) +
                     ratio + hint("x", d.position_factor * std::pow(1000.0, -kx)));
   const bool force = d.input_kind == InputKind::kForce;
-  // a ratio no power of 1000 gives (within 25 %: a mass error's share): the unit is named by the
+  // a ratio no power of 1000 gives (within_factor: a mass error's share): the unit is named by the
   // ratio itself (issue 20's review: a position in inches was "likely in mm"), both ways
-  if (std::abs(std::log(std::abs(alpha) / std::pow(1000.0, k))) > std::log(1.25))
+  if (!within_factor(std::abs(alpha), std::pow(1000.0, k)))
     throw DataError(d.source + ": columns '" + d.input_name + "' and '" + d.position_name + "': " + ratio +
                     fmt(", no power of 1000: the input's unit is about %.3g of the model's", 1.0 / alpha) +
                     " (--units " + (force ? "force" : "u") + fmt("=counts:%.2g)", d.input_factor / alpha) +
@@ -447,16 +454,16 @@ void check_position_jumps(const MeasuredData& d, const plant::PlantParams& model
 // 9-period gap passed without a word).
 std::vector<std::string> gap_notes(const MeasuredData& d, double T) {
   constexpr double kNoteGap = 1.5;
-  std::size_t count = 0, worst = 0;
+  std::size_t count = 0;
   double missing = 0.0;
   for (std::size_t k = 1; k < d.size(); ++k) {
     const double h = d.t[k] - d.t[k - 1];
     if (!(h > kNoteGap * T)) continue;
     ++count;
     missing += std::round(h / T) - 1.0;
-    if (worst == 0 || h > d.t[worst] - d.t[worst - 1]) worst = k;
   }
   if (count == 0) return {};
+  const std::size_t worst = largest_time_step(d);
   const double largest = d.t[worst] - d.t[worst - 1];
   return {
       fmt("time gaps: %.0f intervals longer than 1.5 sample periods (%.3g ms)", static_cast<double>(count), T * 1e3) +

@@ -13,6 +13,20 @@ double order_statistic(std::vector<double> v, std::size_t k) {
   return v[k];
 }
 
+double cubic_gap(const std::vector<double>& t, const std::vector<double>& x, std::size_t k, double* w2) {
+  const std::size_t nb[4] = {k - 2, k - 1, k + 1, k + 2};
+  double p = 0.0, sum2 = 0.0;
+  for (std::size_t a = 0; a < 4; ++a) {
+    double w = 1.0;
+    for (std::size_t b = 0; b < 4; ++b)
+      if (b != a) w *= (t[k] - t[nb[b]]) / (t[nb[a]] - t[nb[b]]);
+    p += w * x[nb[a]];
+    sum2 += w * w;
+  }
+  if (w2) *w2 = sum2;
+  return x[k] - p;
+}
+
 double kernel(double s, double L) {
   const double u = s / L;
   if (u <= -1.0 || u >= 1.0) return 0.0;

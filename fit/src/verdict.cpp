@@ -195,16 +195,9 @@ Scatter scatter_at_speed(const Record& rec) {
   std::vector<double> e2, at_speed;
   for (std::size_t k = 2; k + 2 < n; ++k) {
     if (!(speed[k] >= 0.5 * v95) || !(v95 > 0)) continue;
-    const std::size_t nb[4] = {k - 2, k - 1, k + 1, k + 2};
-    double p = 0.0, w2 = 0.0;
-    for (std::size_t a = 0; a < 4; ++a) {
-      double w = 1.0;
-      for (std::size_t b = 0; b < 4; ++b)
-        if (b != a) w *= (t[k] - t[nb[b]]) / (t[nb[a]] - t[nb[b]]);
-      p += w * x[nb[a]];
-      w2 += w * w;
-    }
-    e2.push_back((x[k] - p) * (x[k] - p) / (1.0 + w2));
+    double w2 = 0.0;
+    const double e = cubic_gap(t, x, k, &w2);
+    e2.push_back(e * e / (1.0 + w2));
     at_speed.push_back(speed[k]);
   }
   if (e2.size() < kMinSamples) return {};
@@ -292,22 +285,19 @@ std::string within_text(const NoiseFloor& f) {
 }
 
 std::string describe(const NoiseFloor& f) {
+  // a stated error the record contradicts, and what was taken (bound_sensor, bound_stamp_error)
+  const auto taken = [](const char* what, double given, double used, double scale, const char* unit) {
+    return given > 0
+               ? std::string("; ") + what + fmt(" %.3g", given * scale) + unit + fmt(" taken as %.3g", used * scale) +
+                     unit + ", the most the record's own scatter at speed allows"
+               : std::string();
+  };
   return fmt("the noise floor (gap %.3g um, force residual %.3g N RMS; ", f.gap * 1e6, f.force) + within_text(f) +
          fmt("; the smallest constant force it shows: %.3g N at W = %.3g s, L = %.3g ms", f.limit, f.window,
              f.half_width * 1e3) +
-         (f.noise_given > 0 ? fmt("; plant.sensor's noise %.3g nm taken as %.3g nm, the most the record's own "
-                                  "scatter at speed allows",
-                                  f.noise_given * 1e9, f.noise * 1e9)
-                            : std::string()) +
-         (f.quantization_given > 0 ? fmt("; plant.sensor's quantization %.3g nm taken as %.3g nm, the most the "
-                                         "record's own scatter and steps allow",
-                                         f.quantization_given * 1e9, f.quantization * 1e9)
-                                   : std::string()) +
-         (f.stamp_given > 0 ? fmt("; --time-stamp-error %.3g us taken as %.3g us, the most the record's own scatter "
-                                  "at speed allows",
-                                  f.stamp_given * 1e6, f.stamp_error * 1e6)
-                            : std::string()) +
-         ")";
+         taken("plant.sensor's noise", f.noise_given, f.noise, 1e9, " nm") +
+         taken("plant.sensor's quantization", f.quantization_given, f.quantization, 1e9, " nm") +
+         taken("--time-stamp-error", f.stamp_given, f.stamp_error, 1e6, " us") + ")";
 }
 
 bool within_floor(const NoiseFloor& f, double gap, double force_rms) {
@@ -377,7 +367,7 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
         "factor, e.g. inches or cm read as m, looks like this: --units), and the scenario's plant.mass",
         par(c.effect, "mass") / env.nominal_mass);
   if (n == "mass_error" && why == Reason::kImplausible && c.effect.parameters.count("mass") &&
-      std::abs(par(c.effect, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass)
+      small_mass_change(env, c.effect))
     return fmt(
         "a mass change of %.2g %%: weigh the moving parts (plant.mass), or record strong accelerations and "
         "decelerations at speed, away from reversals and stops (where friction's form can fake a small mass)",

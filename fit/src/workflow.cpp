@@ -84,9 +84,12 @@ struct Context {
   // the model's own constant force (plant.effects.constant_force): it stays as given, and no
   // direction asymmetry is carried as a constant force on top of it
   bool own_constant_force{false};
-  // the sensor's noise floor (verdict.hpp), when the scenario gives plant.sensor: a model within it
-  // is not searched further (run_step)
-  const NoiseFloor* floor{nullptr};
+  // the sensor's noise floor (verdict.hpp) at the settings used, computed once (run_fit); with
+  // plant.sensor and at the default W and L a model within it is not searched further (run_step):
+  // other W and L change the floor, and an all-clear there is judged again at the defaults
+  // (hidden_by_settings), which must see a searched model
+  const NoiseFloor& floor;
+  bool stop_within_floor{false};
   void say(const std::string& s) const {
     if (log) log(s);
   }
@@ -758,7 +761,7 @@ bool run_step(const Context& cx, Search& s, StepResult& st) {
   // (residual analysis, Ljung 1999, ch. 16: stop when the residual is at the noise level). An
   // effect named beyond it fits that noise (issue 20's point 7: an input delay, score 16.6, named
   // on seed-777 record 1554002369 with the gap already at 2.6x its floor).
-  if (cx.floor && within_floor(*cx.floor, s.rp.gap, st.force_rms_before)) {
+  if (cx.stop_within_floor && within_floor(cx.floor, s.rp.gap, st.force_rms_before)) {
     st.verdict = fmt("within the noise floor (gap %.4g um, force residual %.4g N RMS): nothing more is named",
                      s.rp.gap * 1e6, st.force_rms_before);
     cx.say(st.verdict);
@@ -1109,7 +1112,6 @@ std::string hidden_by_settings(const Context& cx, const plant::PlantParams& mode
 // unexplained (above it: explain_unexplained), with the model-form changes; one conclusion line.
 void conclude(const Context& cx, const plant::PlantParams& model, const std::vector<std::string>& added,
               FitResult& out) {
-  out.floor = noise_floor(cx.rec, model, FloorOptions{cx.opt.stamp_error, cx.opt.replay_window});
   const double gap_final = out.replay_final.gap, force_final = out.force_rms_final;
   // Without plant.sensor the floor is a guess from the record (its smallest position step), which a
   // record that never slows down makes large: it never gives an all-clear (issue 20's review).
@@ -1171,12 +1173,16 @@ FitResult run_fit(const Record& rec_in, const plant::PlantParams& model, const F
   out.smoothing_initial = model.friction.static_smoothing_velocity;
   out.shape_initial = model.friction.static_smoothing_shape;
   out.exponent_initial = model.friction.stribeck_exponent;
-  const NoiseFloor floor = noise_floor(rec, model, FloorOptions{opt.stamp_error, opt.replay_window});
-  const Context cx{
-      rec, opt, out.envelope, rec.active_points(), mean_position(rec), log, model.effects.constant_force.enabled,
-      // at the default W and L only: longer ones raise the floor, and an all-clear there is
-      // judged again at the defaults (hidden_by_settings), which must see a searched model
-      floor.from_scenario && !(opt.replay_window > 0) && !(opt.record.filter_half_width > 0) ? &floor : nullptr};
+  out.floor = noise_floor(rec, model, FloorOptions{opt.stamp_error, opt.replay_window});
+  const Context cx{rec,
+                   opt,
+                   out.envelope,
+                   rec.active_points(),
+                   mean_position(rec),
+                   log,
+                   model.effects.constant_force.enabled,
+                   out.floor,
+                   out.floor.from_scenario && !(opt.replay_window > 0) && !(opt.record.filter_half_width > 0)};
   Search s = start(cx, model, out);
   int additions = 0;
   for (int it = 0; additions < opt.max_effects && it < 2 * opt.max_effects + 2; ++it) {

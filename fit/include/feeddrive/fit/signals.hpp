@@ -36,6 +36,12 @@ struct Motion {
 /// The k-th smallest value of v (0-based, k < v.size()).
 double order_statistic(std::vector<double> v, std::size_t k);
 
+/// x_k less the cubic through its four neighbours k-2, k-1, k+1, k+2 at t_k (Lagrange, on the
+/// stamps as they are; 2 <= k, k + 2 < x.size()): an isolated error e_k of sample k shows in full,
+/// a smooth motion hardly. If w2 != nullptr it receives the sum of the cubic's squared weights
+/// (34/36 on equal steps), so that independent errors of variance s^2 give (1 + w2) s^2.
+double cubic_gap(const std::vector<double>& t, const std::vector<double>& x, std::size_t k, double* w2 = nullptr);
+
 /// half_window: M, the samples on each side of the local cubic (>= 2).
 Motion estimate_motion(const std::vector<double>& t, const std::vector<double>& x, int half_window);
 
