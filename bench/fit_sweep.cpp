@@ -11,10 +11,14 @@
 // (as drivegen/sweep.hpp counts them); fit_bench.sh sums the lines.
 //   fit_sweep N SEED [SHARD SHARDS] [DURATION_S] [MIX]
 // FD_SWEEP_ONLY=i,j,...: only the cases of these indices in the mix (to look at a few records).
+// FD_SWEEP_DUMP=DIR: also write each selected case's record and model (DIR/<seed>/data.csv,
+// model.yaml), to run feeddrive-fit on it.
 // FD_SWEEP_NOFORM=1: the same cases with the model's friction form (no smoother transition,
 // asymmetry or other Stribeck exponent), to tell a miss caused by the form from one that is not.
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -48,6 +52,13 @@ int main(int argc, char** argv) {
     if (static_cast<int>(i % static_cast<std::size_t>(shards)) != shard) continue;
     cases[i].duration = duration;
     if (std::getenv("FD_SWEEP_NOFORM")) cases[i].form_deviation = false;
+    if (const char* dump = std::getenv("FD_SWEEP_DUMP")) {
+      const fdgen::Generated g = fdgen::generate(cases[i]);
+      const std::string dir = std::string(dump) + "/" + std::to_string(cases[i].seed);
+      std::filesystem::create_directories(dir);
+      std::ofstream(dir + "/data.csv") << g.csv();
+      std::ofstream(dir + "/model.yaml") << g.scenario_yaml;
+    }
     try {
       // FD_SWEEP_VERBOSE=1: the fit's log on stderr (to look at one case)
       const sweep::Outcome o =

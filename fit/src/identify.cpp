@@ -62,10 +62,10 @@ std::vector<std::array<double, 3>> pitch_periodogram(const Ctx& c, bool times_th
   const Motion& m = rec.motion;
   const long ni = static_cast<long>(m.x_mid.size());
   const double range = std::max(rec.x_max - rec.x_min, 1e-4);
-  // The pitches plausibility.hpp admits: two periods within the travel, resolved by the samples
-  // and the filter at the peak speed.
+  // The pitches plausibility.hpp admits (Envelope::min_pitch, max_pitch).
+  const Envelope env = envelope(rec, c.model);
   const double p_max = 0.5 * range;
-  const double p_min = std::max({1e-3, 8.0 * rec.v_max_abs * rec.period, 4.0 * rec.v_max_abs * rec.bank.half_width});
+  const double p_min = env.min_pitch();
   if (p_min > p_max) return {};
   const double k_lo = 2 * kPi / p_max, k_hi = 2 * kPi / p_min, dk = 2 * kPi / (8.0 * range);
   const double gain = thrust_per_input(rec, c.model);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace feeddrive::fit {
 using text::fmt;
@@ -16,9 +17,27 @@ std::string ripple_pitch(const Envelope& env, double p) {
   if (p > env.max_pitch())
     return fmt("pitch %.3g mm: fewer than two periods within the %.3g mm travelled", p * 1e3, env.travel * 1e3);
   if (p < env.min_pitch())
-    return fmt("pitch %.3g mm: shorter than the %.3g mm the data resolves at %.3g mm/s", p * 1e3, env.min_pitch() * 1e3,
-               env.v_max * 1e3);
+    return fmt("pitch %.3g mm: shorter than the %.3g mm the data resolves at %.3g mm/s (half its moving distance)",
+               p * 1e3, env.min_pitch() * 1e3, env.v_resolve * 1e3);
   return "";
+}
+
+// The distance-weighted median of |v| over the samples moving at least v_stick: on a regular
+// grid a sample's distance is |v| times the period, so the weight is |v|. `none` if none moves.
+double distance_median_speed(const std::vector<double>& v, double v_stick, double none) {
+  std::vector<double> moving;
+  double total = 0.0;
+  for (double x : v)
+    if (std::abs(x) >= v_stick && std::abs(x) > 0.0) {
+      moving.push_back(std::abs(x));
+      total += std::abs(x);
+    }
+  if (moving.empty()) return none;
+  std::sort(moving.begin(), moving.end());
+  double below = 0.0;
+  for (double x : moving)
+    if ((below += x) >= 0.5 * total) return x;
+  return moving.back();
 }
 
 }  // namespace
@@ -31,7 +50,9 @@ double friction_level(const plant::PlantParams& m) {
   return c;
 }
 
-double Envelope::min_pitch() const { return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width}); }
+double Envelope::min_pitch() const {
+  return std::max({1e-3, 8.0 * v_resolve * period, 4.0 * v_resolve * filter_half_width});
+}
 
 Envelope envelope(const Record& rec, const plant::PlantParams& model) {
   Envelope e;
@@ -62,6 +83,7 @@ Envelope envelope(const Record& rec, const plant::PlantParams& model) {
     run = 0;
   }
   e.stick_fraction = static_cast<double>(in_stick) / static_cast<double>(d.size());
+  e.v_resolve = distance_median_speed(rec.motion.v, e.stick_velocity, e.v_max);
   int sign = 0;
   for (double v : rec.motion.v) {
     if (std::abs(v) < e.stick_velocity) continue;
@@ -99,6 +121,16 @@ std::string prerequisite(const Envelope& env, const plant::PlantParams& model, c
   return "";
 }
 
+std::string viscous_within_form(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e) {
+  if (e.name != "viscous_friction") return "";
+  const double level = friction_level(model), f = std::abs(par(e, "viscous")) * env.v_max;
+  if (!(level > 0 && f < kAsymmetry * level)) return "";
+  return fmt(
+      "its force at the peak speed, %.3g N, is within %.0f %% of the %.4g N friction level: the form of the "
+      "friction curve at speed, not a viscous friction",
+      f, 100 * kAsymmetry, level);
+}
+
 bool small_mass_change(const Envelope& env, const plant::NamedEffect& e) {
   return e.name == "mass_error" && std::abs(par(e, "mass") - env.nominal_mass) < kSmallMassChange * env.nominal_mass;
 }
@@ -128,6 +160,7 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
   if (n == "coulomb_friction" && par(e, "coulomb_force") > F) return above("Coulomb level", par(e, "coulomb_force"));
   if (n == "viscous_friction" && par(e, "viscous") * env.v_max > F)
     return above("viscous force at the peak speed", par(e, "viscous") * env.v_max);
+  if (const std::string w = viscous_within_form(env, model, e); !w.empty()) return w;
   if (n == "stribeck_friction") {
     if (par(e, "static_force") > F) return above("static level", par(e, "static_force"));
     if (par(e, "static_force") - par(e, "coulomb_force") < 0.05 * par(e, "coulomb_force"))
@@ -171,8 +204,14 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
   if (n == "reluctance_ripple") {
     const std::string p = ripple_pitch(env, par(e, "pitch"));
     if (!p.empty()) return p;
-    if (std::abs(par(e, "reluctance_amplitude")) > 0.2)
-      return fmt("relative ripple amplitude %.3g exceeds 0.2", std::abs(par(e, "reluctance_amplitude")));
+    const double a = std::abs(par(e, "reluctance_amplitude"));
+    if (a > 0.2) return fmt("relative ripple amplitude %.3g exceeds 0.2", a);
+    // The ripple scales the thrust by 1 + A sin(...), as a mass error scales the inertial force:
+    // a modulation below kLeastMassChange is what a mass change that small is (plausibility.hpp),
+    // another effect's form error, not a ripple worth naming.
+    if (a < kLeastMassChange)
+      return fmt("relative ripple amplitude %.2g %% is below %.0f %% of the thrust: no ripple worth naming", 100 * a,
+                 100 * kLeastMassChange);
   }
   if (n == "grinding_force") {
     const double xc = par(e, "contact_position");
