@@ -364,7 +364,7 @@ void md_list(std::ostringstream& md, const char* title, const std::vector<std::s
 void md_effects(std::ostringstream& md, const FitResult& r) {
   char buf[512];
   md << "\n## Effects found\n\n";
-  if (r.effects.empty()) md << "None: no candidate is significant.\n";
+  if (r.effects.empty()) md << "None named: each step above says why each candidate was passed over.\n";
   for (const Effect& e : r.effects) {
     md << "- `" << e.name << "`" << (r.tentative.count(e.name) ? " (**tentative**)" : "") << ": ";
     std::string sep;

@@ -334,6 +334,14 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
           "a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "
           "pitch you suspect",
           env.travel * 1e3);
+    // an amplitude limit no record of motion changes (plausibility.cpp: a thrust modulation below
+    // 1 % is what a mass or gain error that small is)
+    if (n == "reluctance_ripple" && c.passed_over.find("of the thrust") != std::string::npos)
+      return fmt(
+          "a thrust that changes with position by less than 1 %% (pitch about %.3g mm): no record of motion tells it "
+          "from a mass or gain error that small; measure the thrust at rest at several positions over one pitch (a "
+          "force sensor, or the command holding a known load)",
+          p * 1e3);
     return fmt(
         "a force periodic in position (pitch about %.3g mm): record more travel over the same range, e.g. a "
         "record of %.3g s with full-travel moves at several speeds",
@@ -351,6 +359,9 @@ std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason
     return "a constant force or a friction that differs between the directions: only the drive at rest tells them "
            "apart (a constant force pushes at rest, a friction does not): record holds at rest, with the thrust, at "
            "several positions";
+  if (n == "coulomb_friction" && why == Reason::kImplausible && c.passed_over.find("form") != std::string::npos)
+    return "a change of the friction level within its form: refit the model's friction levels (plant.friction) from "
+           "constant-speed moves in both directions, the thrust at each speed";
   if (n == "constant_force" || n == "coulomb_friction")
     return fmt(
         "a force that depends on the direction of motion or not: record moves in both directions (reversals), "

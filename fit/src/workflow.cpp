@@ -161,6 +161,16 @@ Search start(const Context& cx, const plant::PlantParams& model, FitResult& out)
   out.replay_initial = replay(cx.rec, model, cx.opt.replay_window, cx.opt.stop);
   out.force_rms_initial = rms(force_residual(cx.rec, model), cx.n);
   if (!std::isfinite(out.replay_initial.gap) || !std::isfinite(out.force_rms_initial)) throw_not_finite(*cx.rec.data);
+  // The model form is refitted on the force residual; a refit that lengthens the replay gap is not
+  // kept, as after an addition (accept): issue 20's review had the exact model of a static-friction
+  // scenario, within the floor as given (0.039 um), end unexplained at 0.143 um by its refit.
+  if (!(s.rp.gap <= out.replay_initial.gap)) {
+    cx.say(fmt("model form: its refit lengthens the replay gap (%.4g -> %.4g um); the form is kept as given",
+               out.replay_initial.gap * 1e6, s.rp.gap * 1e6));
+    s.current = model;
+    refresh(cx, s);
+    s.rp = out.replay_initial;
+  }
   cx.say("initial model: gap " +
          fmt("%.4g um, force residual RMS %.4g N", out.replay_initial.gap * 1e6, out.force_rms_initial));
   return s;
@@ -231,6 +241,23 @@ void hold_time_constant(const Context& cx, JointFit& jf) {
   jf.rss = force_residual(cx.rec, jf.params).squaredNorm();
 }
 
+// A reluctance ripple whose fitted amplitude is below the least one named (kLeastMassChange,
+// plausibility.hpp) only by its uncertainty: its 95 % interval reaches the limit (issue 20's review:
+// 0.9986 % +- 0.008 %, score 2325, was refused outright). The caveat, or "".
+std::string borderline_amplitude(const Context& cx, const plant::PlantParams& p,
+                                 const std::vector<std::string>& effects, const Effect& e) {
+  const double a = std::abs(par(e, "reluctance_amplitude"));
+  if (e.name != "reluctance_ripple" || !(a < kLeastMassChange)) return "";  // another limit failed
+  const auto ci = confidence_intervals(cx.rec, p, effects);
+  const double w =
+      ci.count(e.name) && ci.at(e.name).count("reluctance_amplitude") ? ci.at(e.name).at("reluctance_amplitude") : 0.0;
+  if (!(a + w >= kLeastMassChange)) return "";
+  return fmt(
+      "tentative: the fitted amplitude %.3g +- %.2g %% (95 %%) of the thrust reaches the %.0f %% limit within "
+      "its interval; measure the thrust at rest at several positions to confirm it",
+      100 * a, 100 * w, 100 * kLeastMassChange);
+}
+
 // A ripple whose fitted pitch fails a resolvability limit only by its uncertainty, or a grinding
 // force that fails its time constant's (borderline_grinding): the caveat (named as tentative:
 // docs/fit.md, "Tentative effects"); empty if e is no such case. The 95 % interval is that of the
@@ -242,7 +269,7 @@ std::string borderline(const Context& cx, const plant::PlantParams& p, const std
   if (!is_ripple(e.name)) return "";
   const Envelope& env = cx.env;
   const double pitch = e.parameters.at("pitch");
-  if (pitch <= env.max_pitch() && pitch >= env.min_pitch()) return "";  // another limit failed
+  if (pitch <= env.max_pitch() && pitch >= env.min_pitch()) return borderline_amplitude(cx, p, effects, e);
   const double limit = pitch > env.max_pitch() ? env.max_pitch() : env.min_pitch();
   const auto ci = confidence_intervals(cx.rec, p, effects);
   const double w = ci.count(e.name) && ci.at(e.name).count("pitch") ? ci.at(e.name).at("pitch") : 0.0;
@@ -351,8 +378,6 @@ std::string plausibility_pass(const Context& cx, const Search& s, const std::str
     std::string why = implausible(cx.env, jf.params, e);
     if (why.empty() && e.name == name) why = unresolved_presliding(cx, jf.params, fs.effects, e);
     if (why.empty()) continue;
-    // a viscous friction named before: judged at the end (confirm), it blocks no candidate
-    if (e.name != name && why == viscous_within_form(cx.env, jf.params, e)) continue;
     if (small_mass_change(cx.env, e) && (e.name == name ? small_mass_confirmed(cx, jf, fs) : s.small_mass)) continue;
     if (const std::string cav = borderline(cx, jf.params, fs.effects, e); !cav.empty()) {
       if (e.name == name) {
@@ -628,15 +653,24 @@ Choice choose(const Context& cx, const Search& s, StepResult& st) {
   return ch;
 }
 
-// A step that adds nothing: its verdict names the best candidate with its score, and why the
-// others were passed over; the model is unchanged.
+// A step that adds nothing: its verdict names the best candidate with its score, and why it and
+// the others were passed over; the model is unchanged. A best candidate above the threshold is
+// significant but refused, not "no significant effect" (issue 20's review: "no significant
+// effect: the best candidate, reluctance_ripple, scores 2.11e+03").
 void no_addition(const Context& cx, const Search& s, const std::string& why_not, StepResult& st) {
   const CandidateFit* best = nullptr;
   for (const CandidateFit& c : st.ranking)
     if (!best && std::isfinite(c.score)) best = &c;
-  st.verdict = best ? "no significant effect: the best candidate, " + best->effect.name +
-                          fmt(", scores %.3g (threshold %.3g)", best->score, cx.opt.score_threshold)
-                    : std::string("no significant effect: no candidate is eligible");
+  const bool significant = best && best->score >= cx.opt.score_threshold;
+  st.verdict = !best ? std::string("no significant effect: no candidate is eligible")
+               : significant
+                   ? "nothing named: the best candidate, " + best->effect.name +
+                         fmt(", scores %.3g (threshold %.3g) but is passed over", best->score, cx.opt.score_threshold)
+                   : "no significant effect: the best candidate, " + best->effect.name +
+                         fmt(", scores %.3g (threshold %.3g)", best->score, cx.opt.score_threshold);
+  const std::string own = best ? best->effect.name + " " + best->passed_over : std::string();
+  if (significant && !best->passed_over.empty() && why_not.find(own) == std::string::npos)
+    st.verdict += ": " + best->passed_over;
   if (!why_not.empty()) st.verdict += "; passed over: " + why_not;
   st.gap_after = st.gap_before;
   st.force_rms_after = st.force_rms_before;
@@ -856,8 +890,7 @@ void final_swaps(const Context& cx, Search& s) {
 // The evidence that a named effect e still earns its place with all the others in (stage 4,
 // workflow.hpp): the model without it (the others refitted, as in cheapest_removal), its BIC
 // loss, the out-of-sample verdict of keeping it and whether it shrinks the replay gap by
-// min_gap_reduction: the three criteria it entered on (choose), after its plausibility as more
-// than model form (viscous_within_form). `why` is empty when it passes, or
+// min_gap_reduction: the three criteria it entered on (choose). `why` is empty when it passes, or
 // when the model without it cannot be replayed (then it is kept: nothing to compare).
 struct Confirmation {
   Without without;
@@ -871,11 +904,6 @@ Confirmation confirm(const Context& cx, const Search& s, const std::string& e, c
     w.params.validate();
     c.rp = replay(cx.rec, w.params, cx.opt.replay_window, cx.opt.stop);
   } catch (const std::exception&) {  // the model without it cannot be replayed: keep it
-    return c;
-  }
-  // a viscous friction named before the friction it is now within the form of (plausibility.hpp)
-  if (const std::string form = viscous_within_form(cx.env, s.current, effect_of(s.current, e)); !form.empty()) {
-    c.why = "in the final model " + form;
     return c;
   }
   const double loss = c.without.loss;

@@ -77,24 +77,25 @@ TEST(Plausibility, AReluctanceRippleBelowOnePercentOfTheThrustIsNotNamed) {
   };
   EXPECT_EQ(implausible(e, plant::PlantParams{}, rel(0.03)), "");
   EXPECT_EQ(implausible(e, plant::PlantParams{}, rel(-0.012)), "");  // the sign is a phase
-  EXPECT_NE(implausible(e, plant::PlantParams{}, rel(0.004)).find("below 1 % of the thrust"), std::string::npos);
+  EXPECT_NE(implausible(e, plant::PlantParams{}, rel(0.004)).find("below the 1 % of the thrust"), std::string::npos);
 }
 
-// A viscous friction whose force at the peak speed is within the 3 % direction asymmetry of the
-// friction level is the friction curve's form at speed (plausibility.hpp, viscous_within_form):
-// 10 N s/m at 100 mm/s is 1 N against 40 N of Coulomb friction (3 %: 1.2 N); 50 N s/m is 5 N.
-// Without a friction to compare it with, it is judged as any viscous friction.
-TEST(Plausibility, AViscousFrictionWithinTheFrictionsFormIsNotNamed) {
+// A Coulomb friction that changes the friction level by less than the 3 % direction asymmetry of
+// real friction is within the friction's form, as a constant force that size is
+// (plausibility.cpp): 1 N against 40 N of Coulomb friction in the model (3 %: 1.2 N); 5 N is
+// named. Without a friction in the model, it is judged as any Coulomb friction.
+TEST(Plausibility, ACoulombFrictionWithinTheFrictionsFormIsNotNamed) {
   const Envelope e = drive();
   plant::PlantParams bare;
   bare.friction.model = plant::FrictionModel::kNone;
   plant::PlantParams m = bare;
-  m.effects.coulomb_friction.enabled = true;
-  m.effects.coulomb_friction.coulomb_force = 40.0;
-  const auto visc = [](double c) { return plant::NamedEffect{"viscous_friction", {{"viscous", c}}}; };
-  EXPECT_NE(implausible(e, m, visc(10.0)).find("form of the friction curve"), std::string::npos);
-  EXPECT_EQ(implausible(e, m, visc(50.0)), "");
-  EXPECT_EQ(implausible(e, bare, visc(10.0)), "");
+  m.friction.model = plant::FrictionModel::kStatic;
+  m.friction.static_force = 40.0;
+  m.friction.coulomb_force = 40.0;
+  const auto coul = [](double f) { return plant::NamedEffect{"coulomb_friction", {{"coulomb_force", f}}}; };
+  EXPECT_NE(implausible(e, m, coul(1.0)).find("within the friction's form"), std::string::npos);
+  EXPECT_EQ(implausible(e, m, coul(5.0)), "");
+  EXPECT_EQ(implausible(e, bare, coul(1.0)), "");
 }
 
 TEST(Plausibility, SpringRestWithinReachAndGrindingOnlyWhereDescribed) {

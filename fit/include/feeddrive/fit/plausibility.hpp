@@ -70,14 +70,6 @@ constexpr double kSmallMassChange = 0.02;
 /// effects they held were named, such ripples stood in for the form of a cogging ripple, a
 /// grinding force or a mass error.
 constexpr double kLeastMassChange = 0.01;
-/// Why a viscous_friction is model form, or "": its force at the peak speed is within
-/// kAsymmetryTolerance of the friction level, as small as the asymmetry a constant force that
-/// size is. The friction curve's form at speed (a transition, a Stribeck exponent, a direction
-/// asymmetry) is not known better than that; on the independent generator's records such terms
-/// (0.17-0.18 N against 16-50 N of friction) stood in for it. Judged when the viscous friction
-/// is the candidate; one named before the friction it is compared with is removed by the final
-/// confirmation (workflow.cpp, confirm).
-std::string viscous_within_form(const Envelope& env, const plant::PlantParams& model, const plant::NamedEffect& e);
 /// True for a mass_error whose mass is within kSmallMassChange of the nominal.
 bool small_mass_change(const Envelope& env, const plant::NamedEffect& e);
 /// The friction level a direction asymmetry scales: the static levels of the model's static
