@@ -630,6 +630,22 @@ GeneratedFit generate_and_fit(const std::string& name, const std::string& args) 
   return g;
 }
 
+// Presliding resolved only at its fitted value is not named (workflow.cpp, unresolved_presliding):
+// fd-drivegen 8484012729 is effect-free (seed 4242's record 3 of issue 20's mix) with a 65 nm
+// encoder; its friction's other form left a gap the bristles took 9 % off at a deflection of
+// 0.080 um, whose 95 % interval reaches 0.051 um, below one count. Nothing is named, and the
+// presliding candidate is passed over for it.
+TEST(FitVerdict, PreslidingResolvedOnlyAtItsFittedValueIsNotNamed) {
+  const GeneratedFit g = generate_and_fit("presliding_unresolved", "8484012729 10");
+  ASSERT_TRUE(g.run.code == 0 || g.run.code == 3) << g.run.err << g.run.out;
+  EXPECT_TRUE(g.findings["effects"].empty()) << g.findings["conclusion"];
+  std::string why;
+  for (const auto& st : g.findings["steps"])
+    for (const auto& c : st["ranking"])
+      if (c["name"] == "presliding") why += c["passed_over"].get<std::string>() + "\n";
+  EXPECT_NE(why.find("within its 95 % interval, below the sensor's resolution"), std::string::npos) << why;
+}
+
 // "Unexplained": a 49.5 mm ripple over 79 mm of travel (1.6 periods) and a 30 % mass error. The
 // ripple cannot be resolved; the gap stays at ~23 um against a 0.04 um floor: exit 3, and the
 // report says where, what it resembles, why not and what record would settle it.
@@ -679,6 +695,93 @@ TEST(FitVerdict, ARippleTooShortForTheFilterIsWhatTheRestResembles) {
   EXPECT_NE(all.find("faster than the filter resolves"), std::string::npos) << all;
   EXPECT_NE(all.find("record the moves at most"), std::string::npos) << all;
   EXPECT_EQ(all.find("no candidate of the vocabulary"), std::string::npos) << all;
+  // no ripple at a longer pitch it does not have (issue 20's review: a 4 mm cogging was named at
+  // 10.3 mm once the periodogram stopped at the shortest resolved pitch)
+  EXPECT_TRUE(j["effects"].empty()) << j["conclusion"];
+}
+
+// The model's own record (scenarios/fit/model.yaml) with `sets` added to the drive, fitted with
+// the model and `fit_sets`: the fit's result and its findings.json.
+struct SimFit {
+  ProcResult r;
+  nlohmann::json j;
+};
+SimFit sim_and_fit(const std::string& name, const std::string& sets, const std::string& fit_sets = "") {
+  const fs::path sim = scratch() / ("sim_" + name);
+  const ProcResult s =
+      run(kSim, model_scenario().string() + " " + sets + " --out " + sim.string() + " --no-plots --quiet");
+  EXPECT_EQ(s.code, 0) << s.err;
+  const fs::path out = scratch() / name;
+  SimFit f;
+  f.r = run_fit("--scenario " + model_scenario().string() + " " + fit_sets + " --data " +
+                (sim / "timeseries.csv").string() + " --position-column x_measured --out " + out.string() +
+                " --no-plots -q");
+  if (fs::exists(out / "findings.json")) f.j = issue20::findings(out);
+  return f;
+}
+
+// A true viscous friction of 10 N s/m, 3 N at the 296 mm/s peak, 2.5 % of the model's 120 N
+// friction level: named and recovered (issue 20's review of a rule, since removed, that took a
+// viscous force under 3 % of the friction level for the friction's form, refused this one at
+// score 2751 and named a 1 N Coulomb friction in its place). 20 %: the tolerance of a level
+// (docs/fit.md, "What the tests establish").
+TEST(FitVerdict, ASmallTrueViscousFrictionIsNamedNotACoulombFriction) {
+  const SimFit f = sim_and_fit("visc10", "--set plant.effects.viscous_friction.viscous=10");
+  ASSERT_EQ(f.r.code, 0) << f.r.err << f.r.out;
+  EXPECT_EQ(f.j["verdict"], "explained");
+  bool viscous = false;
+  for (const auto& e : f.j["effects"]) {
+    EXPECT_NE(e["name"], "coulomb_friction") << f.j["conclusion"];
+    if (e["name"] == "viscous_friction") {
+      viscous = true;
+      EXPECT_NEAR(e["parameters"]["viscous"].get<double>(), 10.0, 2.0);
+    }
+  }
+  EXPECT_TRUE(viscous) << f.j["conclusion"];
+}
+
+// A reluctance ripple is named from 1 % of the thrust (plausibility.hpp, kLeastMassChange); one
+// whose fitted amplitude is below only by its uncertainty is tentative (issue 20's point 2; the
+// review: 0.9986 % +- 0.008 %, score 2325, was refused outright, "1 % is below 1 %"). One of 0.8 %
+// is refused: the step says the candidate is significant but passed over (not "no significant
+// effect" at score 2109), and what would settle it is a thrust measured over position, not a
+// longer record, which cannot change an amplitude limit.
+TEST(FitVerdict, AReluctanceRippleAtItsLeastAmplitudeIsTentative) {
+  const std::string ripple =
+      "--set plant.effects.reluctance_ripple.pitch=0.02 --set "
+      "plant.effects.reluctance_ripple.reluctance_phase=0.5 --set "
+      "plant.effects.reluctance_ripple.reluctance_amplitude=";
+  const SimFit at = sim_and_fit("rel0995", ripple + "0.00995");
+  ASSERT_TRUE(at.r.code == 0 || at.r.code == 3) << at.r.err << at.r.out;
+  bool named = false;
+  for (const auto& e : at.j["effects"])
+    if (e["name"] == "reluctance_ripple") {
+      named = true;
+      EXPECT_TRUE(e["tentative"].get<bool>());
+      EXPECT_NE(e["caveat"].get<std::string>().find("reaches the 1 % limit"), std::string::npos) << e["caveat"];
+    }
+  EXPECT_TRUE(named) << at.j["conclusion"];
+
+  const SimFit below = sim_and_fit("rel08", ripple + "0.008");
+  ASSERT_EQ(below.r.code, 3) << below.r.err << below.r.out;
+  std::string steps, all;
+  for (const auto& st : below.j["steps"]) steps += st["verdict"].get<std::string>() + "\n";
+  for (const auto& u : below.j["unexplained"]) all += u.get<std::string>() + "\n";
+  EXPECT_NE(steps.find("nothing named: the best candidate, reluctance_ripple"), std::string::npos) << steps;
+  EXPECT_EQ(steps.find("no significant effect: the best candidate, reluctance_ripple"), std::string::npos) << steps;
+  EXPECT_NE(all.find("measure the thrust at rest at several positions"), std::string::npos) << all;
+}
+
+// The exact model of a static-friction drive: within the noise floor as given, so "no
+// discrepancy" (issue 20's point 1). The review found it "unexplained" at 0.143 um, 5.8x the floor:
+// the model form's refit on the force residual (eps 0.01 -> 0.041 mm/s) lengthened the replay gap
+// from 0.039 um, and was kept. Now a form refit that lengthens the gap is not kept.
+TEST(FitVerdict, TheExactModelOfAStaticFrictionDriveShowsNoDiscrepancy) {
+  const SimFit f =
+      sim_and_fit("exact_static", "--set plant.friction.model=static", "--set plant.friction.model=static");
+  ASSERT_EQ(f.r.code, 0) << f.r.err << f.r.out;
+  EXPECT_EQ(f.j["verdict"], "no_discrepancy") << f.j["conclusion"];
+  EXPECT_TRUE(f.j["effects"].empty()) << f.j["conclusion"];
 }
 
 // A plant.sensor noise the record contradicts is taken at the most the record allows (fit/verdict.hpp,
