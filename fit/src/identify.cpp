@@ -62,16 +62,14 @@ std::vector<std::array<double, 3>> pitch_periodogram(const Ctx& c, bool times_th
   const Motion& m = rec.motion;
   const long ni = static_cast<long>(m.x_mid.size());
   const double range = std::max(rec.x_max - rec.x_min, 1e-4);
-  // Up to one period over the travel: a ripple seen over 1-2 periods is fitted at its own pitch, which the plausibility
-  // rules then judge (fewer than two periods: tentative, or what the rest resembles), not at a
-  // harmonic within two periods with a mass error taking the rest (issue 20's point 7: a 1.5-period
-  // reluctance ripple of 82 mm named at 41 mm next to a spurious 2.3 % mass error).
-  // Down to the pitch the samples resolve where the drive moves half its distance: a ripple
+  // Up to two periods over the travel (Envelope::max_pitch; starts beyond it named long-pitch
+  // ripples, tentative at the limit, for springs and constant forces on the independent
+  // generator's records). Down to the pitch the samples resolve where the drive moves half its distance: a ripple
   // shorter than the filter passes there is fitted at its own pitch and then judged too short
   // (what the rest resembles), not at a longer pitch it does not have (issue 20's review: a 4 mm
   // cogging named at 10.3 mm).
   const Envelope env = envelope(rec, c.model);
-  const double p_max = range;
+  const double p_max = 0.5 * range;
   const double p_min = std::max(1e-3, 8.0 * env.v_resolve * env.period);
   if (p_min > p_max) return {};
   const double k_lo = 2 * kPi / p_max, k_hi = 2 * kPi / p_min, dk = 2 * kPi / (8.0 * range);

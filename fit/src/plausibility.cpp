@@ -22,6 +22,16 @@ std::string ripple_pitch(const Envelope& env, double p) {
   return "";
 }
 
+// Why a force `what` of size |f| is within the direction asymmetry real friction has,
+// kAsymmetryTolerance of a friction level (> 0), ending with `so`; "" if it is not: a constant
+// force, a change of the Coulomb level or a spring's change over the travel that small is within
+// the friction's form.
+std::string within_asymmetry(const std::string& what, double f, double level, const char* so) {
+  if (!(level > 0 && std::abs(f) < kAsymmetry * level)) return "";
+  return what + fmt(" %.3g N is within %.0f %% of the %.4g N friction level: ", std::abs(f), 100 * kAsymmetry, level) +
+         so;
+}
+
 // The distance-weighted median of |v| over the samples moving at least v_stick: on a regular
 // grid a sample's distance is |v| times the period, so the weight is |v|. `none` if none moves.
 double distance_median_speed(const std::vector<double>& v, double v_stick, double none) {
@@ -140,12 +150,10 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     // between the directions are the same force (they differ only in stick phases, which the fit
     // leaves out). Real friction is asymmetric by a few per cent; a smaller force is not told
     // from that.
-    const double level = friction_level(model);
-    if (level > 0 && std::abs(par(e, "force")) < kAsymmetry * level)
-      return fmt(
-          "force %.3g N is within a %.0f %% direction asymmetry of the %.4g N Coulomb friction, from which "
-          "moving data cannot tell it",
-          std::abs(par(e, "force")), 100 * kAsymmetry, level);
+    const std::string w = within_asymmetry("force", par(e, "force"), friction_level(model),
+                                           "a direction asymmetry of the friction, from which moving data cannot "
+                                           "tell it");
+    if (!w.empty()) return w;
   }
   if (n == "coulomb_friction" && par(e, "coulomb_force") > F) return above("Coulomb level", par(e, "coulomb_force"));
   if (n == "coulomb_friction") {
@@ -155,12 +163,9 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
     // 0.2 N s/m viscous friction).
     plant::PlantParams without = model;
     without.effects.coulomb_friction.enabled = false;
-    const double level = friction_level(without);
-    if (level > 0 && std::abs(par(e, "coulomb_force")) < kAsymmetry * level)
-      return fmt(
-          "Coulomb level %.3g N is within %.0f %% of the %.4g N friction level: a change of the level within "
-          "the friction's form",
-          std::abs(par(e, "coulomb_force")), 100 * kAsymmetry, level);
+    const std::string w = within_asymmetry("Coulomb level", par(e, "coulomb_force"), friction_level(without),
+                                           "a change of the level within the friction's form");
+    if (!w.empty()) return w;
   }
   if (n == "viscous_friction" && par(e, "viscous") * env.v_max > F)
     return above("viscous force at the peak speed", par(e, "viscous") * env.v_max);
@@ -233,12 +238,9 @@ std::string implausible(const Envelope& env, const plant::PlantParams& model, co
                  env.travel * 1e3);
     if (par(e, "stiffness") * env.travel > F)
       return above("spring force over the travel", par(e, "stiffness") * env.travel);
-    const double level = friction_level(model);
-    if (level > 0 && par(e, "stiffness") * env.travel < kAsymmetry * level)
-      return fmt(
-          "its force changes by only %.3g N over the travel, within a %.0f %% direction asymmetry of the "
-          "%.4g N Coulomb friction: a constant force in disguise",
-          par(e, "stiffness") * env.travel, 100 * kAsymmetry, level);
+    const std::string w = within_asymmetry("its change over the travel,", par(e, "stiffness") * env.travel,
+                                           friction_level(model), "a constant force in disguise");
+    if (!w.empty()) return w;
   }
   if (n == "mass_error") {
     const double m = par(e, "mass");

@@ -313,40 +313,48 @@ const char* verdict_name(Verdict v) {
   return "unexplained";
 }
 
+namespace {
+
+// what_would_settle for a ripple (cogging_ripple, reluctance_ripple).
+std::string settle_ripple(const Envelope& env, const CandidateFit& c, Reason why, double longer) {
+  const std::string& n = c.effect.name;
+  const double p = par(c.effect, "pitch");
+  if (p > 0 && p > env.max_pitch())
+    return fmt(
+        "a force periodic in position, pitch about %.3g mm, seen over %.2g periods: record a travel of at least 3 "
+        "periods (%.3g mm)",
+        p * 1e3, env.travel / p, 3 * p * 1e3);
+  if (p > 0 && p < env.min_pitch())
+    return fmt(
+        "a force periodic in position, pitch about %.3g mm (or shorter: not resolved), faster than the filter "
+        "resolves at %.3g mm/s, the speed of half the distance moved: record the moves at most %.3g mm/s (or at a "
+        "higher sample rate)",
+        p * 1e3, env.v_resolve * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
+  if (why == Reason::kPrerequisite)
+    return fmt(
+        "a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "
+        "pitch you suspect",
+        env.travel * 1e3);
+  // an amplitude limit no record of motion changes (plausibility.cpp: a thrust modulation below
+  // 1 % is what a mass or gain error that small is)
+  if (n == "reluctance_ripple" && c.passed_over.find("of the thrust") != std::string::npos)
+    return fmt(
+        "a thrust that changes with position by less than 1 %% (pitch about %.3g mm): no record of motion tells it "
+        "from a mass or gain error that small; measure the thrust at rest at several positions over one pitch (a "
+        "force sensor, or the command holding a known load)",
+        p * 1e3);
+  return fmt(
+      "a force periodic in position (pitch about %.3g mm): record more travel over the same range, e.g. a "
+      "record of %.3g s with full-travel moves at several speeds",
+      p * 1e3, longer);
+}
+
+}  // namespace
+
 std::string what_would_settle(const Envelope& env, const CandidateFit& c, Reason why) {
   const std::string& n = c.effect.name;
   const double longer = std::max(2.0 * env.duration, env.duration + 10.0);
-  if (is_ripple(n)) {
-    const double p = par(c.effect, "pitch");
-    if (p > 0 && p > env.max_pitch())
-      return fmt(
-          "a force periodic in position, pitch about %.3g mm, seen over %.2g periods: record a travel of at least 3 "
-          "periods (%.3g mm)",
-          p * 1e3, env.travel / p, 3 * p * 1e3);
-    if (p > 0 && p < env.min_pitch())
-      return fmt(
-          "a force periodic in position, pitch about %.3g mm (or shorter: not resolved), faster than the filter "
-          "resolves at %.3g mm/s, the speed of half the distance moved: record the moves at most %.3g mm/s (or at a "
-          "higher sample rate)",
-          p * 1e3, env.v_resolve * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
-    if (why == Reason::kPrerequisite)
-      return fmt(
-          "a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "
-          "pitch you suspect",
-          env.travel * 1e3);
-    // an amplitude limit no record of motion changes (plausibility.cpp: a thrust modulation below
-    // 1 % is what a mass or gain error that small is)
-    if (n == "reluctance_ripple" && c.passed_over.find("of the thrust") != std::string::npos)
-      return fmt(
-          "a thrust that changes with position by less than 1 %% (pitch about %.3g mm): no record of motion tells it "
-          "from a mass or gain error that small; measure the thrust at rest at several positions over one pitch (a "
-          "force sensor, or the command holding a known load)",
-          p * 1e3);
-    return fmt(
-        "a force periodic in position (pitch about %.3g mm): record more travel over the same range, e.g. a "
-        "record of %.3g s with full-travel moves at several speeds",
-        p * 1e3, longer);
-  }
+  if (is_ripple(n)) return settle_ripple(env, c, why, longer);
   if (why == Reason::kPrerequisite && n == "presliding")
     return "friction at the reversals: record at least 3 reversals or stick phases (short back-and-forth moves)";
   if (why == Reason::kPrerequisite && n == "grinding_force")

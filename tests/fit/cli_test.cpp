@@ -775,7 +775,8 @@ TEST(FitVerdict, AReluctanceRippleAtItsLeastAmplitudeIsTentative) {
 // The exact model of a static-friction drive: within the noise floor as given, so "no
 // discrepancy" (issue 20's point 1). The review found it "unexplained" at 0.143 um, 5.8x the floor:
 // the model form's refit on the force residual (eps 0.01 -> 0.041 mm/s) lengthened the replay gap
-// from 0.039 um, and was kept. Now a form refit that lengthens the gap is not kept.
+// from 0.039 um, and was kept. Now, with nothing named, a form refit that lengthens the gap is not
+// kept (workflow.cpp, form_as_given).
 TEST(FitVerdict, TheExactModelOfAStaticFrictionDriveShowsNoDiscrepancy) {
   const SimFit f =
       sim_and_fit("exact_static", "--set plant.friction.model=static", "--set plant.friction.model=static");
