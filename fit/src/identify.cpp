@@ -62,15 +62,10 @@ std::vector<std::array<double, 3>> pitch_periodogram(const Ctx& c, bool times_th
   const Motion& m = rec.motion;
   const long ni = static_cast<long>(m.x_mid.size());
   const double range = std::max(rec.x_max - rec.x_min, 1e-4);
-  // Up to two periods over the travel (Envelope::max_pitch; starts beyond it named long-pitch
-  // ripples, tentative at the limit, for springs and constant forces on the independent
-  // generator's records). Down to the pitch the samples resolve where the drive moves half its distance: a ripple
-  // shorter than the filter passes there is fitted at its own pitch and then judged too short
-  // (what the rest resembles), not at a longer pitch it does not have (issue 20's review: a 4 mm
-  // cogging named at 10.3 mm).
+  // The pitches plausibility.hpp admits (Envelope::min_pitch, max_pitch).
   const Envelope env = envelope(rec, c.model);
-  const double p_max = 0.5 * range;
-  const double p_min = std::max(1e-3, 8.0 * env.v_resolve * env.period);
+  const double p_max = env.max_pitch();
+  const double p_min = env.min_pitch();
   if (p_min > p_max) return {};
   const double k_lo = 2 * kPi / p_max, k_hi = 2 * kPi / p_min, dk = 2 * kPi / (8.0 * range);
   const double gain = thrust_per_input(rec, c.model);

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <vector>
 
 namespace feeddrive::fit {
 using text::fmt;
@@ -17,8 +16,8 @@ std::string ripple_pitch(const Envelope& env, double p) {
   if (p > env.max_pitch())
     return fmt("pitch %.3g mm: fewer than two periods within the %.3g mm travelled", p * 1e3, env.travel * 1e3);
   if (p < env.min_pitch())
-    return fmt("pitch %.3g mm: shorter than the %.3g mm the data resolves at %.3g mm/s (half its moving distance)",
-               p * 1e3, env.min_pitch() * 1e3, env.v_resolve * 1e3);
+    return fmt("pitch %.3g mm: shorter than the %.3g mm the data resolves at %.3g mm/s", p * 1e3, env.min_pitch() * 1e3,
+               env.v_max * 1e3);
   return "";
 }
 
@@ -32,24 +31,6 @@ std::string within_asymmetry(const std::string& what, double f, double level, co
          so;
 }
 
-// The distance-weighted median of |v| over the samples moving at least v_stick: on a regular
-// grid a sample's distance is |v| times the period, so the weight is |v|. `none` if none moves.
-double distance_median_speed(const std::vector<double>& v, double v_stick, double none) {
-  std::vector<double> moving;
-  double total = 0.0;
-  for (double x : v)
-    if (std::abs(x) >= v_stick && std::abs(x) > 0.0) {
-      moving.push_back(std::abs(x));
-      total += std::abs(x);
-    }
-  if (moving.empty()) return none;
-  std::sort(moving.begin(), moving.end());
-  double below = 0.0;
-  for (double x : moving)
-    if ((below += x) >= 0.5 * total) return x;
-  return moving.back();
-}
-
 }  // namespace
 
 double friction_level(const plant::PlantParams& m) {
@@ -60,9 +41,7 @@ double friction_level(const plant::PlantParams& m) {
   return c;
 }
 
-double Envelope::min_pitch() const {
-  return std::max({1e-3, 8.0 * v_resolve * period, 4.0 * v_resolve * filter_half_width});
-}
+double Envelope::min_pitch() const { return std::max({1e-3, 8.0 * v_max * period, 4.0 * v_max * filter_half_width}); }
 
 Envelope envelope(const Record& rec, const plant::PlantParams& model) {
   Envelope e;
@@ -93,7 +72,6 @@ Envelope envelope(const Record& rec, const plant::PlantParams& model) {
     run = 0;
   }
   e.stick_fraction = static_cast<double>(in_stick) / static_cast<double>(d.size());
-  e.v_resolve = distance_median_speed(rec.motion.v, e.stick_velocity, e.v_max);
   int sign = 0;
   for (double v : rec.motion.v) {
     if (std::abs(v) < e.stick_velocity) continue;

@@ -327,9 +327,8 @@ std::string settle_ripple(const Envelope& env, const CandidateFit& c, Reason why
   if (p > 0 && p < env.min_pitch())
     return fmt(
         "a force periodic in position, pitch about %.3g mm (or shorter: not resolved), faster than the filter "
-        "resolves at %.3g mm/s, the speed of half the distance moved: record the moves at most %.3g mm/s (or at a "
-        "higher sample rate)",
-        p * 1e3, env.v_resolve * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
+        "resolves at %.3g mm/s: record the moves at most %.3g mm/s (or at a higher sample rate)",
+        p * 1e3, env.v_max * 1e3, p / (4.0 * env.filter_half_width) * 1e3);
   if (why == Reason::kPrerequisite)
     return fmt(
         "a force periodic in position cannot be resolved over %.3g mm: record a travel of at least 3 periods of the "

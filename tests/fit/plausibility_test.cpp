@@ -16,7 +16,6 @@ Envelope drive() {  // 100 mm of travel at up to 100 mm/s, 1 kHz, L = 10 ms, 200
   e.x_max = 0.1;
   e.travel = 0.1;
   e.v_max = 0.1;
-  e.v_resolve = 0.1;  // moves at its peak speed
   e.peak_thrust = 200.0;
   e.period = 1e-3;
   e.filter_half_width = 0.01;
@@ -45,25 +44,6 @@ TEST(Plausibility, RipplePitchMustBeResolvedByTheData) {
   EXPECT_NE(implausible(e, m, cog(0.002, 5.0)).find("shorter than"), std::string::npos);
   // 378 N on a 200 N drive
   EXPECT_NE(implausible(e, m, cog(0.024, 378.0)).find("fifth of the peak thrust"), std::string::npos);
-}
-
-// A drive that covers half its distance at 25 mm/s or less (accelerating, creeping) resolves a
-// 3 mm pitch there: a period spans 120 ms, 12 filter half-widths (4 needed). At its 100 mm/s peak
-// it would not (30 ms, 3 half-widths); those points are filtered alike in data and model and only
-// add no information (plausibility.hpp, Envelope::min_pitch).
-TEST(Plausibility, TheRipplePitchIsResolvedWhereTheDriveMovesMostOfItsDistance) {
-  Envelope e = drive();
-  e.v_resolve = 0.025;
-  EXPECT_DOUBLE_EQ(e.min_pitch(), 0.001);  // 4 L v = 1 mm, and the 1 mm least pitch
-  const plant::NamedEffect cog{"cogging_ripple",
-                               {{"pitch", 0.003},
-                                {"cogging_amplitude", 5.0},
-                                {"cogging_phase", 0.0},
-                                {"cogging_third", 0.0},
-                                {"cogging_third_phase", 0.0}}};
-  EXPECT_EQ(implausible(e, plant::PlantParams{}, cog), "");
-  e.v_resolve = 0.1;
-  EXPECT_NE(implausible(e, plant::PlantParams{}, cog).find("half its moving distance"), std::string::npos);
 }
 
 // A reluctance ripple scales the thrust by 1 + A sin(...) as a mass error scales the inertial

@@ -39,13 +39,8 @@ struct Envelope {
   /// The smallest position change the sensor resolves [m]: one count (plant.sensor's quantization,
   /// or the record's smallest position step if the scenario gives no sensor) or its noise, the larger.
   double resolution{0.0};
-  /// The speed at or below which the drive covers half of the distance it moves [m/s] (the
-  /// distance-weighted median of |v^| above the stick velocity; v_max if it never moves).
-  double v_resolve{0.0};
-  /// Shortest ripple pitch the data resolves [m]: over at least half of the distance moved (at
-  /// v_resolve) a period must span at least 8 samples and 4 filter half-widths (the filter passes
-  /// it), and at least 1 mm. Where the drive moves faster the filter attenuates the ripple in the
-  /// data and in the model alike, so those points only add no information.
+  /// Shortest ripple pitch the data resolves [m]: at the peak speed a period must span at least
+  /// 8 samples and 4 filter half-widths (the filter passes it), and at least 1 mm.
   double min_pitch() const;
   /// Longest ripple pitch: two periods within the travel.
   double max_pitch() const { return 0.5 * travel; }
